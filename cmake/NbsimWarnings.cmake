@@ -1,0 +1,13 @@
+# nbsim_target_defaults(<target>): C++20, warnings on our own code only, optional sanitizers.
+function(nbsim_target_defaults target)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion)
+  if(NBSIM_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  if(NBSIM_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()

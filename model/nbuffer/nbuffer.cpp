@@ -1,0 +1,240 @@
+// N-buffer construction, queries and incremental updates; see nbuffer.h.
+#include "model/nbuffer/nbuffer.h"
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+
+#include "model/common/error.h"
+
+namespace nbsim {
+
+namespace {
+
+template <FarOp Op>
+inline float far2(float a, float b) noexcept {
+  if constexpr (Op == FarOp::Max) return a > b ? a : b;
+  else return a < b ? a : b;
+}
+
+// out[x] for x in [x0, x1) of a level whose rows below are `a` (row y) and `b` (row y + s, or
+// null past the top edge): the farthest of a[x], a[x + s], b[x], b[x + s], skipping what lies
+// outside the image. Written as plain loops so that the compiler vectorizes them.
+template <FarOp Op>
+void reduce_row(const float* a, const float* b, float* out, int x0, int x1, int width, int s) noexcept {
+  const int split = std::clamp(width - s, x0, x1);  // x < split has x + s inside the image
+  if (b) {
+    for (int x = x0; x < split; ++x) out[x] = far2<Op>(far2<Op>(a[x], a[x + s]), far2<Op>(b[x], b[x + s]));
+    for (int x = split; x < x1; ++x) out[x] = far2<Op>(a[x], b[x]);
+  } else {
+    for (int x = x0; x < split; ++x) out[x] = far2<Op>(a[x], a[x + s]);
+    for (int x = split; x < x1; ++x) out[x] = a[x];
+  }
+}
+
+void reduce_row(FarOp op, const float* a, const float* b, float* out, int x0, int x1, int width, int s) noexcept {
+  if (op == FarOp::Max) reduce_row<FarOp::Max>(a, b, out, x0, x1, width, s);
+  else reduce_row<FarOp::Min>(a, b, out, x0, x1, width, s);
+}
+
+void grow(Rect& box, int x, int y) noexcept {
+  if (box.empty()) { box = {x, y, 1, 1}; return; }
+  const int x0 = std::min(box.x, x), y0 = std::min(box.y, y);
+  const int x1 = std::max(box.x1(), x + 1), y1 = std::max(box.y1(), y + 1);
+  box = {x0, y0, x1 - x0, y1 - y0};
+}
+
+}  // namespace
+
+long long UpdateStats::total_recomputed() const noexcept {
+  return std::accumulate(texels_recomputed.begin(), texels_recomputed.end(), 0LL);
+}
+long long UpdateStats::total_changed() const noexcept {
+  return std::accumulate(texels_changed.begin(), texels_changed.end(), 0LL);
+}
+
+NBuffer::NBuffer(int width, int height, NBufferConfig config) : width_(width), height_(height), config_(config) {
+  if (width < 1 || height < 1)
+    throw InputError("N-buffer size must be at least 1x1, got " + std::to_string(width) + "x" + std::to_string(height));
+  full_levels_ = nbuffer_level_count(width, height);
+  if (config.max_level < -1)
+    throw InputError("N-buffer max_level must be -1 (all levels) or at least 0, got " + std::to_string(config.max_level));
+  levels_ = config.max_level < 0 ? full_levels_ : std::min(config.max_level + 1, full_levels_);
+  data_.assign(static_cast<std::size_t>(levels_) * pixels(), far_limit(config.op));
+}
+
+NBuffer::NBuffer(const DepthImage& depth, NBufferConfig config) : NBuffer(depth.width, depth.height, config) {
+  build(depth);
+}
+
+void NBuffer::build(const DepthImage& depth) {
+  NBSIM_CHECK(depth.width == width_ && depth.height == height_, "depth image size differs from the N-buffer's");
+  float* l0 = level_ptr(0);
+  for (std::size_t i = 0; i < pixels(); ++i) l0[i] = quantize_toward_far(depth.texels[i], config_.format, config_.op);
+  for (int i = 1; i < levels_; ++i) build_level(i);
+}
+
+void NBuffer::build_level(int dst) {
+  const int s = 1 << (dst - 1);
+  const float* src = level_ptr(dst - 1);
+  float* out = level_ptr(dst);
+  for (int y = 0; y < height_; ++y) {
+    const float* a = src + static_cast<std::size_t>(y) * width_;
+    const float* b = y + s < height_ ? a + static_cast<std::size_t>(s) * width_ : nullptr;
+    reduce_row(config_.op, a, b, out + static_cast<std::size_t>(y) * width_, 0, width_, width_, s);
+  }
+}
+
+QueryResult NBuffer::query(const Rect& r, CoveringKind kind) const {
+  if (r.empty())
+    throw InputError("empty query rectangle " + std::to_string(r.x) + "," + std::to_string(r.y) + "," +
+                     std::to_string(r.w) + "," + std::to_string(r.h) + " (width and height must be at least 1)");
+  const Rect c = clip(r, width_, height_);
+  if (c.empty())
+    throw InputError("query rectangle " + std::to_string(r.x) + "," + std::to_string(r.y) + "," +
+                     std::to_string(r.w) + "," + std::to_string(r.h) + " lies outside the " +
+                     std::to_string(width_) + "x" + std::to_string(height_) + " image");
+  QueryResult q;
+  const Covering cov = cover(c, kind, full_levels_ - 1);
+  q.level = cov.level;
+  if (cov.level >= levels_) {  // partial build: the level is missing, answer the far limit
+    q.value = far_limit(config_.op);
+    q.complete = false;
+    return q;
+  }
+  q.value = neutral_depth(config_.op);
+  for (int i = 0; i < cov.count; ++i) {
+    // Anchors of a clipped rectangle lie inside the image; squares may reach past its right and
+    // top edges, where the level already treats pixels as neutral.
+    const Texel t{cov.squares[static_cast<std::size_t>(i)].x, cov.squares[static_cast<std::size_t>(i)].y};
+    q.texels[static_cast<std::size_t>(q.texel_count++)] = t;
+    q.value = farther(config_.op, q.value, texel(cov.level, t.x, t.y));
+  }
+  return q;
+}
+
+UpdateStats NBuffer::new_stats() const {
+  UpdateStats s;
+  s.texels_recomputed.assign(static_cast<std::size_t>(levels_), 0);
+  s.texels_changed.assign(static_cast<std::size_t>(levels_), 0);
+  return s;
+}
+
+UpdateStats NBuffer::update(const DepthImage& depth, const Rect& dirty) {
+  NBSIM_CHECK(depth.width == width_ && depth.height == height_, "depth image size differs from the N-buffer's");
+  UpdateStats stats = new_stats();
+  const Rect r = clip(dirty, width_, height_);
+  if (r.empty()) return stats;
+
+  // Level 0: copy the dirty pixels, note the bounding box of those that changed.
+  Rect changed;
+  float* l0 = level_ptr(0);
+  for (int y = r.y; y < r.y1(); ++y) {
+    for (int x = r.x; x < r.x1(); ++x) {
+      const float v = quantize_toward_far(depth.at(x, y), config_.format, config_.op);
+      float& t = l0[static_cast<std::size_t>(y) * width_ + x];
+      if (t != v) { t = v; ++stats.texels_changed[0]; grow(changed, x, y); }
+    }
+  }
+  stats.texels_recomputed[0] = r.area();
+
+  // Level i: a texel at (x, y) reads level i - 1 at x and x + s, y and y + s, so a change in box B
+  // of level i - 1 reaches [B.x - s, B.x1) x [B.y - s, B.y1) of level i, clipped to the image.
+  std::vector<float> row(static_cast<std::size_t>(width_));
+  for (int i = 1; i < levels_ && !changed.empty(); ++i) {
+    const int s = 1 << (i - 1);
+    const Rect reach = clip({changed.x - s, changed.y - s, changed.w + s, changed.h + s}, width_, height_);
+    changed = {};
+    const float* src = level_ptr(i - 1);
+    float* dst = level_ptr(i);
+    for (int y = reach.y; y < reach.y1(); ++y) {
+      const float* a = src + static_cast<std::size_t>(y) * width_;
+      const float* b = y + s < height_ ? a + static_cast<std::size_t>(s) * width_ : nullptr;
+      reduce_row(config_.op, a, b, row.data(), reach.x, reach.x1(), width_, s);
+      float* out = dst + static_cast<std::size_t>(y) * width_;
+      for (int x = reach.x; x < reach.x1(); ++x) {
+        if (out[x] != row[static_cast<std::size_t>(x)]) {
+          out[x] = row[static_cast<std::size_t>(x)];
+          ++stats.texels_changed[static_cast<std::size_t>(i)];
+          grow(changed, x, y);
+        }
+      }
+    }
+    stats.texels_recomputed[static_cast<std::size_t>(i)] = reach.area();
+  }
+  return stats;
+}
+
+UpdateStats NBuffer::update(std::span<const PixelWrite> writes) {
+  UpdateStats stats = new_stats();
+  if (stamp_.size() != pixels()) { stamp_.assign(pixels(), 0); epoch_ = 0; }
+  auto next_epoch = [this] {
+    if (++epoch_ == 0) { std::fill(stamp_.begin(), stamp_.end(), 0u); epoch_ = 1; }
+  };
+
+  // Level 0: apply the writes in order; keep each changed pixel once.
+  std::vector<Texel> changed, next;
+  next_epoch();
+  float* l0 = level_ptr(0);
+  for (const PixelWrite& w : writes) {
+    if (w.x < 0 || w.y < 0 || w.x >= width_ || w.y >= height_)
+      throw InputError("pixel write at (" + std::to_string(w.x) + "," + std::to_string(w.y) + ") outside the " +
+                       std::to_string(width_) + "x" + std::to_string(height_) + " image");
+    const std::size_t k = static_cast<std::size_t>(w.y) * width_ + w.x;
+    const float v = quantize_toward_far(w.depth, config_.format, config_.op);
+    ++stats.texels_recomputed[0];
+    if (l0[k] == v) continue;
+    l0[k] = v;
+    if (stamp_[k] != epoch_) { stamp_[k] = epoch_; changed.push_back({w.x, w.y}); }
+  }
+  // A pixel written twice may end where it started: count only net changes.
+  stats.texels_changed[0] = static_cast<long long>(changed.size());
+
+  // Level i: a changed texel (x, y) of level i - 1 is read by the level-i texels at x or x - s and
+  // y or y - s. Recompute each of those once; only those whose value changes propagate further.
+  for (int i = 1; i < levels_ && !changed.empty(); ++i) {
+    const int s = 1 << (i - 1);
+    next_epoch();
+    next.clear();
+    const float* src = level_ptr(i - 1);
+    float* dst = level_ptr(i);
+    for (const Texel t : changed) {
+      for (int dy = 0; dy <= s; dy += s) {
+        for (int dx = 0; dx <= s; dx += s) {
+          const int x = t.x - dx, y = t.y - dy;
+          if (x < 0 || y < 0) continue;
+          const std::size_t k = static_cast<std::size_t>(y) * width_ + x;
+          if (stamp_[k] == epoch_) continue;
+          stamp_[k] = epoch_;
+          float v = src[k];
+          if (x + s < width_) v = farther(config_.op, v, src[k + s]);
+          if (y + s < height_) {
+            const std::size_t up = k + static_cast<std::size_t>(s) * width_;
+            v = farther(config_.op, v, src[up]);
+            if (x + s < width_) v = farther(config_.op, v, src[up + s]);
+          }
+          ++stats.texels_recomputed[static_cast<std::size_t>(i)];
+          if (dst[k] != v) { dst[k] = v; next.push_back({x, y}); }
+        }
+      }
+    }
+    stats.texels_changed[static_cast<std::size_t>(i)] = static_cast<long long>(next.size());
+    std::swap(changed, next);
+  }
+  return stats;
+}
+
+DepthImage NBuffer::level_image(int i) const {
+  DepthImage img;
+  img.width = width_;
+  img.height = height_;
+  const auto l = level(i);
+  img.texels.assign(l.begin(), l.end());
+  return img;
+}
+
+long long NBuffer::storage_bytes() const noexcept {
+  return static_cast<long long>(levels_) * static_cast<long long>(pixels()) * nbsim::storage_bytes(config_.format);
+}
+
+}  // namespace nbsim

@@ -1,0 +1,100 @@
+// The N-buffer (Décoret 2005): a stack of same-resolution depth maps where level i holds, at
+// (x, y), the farthest depth of the 2^i x 2^i square [x, x + 2^i) x [y, y + 2^i). Pixels outside
+// the image are neutral. Plain C++ core of the N-buffer unit (model/nbuffer); no SystemC here.
+//
+// Level 0 is a quantized copy of the depth buffer (storage format), level i + 1 is built from four
+// texels of level i (Fig. 2). Queries answer a rectangle with at most four lookups (covering.h).
+// Updates apply changed level-0 pixels and rewrite, per level, only the texels to their left and
+// below that can change, stopping where a recomputed texel keeps its value.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "model/common/depth.h"
+#include "model/common/query.h"
+#include "model/common/rect.h"
+#include "model/common/storage.h"
+#include "model/nbuffer/covering.h"
+
+namespace nbsim {
+
+struct NBufferConfig {
+  FarOp op = FarOp::Max;
+  StorageFormat format = StorageFormat::F32;
+  // Highest level built (a partial build models only what a scene needs: sprites of at most 32 px
+  // need levels up to 5). -1 builds all nbuffer_level_count(W, H) levels. Tunable.
+  int max_level = -1;
+};
+
+// One changed level-0 pixel and its new depth.
+struct PixelWrite {
+  int x = 0;
+  int y = 0;
+  float depth = 0.0f;
+};
+
+// Work done by an update, per level (index = level).
+struct UpdateStats {
+  std::vector<long long> texels_recomputed;  // texels read-modify-written (4 reads each above level 0)
+  std::vector<long long> texels_changed;     // of those, texels whose stored value changed
+
+  long long total_recomputed() const noexcept;
+  long long total_changed() const noexcept;
+};
+
+class NBuffer {
+ public:
+  // An N-buffer of the given size, every texel at the far limit (a cleared depth buffer).
+  NBuffer(int width, int height, NBufferConfig config = {});
+  // Builds from a depth image.
+  explicit NBuffer(const DepthImage& depth, NBufferConfig config = {});
+
+  // Replaces level 0 with `depth` (same size) and rebuilds every level.
+  void build(const DepthImage& depth);
+
+  // Farthest depth of r (clipped to the image) with at most four lookups. Throws InputError when
+  // r is empty or lies outside the image. When the level the covering needs was not built, the
+  // answer is the far limit with complete == false (conservative, never wrong).
+  QueryResult query(const Rect& r, CoveringKind kind = CoveringKind::Four) const;
+
+  // Incremental updates; the result equals a full rebuild from the new level 0.
+  // The pixels of `depth` inside `dirty` replace level 0's (depth must be the N-buffer's size).
+  UpdateStats update(const DepthImage& depth, const Rect& dirty);
+  // Each write replaces one level-0 pixel (the last write to a pixel wins).
+  UpdateStats update(std::span<const PixelWrite> writes);
+
+  int width() const noexcept { return width_; }
+  int height() const noexcept { return height_; }
+  const NBufferConfig& config() const noexcept { return config_; }
+  // Levels this image would have in full, and levels actually built (max_level + 1).
+  int full_level_count() const noexcept { return full_levels_; }
+  int level_count() const noexcept { return levels_; }
+  int top_level() const noexcept { return levels_ - 1; }
+
+  float texel(int level, int x, int y) const noexcept {
+    return data_[offset(level) + static_cast<std::size_t>(y) * width_ + x];
+  }
+  std::span<const float> level(int i) const noexcept { return {data_.data() + offset(i), pixels()}; }
+  DepthImage level_image(int i) const;
+
+  // Bytes the levels occupy in memory in the storage format.
+  long long storage_bytes() const noexcept;
+
+ private:
+  std::size_t pixels() const noexcept { return static_cast<std::size_t>(width_) * height_; }
+  std::size_t offset(int level) const noexcept { return static_cast<std::size_t>(level) * pixels(); }
+  float* level_ptr(int i) noexcept { return data_.data() + offset(i); }
+  void build_level(int dst);
+  UpdateStats new_stats() const;
+
+  int width_ = 0, height_ = 0;
+  NBufferConfig config_;
+  int full_levels_ = 1, levels_ = 1;
+  std::vector<float> data_;            // levels_ planes of width_ * height_ texels
+  std::vector<std::uint32_t> stamp_;   // per-pixel visit marks for set updates (lazily sized)
+  std::uint32_t epoch_ = 0;
+};
+
+}  // namespace nbsim

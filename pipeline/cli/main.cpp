@@ -1,0 +1,88 @@
+// nbsim: the one command-line entry point. Wires the subcommand modules and maps failures to exit
+// statuses (0 success, 2 bad usage or bad input, 1 other failures).
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <string_view>
+#include <vector>
+
+#include "model/common/error.h"
+#include "pipeline/cli/command.h"
+
+namespace nbsim::cli {
+
+namespace {
+
+bool parse_int(std::string_view s, int& out) {
+  const char* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, out);
+  return ec == std::errc() && p == end && !s.empty();
+}
+
+}  // namespace
+
+Rect parse_rect(const std::string& text) {
+  std::vector<std::string_view> parts;
+  std::string_view rest(text);
+  for (std::size_t comma; (comma = rest.find(',')) != std::string_view::npos; rest.remove_prefix(comma + 1))
+    parts.push_back(rest.substr(0, comma));
+  parts.push_back(rest);
+  int v[4] = {};
+  if (parts.size() != 4 || !parse_int(parts[0], v[0]) || !parse_int(parts[1], v[1]) || !parse_int(parts[2], v[2]) ||
+      !parse_int(parts[3], v[3]))
+    throw InputError(fmt::format("bad rectangle '{}': expected X,Y,W,H with four integers", text));
+  if (v[2] < 1 || v[3] < 1)
+    throw InputError(fmt::format("empty rectangle '{}': width and height must be at least 1", text));
+  return {v[0], v[1], v[2], v[3]};
+}
+
+std::pair<int, int> parse_size(const std::string& text, const std::string& option) {
+  const auto x = text.find('x');
+  int w = 0, h = 0;
+  if (x == std::string::npos || !parse_int(std::string_view(text).substr(0, x), w) ||
+      !parse_int(std::string_view(text).substr(x + 1), h) || w < 1 || h < 1)
+    throw InputError(fmt::format("bad {} '{}': expected WxH with positive integers, e.g. 512x512", option, text));
+  return {w, h};
+}
+
+double tidy(float v) {
+  char buf[32];
+  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  *p = '\0';
+  return std::strtod(buf, nullptr);
+}
+
+}  // namespace nbsim::cli
+
+int main(int argc, char** argv) {
+  using namespace nbsim;
+  CLI::App app{"nbsim: a cycle-approximate GPU pipeline model with an N-buffer depth-query unit", "nbsim"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "nbsim " NBSIM_VERSION);
+  cli::Action action;
+  cli::add_nbuffer_commands(app, action);
+  cli::add_info_command(app, action);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "nbsim: error: %s\n", e.what());
+    return 2;
+  }
+  try {
+    return action ? action() : 0;
+  } catch (const InputError& e) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "nbsim: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "nbsim: failed: %s\n", e.what());
+    return 1;
+  }
+}
