@@ -22,6 +22,28 @@ bool parse_int(std::string_view s, int& out) {
   return ec == std::errc() && p == end && !s.empty();
 }
 
+// When parsing fails because a command needs a subcommand, name the word that was not one
+// (CLI11 only says "A subcommand is required").
+std::string unknown_subcommand(CLI::App& app, int argc, char** argv) {
+  CLI::App* cur = &app;
+  std::string path = app.get_name();
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.empty() || arg[0] == '-') continue;
+    const auto subs = cur->get_subcommands([&](CLI::App* a) { return a->get_name() == arg; });
+    if (!subs.empty()) {
+      cur = subs.front();
+      path += " " + arg;
+      continue;
+    }
+    if (cur->get_require_subcommand_min() == 0) return {};
+    std::string names;
+    for (CLI::App* a : cur->get_subcommands([](CLI::App*) { return true; })) names += (names.empty() ? "" : ", ") + a->get_name();
+    return fmt::format("unknown command '{}' for '{}'; expected one of: {}", arg, path, names);
+  }
+  return {};
+}
+
 }  // namespace
 
 Rect parse_rect(const std::string& text) {
@@ -68,6 +90,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    if (const std::string what = cli::unknown_subcommand(app, argc, argv); !what.empty()) {
+      std::fprintf(stderr, "nbsim: error: %s\nRun with --help for more information.\n", what.c_str());
+      return 2;
+    }
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   } catch (const InputError& e) {

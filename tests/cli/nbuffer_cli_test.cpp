@@ -1,33 +1,248 @@
-// NBufferCliTest: `nbsim nbuffer ...` exit statuses and messages.
+// NBufferCliTest: `nbsim nbuffer query|build|coverage` from the outside: exit statuses, messages
+// and outputs, including every refused input (exit 2 with a message naming the problem).
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
 #include <string>
+#include <sys/wait.h>
+
+#include "pipeline/io/image_io.h"
 
 namespace {
 
+namespace fs = std::filesystem;
+
 struct CliResult {
   int status = -1;
-  std::string out;  // stdout and stderr together
+  std::string out;  // stdout
+  std::string err;  // stderr
 };
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("nbsim_cli_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir / name;
+}
 
 CliResult nbsim(const std::string& args) {
   CliResult r;
-  const std::string cmd = std::string(NBSIM_EXE) + " " + args + " 2>&1";
+  const fs::path err = scratch("stderr.txt");
+  const std::string cmd = std::string(NBSIM_EXE) + " " + args + " 2>" + err.string();
   FILE* p = popen(cmd.c_str(), "r");
   std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  while (std::fgets(buf.data(), static_cast<int>(buf.size()), p)) r.out += buf.data();
   const int st = pclose(p);
   r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  std::ifstream e(err);
+  r.err.assign(std::istreambuf_iterator<char>(e), {});
   return r;
 }
 
-// --help works on the nbuffer query command and exits 0.
+// A 4x4 depth image, y up, whose farthest pixel is (3, 0) at 0.9.
+fs::path small_depth(const std::string& name) {
+  nbsim::DepthImage img(4, 4, 0.25f);
+  img.at(3, 0) = 0.9f;
+  img.at(0, 3) = 0.5f;
+  const fs::path f = scratch(name);
+  nbsim::io::write_depth(img, f);
+  return f;
+}
+
+fs::path depth_with(float bad, int x, int y, const std::string& name) {
+  nbsim::DepthImage img(8, 6, 0.5f);
+  img.at(x, y) = bad;
+  const fs::path f = scratch(name);
+  nbsim::io::write_depth(img, f);
+  return f;
+}
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// --help works on every nbuffer subcommand and exits 0.
 TEST(NBufferCliTest, HelpExitsZero) {
-  const CliResult r = nbsim("nbuffer query --help");
-  EXPECT_EQ(r.status, 0) << r.out;
-  EXPECT_NE(r.out.find("--rect"), std::string::npos) << r.out;
+  for (const char* sub : {"", "nbuffer", "nbuffer query", "nbuffer build", "nbuffer coverage", "info"}) {
+    const CliResult r = nbsim(std::string(sub) + " --help");
+    EXPECT_EQ(r.status, 0) << sub << ": " << r.err;
+    EXPECT_TRUE(has(r.out, "Usage")) << sub << ": " << r.out;
+  }
+}
+
+// A query prints one JSON line per rectangle with the farthest depth and the texels read.
+TEST(NBufferCliTest, QueryPrintsOneJsonLinePerRect) {
+  const fs::path f = small_depth("q.exr");
+  const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,4,4 --rect 0,1,2,3 --rect 3,0,1,1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  std::vector<nlohmann::json> js;
+  while (std::getline(lines, line)) js.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(js.size(), 3u) << r.out;
+  EXPECT_EQ(js[0]["rect"], nlohmann::json({0, 0, 4, 4}));
+  EXPECT_FLOAT_EQ(js[0]["value"].get<float>(), 0.9f) << "the far pixel (3,0) is inside the whole image";
+  EXPECT_EQ(js[0]["level"], 1) << "a 4x4 image has levels 0 and 1; four level-1 squares cover it";
+  EXPECT_EQ(js[0]["texels"], nlohmann::json({{0, 0}, {2, 0}, {0, 2}, {2, 2}}));
+  EXPECT_FLOAT_EQ(js[1]["value"].get<float>(), 0.5f) << "rows 1..3 of columns 0..1 hold 0.5 at (0,3)";
+  EXPECT_FLOAT_EQ(js[2]["value"].get<float>(), 0.9f);
+  EXPECT_EQ(js[2]["texels"], nlohmann::json({{3, 0}}));
+}
+
+// Min op (reversed Z) and quantized formats are accepted; u16 rounds toward far.
+TEST(NBufferCliTest, QueryMinOpAndFormats) {
+  const fs::path f = small_depth("m.exr");
+  CliResult r = nbsim("nbuffer query --depth " + f.string() + " --op min --rect 0,0,4,4");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FLOAT_EQ(nlohmann::json::parse(r.out)["value"].get<float>(), 0.25f);
+  r = nbsim("nbuffer query --depth " + f.string() + " --format u16 --rect 1,1,1,1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_GE(nlohmann::json::parse(r.out)["value"].get<float>(), 0.25f) << "u16 must round toward far";
+}
+
+// TIFF and PFM files are read like EXR, with the same y-up orientation.
+TEST(NBufferCliTest, ReadsTiffAndPfm) {
+  const fs::path tif = small_depth("fmt.tif");
+  // PFM by hand (OpenImageIO reads PFM but does not write it): rows go bottom to top, so the
+  // first float is pixel (0, 0) and the fourth is (3, 0).
+  const fs::path pfm = scratch("fmt.pfm");
+  {
+    std::ofstream o(pfm, std::ios::binary);
+    o << "Pf\n4 4\n-1.0\n";
+    std::array<float, 16> px;
+    px.fill(0.25f);
+    px[3] = 0.9f;
+    o.write(reinterpret_cast<const char*>(px.data()), sizeof px);
+  }
+  for (const fs::path& f : {tif, pfm}) {
+    const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 3,0,1,1");
+    ASSERT_EQ(r.status, 0) << f << ": " << r.err;
+    EXPECT_FLOAT_EQ(nlohmann::json::parse(r.out)["value"].get<float>(), 0.9f) << f << " read upside down?";
+  }
+}
+
+// Each bad depth file is refused with exit 2 and a message naming the file and the first bad pixel.
+TEST(NBufferCliTest, RefusesBadDepthValues) {
+  struct Row { float v; const char* what; };
+  const Row rows[] = {{std::numeric_limits<float>::quiet_NaN(), "NaN"},
+                      {std::numeric_limits<float>::infinity(), "infinite"},
+                      {1.5f, "outside [0, 1]"},
+                      {-0.25f, "outside [0, 1]"}};
+  int i = 0;
+  for (const Row& row : rows) {
+    const fs::path f = depth_with(row.v, 5, 2, "bad" + std::to_string(i++) + ".exr");
+    const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,2,2");
+    EXPECT_EQ(r.status, 2) << row.what;
+    EXPECT_TRUE(has(r.err, f.string())) << "message must name the file: " << r.err;
+    EXPECT_TRUE(has(r.err, row.what)) << r.err;
+    EXPECT_TRUE(has(r.err, "(5, 2)")) << "message must name the first bad pixel: " << r.err;
+    EXPECT_TRUE(r.out.empty()) << "nothing may be printed for a refused file";
+  }
+}
+
+// Several channels, a missing file and a garbage file are refused with exit 2 naming the file.
+TEST(NBufferCliTest, RefusesUnreadableFiles) {
+  const fs::path rgb = scratch("rgb.exr");
+  {
+    namespace OIIO = OIIO_NAMESPACE;
+    std::vector<float> px(4 * 4 * 3, 0.5f);
+    auto out = OIIO::ImageOutput::create(rgb.string());
+    ASSERT_TRUE(out);
+    ASSERT_TRUE(out->open(rgb.string(), OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::FLOAT)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, px.data()));
+    out->close();
+  }
+  CliResult r = nbsim("nbuffer query --depth " + rgb.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "3 channels") && has(r.err, rgb.string())) << r.err;
+
+  r = nbsim("nbuffer query --depth /nonexistent/depth.exr --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "/nonexistent/depth.exr") && has(r.err, "does not exist")) << r.err;
+
+  const fs::path junk = scratch("junk.exr");
+  std::ofstream(junk) << "this is not an image at all";
+  r = nbsim("nbuffer query --depth " + junk.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, junk.string()) && has(r.err, "cannot be read")) << r.err;
+
+  const fs::path empty = scratch("empty.exr");
+  std::ofstream(empty).flush();
+  r = nbsim("nbuffer query --depth " + empty.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, empty.string())) << r.err;
+}
+
+// Bad arguments exit 2 with a message naming the problem; no output is half-written.
+TEST(NBufferCliTest, RefusesBadArguments) {
+  const fs::path f = small_depth("args.exr");
+  const std::string q = "nbuffer query --depth " + f.string();
+  struct Row { std::string args; std::string message; };
+  const Row rows[] = {
+      {q + " --rect 0,0,0,2", "empty rectangle"},
+      {q + " --rect 0,0,2", "bad rectangle"},
+      {q + " --rect a,b,c,d", "bad rectangle"},
+      {q + " --rect 0,0,2,2,2", "bad rectangle"},
+      {q + " --rect 1,1,1,1 --rect 10,10,2,2", "outside"},
+      {q + " --rect 0,0,2,2 --op mean", "--op"},
+      {q + " --rect 0,0,2,2 --format f64", "--format"},
+      {q + " --rect 0,0,2,2 --covering three", "--covering"},
+      {q, "--rect"},
+      {"nbuffer query --rect 0,0,1,1", "--depth"},
+      {"nbuffer frobnicate", "frobnicate"},
+      {"nbuffer coverage --size 0x4 --out " + scratch("c.png").string(), "--size"},
+      {"nbuffer query --scene city --size 12 --rect 0,0,1,1", "--size"},
+  };
+  for (const Row& row : rows) {
+    const CliResult r = nbsim(row.args);
+    EXPECT_EQ(r.status, 2) << row.args << "\n" << r.err;
+    EXPECT_TRUE(has(r.err, row.message)) << row.args << ": message should mention '" << row.message << "': " << r.err;
+    EXPECT_TRUE(r.out.empty()) << row.args << ": printed " << r.out;
+  }
+}
+
+// A partly outside rectangle is clipped: it answers from the pixels inside only.
+TEST(NBufferCliTest, ClipsPartlyOutsideRect) {
+  const fs::path f = small_depth("clip.exr");
+  const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect -5,-5,7,7");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FLOAT_EQ(nlohmann::json::parse(r.out)["value"].get<float>(), 0.25f) << "only pixels [0,2)x[0,2) count";
+}
+
+// build writes every level as EXR and PNG, readable back with level 0 equal to the input.
+TEST(NBufferCliTest, BuildWritesEveryLevel) {
+  const fs::path f = small_depth("b.exr");
+  const fs::path out = scratch("levels");
+  const CliResult r = nbsim("nbuffer build --depth " + f.string() + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_TRUE(fs::exists(out / ("level_0" + std::to_string(i) + ".exr"))) << i;
+    EXPECT_TRUE(fs::exists(out / ("level_0" + std::to_string(i) + ".png"))) << i;
+  }
+  EXPECT_FALSE(fs::exists(out / "level_02.exr")) << "a 4x4 image has exactly 2 levels";
+  const nbsim::DepthImage l1 = nbsim::io::read_depth(out / "level_01.exr");
+  EXPECT_FLOAT_EQ(l1.at(2, 0), 0.9f) << "level 1 at (2,0) covers the far pixel (3,0)";
+  EXPECT_FLOAT_EQ(l1.at(3, 3), 0.25f);
+  EXPECT_TRUE(fs::exists(out / "levels.json"));
+}
+
+// coverage writes the image and the CSV and prints a summary.
+TEST(NBufferCliTest, CoverageWritesImageAndCsv) {
+  const fs::path png = scratch("cov.png");
+  const CliResult r = nbsim("nbuffer coverage --size 16x8 --out " + png.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(png));
+  std::ifstream csv(fs::path(png).replace_extension(".csv"));
+  std::string line;
+  int rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, 1 + 16 * 8) << "one header and one row per box size";
+  EXPECT_TRUE(has(r.out, "four squares")) << r.out;
 }
 
 }  // namespace
