@@ -1,0 +1,23 @@
+# nbsim_embed_shaders(<target> <files...>): compiles the GLSL files of shaders/ into the target as
+# strings (nbsim::shaders::<name>, e.g. scene_vert), so the binary runs from anywhere. Editing a
+# shader re-runs the configure step.
+function(nbsim_embed_shaders target)
+  set(out ${CMAKE_CURRENT_BINARY_DIR}/nbsim_shaders.cpp)
+  set(hdr ${CMAKE_CURRENT_BINARY_DIR}/nbsim_shaders.h)
+  set(body "// Generated from shaders/ by cmake/NbsimShaders.cmake. Do not edit.\n#include \"nbsim_shaders.h\"\nnamespace nbsim::shaders {\n")
+  set(decl "// Generated from shaders/ by cmake/NbsimShaders.cmake. Do not edit.\n#pragma once\nnamespace nbsim::shaders {\n")
+  foreach(f ${ARGN})
+    get_filename_component(name ${f} NAME)
+    string(REPLACE "." "_" sym ${name})
+    file(READ ${f} text)
+    string(APPEND body "extern const char* const ${sym} = R\"nbsim_glsl(${text})nbsim_glsl\";\n")
+    string(APPEND decl "extern const char* const ${sym};\n")
+    set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${f})
+  endforeach()
+  string(APPEND body "}  // namespace nbsim::shaders\n")
+  string(APPEND decl "}  // namespace nbsim::shaders\n")
+  file(CONFIGURE OUTPUT ${out} CONTENT "${body}" @ONLY)
+  file(CONFIGURE OUTPUT ${hdr} CONTENT "${decl}" @ONLY)
+  target_sources(${target} PRIVATE ${out})
+  target_include_directories(${target} PUBLIC ${CMAKE_CURRENT_BINARY_DIR})
+endfunction()
