@@ -32,10 +32,19 @@ inline float quantize_toward_far(float d, StorageFormat f, FarOp op) noexcept {
   if (f == StorageFormat::F32) return d;
   const double scale = f == StorageFormat::U24 ? 16777215.0 : 65535.0;
   const double v = static_cast<double>(d) * scale;  // exact: 24 + 24 bits fit a double
-  const double code = op == FarOp::Max ? std::ceil(v) : std::floor(v);
-  // code / scale is >= d (resp. <=) in the reals; both roundings below are monotone and d is
-  // representable, so the float result stays on the far side of d.
-  return static_cast<float>(code / scale);
+  auto stored = [scale](double code) { return static_cast<float>(code / scale); };
+  // code / scale is on the far side of d in the reals; both roundings in stored() are monotone
+  // and d is representable, so the float result stays on the far side of d. A stored value read
+  // back may lie a hair past its code in the reals, so step back one code when the nearer code's
+  // float still is on the far side of d: then quantizing a stored value returns it unchanged.
+  if (op == FarOp::Max) {
+    double code = std::ceil(v);
+    if (code > 0 && stored(code - 1) >= d) code -= 1;
+    return stored(code);
+  }
+  double code = std::floor(v);
+  if (code < scale && stored(code + 1) <= d) code += 1;
+  return stored(code);
 }
 
 }  // namespace nbsim

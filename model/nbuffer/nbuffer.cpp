@@ -59,7 +59,7 @@ NBuffer::NBuffer(int width, int height, NBufferConfig config) : width_(width), h
   full_levels_ = nbuffer_level_count(width, height);
   if (config.max_level < -1)
     throw InputError("N-buffer max_level must be -1 (all levels) or at least 0, got " + std::to_string(config.max_level));
-  levels_ = config.max_level < 0 ? full_levels_ : std::min(config.max_level + 1, full_levels_);
+  levels_ = config.max_level < 0 ? full_levels_ : std::min(config.max_level, full_levels_ - 1) + 1;
   data_.assign(static_cast<std::size_t>(levels_) * pixels(), far_limit(config.op));
 }
 
@@ -67,22 +67,94 @@ NBuffer::NBuffer(const DepthImage& depth, NBufferConfig config) : NBuffer(depth.
   build(depth);
 }
 
+namespace {
+
+// Full builds (NBuffer::build). A level pass costs about what copying its plane costs plus its
+// arithmetic, and the two overlap poorly. So the build (1) runs level 0 and the levels with small
+// steps band by band, top down, so that the rows a level reads were written a moment ago and are
+// still in L2, and (2) computes four rows y, y + s, y + 2s, y + 3s of a level together from the
+// five rows below, so that each horizontal pair far(a[x], a[x + s]) is loaded and reduced once
+// instead of twice. Together about 15% faster than level by level at 1024x1024.
+// The two constants are tunable: the fastest of the band heights (32 to 256 rows) and banded
+// steps (8 to 128) timed at 1024x1024 on the project's 2-core machines (1 MiB L2 per core).
+constexpr int build_band_rows = 64;      // rows per band: at 1024 px, the bands of the 3 planes in use fit L2
+constexpr int build_band_max_step = 16;  // levels with s <= this are banded; the others go plane by plane
+static_assert(4 * build_band_max_step <= build_band_rows, "a banded level's four-row groups must fit a band");
+
+// Rows y, y + s, y + 2s, y + 3s of level i + 1 (`out`, rows `row_step` floats apart) from rows
+// y .. y + 4s of level i (`in`), all inside the image. Same reduction order as reduce_row, so the
+// results are bit-identical to it (signed zeros and NaNs included).
+template <FarOp Op>
+void reduce_four_rows(const float* __restrict in, float* __restrict out, std::ptrdiff_t row_step, int width,
+                      int s) noexcept {
+  const int split = std::clamp(width - s, 0, width);  // x < split has x + s inside the image
+  const float* __restrict i0 = in;
+  const float* __restrict i1 = in + row_step;
+  const float* __restrict i2 = in + 2 * row_step;
+  const float* __restrict i3 = in + 3 * row_step;
+  const float* __restrict i4 = in + 4 * row_step;
+  float* __restrict o0 = out;
+  float* __restrict o1 = out + row_step;
+  float* __restrict o2 = out + 2 * row_step;
+  float* __restrict o3 = out + 3 * row_step;
+  for (int x = 0; x < split; ++x) {
+    const float h0 = far2<Op>(i0[x], i0[x + s]), h1 = far2<Op>(i1[x], i1[x + s]), h2 = far2<Op>(i2[x], i2[x + s]);
+    const float h3 = far2<Op>(i3[x], i3[x + s]), h4 = far2<Op>(i4[x], i4[x + s]);
+    o0[x] = far2<Op>(h0, h1);
+    o1[x] = far2<Op>(h1, h2);
+    o2[x] = far2<Op>(h2, h3);
+    o3[x] = far2<Op>(h3, h4);
+  }
+  for (int x = split; x < width; ++x) {
+    o0[x] = far2<Op>(i0[x], i1[x]);
+    o1[x] = far2<Op>(i1[x], i2[x]);
+    o2[x] = far2<Op>(i2[x], i3[x]);
+    o3[x] = far2<Op>(i3[x], i4[x]);
+  }
+}
+
+// Rows [y0, y1) of a level with step s from the level below (`src`), whose rows [y0, height) must
+// be final. Four-row groups where their five source rows exist, single rows elsewhere.
+template <FarOp Op>
+void reduce_rows(const float* src, float* dst, int width, int height, int s, int y0, int y1) noexcept {
+  const std::size_t w = static_cast<std::size_t>(width);
+  const std::ptrdiff_t row_step = static_cast<std::ptrdiff_t>(s) * width;
+  int y = y0;
+  for (; y + 4 * s <= y1 && y + 5 * s <= height; y += 4 * s)
+    for (int r = y; r < y + s; ++r) reduce_four_rows<Op>(src + r * w, dst + r * w, row_step, width, s);
+  for (; y < y1; ++y)
+    reduce_row<Op>(src + y * w, y + s < height ? src + (y + s) * w : nullptr, dst + y * w, 0, width, width, s);
+}
+
+void reduce_rows(FarOp op, const float* src, float* dst, int width, int height, int s, int y0, int y1) noexcept {
+  if (op == FarOp::Max) reduce_rows<FarOp::Max>(src, dst, width, height, s, y0, y1);
+  else reduce_rows<FarOp::Min>(src, dst, width, height, s, y0, y1);
+}
+
+}  // namespace
+
 void NBuffer::build(const DepthImage& depth) {
   NBSIM_CHECK(depth.width == width_ && depth.height == height_, "depth image size differs from the N-buffer's");
+  // Level i's rows [y0, y1) need level i - 1's rows [y0, y1 + s): bands go from the top down.
+  int banded = 1;  // levels [1, banded) are built band by band
+  while (banded < levels_ && (1 << (banded - 1)) <= build_band_max_step) ++banded;
+  const std::size_t w = static_cast<std::size_t>(width_);
   float* l0 = level_ptr(0);
-  for (std::size_t i = 0; i < pixels(); ++i) l0[i] = quantize_toward_far(depth.texels[i], config_.format, config_.op);
-  for (int i = 1; i < levels_; ++i) build_level(i);
+  for (int y1 = height_; y1 > 0; y1 -= build_band_rows) {
+    const int y0 = std::max(0, y1 - build_band_rows);
+    const float* in = depth.texels.data() + y0 * w;
+    float* out = l0 + y0 * w;
+    const std::size_t n = static_cast<std::size_t>(y1 - y0) * w;
+    if (config_.format == StorageFormat::F32) std::copy(in, in + n, out);
+    else for (std::size_t i = 0; i < n; ++i) out[i] = quantize_toward_far(in[i], config_.format, config_.op);
+    for (int i = 1; i < banded; ++i)
+      reduce_rows(config_.op, level_ptr(i - 1), level_ptr(i), width_, height_, 1 << (i - 1), y0, y1);
+  }
+  for (int i = banded; i < levels_; ++i) build_level(i);
 }
 
 void NBuffer::build_level(int dst) {
-  const int s = 1 << (dst - 1);
-  const float* src = level_ptr(dst - 1);
-  float* out = level_ptr(dst);
-  for (int y = 0; y < height_; ++y) {
-    const float* a = src + static_cast<std::size_t>(y) * width_;
-    const float* b = y + s < height_ ? a + static_cast<std::size_t>(s) * width_ : nullptr;
-    reduce_row(config_.op, a, b, out + static_cast<std::size_t>(y) * width_, 0, width_, width_, s);
-  }
+  reduce_rows(config_.op, level_ptr(dst - 1), level_ptr(dst), width_, height_, 1 << (dst - 1), 0, height_);
 }
 
 QueryResult NBuffer::query(const Rect& r, CoveringKind kind) const {
@@ -172,22 +244,35 @@ UpdateStats NBuffer::update(std::span<const PixelWrite> writes) {
     if (++epoch_ == 0) { std::fill(stamp_.begin(), stamp_.end(), 0u); epoch_ = 1; }
   };
 
-  // Level 0: apply the writes in order; keep each changed pixel once.
-  std::vector<Texel> changed, next;
-  next_epoch();
-  float* l0 = level_ptr(0);
-  for (const PixelWrite& w : writes) {
+  // Reject the whole batch before touching level 0: a half-applied batch would leave level 0
+  // out of step with the levels above it.
+  for (const PixelWrite& w : writes)
     if (w.x < 0 || w.y < 0 || w.x >= width_ || w.y >= height_)
       throw InputError("pixel write at (" + std::to_string(w.x) + "," + std::to_string(w.y) + ") outside the " +
                        std::to_string(width_) + "x" + std::to_string(height_) + " image");
+
+  // Level 0: apply the writes in order; note each pixel the first time it changes, with its value
+  // before the batch.
+  std::vector<Texel> changed, next;
+  std::vector<float> before;
+  next_epoch();
+  float* l0 = level_ptr(0);
+  for (const PixelWrite& w : writes) {
     const std::size_t k = static_cast<std::size_t>(w.y) * width_ + w.x;
     const float v = quantize_toward_far(w.depth, config_.format, config_.op);
     ++stats.texels_recomputed[0];
     if (l0[k] == v) continue;
+    if (stamp_[k] != epoch_) { stamp_[k] = epoch_; changed.push_back({w.x, w.y}); before.push_back(l0[k]); }
     l0[k] = v;
-    if (stamp_[k] != epoch_) { stamp_[k] = epoch_; changed.push_back({w.x, w.y}); }
   }
-  // A pixel written twice may end where it started: count only net changes.
+  // A pixel written twice may end where it started: keep (and count) only net changes, so that
+  // such a pixel recomputes nothing above level 0.
+  std::size_t kept = 0;
+  for (std::size_t j = 0; j < changed.size(); ++j) {
+    const Texel t = changed[j];
+    if (l0[static_cast<std::size_t>(t.y) * width_ + t.x] != before[j]) changed[kept++] = t;
+  }
+  changed.resize(kept);
   stats.texels_changed[0] = static_cast<long long>(changed.size());
 
   // Level i: a changed texel (x, y) of level i - 1 is read by the level-i texels at x or x - s and

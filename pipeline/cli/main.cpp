@@ -86,7 +86,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "nbsim " NBSIM_VERSION);
   cli::Action action;
   cli::add_nbuffer_commands(app, action);
+  cli::add_bench_commands(app, action);
   cli::add_info_command(app, action);
+  cli::add_capture_command(app, action);
+  cli::add_trace_commands(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,315 @@
+// `nbsim trace info|verify|dump`: look inside a depth trace (traces/FORMAT.md) captured by the GL
+// renderer: its header and per-frame summary, a full integrity check, and one frame's images.
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+
+#include "model/common/error.h"
+#include "pipeline/cli/command.h"
+#include "pipeline/io/image_io.h"
+#include "traces/format/codec.h"
+#include "traces/format/reader.h"
+
+namespace nbsim::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace tr = nbsim::trace;
+using ojson = nlohmann::ordered_json;
+
+// What `info` says about one frame.
+struct FrameSummary {
+  std::uint32_t frame = 0;
+  tr::TestMode mode = tr::TestMode::None;
+  std::uint64_t offset = 0;
+  std::size_t draws = 0;
+  std::uint64_t fragments = 0, samples_passed = 0;
+  std::optional<std::uint64_t> objects_visible, covered_pixels;
+  double gl_ms = 0.0;
+  std::vector<std::string> depths;  // "after_occluders", "final"
+  std::vector<std::string> level_text;  // "max x9", ...
+  std::vector<ojson> level_json;
+};
+
+FrameSummary summarize(const tr::Frame& f) {
+  FrameSummary s;
+  s.frame = f.begin.frame;
+  s.mode = f.begin.mode;
+  s.offset = f.offset;
+  s.draws = f.draws.size();
+  for (const tr::DrawRecord& d : f.draws) {
+    s.fragments += d.gl.fragments;
+    s.samples_passed += d.gl.samples_passed;
+  }
+  if (f.truth) {
+    s.objects_visible = static_cast<std::uint64_t>(
+        std::count_if(f.truth->visible_pixels.begin(), f.truth->visible_pixels.end(), [](std::uint32_t n) { return n > 0; }));
+    s.covered_pixels = f.truth->covered_pixels;
+  }
+  s.gl_ms = f.end.gl_ms;
+  for (const tr::DepthSnapshot& d : f.depths) s.depths.emplace_back(tr::to_string(d.which));
+  for (const tr::NBufferLevels& l : f.levels) {
+    const std::string_view op = to_string(static_cast<FarOp>(l.op));
+    s.level_text.push_back(fmt::format("{} x{}", op, l.levels));
+    s.level_json.push_back({{"op", op}, {"levels", l.levels}, {"size", fmt::format("{}x{}", l.width, l.height)}});
+  }
+  return s;
+}
+
+std::string mib(std::uint64_t bytes) { return fmt::format("{:.2f} MiB", static_cast<double>(bytes) / (1 << 20)); }
+
+int run_info(const std::string& file, bool json) {
+  tr::FrameReader frames{fs::path(file)};
+  std::vector<FrameSummary> summaries;
+  while (const auto f = frames.next()) summaries.push_back(summarize(*f));
+  const tr::TraceReader& t = frames.trace();
+  const tr::TraceStats& st = t.stats();
+  std::uint64_t fragments = 0, samples = 0, draws = 0;
+  for (const FrameSummary& s : summaries) {
+    fragments += s.fragments;
+    samples += s.samples_passed;
+    draws += s.draws;
+  }
+
+  if (json) {
+    ojson j;
+    j["file"] = file;
+    j["format_version"] = t.version();
+    j["bytes"] = t.file_bytes();
+    j["chunks"] = st.chunks;
+    j["compressed_chunks"] = st.compressed_chunks;
+    j["payload_bytes"] = st.raw_bytes;
+    j["stored_payload_bytes"] = st.stored_bytes;
+    ojson props = ojson::object();
+    for (const auto& [k, v] : t.properties()) props[k] = v;
+    j["properties"] = props;
+    if (const tr::SceneObjects* sc = t.scene())
+      j["scene"] = {{"objects", sc->objects.size()}, {"bvh_nodes", sc->node_bounds.size()}};
+    else
+      j["scene"] = nullptr;
+    ojson fr = ojson::array();
+    for (const FrameSummary& s : summaries) {
+      ojson o;
+      o["frame"] = s.frame;
+      o["mode"] = tr::to_string(s.mode);
+      o["draws"] = s.draws;
+      o["fragments"] = s.fragments;
+      o["samples_passed"] = s.samples_passed;
+      o["objects_visible"] = s.objects_visible ? ojson(*s.objects_visible) : ojson(nullptr);
+      o["covered_pixels"] = s.covered_pixels ? ojson(*s.covered_pixels) : ojson(nullptr);
+      o["gl_ms"] = s.gl_ms;
+      o["depth"] = s.depths;
+      o["levels"] = s.level_json;
+      o["offset"] = s.offset;
+      fr.push_back(std::move(o));
+    }
+    j["frames"] = std::move(fr);
+    j["totals"] = {{"frames", summaries.size()}, {"draws", draws}, {"fragments", fragments}, {"samples_passed", samples}};
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+
+  fmt::print("trace {}: format version {}, {} bytes, {} chunks ({} compressed; payload {} stored as {})\n", file,
+             t.version(), t.file_bytes(), st.chunks, st.compressed_chunks, mib(st.raw_bytes), mib(st.stored_bytes));
+  fmt::print("properties:\n");
+  for (const auto& [k, v] : t.properties()) fmt::print("  {}: {}\n", k, v);
+  if (const tr::SceneObjects* sc = t.scene())
+    fmt::print("scene: {} objects, {} BVH nodes\n", sc->objects.size(), sc->node_bounds.size());
+  else
+    fmt::print("scene: none recorded\n");
+  fmt::print("frames: {}\n", summaries.size());
+  for (const FrameSummary& s : summaries) {
+    const std::string visible = s.objects_visible ? fmt::format("{}", *s.objects_visible) : std::string("?");
+    fmt::print("  frame {} ({}): {} draws, {} GL fragments, {} samples passed, {} objects visible (ground truth)", s.frame,
+               tr::to_string(s.mode), s.draws, s.fragments, s.samples_passed, visible);
+    if (!s.depths.empty()) fmt::print("; depth: {}", fmt::join(s.depths, ", "));
+    if (!s.level_text.empty()) fmt::print("; N-buffer: {}", fmt::join(s.level_text, ", "));
+    fmt::print("\n");
+  }
+  fmt::print("total: {} draws, {} GL fragments, {} samples passed\n", draws, fragments, samples);
+  return 0;
+}
+
+int run_verify(const std::string& file) {
+  tr::FrameReader frames{fs::path(file)};
+  while (frames.next()) {
+  }
+  const tr::TraceReader& t = frames.trace();
+  const tr::TraceStats& st = t.stats();
+  fmt::print("{}: sound: format version {}, {} bytes, {} chunks, {} frames, {} draws, payload {} stored as {}\n", file,
+             t.version(), t.file_bytes(), st.chunks, st.frames, st.draws, mib(st.raw_bytes), mib(st.stored_bytes));
+  return 0;
+}
+
+std::string lower_extension(const fs::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return e;
+}
+
+// A colour per object id (a fixed integer hash, bright enough to tell from the black background).
+std::array<std::uint8_t, 3> id_colour(std::int32_t id) {
+  if (id < 0) return {0, 0, 0};
+  std::uint32_t h = static_cast<std::uint32_t>(id) * 0x9E3779B1u;
+  h ^= h >> 15;
+  h *= 0x85EBCA77u;
+  h ^= h >> 13;
+  return {static_cast<std::uint8_t>(64 + (h & 0xBF)), static_cast<std::uint8_t>(64 + ((h >> 8) & 0xBF)),
+          static_cast<std::uint8_t>(64 + ((h >> 16) & 0xBF))};
+}
+
+struct DumpOptions {
+  std::string file;
+  std::uint32_t frame = 0;
+  std::string depth;
+  std::string which = "final";
+  std::string levels;
+  std::string truth;
+};
+
+int run_dump(const DumpOptions& o) {
+  if (o.depth.empty() && o.levels.empty() && o.truth.empty())
+    throw InputError("nothing to dump: pass --depth OUT.exr, --levels DIR or --truth OUT.csv|OUT.png");
+  const std::string truth_ext = lower_extension(o.truth);
+  if (!o.truth.empty() && truth_ext != ".csv" && truth_ext != ".png")
+    throw InputError(fmt::format("--truth '{}': expected a .csv (visible pixels per object) or .png (ID buffer) file", o.truth));
+
+  tr::FrameReader frames{fs::path(o.file)};
+  std::optional<tr::Frame> frame;
+  std::uint64_t count = 0;
+  std::uint32_t first = 0, last = 0;
+  while ((frame = frames.next())) {
+    if (count++ == 0) first = frame->begin.frame;
+    last = frame->begin.frame;
+    if (frame->begin.frame >= o.frame) break;  // frame numbers increase: it is here or nowhere
+  }
+  if (!frame || frame->begin.frame != o.frame) {
+    if (count == 0) throw InputError(fmt::format("trace '{}' has no frames", o.file));
+    if (frame)
+      throw InputError(fmt::format("trace '{}' has no frame {} (the next frame is {})", o.file, o.frame, last));
+    throw InputError(fmt::format("trace '{}' has no frame {} (its {} frames are numbered {} to {})", o.file, o.frame,
+                                 count, first, last));
+  }
+  const tr::Frame& f = *frame;
+
+  // Check that everything asked for is there before writing anything.
+  const tr::DepthWhich which = o.which == "final" ? tr::DepthWhich::Final : tr::DepthWhich::AfterOccluders;
+  const tr::DepthSnapshot* depth = o.depth.empty() ? nullptr : f.depth(which);
+  if (!o.depth.empty() && !depth) {
+    std::vector<std::string> have;
+    for (const tr::DepthSnapshot& d : f.depths) have.emplace_back(tr::to_string(d.which));
+    throw InputError(fmt::format("frame {} of '{}' has no '{}' depth snapshot (it has: {})", o.frame, o.file,
+                                 tr::to_string(which), have.empty() ? std::string("none") : fmt::format("{}", fmt::join(have, ", "))));
+  }
+  if (!o.levels.empty() && f.levels.empty())
+    throw InputError(fmt::format("frame {} of '{}' records no N-buffer levels (the capture may store them every k-th frame only)",
+                                 o.frame, o.file));
+  if (!o.truth.empty() && !f.truth)
+    throw InputError(fmt::format("frame {} of '{}' records no ground truth", o.frame, o.file));
+  if (truth_ext == ".png" && f.truth->ids.empty())
+    throw InputError(fmt::format("frame {} of '{}' records no ID-buffer image, only visible pixels per object: "
+                                 "use --truth OUT.csv", o.frame, o.file));
+
+  if (depth) {
+    DepthImage img;
+    img.width = depth->width;
+    img.height = depth->height;
+    img.texels = depth->texels;
+    io::write_depth(img, o.depth);
+    fmt::print("wrote {} ({}x{}, '{}' depth of frame {})\n", o.depth, img.width, img.height, tr::to_string(which), o.frame);
+  }
+  if (!o.levels.empty()) {
+    const fs::path dir(o.levels);
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw InputError(fmt::format("cannot create output directory '{}': {}", dir.string(), ec.message()));
+    for (const tr::NBufferLevels& l : f.levels) {
+      const std::string prefix = f.levels.size() == 1 ? "level" : fmt::format("{}_level", to_string(static_cast<FarOp>(l.op)));
+      const std::size_t plane = static_cast<std::size_t>(l.width) * static_cast<std::size_t>(l.height);
+      for (std::int32_t i = 0; i < l.levels; ++i) {
+        DepthImage img;
+        img.width = l.width;
+        img.height = l.height;
+        const auto from = l.texels.begin() + static_cast<std::ptrdiff_t>(plane * static_cast<std::size_t>(i));
+        img.texels.assign(from, from + static_cast<std::ptrdiff_t>(plane));
+        io::write_depth(img, dir / fmt::format("{}_{:02d}.exr", prefix, i));
+      }
+      fmt::print("wrote {} {} levels of {}x{} ({}_NN.exr) to {}\n", l.levels, to_string(static_cast<FarOp>(l.op)), l.width,
+                  l.height, prefix, dir.string());
+    }
+  }
+  if (truth_ext == ".csv") {
+    std::ofstream out(o.truth);
+    if (!out) throw InputError(fmt::format("cannot write '{}'", o.truth));
+    out << "object,visible_pixels\n";
+    for (std::size_t i = 0; i < f.truth->visible_pixels.size(); ++i) out << i << ',' << f.truth->visible_pixels[i] << '\n';
+    if (!out.flush()) throw InputError(fmt::format("cannot write '{}'", o.truth));
+    const auto visible = std::count_if(f.truth->visible_pixels.begin(), f.truth->visible_pixels.end(),
+                                       [](std::uint32_t n) { return n > 0; });
+    fmt::print("wrote {} ({} objects, {} visible, {} covered pixels in frame {})\n", o.truth, f.truth->visible_pixels.size(),
+               visible, f.truth->covered_pixels, o.frame);
+  } else if (truth_ext == ".png") {
+    const tr::GroundTruth& t = *f.truth;
+    std::vector<std::uint8_t> rgb(t.ids.size() * 3);
+    for (std::size_t i = 0; i < t.ids.size(); ++i) {
+      const auto c = id_colour(t.ids[i]);
+      std::copy(c.begin(), c.end(), rgb.begin() + static_cast<std::ptrdiff_t>(3 * i));
+    }
+    io::write_rgb8(t.id_width, t.id_height, rgb, o.truth);
+    fmt::print("wrote {} ({}x{} ID buffer of frame {}, one colour per object, black where none)\n", o.truth, t.id_width,
+               t.id_height, o.frame);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_trace_commands(CLI::App& app, Action& action) {
+  auto* tc = app.add_subcommand("trace", "Depth traces captured by the GL renderer: summary, integrity check, frame images");
+  tc->require_subcommand(1);
+  tc->footer("Trace files are specified in traces/FORMAT.md. A damaged or unreadable trace exits with status 2 and a\n"
+             "message naming the chunk (index and type) and its byte offset.");
+
+  {
+    auto* cmd = tc->add_subcommand("info", "Header properties and a per-frame summary (draws, GL fragments, samples passed, visible objects)");
+    auto file = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    cmd->add_option("FILE", *file, "Trace file")->required();
+    cmd->add_flag("--json", *json, "Print one JSON object instead of text");
+    cmd->footer("'objects visible' counts the objects with at least one pixel in the frame's ID buffer (ground truth).\n"
+                "The whole trace is read and checked, as by 'nbsim trace verify'.");
+    cmd->callback([&action, file, json] { action = [=] { return run_info(*file, *json); }; });
+  }
+  {
+    auto* cmd = tc->add_subcommand("verify", "Check every chunk (CRC-32, lengths, order, records); exit 0 when sound, 2 when not");
+    auto file = std::make_shared<std::string>();
+    cmd->add_option("FILE", *file, "Trace file")->required();
+    cmd->footer("Prints one summary line when the trace is sound. Otherwise prints the first problem, naming the chunk\n"
+                "(index and type) and its byte offset, and exits with status 2.");
+    cmd->callback([&action, file] { action = [=] { return run_verify(*file); }; });
+  }
+  {
+    auto* cmd = tc->add_subcommand("dump", "Write one frame's depth snapshot, N-buffer levels (EXR) and ground truth (CSV or PNG)");
+    auto o = std::make_shared<DumpOptions>();
+    cmd->add_option("FILE", o->file, "Trace file")->required();
+    cmd->add_option("--frame", o->frame, "Frame number (as recorded in the trace)")->required();
+    cmd->add_option("--depth", o->depth, "Write the depth snapshot as a single-channel float image (EXR), y up");
+    cmd->add_option("--which", o->which, "Which snapshot: final (end of frame) or occluders (after the occluder pass)")
+        ->check(CLI::IsMember({"final", "occluders"}))
+        ->capture_default_str();
+    cmd->add_option("--levels", o->levels, "Write the N-buffer levels the GLSL shader built as DIR/level_NN.exr");
+    cmd->add_option("--truth", o->truth, "Write the ground truth: OUT.csv (visible pixels per object) or OUT.png (ID buffer)");
+    cmd->footer("At least one of --depth, --levels, --truth. Nothing is written when the frame lacks any of them.\n"
+                "With both max and min N-buffers in the frame, the level files are named max_level_NN.exr and min_level_NN.exr.");
+    cmd->callback([&action, o] { action = [=] { return run_dump(*o); }; });
+  }
+}
+
+}  // namespace nbsim::cli

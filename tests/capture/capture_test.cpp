@@ -1,0 +1,203 @@
+// CaptureTest: the GL renderer run headless on a small city, checked against itself and against
+// the C++ core: GLSL N-buffer levels equal the core's bit for bit, GL's counters are consistent,
+// the ID-buffer ground truth adds up, and no culling mode hides a visible object.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include <filesystem>
+#include <set>
+
+#include "model/nbuffer/nbuffer.h"
+#include "traces/capture/capture.h"
+#include "traces/capture/renderer.h"
+#include "traces/format/reader.h"
+
+namespace nbsim::capture {
+namespace {
+
+struct Small {
+  City city;
+  std::vector<CameraPose> poses;
+  Small(PathKind path, int frames) {
+    CityParams p;
+    p.objects = 600;
+    p.seed = 7;
+    city = make_city(p);
+    poses = make_path(city, path, frames, 7);
+  }
+};
+
+RendererOptions options(trace::TestMode mode, bool reversed = false) {
+  RendererOptions o;
+  o.width = 160;
+  o.height = 120;
+  o.mode = mode;
+  o.projection.reversed_z = reversed;
+  return o;
+}
+
+// The city has the requested objects, a BVH whose leaves hold every object once, and bounds that
+// contain each object's triangles.
+TEST(CaptureTest, CityAndBvhAreConsistent) {
+  CityParams p;
+  p.objects = 5000;
+  const City c = make_city(p);
+  ASSERT_EQ(c.objects.size(), 5000u);
+  std::vector<int> seen(c.objects.size(), 0);
+  for (std::size_t n = 0; n < c.scene.node_bounds.size(); ++n)
+    if (c.scene.node_left[n] < 0)
+      for (std::uint32_t i = c.scene.node_first[n]; i < c.scene.node_first[n] + c.scene.node_count[n]; ++i) ++seen[c.scene.leaf_objects[i]];
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int k) { return k == 1; })) << "every object in exactly one leaf";
+  for (std::size_t n = 0; n < c.scene.node_bounds.size(); ++n) {
+    if (c.scene.node_left[n] < 0) continue;
+    for (auto child : {c.scene.node_left[n], c.scene.node_right[n]})
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_LE(c.scene.node_bounds[n].lo[k], c.scene.node_bounds[static_cast<std::size_t>(child)].lo[k]) << "parent bounds contain children";
+        EXPECT_GE(c.scene.node_bounds[n].hi[k], c.scene.node_bounds[static_cast<std::size_t>(child)].hi[k]);
+      }
+  }
+}
+
+// The GLSL N-buffer levels equal the C++ core's levels built from the captured depth, bit for bit.
+TEST(CaptureTest, GlslLevelsEqualCoreLevels) {
+  for (bool reversed : {false, true}) {
+    Small s(PathKind::Walk, 3);
+    Renderer r(s.city, options(trace::TestMode::NBuffer, reversed));
+    for (std::uint32_t f = 0; f < 3; ++f) {
+      const CapturedFrame fr = r.render(f, s.poses[f], true);
+      ASSERT_TRUE(fr.levels.has_value());
+      const auto& d = fr.depth.at(0);
+      ASSERT_EQ(d.which, trace::DepthWhich::AfterOccluders);
+      DepthImage img(d.width, d.height, 0.0f);
+      img.texels = d.texels;
+      const NBuffer core(img, {reversed ? FarOp::Min : FarOp::Max, StorageFormat::F32, -1});
+      ASSERT_EQ(fr.levels->levels, core.level_count());
+      for (int i = 0; i < core.level_count(); ++i) {
+        const auto level = core.level(i);
+        const float* gl = fr.levels->texels.data() + static_cast<std::size_t>(i) * level.size();
+        EXPECT_EQ(std::memcmp(gl, level.data(), level.size() * 4), 0) << "frame " << f << " level " << i << " reversed " << reversed;
+      }
+    }
+  }
+}
+
+// For every mode: samples passed never exceed rasterized fragments, the ID-buffer pixels add up
+// to the covered pixels, and every object with visible pixels was rendered by the technique.
+TEST(CaptureTest, CountersAndGroundTruthAreConsistent) {
+  for (auto mode : {trace::TestMode::OcclusionQuery, trace::TestMode::OcclusionQueryHier, trace::TestMode::NBuffer,
+                    trace::TestMode::NBufferHier, trace::TestMode::None}) {
+    for (PathKind path : {PathKind::Walk, PathKind::Fly}) {
+      Small s(path, 4);
+      Renderer r(s.city, options(mode));
+      for (std::uint32_t f = 0; f < 4; ++f) {
+        const CapturedFrame fr = r.render(f, s.poses[f], false);
+        for (const auto& d : fr.draws) {
+          EXPECT_LE(d.gl.samples_passed, d.gl.fragments) << "draw " << d.index << " frame " << f;
+          if (!d.clip_positions.empty()) {
+            EXPECT_EQ(d.clip_positions.size() % 3, 0u) << "whole triangles captured";
+          }
+        }
+        std::uint64_t sum = 0;
+        for (auto v : fr.truth.visible_pixels) sum += v;
+        EXPECT_EQ(sum, fr.truth.covered_pixels) << "ID-buffer pixels add up";
+        EXPECT_LE(fr.truth.covered_pixels, 160u * 120u);
+        for (std::size_t o = 0; o < fr.truth.visible_pixels.size(); ++o) {
+          if (!fr.truth.visible_pixels[o]) continue;
+          EXPECT_TRUE(std::binary_search(fr.rendered_objects.begin(), fr.rendered_objects.end(), o))
+              << "object " << o << " is visible (" << fr.truth.visible_pixels[o] << " px) but mode "
+              << static_cast<int>(mode) << " culled it in frame " << f;
+        }
+      }
+    }
+  }
+}
+
+// Occlusion-query decisions agree with GL's samples passed, and bounds crossing the near plane
+// are never culled.
+TEST(CaptureTest, QueryDecisionsFollowGlCounters) {
+  Small s(PathKind::Walk, 3);
+  Renderer r(s.city, options(trace::TestMode::OcclusionQuery));
+  for (std::uint32_t f = 0; f < 3; ++f) {
+    const CapturedFrame fr = r.render(f, s.poses[f], false);
+    int queries = 0;
+    for (const auto& d : fr.draws) {
+      if (d.role != trace::DrawRole::BoundsQuery) continue;
+      ++queries;
+      ASSERT_TRUE(d.has_bounds);
+      EXPECT_EQ(d.bounds.visible, d.bounds.crosses_near || d.gl.samples_passed > 0) << "draw " << d.index;
+      EXPECT_EQ(d.clip_positions.size(), 36u) << "a box is 12 triangles";
+      EXPECT_FALSE(d.state.write) << "queries do not write depth";
+    }
+    if (f > 0) {
+      EXPECT_GT(queries, 0) << "frame " << f << " tested no bounds";
+    }
+  }
+}
+
+// A captured trace file checks itself when read back: header properties name the renderer, the
+// GLSL levels equal the core's levels from the recorded depth, the counters and the ground truth
+// are consistent, and every visible object was drawn (as an occluder or a visible object).
+TEST(CaptureTest, TraceFileChecksItself) {
+  for (bool reversed : {false, true}) {
+    CaptureOptions o;
+    o.width = 128;
+    o.height = 96;
+    o.frames = 4;
+    o.objects = 800;
+    o.seed = 5;
+    o.mode = trace::TestMode::NBuffer;
+    o.levels_every = 1;
+    o.reversed_z = reversed;
+    const auto file = std::filesystem::path(::testing::TempDir()) / ("capture_" + std::to_string(::getpid()) + ".nbt");
+    const CaptureSummary sum = capture_city(o, file.string());
+    EXPECT_EQ(sum.frames, 4);
+    EXPECT_EQ(sum.visible_not_rendered, 0u);
+
+    trace::FrameReader frames(file);
+    const trace::TraceReader& tr = frames.trace();
+    ASSERT_NE(tr.property("gl_renderer"), nullptr);
+    EXPECT_NE(tr.property("gl_renderer")->find("llvmpipe"), std::string::npos) << *tr.property("gl_renderer");
+    EXPECT_EQ(*tr.property("depth_func"), reversed ? "GREATER" : "LESS");
+    ASSERT_NE(tr.scene(), nullptr);
+    EXPECT_EQ(tr.scene()->objects.size(), 800u);
+    const FarOp op = reversed ? FarOp::Min : FarOp::Max;
+    int count = 0;
+    while (auto f = frames.next()) {
+      ++count;
+      const trace::DepthSnapshot* d = f->depth(trace::DepthWhich::AfterOccluders);
+      const trace::NBufferLevels* l = f->nbuffer(op);
+      ASSERT_NE(d, nullptr);
+      ASSERT_NE(l, nullptr);
+      DepthImage img(d->width, d->height, 0.0f);
+      img.texels = d->texels;
+      const NBuffer core(img, {op, StorageFormat::F32, -1});
+      ASSERT_EQ(l->levels, core.level_count());
+      EXPECT_EQ(std::memcmp(l->texels.data(), core.level(0).data(), l->texels.size() * 4), 0)
+          << "GLSL levels differ from the core's in frame " << f->begin.frame;
+      std::set<std::int32_t> drawn;
+      for (const auto& draw : f->draws) {
+        EXPECT_LE(draw.gl.samples_passed, draw.gl.fragments);
+        if (draw.role == trace::DrawRole::Occluder || draw.role == trace::DrawRole::Visible) drawn.insert(draw.object);
+        if (draw.role == trace::DrawRole::NBufferBuild) {
+          EXPECT_EQ(draw.gl.fragments, 128u * 96u) << "a full-screen pass shades every pixel once";
+        }
+      }
+      ASSERT_TRUE(f->truth.has_value());
+      std::uint64_t sum_px = 0;
+      for (std::size_t obj = 0; obj < f->truth->visible_pixels.size(); ++obj) {
+        sum_px += f->truth->visible_pixels[obj];
+        if (f->truth->visible_pixels[obj]) {
+          EXPECT_TRUE(drawn.count(static_cast<std::int32_t>(obj))) << "visible object " << obj << " not drawn";
+        }
+      }
+      EXPECT_EQ(sum_px, f->truth->covered_pixels);
+    }
+    EXPECT_EQ(count, 4);
+    std::filesystem::remove(file);
+  }
+}
+
+}  // namespace
+}  // namespace nbsim::capture

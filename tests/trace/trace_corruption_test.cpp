@@ -1,0 +1,439 @@
+// TraceCorruptionTest: every damaged or hostile trace is refused with an InputError that names the
+// chunk and its byte offset: flipped bytes, truncation anywhere, empty files, garbage, lengths past
+// the end, unknown types and flags, bad zstd, records that decode short or long, broken structure.
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "model/common/error.h"
+#include "tests/trace/sample_trace.h"
+
+namespace {
+
+using namespace nbsim::trace;
+using namespace nbsim::trace::testing;
+using nbsim::InputError;
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Reads the whole trace from memory; returns the InputError's message, or "" when it reads.
+std::string read_error(const Bytes& b) {
+  try {
+    read_all(TraceReader(b, "t.nbtrace"));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+Bytes sample_bytes() {
+  static const Bytes b = [] {
+    const fs::path f = scratch("sample.nbtrace");
+    write_sample_trace(f);
+    return read_file(f);
+  }();
+  return b;
+}
+
+std::uint64_t le64_at(const Bytes& b, std::size_t at) {
+  std::uint64_t v = 0;
+  for (std::size_t i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(b[at + i]) << (8 * i);
+  return v;
+}
+void put_le32(Bytes& b, std::size_t at, std::uint32_t v) {
+  for (std::size_t i = 0; i < 4; ++i) b[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+void put_le64(Bytes& b, std::size_t at, std::uint64_t v) {
+  for (std::size_t i = 0; i < 8; ++i) b[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+// Recomputes the CRC of the chunk at `at` after its header or payload was edited on purpose.
+void refit_crc(Bytes& b, std::size_t at) {
+  const std::size_t stored = static_cast<std::size_t>(le64_at(b, at + 8));
+  put_le32(b, at + kChunkHeaderBytes + stored, crc32(std::span(b).subspan(at, kChunkHeaderBytes + stored)));
+}
+
+// The chunk containing byte `at` (the last chunk starting at or before it).
+std::size_t chunk_of(const std::vector<std::size_t>& offsets, std::size_t at) {
+  std::size_t k = 0;
+  while (k + 1 < offsets.size() && offsets[k + 1] <= at) ++k;
+  return k;
+}
+
+// A hand-built trace: chunks framed by encode_chunk without the writer's checks, so that rules
+// can be broken on purpose.
+struct Builder {
+  Bytes b;
+  std::uint64_t chunks = 0;
+  Builder() {
+    const auto p = encode_preamble(kFormatVersion);
+    b.assign(p.begin(), p.end());
+  }
+  Builder& chunk(ChunkType t, const Bytes& payload, bool compress = false) {
+    const Bytes c = encode_chunk(t, payload, compress);
+    b.insert(b.end(), c.begin(), c.end());
+    ++chunks;
+    return *this;
+  }
+  template <class R>
+  Builder& add(const R& r) {
+    return chunk(RecordChunk<R>::type, encode(r));
+  }
+  Builder& end(std::uint32_t frames) { return add(EndMarker{chunks, frames}); }
+};
+
+// One valid chunk of every type: HEAD, SCEN, FRAM, DRAW, DPTH, NBLV, TRTH, FEND (and END).
+std::vector<std::pair<ChunkType, Bytes>> one_of_each() {
+  return {{ChunkType::Header, encode(sample_properties())},
+          {ChunkType::Scene, encode(sample_scene())},
+          {ChunkType::FrameBegin, encode(sample_frame_begin(0))},
+          {ChunkType::Draw, encode(sample_draw(0, 3))},
+          {ChunkType::Depth, encode(sample_depth(DepthWhich::Final, 32, 16))},
+          {ChunkType::Levels, encode(sample_levels(nbsim::FarOp::Max, 8, 4, 3))},
+          {ChunkType::Truth, encode(sample_truth(6, 8, 4))},
+          {ChunkType::FrameEnd, encode(FrameEnd{0, 1, 0.5})}};
+}
+
+// The builder's traces are sound when nothing is broken (so each refusal below has one cause).
+TEST(TraceCorruptionTest, BuilderBaselineReads) {
+  Builder t;
+  for (const auto& [type, payload] : one_of_each()) t.chunk(type, payload);
+  t.end(1);
+  EXPECT_EQ(read_error(t.b), "");
+  EXPECT_EQ(read_error(sample_bytes()), "");
+}
+
+// Flipping any byte (all eight bits, or only the lowest) is refused, naming the chunk that holds it.
+TEST(TraceCorruptionTest, EveryFlippedByteRefused) {
+  const Bytes good = sample_bytes();
+  const std::vector<std::size_t> offsets = chunk_offsets(good);
+  for (std::size_t i = 0; i < good.size(); ++i) {
+    for (const std::uint8_t mask : {std::uint8_t{0xFF}, std::uint8_t{0x01}}) {
+      Bytes b = good;
+      b[i] ^= mask;
+      const std::string e = read_error(b);
+      ASSERT_FALSE(e.empty()) << "byte " << i << " flipped with mask " << int(mask) << " was not detected";
+      if (i < kMagic.size()) {
+        EXPECT_TRUE(has(e, "not an nbsim trace")) << "byte " << i << ": " << e;
+      } else if (i < kPreambleBytes) {
+        EXPECT_TRUE(has(e, "preamble at byte 0: CRC-32 mismatch")) << "byte " << i << ": " << e;
+      } else {
+        const std::size_t k = chunk_of(offsets, i);
+        EXPECT_TRUE(has(e, "chunk " + std::to_string(k) + " ") && has(e, "at byte " + std::to_string(offsets[k]) + ":"))
+            << "byte " << i << " lies in chunk " << k << " at " << offsets[k] << ": " << e;
+      }
+    }
+  }
+}
+
+// Cutting the file at any length is refused, naming the chunk cut (or the missing END's place).
+TEST(TraceCorruptionTest, EveryTruncationRefused) {
+  const Bytes good = sample_bytes();
+  const std::vector<std::size_t> offsets = chunk_offsets(good);
+  for (std::size_t n = 0; n < good.size(); ++n) {
+    const Bytes b(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(n));
+    const std::string e = read_error(b);
+    ASSERT_FALSE(e.empty()) << "a trace cut to " << n << " bytes was accepted";
+    if (n == 0) {
+      EXPECT_TRUE(has(e, "empty")) << e;
+    } else if (n < kPreambleBytes) {
+      EXPECT_TRUE(has(e, "preamble") && has(e, "truncated")) << n << ": " << e;
+    } else {
+      const std::size_t k = n >= offsets.back() ? offsets.size() - 1 : chunk_of(offsets, n);
+      EXPECT_TRUE(has(e, "chunk " + std::to_string(k) + " ") && has(e, "at byte " + std::to_string(offsets[k]) + ":"))
+          << "cut at " << n << " inside chunk " << k << ": " << e;
+      EXPECT_TRUE(has(e, "truncated") || has(e, "past the end")) << n << ": " << e;
+    }
+  }
+}
+
+// The same through the file reader, on disk, for a spread of lengths.
+TEST(TraceCorruptionTest, TruncatedFilesOnDiskRefused) {
+  const Bytes good = sample_bytes();
+  const fs::path f = scratch("cut.nbtrace");
+  for (std::size_t n = 0; n < good.size(); n += 97) {
+    write_file(f, Bytes(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(n)));
+    EXPECT_THROW(read_all(TraceReader(f)), InputError) << "cut to " << n;
+  }
+}
+
+// A zero-length file is refused as empty, naming the file.
+TEST(TraceCorruptionTest, ZeroLengthFile) {
+  const fs::path f = scratch("zero.nbtrace");
+  write_file(f, {});
+  try {
+    TraceReader t(f);
+    FAIL() << "an empty file was accepted";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(has(e.what(), f.string()) && has(e.what(), "empty (0 bytes)")) << e.what();
+  }
+}
+
+// Garbage is not a trace; garbage after a valid preamble is refused at chunk 0.
+TEST(TraceCorruptionTest, Garbage) {
+  Lcg rng{5};
+  Bytes junk(4096);
+  for (auto& c : junk) c = static_cast<std::uint8_t>(rng.next() >> 24);
+  const fs::path f = scratch("junk.nbtrace");
+  write_file(f, junk);
+  try {
+    TraceReader t(f);
+    FAIL() << "garbage accepted";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(has(e.what(), "not an nbsim trace")) << e.what();
+  }
+  for (std::uint32_t seed = 0; seed < 64; ++seed) {
+    Builder t;
+    Lcg r{seed};
+    for (int i = 0; i < 200; ++i) t.b.push_back(static_cast<std::uint8_t>(r.next() >> 24));
+    const std::string e = read_error(t.b);
+    EXPECT_TRUE(has(e, "chunk 0 ") && has(e, "at byte 16:")) << e;
+  }
+  const std::string text = "This is a text file, not a trace.\n";
+  EXPECT_TRUE(has(read_error(Bytes(text.begin(), text.end())), "not an nbsim trace"));
+}
+
+// A stored length past the end of the file or above the limit is refused before any allocation.
+TEST(TraceCorruptionTest, LengthPastTheEnd) {
+  const Bytes good = sample_bytes();
+  const std::vector<std::size_t> offsets = chunk_offsets(good);
+  const std::size_t at = offsets[3];  // a DRAW of frame 0
+  struct Row {
+    std::uint64_t stored;
+    std::string message;
+  };
+  const Row rows[] = {
+      {good.size(), "points past the end of the file"},
+      {good.size() - at - kChunkHeaderBytes - 3, "points past the end of the file"},  // the CRC cannot fit
+      {std::uint64_t{1} << 62, "exceeds the format's chunk limit"},
+      {~std::uint64_t{0}, "exceeds the format's chunk limit"},
+  };
+  for (const Row& row : rows) {
+    Bytes b = good;
+    put_le64(b, at + 8, row.stored);
+    const std::string e = read_error(b);
+    EXPECT_TRUE(has(e, row.message) && has(e, "chunk 3 (DRAW) at byte " + std::to_string(at) + ":")) << e;
+  }
+}
+
+// Framing that is intact (CRC fixed up) but means nothing to this version is refused.
+TEST(TraceCorruptionTest, UnknownTypesFlagsAndLengths) {
+  const Bytes good = sample_bytes();
+  const std::vector<std::size_t> offsets = chunk_offsets(good);
+  const std::size_t at = offsets[3];
+  struct Row {
+    std::function<void(Bytes&)> edit;
+    std::string message;
+  };
+  const Row rows[] = {
+      {[&](Bytes& b) { put_le32(b, at, fourcc("ZZZZ")); }, "chunk 3 (ZZZZ)"},              // unknown type, named
+      {[&](Bytes& b) { put_le32(b, at, 0x00000001); }, "chunk 3 (0x00000001)"},          // unprintable type in hex
+      {[&](Bytes& b) { put_le32(b, at + 4, 2); }, "unknown flags 0x00000002"},           // reserved flag bits
+      {[&](Bytes& b) { put_le64(b, at + 16, le64_at(b, at + 8) + 1); }, "raw length"},   // raw != stored, uncompressed
+      {[&](Bytes& b) { put_le64(b, at + 16, (std::uint64_t{256} << 20) + 1); }, "raw length 268435457 exceeds"},
+      {[&](Bytes& b) { put_le32(b, at + 4, kFlagZstd); }, "not a zstd frame"},          // flagged but not zstd
+  };
+  for (const Row& row : rows) {
+    Bytes b = good;
+    row.edit(b);
+    refit_crc(b, at);
+    const std::string e = read_error(b);
+    EXPECT_TRUE(has(e, row.message) && has(e, "at byte " + std::to_string(at) + ":")) << "expected '" << row.message << "': " << e;
+  }
+  EXPECT_TRUE(has(read_error([&] {
+                    Bytes b = good;
+                    put_le32(b, at, fourcc("ZZZZ"));
+                    refit_crc(b, at);
+                    return b;
+                  }()),
+                  "unknown chunk type"));
+}
+
+// A zstd payload that does not decompress to the declared raw length is refused.
+TEST(TraceCorruptionTest, BadZstdPayloads) {
+  const Bytes depth = encode(sample_depth(DepthWhich::Final, 32, 32));
+  const Bytes framed = encode_chunk(ChunkType::Depth, depth, true);
+  ASSERT_EQ(framed[4], kFlagZstd) << "the test needs a compressed chunk";
+  auto trace_with = [&](const std::function<void(Bytes&)>& edit) {
+    Builder t;
+    t.add(Properties{}).add(sample_frame_begin(0));
+    Bytes c = framed;
+    edit(c);
+    refit_crc(c, 0);
+    t.b.insert(t.b.end(), c.begin(), c.end());
+    ++t.chunks;
+    t.add(FrameEnd{0, 0, 0.0}).end(1);
+    return t.b;
+  };
+  EXPECT_EQ(read_error(trace_with([](Bytes&) {})), "") << "baseline";
+  // The raw length disagrees with the frame's content size.
+  std::string e = read_error(trace_with([](Bytes& c) { put_le64(c, 16, le64_at(c, 16) - 4); }));
+  EXPECT_TRUE(has(e, "the zstd frame holds") && has(e, "chunk 2 (DPTH)")) << e;
+  // The compressed bytes are damaged after the frame header (CRC recomputed).
+  e = read_error(trace_with([](Bytes& c) {
+    for (std::size_t i = kChunkHeaderBytes + 8; i < c.size() - kChunkCrcBytes; i += 3) c[i] ^= 0x5A;
+  }));
+  EXPECT_TRUE(has(e, "chunk 2 (DPTH)") && (has(e, "zstd") || has(e, "decompresses"))) << e;
+}
+
+// Every record type refuses a payload one byte short or one byte long (CRC intact).
+TEST(TraceCorruptionTest, RecordsThatDecodeShortOrLong) {
+  const auto chunks = one_of_each();
+  for (std::size_t k = 0; k <= chunks.size(); ++k) {  // k == chunks.size(): the END record
+    for (const bool longer : {false, true}) {
+      Builder t;
+      for (std::size_t i = 0; i < chunks.size(); ++i) {
+        Bytes p = chunks[i].second;
+        if (i == k) longer ? p.push_back(0) : p.pop_back();
+        t.chunk(chunks[i].first, p, i == 4);  // the depth snapshot compressed, to decode through zstd
+      }
+      Bytes end = encode(EndMarker{t.chunks, 1});
+      if (k == chunks.size()) longer ? end.push_back(0) : end.pop_back();
+      t.chunk(ChunkType::End, end);
+      const std::string e = read_error(t.b);
+      const std::string type = k == chunks.size() ? "END " : chunk_type_name(chunks[k].first);
+      EXPECT_TRUE(has(e, "chunk " + std::to_string(k) + " (" + type + ")")) << e;
+      EXPECT_TRUE(has(e, longer ? "decodes long" : "decodes short")) << type << (longer ? " long: " : " short: ") << e;
+    }
+  }
+}
+
+// Field values outside their types are refused, naming the field.
+TEST(TraceCorruptionTest, FieldValuesOutOfRange) {
+  struct Row {
+    ChunkType type;
+    std::function<void(Bytes&)> edit;
+    std::string message;
+  };
+  const Row rows[] = {
+      {ChunkType::Draw, [](Bytes& p) { p[4] = 7; }, "field 'role' is 7"},                       // DrawRole 0..6
+      {ChunkType::Draw, [](Bytes& p) { p[15] = 2; }, "field 'state.write' is 2, not 0 or 1"},   // bools are 0/1
+      {ChunkType::Draw, [](Bytes& p) { p[14] = 8; }, "state.func"},                             // DepthFunc 0..7
+      {ChunkType::Draw, [](Bytes& p) { p[13] = 32; }, "level 32"},                              // levels below 32
+      {ChunkType::FrameBegin, [](Bytes& p) { p[4] = 5; }, "field 'mode' is 5"},                 // TestMode 0..4
+      {ChunkType::Depth, [](Bytes& p) { p[0] = 2; }, "field 'which' is 2"},                     // DepthWhich 0..1
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 0); }, "depth snapshot size 0x16"},       // sides >= 1
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 100000); }, "depth snapshot size 100000x16"},
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 0x80000000u); }, "outside 1x1"},         // negative side
+      {ChunkType::Levels, [](Bytes& p) { p[0] = 2; }, "field 'op' is 2"},                       // FarOp 0..1
+      {ChunkType::Levels, [](Bytes& p) { put_le32(p, 9, 33); }, "level count 33"},              // at most 32 levels
+      {ChunkType::Truth, [](Bytes& p) { put_le32(p, 0, 0xFFFFFFFFu); }, "counts 4294967295 elements"},  // hostile count
+      {ChunkType::Scene, [](Bytes& p) { put_le32(p, 0, 0x7FFFFFFFu); }, "counts 2147483647 elements"},
+      {ChunkType::Header, [](Bytes& p) { put_le32(p, 0, 5000); }, "counts 5000 elements"},
+  };
+  for (const Row& row : rows) {
+    Builder t;
+    std::size_t k = 0, at = 0;
+    for (const auto& [type, payload] : one_of_each()) {
+      Bytes p = payload;
+      if (type == row.type) {
+        row.edit(p);
+        k = t.chunks;
+        at = t.b.size();
+      }
+      t.chunk(type, p);
+    }
+    t.end(1);
+    const std::string e = read_error(t.b);
+    EXPECT_TRUE(has(e, row.message)) << "expected '" << row.message << "': " << e;
+    EXPECT_TRUE(has(e, "chunk " + std::to_string(k) + " (" + chunk_type_name(row.type) + ") at byte " + std::to_string(at)))
+        << e;
+  }
+}
+
+// Chunks in an order the format forbids, or counts that disagree, are refused (FORMAT.md
+// "Structure"), naming the offending chunk.
+TEST(TraceCorruptionTest, StructureRulesRefused) {
+  const FrameEnd fend0{0, 0, 0.0};
+  auto draw = [](std::uint32_t index, std::int32_t object, std::int32_t node) {
+    DrawRecord d = sample_draw(index, 0);
+    d.object = object;
+    d.node = node;
+    return d;
+  };
+  GroundTruth bad_ids = sample_truth(6, 8, 4);
+  bad_ids.ids[3] = 6;
+  struct Row {
+    std::function<Bytes()> build;
+    std::string chunk;  // "chunk N (TYPE)"
+    std::string message;
+  };
+  const Properties P;
+  const Row rows[] = {
+      {[&] { return Builder().add(sample_frame_begin(0)).b; }, "chunk 0 (FRAM)", "the first chunk must be HEAD"},
+      {[&] { return Builder().add(P).add(P).end(0).b; }, "chunk 1 (HEAD)", "a second HEAD"},
+      {[&] { return Builder().add(P).add(sample_frame_begin(0)).add(fend0).add(sample_scene()).end(1).b; },
+       "chunk 3 (SCEN)", "directly follow HEAD"},
+      {[&] { return Builder().add(P).add(draw(0, -1, -1)).b; }, "chunk 1 (DRAW)", "outside a frame"},
+      {[&] { return Builder().add(P).add(sample_truth(0, 0, 0)).b; }, "chunk 1 (TRTH)", "outside a frame"},
+      {[&] { return Builder().add(P).add(fend0).b; }, "chunk 1 (FEND)", "FEND outside a frame"},
+      {[&] { return Builder().add(P).add(sample_frame_begin(0)).add(sample_frame_begin(1)).b; }, "chunk 2 (FRAM)",
+       "FEND is missing"},
+      {[&] { return Builder().add(P).add(sample_frame_begin(3)).add(FrameEnd{3, 0, 0}).add(sample_frame_begin(3)).b; },
+       "chunk 3 (FRAM)", "frame number 3 does not increase"},
+      {[&] { return Builder().add(P).add(sample_frame_begin(0)).add(FrameEnd{1, 0, 0}).b; }, "chunk 2 (FEND)",
+       "FEND of frame 1 closes frame 0"},
+      {[&] { return Builder().add(P).add(sample_frame_begin(0)).add(draw(0, -1, -1)).add(FrameEnd{0, 2, 0}).b; },
+       "chunk 3 (FEND)", "counts 2 draws, but frame 0 has 1"},
+      {[&] { return Builder().add(P).add(sample_frame_begin(0)).end(0).b; }, "chunk 2 (END )", "END inside frame 0"},
+      {[&] { return Builder().add(P).add(EndMarker{5, 0}).b; }, "chunk 1 (END )", "counts 5 chunks"},
+      {[&] { return Builder().add(P).add(sample_frame_begin(0)).add(fend0).add(EndMarker{3, 2}).b; }, "chunk 3 (END )",
+       "counts 2 frames, the file has 1"},
+      {[&] {
+         Bytes b = Builder().add(P).end(0).b;
+         b.push_back(0);
+         return b;
+       },
+       "chunk 1 (END )", "data follows the END chunk"},
+      {[&] {
+         Builder t;
+         t.add(P).end(0);
+         t.add(sample_frame_begin(0));
+         return t.b;
+       },
+       "chunk 1 (END )", "data follows the END chunk"},
+      // Per-record rules, checked by the frame reader.
+      {[&] { return Builder().add(P).add(sample_frame_begin(0)).add(draw(1, -1, -1)).add(FrameEnd{0, 1, 0}).end(1).b; },
+       "chunk 2 (DRAW)", "draw index 1 in frame 0, expected 0"},
+      {[&] {
+         return Builder().add(P).add(sample_frame_begin(0)).add(sample_depth(DepthWhich::Final, 2, 2))
+             .add(sample_depth(DepthWhich::Final, 2, 2)).add(fend0).end(1).b;
+       },
+       "chunk 3 (DPTH)", "a second 'final' depth snapshot"},
+      {[&] {
+         return Builder().add(P).add(sample_frame_begin(0)).add(sample_levels(nbsim::FarOp::Min, 2, 2, 1))
+             .add(sample_levels(nbsim::FarOp::Min, 2, 2, 1)).add(fend0).end(1).b;
+       },
+       "chunk 3 (NBLV)", "a second N-buffer with op 'min'"},
+      {[&] {
+         return Builder().add(P).add(sample_frame_begin(0)).add(sample_truth(0, 0, 0)).add(sample_truth(0, 0, 0))
+             .add(fend0).end(1).b;
+       },
+       "chunk 3 (TRTH)", "a second ground truth"},
+      {[&] {
+         return Builder().add(P).add(sample_scene()).add(sample_frame_begin(0)).add(draw(0, 6, -1)).add(FrameEnd{0, 1, 0})
+             .end(1).b;
+       },
+       "chunk 3 (DRAW)", "draw names object 6, but the scene has 6 objects"},
+      {[&] {
+         return Builder().add(P).add(sample_scene()).add(sample_frame_begin(0)).add(draw(0, 1, 3)).add(FrameEnd{0, 1, 0})
+             .end(1).b;
+       },
+       "chunk 3 (DRAW)", "BVH node 3"},
+      {[&] {
+         return Builder().add(P).add(sample_scene()).add(sample_frame_begin(0)).add(sample_truth(5, 0, 0)).add(fend0)
+             .end(1).b;
+       },
+       "chunk 3 (TRTH)", "ground truth for 5 objects, but the scene has 6"},
+      {[&] { return Builder().add(P).add(sample_scene()).add(sample_frame_begin(0)).add(bad_ids).add(fend0).end(1).b; },
+       "chunk 3 (TRTH)", "ID-buffer pixel 3 holds object 6"},
+  };
+  for (const Row& row : rows) {
+    const std::string e = read_error(row.build());
+    EXPECT_TRUE(has(e, row.chunk) && has(e, row.message)) << "expected " << row.chunk << ": '" << row.message << "' in: " << e;
+  }
+  // Without a scene, object and node ids are not checked against anything.
+  EXPECT_EQ(read_error(Builder().add(P).add(sample_frame_begin(0)).add(draw(0, 99, 99)).add(FrameEnd{0, 1, 0}).end(1).b), "");
+}
+
+}  // namespace

@@ -1,0 +1,111 @@
+// The bytes of a trace (traces/FORMAT.md): the preamble, chunk framing (zstd, CRC-32) and the
+// little-endian encoding of every record. TraceWriter and TraceReader sit on top of it.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "traces/format/records.h"
+
+namespace nbsim::trace {
+
+// The newest format version this build writes and reads (FORMAT.md's version table). Fixed by
+// the format: bump it, and add a row to the table, whenever a byte changes meaning.
+inline constexpr std::uint32_t kFormatVersion = 1;
+
+// Fixed by the format (FORMAT.md "Preamble" and "Chunks").
+inline constexpr std::array<std::uint8_t, 8> kMagic = {0x89, 'N', 'B', 'T', 'R', '\r', '\n', 0x1A};
+inline constexpr std::size_t kPreambleBytes = 16;    // magic, version, CRC-32
+inline constexpr std::size_t kChunkHeaderBytes = 24;  // type, flags, stored length, raw length
+inline constexpr std::size_t kChunkCrcBytes = 4;
+inline constexpr std::uint32_t kFlagZstd = 1;         // bit 0: the payload is one zstd frame
+inline constexpr std::uint32_t kKnownFlags = kFlagZstd;
+
+// Limits, fixed by the format, so that a damaged or hostile file never causes a huge allocation.
+// 256 MiB holds the N-buffer levels of a 2048x2048 frame (11 planes of 16 MiB).
+inline constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{256} << 20;  // stored and raw
+inline constexpr std::size_t kMaxKeyBytes = 64;
+inline constexpr std::size_t kMaxValueBytes = 64 * 1024;
+inline constexpr std::size_t kMaxProperties = 1024;
+inline constexpr std::int32_t kMaxImageSide = 16384;
+inline constexpr std::int32_t kMaxLevels = 32;
+
+// Tunable writer choices (not part of the format: any reader reads any choice). Payloads below
+// 1 KiB rarely shrink; zstd level 3 (its default) compresses depth images ~3-10x at >100 MB/s.
+inline constexpr std::size_t kCompressMinBytes = 1024;
+inline constexpr int kZstdLevel = 3;
+
+bool is_known_chunk_type(std::uint32_t type) noexcept;
+// "DRAW" for a printable fourcc, else "0x1234abcd".
+std::string chunk_type_name(std::uint32_t type);
+inline std::string chunk_type_name(ChunkType type) { return chunk_type_name(static_cast<std::uint32_t>(type)); }
+
+std::string_view to_string(DrawRole role) noexcept;
+std::string_view to_string(TestMode mode) noexcept;
+std::string_view to_string(DepthWhich which) noexcept;
+std::string_view to_string(DepthFunc func) noexcept;
+std::string_view to_string(CullFace cull) noexcept;
+
+// CRC-32 as zlib computes it (polynomial 0xEDB88320, initial value 0), continued from `crc`.
+std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc = 0) noexcept;
+
+// The 16-byte preamble of a file of `version`.
+std::array<std::uint8_t, kPreambleBytes> encode_preamble(std::uint32_t version);
+
+// One framed chunk: header, payload (zstd-compressed when `compress` and it shrinks a payload of
+// at least kCompressMinBytes) and CRC-32. The payload must be at most kMaxChunkBytes.
+std::vector<std::uint8_t> encode_chunk(ChunkType type, std::span<const std::uint8_t> payload, bool compress = true);
+
+// Records -> payload bytes, in the layout of kFormatVersion. The record must be consistent
+// (record_problem() empty); a record above kMaxChunkBytes is refused later by encode_chunk.
+std::vector<std::uint8_t> encode(const Properties& properties);
+std::vector<std::uint8_t> encode(const SceneObjects& scene);
+std::vector<std::uint8_t> encode(const FrameBegin& frame);
+std::vector<std::uint8_t> encode(const DrawRecord& draw);
+std::vector<std::uint8_t> encode(const DepthSnapshot& depth);
+std::vector<std::uint8_t> encode(const NBufferLevels& levels);
+std::vector<std::uint8_t> encode(const GroundTruth& truth);
+std::vector<std::uint8_t> encode(const FrameEnd& frame);
+std::vector<std::uint8_t> encode(const EndMarker& end);
+
+// What makes a record impossible to store or read back ("" when it is consistent): mismatched
+// vector sizes, an image size out of range, a bad property key, ... Decoders refuse the same.
+std::string record_problem(const Properties& properties);
+std::string record_problem(const SceneObjects& scene);
+std::string record_problem(const DrawRecord& draw);
+std::string record_problem(const DepthSnapshot& depth);
+std::string record_problem(const NBufferLevels& levels);
+std::string record_problem(const GroundTruth& truth);
+
+// Payload bytes of a file of `version` (1 ..= kFormatVersion) -> record. Each decoder switches on
+// the version, so a later version can add fields while older files still read. Throws InputError
+// saying what is wrong (a payload that decodes short or long, an enum value out of range, ...);
+// TraceReader adds the file, chunk and byte offset.
+Properties decode_properties(std::span<const std::uint8_t> payload, std::uint32_t version);
+SceneObjects decode_scene(std::span<const std::uint8_t> payload, std::uint32_t version);
+FrameBegin decode_frame_begin(std::span<const std::uint8_t> payload, std::uint32_t version);
+DrawRecord decode_draw(std::span<const std::uint8_t> payload, std::uint32_t version);
+DepthSnapshot decode_depth(std::span<const std::uint8_t> payload, std::uint32_t version);
+NBufferLevels decode_levels(std::span<const std::uint8_t> payload, std::uint32_t version);
+GroundTruth decode_truth(std::span<const std::uint8_t> payload, std::uint32_t version);
+FrameEnd decode_frame_end(std::span<const std::uint8_t> payload, std::uint32_t version);
+EndMarker decode_end(std::span<const std::uint8_t> payload, std::uint32_t version);
+
+// The chunk type each record is stored in.
+template <class Record> struct RecordChunk;
+template <> struct RecordChunk<Properties> { static constexpr ChunkType type = ChunkType::Header; };
+template <> struct RecordChunk<SceneObjects> { static constexpr ChunkType type = ChunkType::Scene; };
+template <> struct RecordChunk<FrameBegin> { static constexpr ChunkType type = ChunkType::FrameBegin; };
+template <> struct RecordChunk<DrawRecord> { static constexpr ChunkType type = ChunkType::Draw; };
+template <> struct RecordChunk<DepthSnapshot> { static constexpr ChunkType type = ChunkType::Depth; };
+template <> struct RecordChunk<NBufferLevels> { static constexpr ChunkType type = ChunkType::Levels; };
+template <> struct RecordChunk<GroundTruth> { static constexpr ChunkType type = ChunkType::Truth; };
+template <> struct RecordChunk<FrameEnd> { static constexpr ChunkType type = ChunkType::FrameEnd; };
+template <> struct RecordChunk<EndMarker> { static constexpr ChunkType type = ChunkType::End; };
+
+}  // namespace nbsim::trace

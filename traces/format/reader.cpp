@@ -1,0 +1,403 @@
+// TraceReader (framing and structure checks over a file or a memory buffer) and FrameReader (one
+// frame at a time, with the per-record rules); see reader.h and traces/FORMAT.md.
+#include "traces/format/reader.h"
+
+#include <fmt/format.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <system_error>
+
+#include "model/common/error.h"
+#include "traces/format/codec.h"
+
+namespace nbsim::trace {
+
+class TraceReader::Source {
+ public:
+  virtual ~Source() = default;
+  // Reads up to n bytes; fewer only at the end of the data.
+  virtual std::size_t read(std::uint8_t* dst, std::size_t n) = 0;
+  virtual std::uint64_t size() const = 0;
+};
+
+namespace {
+
+class FileSource final : public TraceReader::Source {
+ public:
+  explicit FileSource(const std::filesystem::path& file) {
+    const std::string name = file.string();
+    std::error_code ec;
+    const auto status = std::filesystem::status(file, ec);
+    if (!std::filesystem::exists(status)) throw InputError(fmt::format("trace '{}' does not exist", name));
+    if (!std::filesystem::is_regular_file(status)) throw InputError(fmt::format("trace '{}' is not a regular file", name));
+    f_ = std::fopen(name.c_str(), "rb");
+    if (!f_) throw InputError(fmt::format("trace '{}' cannot be opened: {}", name, std::strerror(errno)));
+    size_ = std::filesystem::file_size(file, ec);
+    if (ec) {
+      std::fclose(f_);
+      throw InputError(fmt::format("trace '{}' cannot be read: {}", name, ec.message()));
+    }
+  }
+  ~FileSource() override { std::fclose(f_); }
+  FileSource(const FileSource&) = delete;
+  FileSource& operator=(const FileSource&) = delete;
+
+  std::size_t read(std::uint8_t* dst, std::size_t n) override { return std::fread(dst, 1, n, f_); }
+  std::uint64_t size() const override { return size_; }
+
+ private:
+  std::FILE* f_ = nullptr;
+  std::uint64_t size_ = 0;
+};
+
+class MemorySource final : public TraceReader::Source {
+ public:
+  explicit MemorySource(std::vector<std::uint8_t> bytes) : bytes_(std::move(bytes)) {}
+  std::size_t read(std::uint8_t* dst, std::size_t n) override {
+    n = std::min(n, bytes_.size() - pos_);
+    if (n) std::memcpy(dst, bytes_.data() + pos_, n);
+    pos_ += n;
+    return n;
+  }
+  std::uint64_t size() const override { return bytes_.size(); }
+
+ private:
+  std::vector<std::uint8_t> bytes_;
+  std::size_t pos_ = 0;
+};
+
+std::uint32_t le32(const std::uint8_t* p) {
+  return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+         static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
+}
+std::uint64_t le64(const std::uint8_t* p) {
+  return static_cast<std::uint64_t>(le32(p)) | static_cast<std::uint64_t>(le32(p + 4)) << 32;
+}
+
+struct Dctx {
+  Dctx() : ctx(ZSTD_createDCtx()) { NBSIM_CHECK(ctx != nullptr, "ZSTD_createDCtx failed"); }
+  ~Dctx() { ZSTD_freeDCtx(ctx); }
+  Dctx(const Dctx&) = delete;
+  Dctx& operator=(const Dctx&) = delete;
+  ZSTD_DCtx* ctx;
+};
+
+}  // namespace
+
+TraceReader::TraceReader(const std::filesystem::path& file)
+    : src_(std::make_unique<FileSource>(file)), name_(file.string()) {
+  open();
+}
+
+TraceReader::TraceReader(std::vector<std::uint8_t> bytes, std::string name)
+    : src_(std::make_unique<MemorySource>(std::move(bytes))), name_(std::move(name)) {
+  open();
+}
+
+TraceReader::~TraceReader() = default;
+TraceReader::TraceReader(TraceReader&&) noexcept = default;
+TraceReader& TraceReader::operator=(TraceReader&&) noexcept = default;
+
+const std::string* TraceReader::property(std::string_view key) const noexcept {
+  for (const auto& [k, v] : properties_)
+    if (k == key) return &v;
+  return nullptr;
+}
+
+std::size_t TraceReader::read_bytes(std::uint8_t* dst, std::size_t n) {
+  const std::size_t got = src_->read(dst, n);
+  pos_ += got;
+  return got;
+}
+
+void TraceReader::fail_at(std::uint64_t index, std::uint64_t offset, std::string_view type, std::string_view what) const {
+  if (type.empty()) throw InputError(fmt::format("{}: chunk {} at byte {}: {}", name_, index, offset, what));
+  throw InputError(fmt::format("{}: chunk {} ({}) at byte {}: {}", name_, index, type, offset, what));
+}
+
+void TraceReader::fail(const Chunk& chunk, std::string_view what) const {
+  fail_at(chunk.index, chunk.offset, chunk_type_name(chunk.type), what);
+}
+
+void TraceReader::open() {
+  size_ = src_->size();
+  std::array<std::uint8_t, kPreambleBytes> pre{};
+  const std::size_t got = read_bytes(pre.data(), pre.size());
+  if (got == 0) throw InputError(fmt::format("{}: not an nbsim trace: the file is empty (0 bytes)", name_));
+  if (!std::equal(pre.begin(), pre.begin() + static_cast<std::ptrdiff_t>(std::min(got, kMagic.size())), kMagic.begin()))
+    throw InputError(fmt::format("{}: not an nbsim trace: no nbsim trace magic at byte 0", name_));
+  if (got < pre.size())
+    throw InputError(fmt::format("{}: preamble at byte 0: the file ends after {} of the {} preamble bytes (truncated)",
+                                 name_, got, kPreambleBytes));
+  const std::uint32_t stored_crc = le32(pre.data() + 12);
+  if (const std::uint32_t crc = crc32(std::span(pre).first(12)); crc != stored_crc)
+    throw InputError(fmt::format("{}: preamble at byte 0: CRC-32 mismatch (stored 0x{:08x}, computed 0x{:08x}): the file is damaged",
+                                 name_, stored_crc, crc));
+  version_ = le32(pre.data() + 8);
+  if (version_ == 0)
+    throw InputError(fmt::format("{}: preamble at byte 8: format version 0 does not exist", name_));
+  if (version_ > kFormatVersion)
+    throw InputError(fmt::format("{}: trace format version {} is newer than this nbsim reads (versions 1 to {}); "
+                                 "update nbsim to read it", name_, version_, kFormatVersion));
+
+  Chunk head = read_chunk();
+  if (head.type != ChunkType::Header) fail(head, "the first chunk must be HEAD");
+  properties_ = decode<Properties>(head);
+  if (auto c = next(); c && c->type == ChunkType::Scene)
+    scene_ = decode<SceneObjects>(*c);
+  else
+    pending_ = std::move(c);
+}
+
+Chunk TraceReader::read_chunk() {
+  Chunk c;
+  c.index = next_index_;
+  c.offset = pos_;
+  std::array<std::uint8_t, kChunkHeaderBytes + kChunkCrcBytes> head{};
+  const std::size_t got = read_bytes(head.data(), kChunkHeaderBytes);
+  if (got == 0) {
+    const std::string last = stats_.chunks ? fmt::format(" after chunk {}", c.index - 1) : std::string();
+    fail_at(c.index, c.offset, "", fmt::format("the file ends here{} without an END chunk (truncated)", last));
+  }
+  const std::uint32_t type = got >= 4 ? le32(head.data()) : 0;
+  const std::string type_name = got >= 4 ? chunk_type_name(type) : std::string();
+  if (got < kChunkHeaderBytes)
+    fail_at(c.index, c.offset, type_name,
+            fmt::format("the file ends after {} of the {} chunk header bytes (truncated)", got, kChunkHeaderBytes));
+  const std::uint32_t flags = le32(head.data() + 4);
+  const std::uint64_t stored = le64(head.data() + 8), raw = le64(head.data() + 16);
+  const std::uint64_t left = size_ - std::min(size_, pos_);
+  if (stored > kMaxChunkBytes)
+    fail_at(c.index, c.offset, type_name,
+            fmt::format("stored length {} exceeds the format's chunk limit of {} bytes", stored, kMaxChunkBytes));
+  if (stored + kChunkCrcBytes > left)
+    fail_at(c.index, c.offset, type_name,
+            fmt::format("stored length {} (plus the 4-byte CRC) points past the end of the file: {} bytes follow the header",
+                        stored, left));
+  if (raw > kMaxChunkBytes)
+    fail_at(c.index, c.offset, type_name,
+            fmt::format("raw length {} exceeds the format's chunk limit of {} bytes", raw, kMaxChunkBytes));
+
+  std::vector<std::uint8_t> data(static_cast<std::size_t>(stored));
+  if (read_bytes(data.data(), data.size()) != data.size() ||
+      read_bytes(head.data() + kChunkHeaderBytes, kChunkCrcBytes) != kChunkCrcBytes)
+    fail_at(c.index, c.offset, type_name, "the file ends inside the chunk (truncated while reading)");
+  const std::uint32_t stored_crc = le32(head.data() + kChunkHeaderBytes);
+  const std::uint32_t crc = crc32(data, crc32(std::span(head).first(kChunkHeaderBytes)));
+  if (crc != stored_crc)
+    fail_at(c.index, c.offset, type_name,
+            fmt::format("CRC-32 mismatch (stored 0x{:08x}, computed 0x{:08x}): the chunk is damaged", stored_crc, crc));
+
+  // The bytes are what the writer wrote; now check they mean something this version knows.
+  if (!is_known_chunk_type(type)) fail_at(c.index, c.offset, type_name, "unknown chunk type");
+  if (flags & ~kKnownFlags)
+    fail_at(c.index, c.offset, type_name, fmt::format("unknown flags 0x{:08x}", flags & ~kKnownFlags));
+  c.type = static_cast<ChunkType>(type);
+  c.stored_bytes = stored;
+  c.compressed = (flags & kFlagZstd) != 0;
+  if (!c.compressed) {
+    if (raw != stored) fail(c, fmt::format("raw length {} differs from stored length {} of an uncompressed payload", raw, stored));
+    c.payload = std::move(data);
+  } else {
+    const unsigned long long declared = ZSTD_getFrameContentSize(data.data(), data.size());
+    if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN)
+      fail(c, "the compressed payload is not a zstd frame with a content size");
+    if (declared != raw)
+      fail(c, fmt::format("the zstd frame holds {} bytes, the chunk header says {}", declared, raw));
+    c.payload.resize(static_cast<std::size_t>(raw));
+    thread_local Dctx dctx;
+    const std::size_t n = ZSTD_decompressDCtx(dctx.ctx, c.payload.data(), c.payload.size(), data.data(), data.size());
+    if (ZSTD_isError(n)) fail(c, fmt::format("zstd cannot decompress the payload: {}", ZSTD_getErrorName(n)));
+    if (n != raw) fail(c, fmt::format("the payload decompresses to {} bytes, the chunk header says {}", n, raw));
+  }
+  ++next_index_;
+  ++stats_.chunks;
+  stats_.compressed_chunks += c.compressed;
+  stats_.stored_bytes += stored;
+  stats_.raw_bytes += raw;
+  return c;
+}
+
+void TraceReader::check_structure(const Chunk& c) {
+  switch (c.type) {
+    case ChunkType::Header:
+      fail(c, "a second HEAD chunk: HEAD is chunk 0 only");
+    case ChunkType::Scene:
+      if (c.index != 1) fail(c, "SCEN must directly follow HEAD (chunk 1)");
+      return;
+    case ChunkType::FrameBegin: {
+      if (in_frame_) fail(c, fmt::format("FRAM inside frame {}: that frame's FEND is missing", frame_));
+      const auto f = decode<FrameBegin>(c);
+      if (any_frame_ && f.frame <= frame_)
+        fail(c, fmt::format("frame number {} does not increase (the previous frame is {})", f.frame, frame_));
+      in_frame_ = any_frame_ = true;
+      frame_ = f.frame;
+      frame_draws_ = 0;
+      return;
+    }
+    case ChunkType::Draw:
+    case ChunkType::Depth:
+    case ChunkType::Levels:
+    case ChunkType::Truth:
+      if (!in_frame_) fail(c, "a frame record outside a frame (no FRAM before it)");
+      if (c.type == ChunkType::Draw) {
+        ++frame_draws_;
+        ++stats_.draws;
+      }
+      return;
+    case ChunkType::FrameEnd: {
+      if (!in_frame_) fail(c, "FEND outside a frame (no FRAM before it)");
+      const auto f = decode<FrameEnd>(c);
+      if (f.frame != frame_) fail(c, fmt::format("FEND of frame {} closes frame {}", f.frame, frame_));
+      if (f.draws != frame_draws_)
+        fail(c, fmt::format("FEND counts {} draws, but frame {} has {} DRAW chunks", f.draws, frame_, frame_draws_));
+      in_frame_ = false;
+      ++stats_.frames;
+      return;
+    }
+    case ChunkType::End: {
+      if (in_frame_) fail(c, fmt::format("END inside frame {}: that frame's FEND is missing", frame_));
+      const auto e = decode<EndMarker>(c);
+      if (e.chunks != c.index) fail(c, fmt::format("END counts {} chunks before it, the file has {}", e.chunks, c.index));
+      if (e.frames != stats_.frames)
+        fail(c, fmt::format("END counts {} frames, the file has {}", e.frames, stats_.frames));
+      const std::uint64_t end_pos = pos_;
+      std::uint8_t extra = 0;
+      if (read_bytes(&extra, 1) != 0)
+        fail(c, fmt::format("data follows the END chunk: it ends at byte {}, the file has {} bytes", end_pos, size_));
+      end_ = e;
+      return;
+    }
+  }
+  NBSIM_CHECK(false, "read_chunk let an unknown chunk type through");
+}
+
+std::optional<Chunk> TraceReader::next() {
+  if (pending_) {
+    std::optional<Chunk> c = std::move(pending_);
+    pending_.reset();
+    return c;
+  }
+  if (end_) return std::nullopt;
+  Chunk c = read_chunk();
+  check_structure(c);
+  if (c.type == ChunkType::End) return std::nullopt;
+  return c;
+}
+
+template <class Record>
+Record TraceReader::decode(const Chunk& chunk) const {
+  NBSIM_CHECK(chunk.type == RecordChunk<Record>::type,
+              fmt::format("decoding a {} chunk as {}", chunk_type_name(chunk.type), chunk_type_name(RecordChunk<Record>::type)));
+  try {
+    if constexpr (std::is_same_v<Record, Properties>) return decode_properties(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, SceneObjects>) return decode_scene(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, FrameBegin>) return decode_frame_begin(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, DrawRecord>) return decode_draw(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, DepthSnapshot>) return decode_depth(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, NBufferLevels>) return decode_levels(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, GroundTruth>) return decode_truth(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, FrameEnd>) return decode_frame_end(chunk.payload, version_);
+    else return decode_end(chunk.payload, version_);
+  } catch (const InputError& e) {
+    fail(chunk, e.what());
+  }
+}
+
+template Properties TraceReader::decode<Properties>(const Chunk&) const;
+template SceneObjects TraceReader::decode<SceneObjects>(const Chunk&) const;
+template FrameBegin TraceReader::decode<FrameBegin>(const Chunk&) const;
+template DrawRecord TraceReader::decode<DrawRecord>(const Chunk&) const;
+template DepthSnapshot TraceReader::decode<DepthSnapshot>(const Chunk&) const;
+template NBufferLevels TraceReader::decode<NBufferLevels>(const Chunk&) const;
+template GroundTruth TraceReader::decode<GroundTruth>(const Chunk&) const;
+template FrameEnd TraceReader::decode<FrameEnd>(const Chunk&) const;
+template EndMarker TraceReader::decode<EndMarker>(const Chunk&) const;
+
+// ---- FrameReader ------------------------------------------------------------------------------
+
+const DepthSnapshot* Frame::depth(DepthWhich which) const noexcept {
+  for (const DepthSnapshot& d : depths)
+    if (d.which == which) return &d;
+  return nullptr;
+}
+
+const NBufferLevels* Frame::nbuffer(FarOp op) const noexcept {
+  for (const NBufferLevels& l : levels)
+    if (l.op == static_cast<std::uint8_t>(op)) return &l;
+  return nullptr;
+}
+
+FrameReader::FrameReader(const std::filesystem::path& file) : trace_(file) {}
+FrameReader::FrameReader(TraceReader trace) : trace_(std::move(trace)) {}
+
+std::optional<Frame> FrameReader::next() {
+  std::optional<Chunk> c = trace_.next();
+  if (!c) return std::nullopt;
+  // TraceReader's structure checks guarantee FRAM here, then frame records, then FEND.
+  NBSIM_CHECK(c->type == ChunkType::FrameBegin, "TraceReader let a frame record through outside a frame");
+  Frame f;
+  f.ordinal = ordinal_;
+  f.offset = c->offset;
+  f.begin = trace_.decode<FrameBegin>(*c);
+  const SceneObjects* scene = trace_.scene();
+  const auto objects = scene ? static_cast<std::int64_t>(scene->objects.size()) : 0;
+  const auto nodes = scene ? static_cast<std::int64_t>(scene->node_bounds.size()) : 0;
+  for (;;) {
+    c = trace_.next();
+    NBSIM_CHECK(c.has_value(), "TraceReader ended inside a frame");
+    switch (c->type) {
+      case ChunkType::Draw: {
+        DrawRecord d = trace_.decode<DrawRecord>(*c);
+        if (d.index != f.draws.size())
+          trace_.fail(*c, fmt::format("draw index {} in frame {}, expected {} (draws count from 0 in file order)",
+                                      d.index, f.begin.frame, f.draws.size()));
+        if (scene && d.object >= objects)
+          trace_.fail(*c, fmt::format("draw names object {}, but the scene has {} objects", d.object, objects));
+        if (scene && d.node >= nodes)
+          trace_.fail(*c, fmt::format("draw names BVH node {}, but the scene has {} nodes", d.node, nodes));
+        f.draws.push_back(std::move(d));
+        break;
+      }
+      case ChunkType::Depth: {
+        DepthSnapshot d = trace_.decode<DepthSnapshot>(*c);
+        if (f.depth(d.which))
+          trace_.fail(*c, fmt::format("a second '{}' depth snapshot in frame {}", to_string(d.which), f.begin.frame));
+        f.depths.push_back(std::move(d));
+        break;
+      }
+      case ChunkType::Levels: {
+        NBufferLevels l = trace_.decode<NBufferLevels>(*c);
+        if (f.nbuffer(static_cast<FarOp>(l.op)))
+          trace_.fail(*c, fmt::format("a second N-buffer with op '{}' in frame {}", to_string(static_cast<FarOp>(l.op)),
+                                      f.begin.frame));
+        f.levels.push_back(std::move(l));
+        break;
+      }
+      case ChunkType::Truth: {
+        if (f.truth) trace_.fail(*c, fmt::format("a second ground truth in frame {}", f.begin.frame));
+        GroundTruth t = trace_.decode<GroundTruth>(*c);
+        if (scene && static_cast<std::int64_t>(t.visible_pixels.size()) != objects)
+          trace_.fail(*c, fmt::format("ground truth for {} objects, but the scene has {}", t.visible_pixels.size(), objects));
+        if (scene)
+          for (std::size_t i = 0; i < t.ids.size(); ++i)
+            if (t.ids[i] >= objects)
+              trace_.fail(*c, fmt::format("ID-buffer pixel {} holds object {}, but the scene has {} objects", i, t.ids[i], objects));
+        f.truth = std::move(t);
+        break;
+      }
+      case ChunkType::FrameEnd:
+        f.end = trace_.decode<FrameEnd>(*c);
+        ++ordinal_;
+        return f;
+      default:
+        NBSIM_CHECK(false, "TraceReader let a non-frame chunk into a frame");
+    }
+  }
+}
+
+}  // namespace nbsim::trace

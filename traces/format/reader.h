@@ -1,0 +1,135 @@
+// TraceReader and FrameReader: stream a depth trace (traces/FORMAT.md) chunk by chunk or frame by
+// frame for replay, `nbsim trace` and tests. Memory stays bounded by one chunk (one frame for
+// FrameReader) however long the trace; every damage is refused with an InputError naming the file,
+// the chunk (index and type) and its byte offset.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "model/common/depth.h"
+#include "traces/format/records.h"
+
+namespace nbsim::trace {
+
+// One chunk as read from the file, payload decompressed and checked against its CRC-32.
+struct Chunk {
+  ChunkType type = ChunkType::End;
+  std::uint64_t index = 0;         // position in the file: 0 is HEAD
+  std::uint64_t offset = 0;        // byte offset of the chunk header in the file
+  std::uint64_t stored_bytes = 0;  // payload bytes in the file (compressed or not)
+  bool compressed = false;
+  std::vector<std::uint8_t> payload;  // the decoded payload
+};
+
+// Running totals of what the reader has read so far.
+struct TraceStats {
+  std::uint64_t chunks = 0;             // including HEAD (and END once read)
+  std::uint64_t compressed_chunks = 0;
+  std::uint64_t stored_bytes = 0;       // payload bytes in the file
+  std::uint64_t raw_bytes = 0;          // payload bytes after decompression
+  std::uint32_t frames = 0;             // complete frames (FEND read)
+  std::uint64_t draws = 0;
+};
+
+class TraceReader {
+ public:
+  // Opens the file and reads the preamble, HEAD and (when it follows) SCEN. Throws InputError when
+  // the file is missing, not a trace, damaged there, or of a newer format version.
+  explicit TraceReader(const std::filesystem::path& file);
+  // The same over bytes in memory (tests, fuzzing); `name` stands for the file in messages.
+  TraceReader(std::vector<std::uint8_t> bytes, std::string name);
+  ~TraceReader();
+  TraceReader(TraceReader&&) noexcept;
+  TraceReader& operator=(TraceReader&&) noexcept;
+
+  const std::string& name() const noexcept { return name_; }
+  std::uint64_t file_bytes() const noexcept { return size_; }
+  std::uint32_t version() const noexcept { return version_; }
+  const Properties& properties() const noexcept { return properties_; }
+  // The value of a header property, or nullptr.
+  const std::string* property(std::string_view key) const noexcept;
+  // The scene, or nullptr when the trace has no SCEN chunk.
+  const SceneObjects* scene() const noexcept { return scene_ ? &*scene_ : nullptr; }
+
+  // The next chunk after HEAD and SCEN (which the constructor consumed), or nullopt once END has
+  // been read. Checks framing (lengths, CRC-32, zstd) and structure (FORMAT.md "Structure": chunk
+  // order, frame numbers, FEND and END counts, nothing after END) and throws InputError otherwise.
+  // The per-record rules that need a record's fields (draw indices, one snapshot per kind, ids
+  // within the scene) are FrameReader's.
+  std::optional<Chunk> next();
+  // The END marker once next() has returned nullopt.
+  const std::optional<EndMarker>& end() const noexcept { return end_; }
+  const TraceStats& stats() const noexcept { return stats_; }
+
+  // Decodes a chunk's payload as the record its type holds (Record is one of the records.h
+  // types, matching chunk.type); throws InputError naming the chunk when the payload is bad.
+  template <class Record>
+  Record decode(const Chunk& chunk) const;
+
+  // Throws InputError "<file>: chunk <index> (<TYPE>) at byte <offset>: <what>".
+  [[noreturn]] void fail(const Chunk& chunk, std::string_view what) const;
+
+  class Source;  // where the bytes come from (file or memory)
+
+ private:
+  void open();
+  Chunk read_chunk();
+  void check_structure(const Chunk& chunk);
+  std::size_t read_bytes(std::uint8_t* dst, std::size_t n);
+  [[noreturn]] void fail_at(std::uint64_t index, std::uint64_t offset, std::string_view type, std::string_view what) const;
+
+  std::unique_ptr<Source> src_;
+  std::string name_;
+  std::uint64_t size_ = 0;
+  std::uint64_t pos_ = 0;
+  std::uint32_t version_ = 0;
+  Properties properties_;
+  std::optional<SceneObjects> scene_;
+  std::optional<Chunk> pending_;  // read by the constructor after HEAD, not SCEN
+  std::optional<EndMarker> end_;
+  TraceStats stats_;
+  std::uint64_t next_index_ = 0;
+  bool in_frame_ = false;
+  bool any_frame_ = false;
+  std::uint32_t frame_ = 0;        // the open (or last) frame's number
+  std::uint32_t frame_draws_ = 0;  // DRAW chunks in the open frame
+};
+
+// One frame, FRAM .. FEND, decoded.
+struct Frame {
+  std::uint64_t ordinal = 0;  // 0 for the trace's first frame
+  std::uint64_t offset = 0;   // byte offset of its FRAM chunk
+  FrameBegin begin;
+  std::vector<DrawRecord> draws;  // draws[i].index == i
+  std::vector<DepthSnapshot> depths;  // at most one per DepthWhich, in file order
+  std::vector<NBufferLevels> levels;  // at most one per FarOp, in file order
+  std::optional<GroundTruth> truth;
+  FrameEnd end;
+
+  const DepthSnapshot* depth(DepthWhich which) const noexcept;
+  const NBufferLevels* nbuffer(FarOp op) const noexcept;
+};
+
+// Groups a trace's chunks into frames, checking the per-record rules of FORMAT.md "Structure".
+class FrameReader {
+ public:
+  explicit FrameReader(const std::filesystem::path& file);
+  explicit FrameReader(TraceReader trace);
+
+  // The next frame, or nullopt after the last one (END read and checked).
+  std::optional<Frame> next();
+  TraceReader& trace() noexcept { return trace_; }
+  const TraceReader& trace() const noexcept { return trace_; }
+
+ private:
+  TraceReader trace_;
+  std::uint64_t ordinal_ = 0;
+};
+
+}  // namespace nbsim::trace
