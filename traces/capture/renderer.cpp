@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "model/common/error.h"
 #include "model/nbuffer/covering.h"
 #include "nbsim_shaders.h"
 
@@ -734,10 +735,16 @@ struct Renderer::Impl {
     glReadPixels(0, 0, opt.width, opt.height, GL_RED_INTEGER, GL_UNSIGNED_INT, ids.data());
     trace::GroundTruth t;
     t.visible_pixels.assign(city.objects.size(), 0);
-    for (auto id : ids) {
+    t.id_width = opt.width;
+    t.id_height = opt.height;
+    t.ids.resize(ids.size());
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      const std::uint32_t id = ids[i];
+      t.ids[i] = static_cast<std::int32_t>(id) - 1;  // -1 where no object
       if (id == 0) continue;
       ++t.covered_pixels;
-      if (id - 1 < t.visible_pixels.size()) ++t.visible_pixels[id - 1];
+      NBSIM_CHECK(id - 1 < t.visible_pixels.size(), "ID buffer holds an id past the scene");
+      ++t.visible_pixels[id - 1];
     }
     glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     return t;
