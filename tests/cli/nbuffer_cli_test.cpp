@@ -15,16 +15,11 @@
 #include <sys/wait.h>
 
 #include "pipeline/io/image_io.h"
+#include "tests/common/run_nbsim.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CliResult {
-  int status = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
 
 fs::path scratch(const std::string& name) {
   const fs::path dir = fs::path(::testing::TempDir()) / ("nbsim_cli_" + std::to_string(::getpid()));
@@ -32,19 +27,10 @@ fs::path scratch(const std::string& name) {
   return dir / name;
 }
 
-CliResult nbsim(const std::string& args) {
-  CliResult r;
-  const fs::path err = scratch("stderr.txt");
-  const std::string cmd = std::string(NBSIM_EXE) + " " + args + " 2>" + err.string();
-  FILE* p = popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), static_cast<int>(buf.size()), p)) r.out += buf.data();
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  std::ifstream e(err);
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
-}
+using nbsim::testing::CliResult;
+using nbsim::testing::has;
+
+CliResult nbsim(const std::string& args) { return nbsim::testing::run_nbsim(args); }
 
 // A 4x4 depth image, y up, whose farthest pixel is (3, 0) at 0.9.
 fs::path small_depth(const std::string& name) {
@@ -64,7 +50,6 @@ fs::path depth_with(float bad, int x, int y, const std::string& name) {
   return f;
 }
 
-bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // --help works on every nbuffer subcommand and exits 0.
 TEST(NBufferCliTest, HelpExitsZero) {

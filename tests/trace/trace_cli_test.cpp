@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 
 #include "pipeline/io/image_io.h"
+#include "tests/common/run_nbsim.h"
 #include "tests/trace/sample_trace.h"
 
 namespace {
@@ -17,27 +18,11 @@ namespace {
 using namespace nbsim::trace;
 using namespace nbsim::trace::testing;
 
-struct CliResult {
-  int status = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
+using nbsim::testing::CliResult;
+using nbsim::testing::has;
 
-CliResult nbsim(const std::string& args) {
-  CliResult r;
-  const fs::path err = scratch("stderr.txt");
-  const std::string cmd = std::string(NBSIM_EXE) + " " + args + " 2>" + err.string();
-  FILE* p = popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), static_cast<int>(buf.size()), p)) r.out += buf.data();
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  std::ifstream e(err);
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
-}
+CliResult nbsim(const std::string& args) { return nbsim::testing::run_nbsim(args); }
 
-bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 const fs::path& sample() {
   static const fs::path f = [] {
