@@ -1,0 +1,78 @@
+// Memory channel and cache models; see memory.h.
+#include "model/memory/memory.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "model/common/error.h"
+
+namespace nbsim::memory {
+
+Channel::Channel(ChannelConfig c) : c_(c) {
+  NBSIM_CHECK(c.bandwidth_bytes_per_cycle > 0 && c.latency_cycles >= 0, "memory channel config not validated");
+}
+
+int Channel::add_client(const std::string& name) {
+  names_.push_back(name);
+  bytes_.push_back(0);
+  return static_cast<int>(names_.size() - 1);
+}
+
+std::uint64_t Channel::transfer(std::uint64_t now, std::uint64_t bytes, int client) {
+  NBSIM_CHECK(client >= 0 && static_cast<std::size_t>(client) < bytes_.size(), "unknown memory client");
+  bytes_[static_cast<std::size_t>(client)] += bytes;
+  const double start = std::max(static_cast<double>(now), free_at_);
+  const double occupy = static_cast<double>(bytes) / c_.bandwidth_bytes_per_cycle;
+  free_at_ = start + occupy;
+  busy_ += occupy;
+  return static_cast<std::uint64_t>(std::ceil(free_at_)) + static_cast<std::uint64_t>(c_.latency_cycles);
+}
+
+Cache::Cache(CacheConfig c) : c_(c) {
+  NBSIM_CHECK(c.size_bytes >= 0 && c.line_bytes > 0 && c.ways > 0, "cache config not validated");
+  sets_ = static_cast<std::uint64_t>(c.size_bytes) / static_cast<std::uint64_t>(c.line_bytes * c.ways);
+  lines_.assign(sets_ * static_cast<std::uint64_t>(c.ways), Line{});
+}
+
+Cache::Result Cache::access(std::uint64_t address, bool write) {
+  Result r;
+  if (sets_ == 0) {  // no cache: every access goes to memory
+    ++misses_;
+    return r;
+  }
+  const std::uint64_t line = address / static_cast<std::uint64_t>(c_.line_bytes);
+  const std::uint64_t set = line % sets_;
+  Line* ways = &lines_[set * static_cast<std::uint64_t>(c_.ways)];
+  ++clock_;
+  Line* victim = ways;
+  for (int w = 0; w < c_.ways; ++w) {
+    Line& l = ways[w];
+    if (l.used && l.tag == line) {
+      l.used = clock_;
+      l.dirty = l.dirty || write;
+      ++hits_;
+      r.hit = true;
+      return r;
+    }
+    if (l.used < victim->used) victim = &l;  // invalid lines (used == 0) go first
+  }
+  ++misses_;
+  if (victim->used && victim->dirty) {
+    r.writeback = true;
+    ++writebacks_;
+  }
+  *victim = {line, clock_, write};
+  return r;
+}
+
+std::uint64_t Cache::flush() {
+  std::uint64_t n = 0;
+  for (Line& l : lines_)
+    if (l.used && l.dirty) ++n, l.dirty = false;
+  writebacks_ += n;
+  return n;
+}
+
+void Cache::invalidate() { std::fill(lines_.begin(), lines_.end(), Line{}); }
+
+}  // namespace nbsim::memory

@@ -1,0 +1,75 @@
+// The memory model shared by the depth unit and the N-buffer unit: a channel with a bandwidth and
+// a latency, and set-associative caches in front of it. Plain C++ with time in cycles; SystemC
+// wrappers turn the cycles into waits. Bytes moved are counted per client (depth, nbuffer, ...).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace nbsim::memory {
+
+struct ChannelConfig {
+  double bandwidth_bytes_per_cycle = 32.0;  // sustained; tunable (32 B/cycle at 1 GHz = 32 GB/s)
+  int latency_cycles = 200;                 // from request to first data; tunable
+};
+
+// A channel that serves requests in order: a request of n bytes occupies it for
+// n / bandwidth cycles after the earlier requests, and completes `latency` cycles after that.
+class Channel {
+ public:
+  explicit Channel(ChannelConfig c);
+  // Reserves the channel for a transfer issued at cycle `now`; returns the cycle it completes.
+  std::uint64_t transfer(std::uint64_t now, std::uint64_t bytes, int client);
+  int add_client(const std::string& name);  // returns the client id used by transfer()
+  std::uint64_t bytes(int client) const { return bytes_.at(static_cast<std::size_t>(client)); }
+  const std::vector<std::string>& clients() const noexcept { return names_; }
+  std::uint64_t busy_cycles() const noexcept { return static_cast<std::uint64_t>(busy_); }
+  const ChannelConfig& config() const noexcept { return c_; }
+
+ private:
+  ChannelConfig c_;
+  double free_at_ = 0.0;  // cycle at which the channel can start the next transfer
+  double busy_ = 0.0;
+  std::vector<std::string> names_;
+  std::vector<std::uint64_t> bytes_;
+};
+
+struct CacheConfig {
+  int size_bytes = 64 * 1024;  // tunable; 0 disables the cache (every access misses)
+  int line_bytes = 256;        // e.g. an 8x8 tile of 32-bit depth; tunable
+  int ways = 4;                // associativity; tunable
+};
+
+// A set-associative cache with LRU replacement and write-back, write-allocate lines. It tracks
+// tags only (the functional data lives in the cores); it reports hits, misses and write-backs.
+class Cache {
+ public:
+  explicit Cache(CacheConfig c);
+  struct Result {
+    bool hit = false;
+    bool writeback = false;  // the line it evicted was dirty
+  };
+  Result access(std::uint64_t address, bool write);
+  // Writes back every dirty line; returns how many.
+  std::uint64_t flush();
+  void invalidate();
+  std::uint64_t hits() const noexcept { return hits_; }
+  std::uint64_t misses() const noexcept { return misses_; }
+  std::uint64_t writebacks() const noexcept { return writebacks_; }
+  const CacheConfig& config() const noexcept { return c_; }
+
+ private:
+  struct Line {
+    std::uint64_t tag = 0;
+    std::uint64_t used = 0;  // LRU stamp; 0 = invalid
+    bool dirty = false;
+  };
+  CacheConfig c_;
+  std::uint64_t sets_ = 0;
+  std::vector<Line> lines_;
+  std::uint64_t clock_ = 0;
+  std::uint64_t hits_ = 0, misses_ = 0, writebacks_ = 0;
+};
+
+}  // namespace nbsim::memory
