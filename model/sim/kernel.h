@@ -1,0 +1,24 @@
+// SystemC basics shared by every unit wrapper: the model's cycle, the current cycle, and a report
+// handler that makes SystemC warnings and errors loud (STYLE.md: they fail tests). Only the thin
+// wrappers include this header; the algorithm cores never include SystemC.
+#pragma once
+
+#include <systemc>
+
+#include <cstdint>
+
+namespace nbsim::sim {
+
+// One cycle of the model's clock is one nanosecond of SystemC time (a 1 GHz clock). Units count in
+// cycles; nothing depends on the absolute frequency.
+inline sc_core::sc_time cycles(std::uint64_t n) { return sc_core::sc_time(static_cast<double>(n), sc_core::SC_NS); }
+
+inline std::uint64_t now_cycles() {
+  return static_cast<std::uint64_t>(sc_core::sc_time_stamp().to_seconds() * 1e9 + 0.5);
+}
+
+// SystemC warnings, errors and fatals throw std::runtime_error with SystemC's message instead of
+// printing and carrying on; info messages are dropped. Call once before elaboration.
+void install_report_handler();
+
+}  // namespace nbsim::sim
