@@ -1,0 +1,42 @@
+// CommandProcessor: the head of the replay pipeline. It streams a trace's frames (from a source
+// the pipeline gives it) and issues, per frame: a clear, every draw with geometry in the recorded
+// order, the depth snapshots where GL took them, and the end of the frame. A draw costs
+// draw_overhead_cycles of command processing.
+#pragma once
+
+#include <functional>
+#include <optional>
+
+#include "model/config/schema.h"
+#include "model/cp/work.h"
+#include "model/sim/unit.h"
+
+namespace nbsim::cp {
+
+struct CommandProcessorConfig {
+  int draw_overhead_cycles = 8;  // decoding a draw's state and launching it; tunable
+
+  static void describe(config::Schema& s, CommandProcessorConfig& c);
+};
+
+// Hands out the trace's frames one at a time (memory stays bounded by a frame); nullopt at the end.
+using FrameSource = std::function<std::optional<trace::Frame>()>;
+
+class CommandProcessor : public sim::Unit {
+ public:
+  sc_core::sc_fifo_out<WorkPtr> out;
+
+  CommandProcessor(const sc_core::sc_module_name& name, stats::Registry& registry, const CommandProcessorConfig& config,
+                   FrameSource source, float clear_depth);
+
+ private:
+  void run();
+  void send(WorkKind kind, const std::shared_ptr<const trace::Frame>& f, std::uint32_t draw = 0,
+            trace::DepthWhich which = trace::DepthWhich::Final);
+  CommandProcessorConfig config_;
+  FrameSource source_;
+  float clear_depth_;
+  stats::Counter &frames_, &draws_, &skipped_;
+};
+
+}  // namespace nbsim::cp

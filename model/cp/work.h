@@ -1,0 +1,39 @@
+// The work the command processor hands to the geometry unit, and on down the pipeline: draws of
+// one frame, and markers that open and close frames and take depth snapshots. Packets are shared
+// pointers so that SystemC fifos move a pointer, never a draw's geometry.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <ostream>
+
+#include "traces/format/reader.h"
+
+namespace nbsim::cp {
+
+enum class WorkKind : std::uint8_t {
+  FrameBegin = 0,  // clear the depth buffer to `clear_depth`
+  Draw = 1,        // one draw with geometry
+  Snapshot = 2,    // the depth buffer as it is now is the frame's `which` snapshot
+  FrameEnd = 3,    // the frame is done; the replay may compare and move on
+  Stop = 4,        // the trace is done
+};
+
+struct Work {
+  WorkKind kind = WorkKind::Draw;
+  std::shared_ptr<const trace::Frame> frame;  // the frame this work belongs to
+  std::uint32_t draw = 0;                     // index into frame->draws (Draw)
+  trace::DepthWhich which = trace::DepthWhich::Final;  // (Snapshot)
+  float clear_depth = 1.0f;                            // (FrameBegin)
+
+  const trace::DrawRecord& record() const { return frame->draws[draw]; }
+};
+
+using WorkPtr = std::shared_ptr<const Work>;
+
+// sc_fifo needs to print what it carries.
+inline std::ostream& operator<<(std::ostream& os, const WorkPtr& w) {
+  return os << "work(" << static_cast<int>(w ? w->kind : WorkKind::Stop) << ")";
+}
+
+}  // namespace nbsim::cp

@@ -1,0 +1,109 @@
+// Geometry stage: clip-space triangles (gl_Position as the vertex shader wrote it) to window-space
+// triangles for triangle setup (model/raster), the way Mesa's draw module does it in front of
+// llvmpipe: frustum clipping without a guard band, perspective divide, viewport transform and,
+// on batches that needed clipping, the draw module's floating-point face cull.
+//
+// What is matched, and where it comes from (Mesa 22.3, src/gallium/auxiliary/draw):
+// - draw_llvm.c generate_clipmask: one outcode bit per plane, 0: x > w, 1: x + w < 0, 2: y > w,
+//   3: y + w < 0, 4: z + w < 0 (z < 0 for clip control ZERO_TO_ONE), 5: z > w. Depth clamp turns
+//   the two z planes off.
+// - draw_llvm.c generate_viewport: every vertex gets 1/w = 1 / w and window = fmuladd(c * (1/w),
+//   scale, translate); LLVM fuses fmuladd into one FMA on hosts that have it (the x86-64 hosts
+//   PLATFORM.md lists do), so `fused_viewport` is on by default.
+// - draw_pt_fetch_shade_pipeline_llvm.c: a batch of vertices in which any vertex has an outcode
+//   runs through the draw pipeline (clip stage, then cull stage) as a whole; other batches go
+//   straight to llvmpipe's setup, which culls by itself (model/raster/setup.h).
+// - draw_pipe_clip.c: a triangle whose three outcodes share a bit is dropped, one with no
+//   outcode passes; the others are clipped plane by plane in outcode-bit order (Sutherland-
+//   Hodgman, with Mesa's choice of interpolation direction) and emitted as a fan (v[i-1], v[i],
+//   v[0]); new vertices get their window position in plain float arithmetic (no FMA).
+// - draw_pipe_cull.c: det = (v0 - v2) x (v1 - v2) in window coordinates, a culled face or a zero
+//   determinant is dropped. (Later Mesa keeps zero-area triangles when only front faces are
+//   culled; which rule 22.3.6 has is not verified, the traces only cull back faces.)
+// The counters map onto GL's: prims_in is GL_CLIPPING_INPUT_PRIMITIVES and prims_out is
+// GL_CLIPPING_OUTPUT_PRIMITIVES as llvmpipe counts it (each triangle that reaches its setup).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "model/geometry/primitive.h"
+
+namespace nbsim::geometry {
+
+// Depth convention of the clip volume. Fixed values, equal to trace::ClipControl.
+enum class ClipControl : std::uint8_t { NegativeOneToOne = 0, ZeroToOne = 1 };
+
+// A clip-space position x, y, z, w (the layout of trace::DrawRecord::clip_positions).
+using ClipPosition = std::array<float, 4>;
+
+struct GeometryConfig {
+  int width_px = 0;   // viewport (and render target) width, 1 .. 16384
+  int height_px = 0;  // viewport height, 1 .. 16384
+  // Vertices per batch of the draw module: llvmpipe's vertex buffer is 4096 bytes and a vertex
+  // with no fragment-shader input takes 16, so 256 vertices, cut to whole triangles (85). Only
+  // matters for draws of more than 85 triangles. Tunable (1 .. 1 << 20), derived, not measured.
+  int batch_triangles = 85;
+  // Window coordinates of shaded vertices with one fused multiply-add (LLVM on FMA hosts) or a
+  // separately rounded multiply and add (hosts without FMA).
+  bool fused_viewport = true;
+};
+
+// The per-draw state the stage reads.
+struct GeometryState {
+  ClipControl clip = ClipControl::NegativeOneToOne;
+  FaceState face;
+  bool depth_clamp = false;  // GL_DEPTH_CLAMP: no near/far clipping
+};
+
+// Per-draw counters of the stage (added to, never reset by the stage).
+struct GeometryCounters {
+  std::uint64_t prims_in = 0;            // triangles entering clipping (GL_CLIPPING_INPUT_PRIMITIVES)
+  std::uint64_t trivially_rejected = 0;  // all three vertices outside one frustum plane
+  std::uint64_t clipped = 0;             // triangles that crossed a plane and were clipped
+  std::uint64_t clipped_away = 0;        // clipped triangles with nothing left (or a NaN distance)
+  std::uint64_t draw_culled = 0;         // dropped by the draw module's float face cull (or all,
+                                         // uncounted by llvmpipe, when both faces are culled)
+  std::uint64_t prims_out = 0;           // triangles handed to setup (GL_CLIPPING_OUTPUT_PRIMITIVES)
+  std::uint64_t batches = 0;             // vertex batches
+  std::uint64_t pipeline_batches = 0;    // batches that went through the clip and cull stages
+
+  GeometryCounters& operator+=(const GeometryCounters& o);
+};
+
+class GeometryStage {
+ public:
+  // Throws InputError for a viewport or batch size outside the limits above.
+  explicit GeometryStage(const GeometryConfig& config);
+
+  // Appends the window-space triangles of one draw to `out` (three clip positions a triangle;
+  // a trailing incomplete triangle is ignored, as GL does) and adds to `counters`.
+  void process(std::span<const ClipPosition> clip_positions, const GeometryState& state,
+               std::vector<WindowTriangle>& out, GeometryCounters& counters) const;
+
+  const GeometryConfig& config() const noexcept { return config_; }
+
+  // The window position of an unclipped vertex, as the draw module's shader epilogue computes it.
+  WindowVertex to_window(const ClipPosition& p, ClipControl clip) const noexcept;
+  // The outcode of a vertex (bit k set: outside plane k, see the header comment).
+  static unsigned outcode(const ClipPosition& p, ClipControl clip, bool depth_clamp) noexcept;
+
+ private:
+  struct Viewport {
+    std::array<float, 3> scale{}, translate{};
+  };
+  const Viewport& viewport(ClipControl clip) const noexcept { return viewports_[static_cast<int>(clip) & 1]; }
+  void emit_batch(std::span<const ClipPosition> batch, const GeometryState& state, std::vector<WindowTriangle>& out,
+                  GeometryCounters& counters) const;
+
+  GeometryConfig config_;
+  std::array<Viewport, 2> viewports_{};  // indexed by ClipControl
+};
+
+// The draw module's float face test on window positions: true when the triangle is dropped
+// (zero determinant, or a culled face). Exposed for tests.
+bool draw_module_culls(const WindowTriangle& t, const FaceState& face) noexcept;
+
+}  // namespace nbsim::geometry

@@ -1,0 +1,102 @@
+// The N-buffer unit's SystemC wrapper: cycles for queries and for the update engine; see unit.h.
+#include "model/nbuffer/unit.h"
+
+namespace nbsim::nbuffer {
+
+NBufferUnit::NBufferUnit(const sc_core::sc_module_name& name, stats::Registry& registry,
+                         const NBufferUnitConfig& config, int width_px, int height_px, FarOp op,
+                         memory::Channel* channel)
+    : sim::Unit(name, registry),
+      core_(config, width_px, height_px, op, stats()),
+      channel_(channel),
+      query_cycles_(stats().counter("query_cycles", "cycles", "cycles from a query's start to its answer, summed")),
+      query_wait_cycles_(stats().counter("query_wait_cycles", "cycles",
+                                         "cycles queries waited for the update engine or for an earlier query")),
+      update_cycles_(stats().counter("update_cycles", "cycles",
+                                     "cycles of update work: the engine's batches and lazy updates inside queries")),
+      memory_stall_cycles_(stats().counter("memory_stall_cycles", "cycles",
+                                           "cycles spent waiting for memory after the unit's own work was done")),
+      update_batches_(stats().counter("update_batches", "batches", "batches the update engine took")) {
+  if (channel_) client_ = channel_->add_client(this->name());
+  SC_THREAD(engine);
+}
+
+void NBufferUnit::wait_until(std::uint64_t done, stats::Counter& counter) {
+  const std::uint64_t now = sim::now_cycles();
+  if (done <= now) return;
+  counter += done - now;
+  wait(sim::cycles(done - now));
+}
+
+void NBufferUnit::post(const UpdateWork& w) {
+  const std::uint64_t texels = w.recomputed();
+  const std::uint64_t bytes = w.bytes_read + w.bytes_written;
+  if (texels == 0 && bytes == 0) return;
+  queued_texels_ += texels;
+  queued_bytes_ += bytes;
+  ++posted_seq_;
+  posted_.notify();
+}
+
+void NBufferUnit::engine() {
+  const NBufferUnitConfig& c = core_.config();
+  for (;;) {
+    while (done_seq_ == posted_seq_) wait(posted_);
+    // Everything queued so far is one batch: its texels stream through the engine's pipeline.
+    const std::uint64_t seq = posted_seq_, texels = queued_texels_, bytes = queued_bytes_;
+    queued_texels_ = queued_bytes_ = 0;
+    ++update_batches_;
+    const std::uint64_t start = sim::now_cycles();
+    const std::uint64_t mem_done = channel_ && bytes ? channel_->transfer(start, bytes, client_) : start;
+    const std::uint64_t n = sim::batch_cycles(texels, c.update_texels_per_cycle, c.update_latency_cycles);
+    work(n);
+    wait_until(mem_done, memory_stall_cycles_);
+    update_cycles_ += sim::now_cycles() - start;
+    done_seq_ = seq;
+    batch_done_.notify();
+  }
+}
+
+void NBufferUnit::drain() {
+  while (!engine_idle()) wait(batch_done_);
+}
+
+QueryAnswer NBufferUnit::query(const Rect& r, float nearest_depth, CoveringKind kind) {
+  const std::uint64_t arrived = sim::now_cycles();
+  // Only once the engine has done the work posted before this query arrived (later work does not
+  // hold it up), and one query at a time.
+  const std::uint64_t needed = posted_seq_;
+  while (done_seq_ < needed) wait(batch_done_);
+  while (port_busy_) wait(port_free_);
+  port_busy_ = true;
+  query_wait_cycles_ += sim::now_cycles() - arrived;
+
+  const NBufferUnitConfig& c = core_.config();
+  QueryAnswer a = core_.query(r, nearest_depth, kind);
+  const std::uint64_t start = sim::now_cycles();
+  const std::uint64_t update_texels = a.update.recomputed();
+  const std::uint64_t update_n = sim::batch_cycles(update_texels, c.update_texels_per_cycle, c.update_latency_cycles);
+  const std::uint64_t bytes = a.bytes_read + a.update.bytes_read + a.update.bytes_written;
+  const std::uint64_t mem_done = channel_ && bytes ? channel_->transfer(start, bytes, client_) : start;
+  work(update_n +
+       sim::batch_cycles(static_cast<std::uint64_t>(a.lookups), c.lookups_per_cycle, c.lookup_latency_cycles));
+  wait_until(mem_done, memory_stall_cycles_);
+  update_cycles_ += update_n;
+  query_cycles_ += sim::now_cycles() - arrived;
+
+  port_busy_ = false;
+  port_free_.notify();
+  return a;
+}
+
+void NBufferUnit::depth_changed(const DepthImage& depth, const Rect& dirty) { post(core_.depth_changed(depth, dirty)); }
+
+void NBufferUnit::depth_changed(std::span<const PixelWrite> writes) { post(core_.depth_changed(writes)); }
+
+void NBufferUnit::depth_cleared(float depth) { post(core_.depth_cleared(depth)); }
+
+void NBufferUnit::end_of_pass() { post(core_.end_of_pass()); }
+
+void NBufferUnit::end_of_frame() { post(core_.end_of_frame()); }
+
+}  // namespace nbsim::nbuffer

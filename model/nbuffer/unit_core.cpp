@@ -1,0 +1,582 @@
+// The N-buffer unit's algorithm core: configuration, reduced-resolution level storage, update
+// policies and queries with their work; see unit_core.h.
+#include "model/nbuffer/unit_core.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "model/common/error.h"
+
+namespace nbsim::nbuffer {
+
+namespace {
+
+// Limits shared by the schema and validate(), so that a config built in code obeys the same ones.
+constexpr int kMaxLevelCap = 30;
+constexpr int kMaxCappedLookups = 4096;
+constexpr int kMaxLatencyCycles = 1'000'000;
+constexpr double kMinRate = 1.0 / 64.0, kMaxLookupRate = 1024.0, kMaxUpdateRate = 65536.0;
+constexpr int kMaxCacheBytes = 1 << 30, kMinLineBytes = 4, kMaxLineBytes = 4096, kMaxWays = 64;
+constexpr int kMaxSidePx = 16384;
+
+constexpr std::string_view kOutcomeLabels[] = {"hidden", "visible", "incomplete", "offscreen"};
+
+std::vector<std::string> level_labels(int levels) {
+  std::vector<std::string> l;
+  for (int i = 0; i < levels; ++i) l.push_back(std::to_string(i));
+  return l;
+}
+
+std::vector<std::string> case_labels() {
+  std::vector<std::string> l;
+  for (int c = 0; c <= static_cast<int>(CoveringCase::Overhang); ++c)
+    l.emplace_back(nbsim::to_string(static_cast<CoveringCase>(c)));
+  return l;
+}
+
+const NBufferUnitConfig& validated(const NBufferUnitConfig& c) {
+  c.validate();
+  return c;
+}
+
+int checked_side(int v, const char* what) {
+  if (v < 1 || v > kMaxSidePx)
+    throw InputError(fmt::format("N-buffer unit: depth buffer {} must be 1 to {} pixels, got {}", what, kMaxSidePx, v));
+  return v;
+}
+
+int ceil_div(int a, int b) noexcept { return (a + b - 1) / b; }
+
+// Trigger buckets of the texels_applied statistic.
+enum Trigger : std::size_t { kEager = 0, kForced = 1, kEndOfPass = 2, kLazy = 3, kFlush = 4 };
+
+}  // namespace
+
+std::string_view to_string(UpdatePolicy p) noexcept {
+  return p == UpdatePolicy::Eager ? "eager" : p == UpdatePolicy::Batched ? "batched" : "lazy";
+}
+
+std::optional<UpdatePolicy> parse_update_policy(std::string_view s) noexcept {
+  if (s == "eager") return UpdatePolicy::Eager;
+  if (s == "batched") return UpdatePolicy::Batched;
+  if (s == "lazy") return UpdatePolicy::Lazy;
+  return std::nullopt;
+}
+
+std::string_view to_string(QueryOutcome o) noexcept { return kOutcomeLabels[static_cast<std::size_t>(o)]; }
+
+int texel_bytes(StorageFormat f) noexcept { return nbsim::storage_bytes(f); }
+
+// ---------------------------------------------------------------------------------------------
+// Configuration
+
+void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c) {
+  s.add("nbuffer.resolution_divisor", c.resolution_divisor, "",
+        "levels are built over a reduced image whose texel is the farthest of a divisor x divisor block of depth "
+        "pixels (conservative); 1, 2, 4 or 8",
+        1, 8);
+  s.add("nbuffer.format", c.format, "level storage format, rounded toward far (u24 stored as 32-bit D24X8)",
+        {"f32", "u24", "u16"});
+  s.add("nbuffer.level_cap", c.level_cap, "level",
+        "highest level built, -1 builds all; larger rectangles are tiled with top-level squares", -1, kMaxLevelCap);
+  s.add("nbuffer.capped_max_lookups", c.capped_max_lookups, "lookups",
+        "most lookups spent tiling a rectangle whose level is above level_cap; beyond, or 0, the query answers "
+        "incomplete (never hidden)",
+        0, kMaxCappedLookups);
+  s.add("nbuffer.update_policy", c.update_policy,
+        "when depth changes reach the levels: eager (at once), batched (at the end of a pass), lazy (when a query "
+        "reads them)",
+        {"eager", "batched", "lazy"});
+  s.add("nbuffer.lookup_latency_cycles", c.lookup_latency_cycles, "cycles",
+        "latency of a query's lookups (address, tag check, data, compare) on cache hits", 0, kMaxLatencyCycles);
+  s.add("nbuffer.lookups_per_cycle", c.lookups_per_cycle, "lookups/cycle",
+        "texel lookups the query port issues per cycle", kMinRate, kMaxLookupRate);
+  s.add("nbuffer.update_texels_per_cycle", c.update_texels_per_cycle, "texels/cycle",
+        "texels the update engine recomputes per cycle", kMinRate, kMaxUpdateRate);
+  s.add("nbuffer.update_latency_cycles", c.update_latency_cycles, "cycles",
+        "fill and drain latency of one batch of the update engine", 0, kMaxLatencyCycles);
+  s.add("nbuffer.cache_size_bytes", c.cache.size_bytes, "bytes",
+        "texel cache of the query port, a multiple of cache_line_bytes x cache_ways; 0 disables it", 0, kMaxCacheBytes);
+  s.add("nbuffer.cache_line_bytes", c.cache.line_bytes, "bytes",
+        "cache line, also the memory burst of a miss and one tile of texels; a power of two", kMinLineBytes,
+        kMaxLineBytes);
+  s.add("nbuffer.cache_ways", c.cache.ways, "ways", "associativity of the texel cache", 1, kMaxWays);
+}
+
+void NBufferUnitConfig::validate() const {
+  auto bad = [](const std::string& msg) { throw InputError(msg); };
+  if (resolution_divisor != 1 && resolution_divisor != 2 && resolution_divisor != 4 && resolution_divisor != 8)
+    bad(fmt::format("nbuffer.resolution_divisor must be 1, 2, 4 or 8, got {}", resolution_divisor));
+  if (!parse_storage_format(format)) bad(fmt::format("nbuffer.format must be one of f32, u24, u16, got '{}'", format));
+  if (!parse_update_policy(update_policy))
+    bad(fmt::format("nbuffer.update_policy must be one of eager, batched, lazy, got '{}'", update_policy));
+  if (level_cap < -1 || level_cap > kMaxLevelCap)
+    bad(fmt::format("nbuffer.level_cap must be -1 (all levels) or 0 to {}, got {}", kMaxLevelCap, level_cap));
+  if (capped_max_lookups < 0 || capped_max_lookups > kMaxCappedLookups)
+    bad(fmt::format("nbuffer.capped_max_lookups must be 0 to {}, got {}", kMaxCappedLookups, capped_max_lookups));
+  if (lookup_latency_cycles < 0 || lookup_latency_cycles > kMaxLatencyCycles)
+    bad(fmt::format("nbuffer.lookup_latency_cycles must be 0 to {}, got {}", kMaxLatencyCycles, lookup_latency_cycles));
+  if (update_latency_cycles < 0 || update_latency_cycles > kMaxLatencyCycles)
+    bad(fmt::format("nbuffer.update_latency_cycles must be 0 to {}, got {}", kMaxLatencyCycles, update_latency_cycles));
+  if (!std::isfinite(lookups_per_cycle) || lookups_per_cycle < kMinRate || lookups_per_cycle > kMaxLookupRate)
+    bad(fmt::format("nbuffer.lookups_per_cycle must be {} to {}, got {}", kMinRate, kMaxLookupRate, lookups_per_cycle));
+  if (!std::isfinite(update_texels_per_cycle) || update_texels_per_cycle < kMinRate ||
+      update_texels_per_cycle > kMaxUpdateRate)
+    bad(fmt::format("nbuffer.update_texels_per_cycle must be {} to {}, got {}", kMinRate, kMaxUpdateRate,
+                    update_texels_per_cycle));
+  const int line = cache.line_bytes;
+  if (line < kMinLineBytes || line > kMaxLineBytes || (line & (line - 1)) != 0)
+    bad(fmt::format("nbuffer.cache_line_bytes must be a power of two from {} to {}, got {}", kMinLineBytes,
+                    kMaxLineBytes, line));
+  if (cache.ways < 1 || cache.ways > kMaxWays)
+    bad(fmt::format("nbuffer.cache_ways must be 1 to {}, got {}", kMaxWays, cache.ways));
+  if (cache.size_bytes < 0 || cache.size_bytes > kMaxCacheBytes || cache.size_bytes % (line * cache.ways) != 0)
+    bad(fmt::format(
+        "nbuffer.cache_size_bytes must be 0 or a multiple of cache_line_bytes x cache_ways = {} up to {}, got {}",
+        line * cache.ways, kMaxCacheBytes, cache.size_bytes));
+}
+
+StorageFormat NBufferUnitConfig::storage_format() const {
+  const auto f = parse_storage_format(format);
+  NBSIM_CHECK(f.has_value(), "nbuffer config used before validate()");
+  return *f;
+}
+
+UpdatePolicy NBufferUnitConfig::policy() const {
+  const auto p = parse_update_policy(update_policy);
+  NBSIM_CHECK(p.has_value(), "nbuffer config used before validate()");
+  return *p;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Work
+
+std::uint64_t UpdateWork::recomputed() const noexcept {
+  std::uint64_t n = 0;
+  for (auto v : texels_recomputed) n += v;
+  return n;
+}
+
+std::uint64_t UpdateWork::changed() const noexcept {
+  std::uint64_t n = 0;
+  for (auto v : texels_changed) n += v;
+  return n;
+}
+
+UpdateWork& UpdateWork::operator+=(const UpdateWork& o) {
+  auto add = [](std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b) {
+    if (a.size() < b.size()) a.resize(b.size(), 0);
+    for (std::size_t i = 0; i < b.size(); ++i) a[i] += b[i];
+  };
+  add(texels_recomputed, o.texels_recomputed);
+  add(texels_changed, o.texels_changed);
+  depth_pixels_reduced += o.depth_pixels_reduced;
+  bytes_read += o.bytes_read;
+  bytes_written += o.bytes_written;
+  return *this;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Core
+
+NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, int height_px, FarOp op,
+                                 stats::Group& g)
+    : config_(validated(config)),
+      op_(op),
+      format_(config_.storage_format()),
+      policy_(config_.policy()),
+      divisor_(config_.resolution_divisor),
+      depth_(checked_side(width_px, "width"), checked_side(height_px, "height"), far_limit(op)),
+      reduced_(divisor_ > 1 ? DepthImage(ceil_div(width_px, divisor_), ceil_div(height_px, divisor_), far_limit(op))
+                            : DepthImage()),
+      nb_(ceil_div(width_px, divisor_), ceil_div(height_px, divisor_), NBufferConfig{op, format_, config_.level_cap}),
+      cache_(config_.cache),
+      queries_(g.vector(
+          "queries", "queries", "queries by outcome",
+          {kOutcomeLabels[0].data(), kOutcomeLabels[1].data(), kOutcomeLabels[2].data(), kOutcomeLabels[3].data()})),
+      cases_(
+          g.vector("query_cases", "queries", "queries by the case of the covering they need (Fig. 3)", case_labels())),
+      lookups_(g.vector("lookups", "lookups", "texels read by queries (depth tests of the query port), per level",
+                        level_labels(nb_.level_count()))),
+      tiled_queries_(
+          g.counter("tiled_queries", "queries", "queries whose level was capped, answered by tiling the top level")),
+      hits_(g.counter("cache_hits", "lookups", "lookups that hit the texel cache")),
+      misses_(g.counter("cache_misses", "lookups", "lookups that missed the texel cache")),
+      bytes_read_(g.counter("bytes_read", "bytes",
+                            "bytes read from memory: cache-line fills and level texels streamed by updates")),
+      bytes_written_(g.counter("bytes_written", "bytes", "level texels written to memory by updates and clears")),
+      recomputed_(g.vector("texels_recomputed", "texels", "texels the update engine recomputed, per level",
+                           level_labels(nb_.level_count()))),
+      changed_(g.vector("texels_changed", "texels", "recomputed texels whose stored value changed, per level",
+                        level_labels(nb_.level_count()))),
+      reduced_pixels_(
+          g.counter("depth_pixels_reduced", "pixels",
+                    "depth pixels read to form reduced-resolution level-0 texels (resolution_divisor > 1)")),
+      changes_(
+          g.vector("depth_changes", "changes", "depth-buffer changes reported, by kind", {"rect", "writes", "clear"})),
+      applied_(g.vector("texels_applied", "texels", "level-0 texels handed to the update engine, by what triggered it",
+                        {"eager", "forced", "end_of_pass", "lazy", "flush"})),
+      frames_(g.counter("frames", "frames", "frames ended")) {
+  g.formula("lookups_per_query", "lookups/query", "lookups per query that reached the levels", [this] {
+    return stats::ratio(
+        static_cast<double>(lookups_.total()),
+        static_cast<double>(queries_.total() - queries_.value(static_cast<std::size_t>(QueryOutcome::Offscreen))));
+  });
+  g.formula("cache_hit_rate", "", "texel cache hits per lookup", [this] {
+    return stats::ratio(static_cast<double>(hits_.value()), static_cast<double>(hits_.value() + misses_.value()));
+  });
+  g.formula("hidden_fraction", "", "queries answered hidden per query", [this] {
+    return stats::ratio(static_cast<double>(queries_.value(0)), static_cast<double>(queries_.total()));
+  });
+
+  // Memory layout: each level a plane of tiles, one tile per cache line (8x8 f32 texels for 256 B).
+  const int per_line = std::max(1, config_.cache.line_bytes / texel_bytes(format_));
+  const int lg = floor_log2(static_cast<unsigned>(per_line));
+  tile_w_ = 1 << ((lg + 1) / 2);
+  tile_h_ = 1 << (lg / 2);
+  tiles_x_ = ceil_div(nb_.width(), tile_w_);
+  tiles_y_ = ceil_div(nb_.height(), tile_h_);
+
+  const std::size_t texels = static_cast<std::size_t>(nb_.width()) * static_cast<std::size_t>(nb_.height());
+  pending_.assign(texels, 0);
+  stamp_.assign(texels, 0);
+  bins_x_ = ceil_div(nb_.width(), kBinPx);
+  bins_y_ = ceil_div(nb_.height(), kBinPx);
+  bins_.resize(static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(bins_y_));
+}
+
+Rect NBufferUnitCore::to_reduced(const Rect& r) const noexcept {
+  const Rect c = clip(r, depth_.width, depth_.height);
+  if (c.empty()) return {};
+  const int d = divisor_;
+  const int x0 = c.x / d, y0 = c.y / d, x1 = ceil_div(c.x1(), d), y1 = ceil_div(c.y1(), d);
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+std::uint64_t NBufferUnitCore::texel_address(int level, int x, int y) const noexcept {
+  const auto line = static_cast<std::uint64_t>(config_.cache.line_bytes);
+  const auto tile = (static_cast<std::uint64_t>(level) * static_cast<std::uint64_t>(tiles_y_) +
+                     static_cast<std::uint64_t>(y / tile_h_)) *
+                        static_cast<std::uint64_t>(tiles_x_) +
+                    static_cast<std::uint64_t>(x / tile_w_);
+  const auto within = static_cast<std::uint64_t>((y % tile_h_) * tile_w_ + x % tile_w_);
+  return tile * line + within * static_cast<std::uint64_t>(texel_bytes(format_));
+}
+
+UpdateWork NBufferUnitCore::new_work() const {
+  UpdateWork w;
+  w.texels_recomputed.assign(static_cast<std::size_t>(nb_.level_count()), 0);
+  w.texels_changed.assign(static_cast<std::size_t>(nb_.level_count()), 0);
+  return w;
+}
+
+// Memory traffic of an update (a model, not a trace of accesses): level 0's changed texels are
+// written (their values come from the depth unit, which forwards the tiles it writes); a level
+// above reads one new source texel per recomputed texel (the other three taps come from the line
+// buffer of the rows it streams) and writes the texels that changed.
+void NBufferUnitCore::account(const UpdateStats& s, UpdateWork& w) {
+  const auto bpt = static_cast<std::uint64_t>(texel_bytes(format_));
+  for (std::size_t i = 0; i < s.texels_recomputed.size(); ++i) {
+    const auto rec = static_cast<std::uint64_t>(s.texels_recomputed[i]);
+    const auto chg = static_cast<std::uint64_t>(s.texels_changed[i]);
+    w.texels_recomputed[i] += rec;
+    w.texels_changed[i] += chg;
+    recomputed_.add(i, rec);
+    changed_.add(i, chg);
+    const std::uint64_t rd = i > 0 ? rec * bpt : 0, wr = chg * bpt;
+    w.bytes_read += rd;
+    w.bytes_written += wr;
+    bytes_read_ += rd;
+    bytes_written_ += wr;
+  }
+}
+
+void NBufferUnitCore::reduce_block(int rx, int ry, UpdateWork& w) {
+  const int d = divisor_;
+  const int x1 = std::min((rx + 1) * d, depth_.width), y1 = std::min((ry + 1) * d, depth_.height);
+  float v = neutral_depth(op_);
+  for (int y = ry * d; y < y1; ++y)
+    for (int x = rx * d; x < x1; ++x) v = farther(op_, v, depth_.at(x, y));
+  reduced_.at(rx, ry) = v;
+  w.depth_pixels_reduced += static_cast<std::uint64_t>(x1 - rx * d) * static_cast<std::uint64_t>(y1 - ry * d);
+}
+
+void NBufferUnitCore::mark_one(int x, int y) {
+  const std::size_t k =
+      static_cast<std::size_t>(y) * static_cast<std::size_t>(nb_.width()) + static_cast<std::size_t>(x);
+  if (pending_[k]) return;
+  pending_[k] = 1;
+  ++pending_count_;
+  const int bx = x / kBinPx, by = y / kBinPx;
+  std::vector<Texel>& bin =
+      bins_[static_cast<std::size_t>(by) * static_cast<std::size_t>(bins_x_) + static_cast<std::size_t>(bx)];
+  if (bin.size() >= 2 * static_cast<std::size_t>(kBinPx * kBinPx)) {
+    // Entries unmarked since (forced applies) piled up: rebuild the list from the flags.
+    bin.clear();
+    const int x1 = std::min((bx + 1) * kBinPx, nb_.width()), y1 = std::min((by + 1) * kBinPx, nb_.height());
+    for (int ty = by * kBinPx; ty < y1; ++ty)
+      for (int tx = bx * kBinPx; tx < x1; ++tx)
+        if (pending_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(nb_.width()) +
+                     static_cast<std::size_t>(tx)])
+          bin.push_back({tx, ty});
+    return;  // (x, y) is flagged, so the rebuilt list holds it
+  }
+  bin.push_back({x, y});
+}
+
+bool NBufferUnitCore::mark(const Rect& rr) {
+  const DepthImage& src = level0_source();
+  bool raises = false;
+  for (int y = rr.y; y < rr.y1(); ++y)
+    for (int x = rr.x; x < rr.x1(); ++x) {
+      const float v = stored(src.at(x, y)), held = nb_.texel(0, x, y);
+      if (v == held) continue;
+      raises = raises || hidden_behind(op_, v, held);  // v strictly farther than what level 0 holds
+      mark_one(x, y);
+    }
+  return raises;
+}
+
+bool NBufferUnitCore::mark(std::span<const Texel> texels) {
+  const DepthImage& src = level0_source();
+  bool raises = false;
+  for (const Texel& t : texels) {
+    const float v = stored(src.at(t.x, t.y)), held = nb_.texel(0, t.x, t.y);
+    if (v == held) continue;
+    raises = raises || hidden_behind(op_, v, held);
+    mark_one(t.x, t.y);
+  }
+  return raises;
+}
+
+void NBufferUnitCore::unmark(const Rect& rr) {
+  for (int y = rr.y; y < rr.y1(); ++y)
+    for (int x = rr.x; x < rr.x1(); ++x) {
+      std::uint8_t& p =
+          pending_[static_cast<std::size_t>(y) * static_cast<std::size_t>(nb_.width()) + static_cast<std::size_t>(x)];
+      if (p) p = 0, --pending_count_;
+    }
+}
+
+void NBufferUnitCore::unmark(std::span<const Texel> texels) {
+  for (const Texel& t : texels) {
+    std::uint8_t& p =
+        pending_[static_cast<std::size_t>(t.y) * static_cast<std::size_t>(nb_.width()) + static_cast<std::size_t>(t.x)];
+    if (p) p = 0, --pending_count_;
+  }
+}
+
+UpdateWork NBufferUnitCore::apply_writes(std::span<const Texel> texels) {
+  UpdateWork w = new_work();
+  if (texels.empty()) return w;
+  const DepthImage& src = level0_source();
+  writes_.clear();
+  for (const Texel& t : texels) writes_.push_back({t.x, t.y, src.at(t.x, t.y)});
+  account(nb_.update(writes_), w);
+  return w;
+}
+
+UpdateWork NBufferUnitCore::apply_pending(const Rect& region) {
+  const Rect r = clip(region, nb_.width(), nb_.height());
+  if (r.empty() || pending_count_ == 0) return new_work();
+  std::vector<Texel> take;
+  const int bx1 = (r.x1() - 1) / kBinPx, by1 = (r.y1() - 1) / kBinPx;
+  for (int by = r.y / kBinPx; by <= by1; ++by)
+    for (int bx = r.x / kBinPx; bx <= bx1; ++bx) {
+      auto& bin =
+          bins_[static_cast<std::size_t>(by) * static_cast<std::size_t>(bins_x_) + static_cast<std::size_t>(bx)];
+      for (const Texel& t : bin) {
+        std::uint8_t& p = pending_[static_cast<std::size_t>(t.y) * static_cast<std::size_t>(nb_.width()) +
+                                   static_cast<std::size_t>(t.x)];
+        if (p) p = 0, --pending_count_, take.push_back(t);
+      }
+      bin.clear();
+    }
+  return apply_writes(take);
+}
+
+UpdateWork NBufferUnitCore::depth_changed(const DepthImage& depth, const Rect& dirty) {
+  NBSIM_CHECK(depth.width == depth_.width && depth.height == depth_.height,
+              "depth image handed to the N-buffer unit differs from its depth buffer size");
+  changes_.add(0);
+  UpdateWork w = new_work();
+  const Rect c = clip(dirty, depth_.width, depth_.height);
+  if (c.empty()) return w;
+  if (&depth != &depth_)
+    for (int y = c.y; y < c.y1(); ++y) {
+      const auto row = static_cast<std::size_t>(y) * static_cast<std::size_t>(depth_.width);
+      std::copy(depth.texels.begin() + static_cast<std::ptrdiff_t>(row + static_cast<std::size_t>(c.x)),
+                depth.texels.begin() + static_cast<std::ptrdiff_t>(row + static_cast<std::size_t>(c.x1())),
+                depth_.texels.begin() + static_cast<std::ptrdiff_t>(row + static_cast<std::size_t>(c.x)));
+    }
+  const Rect rr = to_reduced(c);
+  if (divisor_ > 1)
+    for (int y = rr.y; y < rr.y1(); ++y)
+      for (int x = rr.x; x < rr.x1(); ++x) reduce_block(x, y, w);
+  reduced_pixels_ += w.depth_pixels_reduced;
+
+  const auto area = static_cast<std::uint64_t>(rr.area());
+  if (policy_ == UpdatePolicy::Eager) {
+    account(nb_.update(level0_source(), rr), w);
+    applied_.add(kEager, area);
+  } else if (mark(rr) && policy_ == UpdatePolicy::Batched) {
+    unmark(rr);  // the rectangle is applied whole, its pending texels with it
+    account(nb_.update(level0_source(), rr), w);
+    applied_.add(kForced, area);
+  }
+  return w;
+}
+
+UpdateWork NBufferUnitCore::depth_changed(std::span<const PixelWrite> writes) {
+  for (const PixelWrite& pw : writes)
+    if (pw.x < 0 || pw.y < 0 || pw.x >= depth_.width || pw.y >= depth_.height)
+      throw InputError(fmt::format("N-buffer unit: pixel write at ({}, {}) outside the {}x{} depth buffer", pw.x, pw.y,
+                                   depth_.width, depth_.height));
+  changes_.add(1);
+  UpdateWork w = new_work();
+  // The distinct storage texels the writes fall in.
+  if (++epoch_ == 0) std::fill(stamp_.begin(), stamp_.end(), 0u), epoch_ = 1;
+  scratch_.clear();
+  for (const PixelWrite& pw : writes) {
+    depth_.at(pw.x, pw.y) = pw.depth;
+    const int x = pw.x / divisor_, y = pw.y / divisor_;
+    std::uint32_t& s =
+        stamp_[static_cast<std::size_t>(y) * static_cast<std::size_t>(nb_.width()) + static_cast<std::size_t>(x)];
+    if (s != epoch_) s = epoch_, scratch_.push_back({x, y});
+  }
+  if (divisor_ > 1)
+    for (const Texel& t : scratch_) reduce_block(t.x, t.y, w);
+  reduced_pixels_ += w.depth_pixels_reduced;
+
+  if (policy_ == UpdatePolicy::Eager) {
+    w += apply_writes(scratch_);
+    applied_.add(kEager, scratch_.size());
+  } else if (mark(scratch_) && policy_ == UpdatePolicy::Batched) {
+    unmark(scratch_);
+    w += apply_writes(scratch_);
+    applied_.add(kForced, scratch_.size());
+  }
+  return w;
+}
+
+UpdateWork NBufferUnitCore::depth_cleared(float depth) {
+  changes_.add(2);
+  std::fill(depth_.texels.begin(), depth_.texels.end(), depth);
+  if (divisor_ > 1) std::fill(reduced_.texels.begin(), reduced_.texels.end(), depth);
+  std::fill(pending_.begin(), pending_.end(), std::uint8_t{0});
+  for (auto& bin : bins_) bin.clear();
+  pending_count_ = 0;
+  nb_.build(level0_source());
+  // Every texel of every level takes the clear value (each square holds its in-image anchor), so
+  // a clear writes all levels without reading any.
+  UpdateWork w = new_work();
+  const auto plane = static_cast<std::uint64_t>(nb_.width()) * static_cast<std::uint64_t>(nb_.height());
+  for (std::size_t i = 0; i < w.texels_recomputed.size(); ++i) {
+    w.texels_recomputed[i] = w.texels_changed[i] = plane;
+    recomputed_.add(i, plane);
+    changed_.add(i, plane);
+  }
+  w.bytes_written = plane * w.texels_recomputed.size() * static_cast<std::uint64_t>(texel_bytes(format_));
+  bytes_written_ += w.bytes_written;
+  return w;
+}
+
+UpdateWork NBufferUnitCore::end_of_pass() {
+  if (policy_ != UpdatePolicy::Batched) return new_work();
+  const std::uint64_t before = pending_count_;
+  UpdateWork w = apply_pending({0, 0, nb_.width(), nb_.height()});
+  applied_.add(kEndOfPass, before);
+  return w;
+}
+
+UpdateWork NBufferUnitCore::end_of_frame() {
+  ++frames_;
+  return end_of_pass();
+}
+
+UpdateWork NBufferUnitCore::flush() {
+  const std::uint64_t before = pending_count_;
+  UpdateWork w = apply_pending({0, 0, nb_.width(), nb_.height()});
+  applied_.add(kFlush, before);
+  return w;
+}
+
+void NBufferUnitCore::read_texel(QueryAnswer& a, int level, int x, int y) {
+  a.value = farther(op_, a.value, nb_.texel(level, x, y));
+  if (a.texel_count < 4) a.texels[static_cast<std::size_t>(a.texel_count++)] = {x, y};
+  ++a.lookups;
+  if (cache_.access(texel_address(level, x, y), false).hit) {
+    ++a.cache_hits;
+  } else {
+    ++a.cache_misses;
+    a.bytes_read += static_cast<std::uint64_t>(config_.cache.line_bytes);
+  }
+}
+
+QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth, CoveringKind kind) {
+  QueryAnswer a;
+  a.value = far_limit(op_);
+  auto done = [&](QueryOutcome o) {
+    a.outcome = o;
+    a.hidden = o == QueryOutcome::Hidden;
+    queries_.add(static_cast<std::size_t>(o));
+    return a;
+  };
+  const Rect rr = to_reduced(r);  // empty when r is empty or off the image
+  if (rr.empty()) return done(QueryOutcome::Offscreen);
+  a.reduced = rr;
+  const Covering cov = cover(rr, kind, nb_.full_level_count() - 1);
+  a.kase = cov.kase;
+  a.level = cov.level;
+  cases_.add(static_cast<std::size_t>(cov.kase));
+
+  if (cov.level <= nb_.top_level()) {
+    if (policy_ == UpdatePolicy::Lazy) {
+      int x0 = cov.squares[0].x, y0 = cov.squares[0].y, x1 = x0, y1 = y0;
+      for (int i = 1; i < cov.count; ++i) {
+        const Square& s = cov.squares[static_cast<std::size_t>(i)];
+        x0 = std::min(x0, s.x), y0 = std::min(y0, s.y), x1 = std::max(x1, s.x), y1 = std::max(y1, s.y);
+      }
+      a.update = apply_pending({x0, y0, x1 - x0 + cov.side(), y1 - y0 + cov.side()});
+    }
+    const QueryResult q = nb_.query(rr, kind);
+    NBSIM_CHECK(q.complete && q.level == cov.level, "N-buffer query read another level than its covering");
+    a.value = neutral_depth(op_);
+    for (const Texel& t : q.read()) read_texel(a, q.level, t.x, t.y);
+    NBSIM_CHECK(a.value == q.value, "N-buffer unit's lookups disagree with the N-buffer's answer");
+  } else {
+    // The level needed is above level_cap: tile the rectangle with top-level squares anchored at
+    // its left/bottom edge every S pixels and once more flush with its right/top edge.
+    const int top = nb_.top_level(), side = 1 << top;
+    const long long nx = rr.w > side ? ceil_div(rr.w, side) : 1, ny = rr.h > side ? ceil_div(rr.h, side) : 1;
+    if (nx * ny > config_.capped_max_lookups) {
+      a.complete = false;
+      return done(QueryOutcome::Incomplete);
+    }
+    a.tiled = true;
+    a.level = top;
+    ++tiled_queries_;
+    if (policy_ == UpdatePolicy::Lazy)
+      a.update = apply_pending({rr.x, rr.y, std::max(rr.w, side), std::max(rr.h, side)});
+    a.value = neutral_depth(op_);
+    for (long long j = 0; j < ny; ++j) {
+      const int y = j + 1 < ny ? rr.y + static_cast<int>(j) * side : std::max(rr.y, rr.y1() - side);
+      for (long long i = 0; i < nx; ++i) {
+        const int x = i + 1 < nx ? rr.x + static_cast<int>(i) * side : std::max(rr.x, rr.x1() - side);
+        read_texel(a, top, x, y);
+      }
+    }
+  }
+  if (policy_ == UpdatePolicy::Lazy)
+    applied_.add(kLazy, a.update.texels_recomputed.empty() ? 0 : a.update.texels_recomputed[0]);
+  lookups_.add(static_cast<std::size_t>(a.level), static_cast<std::uint64_t>(a.lookups));
+  hits_ += a.cache_hits;
+  misses_ += a.cache_misses;
+  bytes_read_ += a.bytes_read;
+  return done(hidden_behind(op_, nearest_depth, a.value) ? QueryOutcome::Hidden : QueryOutcome::Visible);
+}
+
+}  // namespace nbsim::nbuffer

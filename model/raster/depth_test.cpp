@@ -1,0 +1,71 @@
+// Early depth test on 4x4 blocks against a float DepthImage; see depth_test.h.
+#include "model/raster/depth_test.h"
+
+#include <bit>
+
+namespace nbsim::raster {
+
+namespace {
+
+template <DepthFunc F>
+void run_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint16_t mask, bool write, bool fused,
+               DepthCounters& k) {
+  std::uint64_t passed = 0, written = 0;
+  for (unsigned m = mask; m != 0; m &= m - 1) {
+    const int i = std::countr_zero(m);
+    const int px = x + (i & 3), py = y + (i >> 2);
+    const float z = plane.at(px, py, fused);
+    float& stored =
+        img.texels[static_cast<std::size_t>(py) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(px)];
+    if (depth_passes(F, z, stored)) {
+      ++passed;
+      if (write) {
+        stored = z;
+        ++written;
+      }
+    }
+  }
+  k.passed += passed;
+  k.written += written;
+}
+
+}  // namespace
+
+DepthCounters& DepthCounters::operator+=(const DepthCounters& o) {
+  fragments += o.fragments;
+  depth_tests += o.depth_tests;
+  passed += o.passed;
+  written += o.written;
+  blocks += o.blocks;
+  return *this;
+}
+
+EarlyDepthTest::EarlyDepthTest(DepthImage& buffer, bool fused_interpolation)
+    : buffer_(&buffer), fused_(fused_interpolation) {}
+
+void EarlyDepthTest::test_block(const DepthPlane& plane, int x, int y, std::uint16_t mask, const DepthState& state,
+                                DepthCounters& k) {
+  if (mask == 0) return;
+  const auto n = static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(mask)));
+  k.fragments += n;
+  k.blocks += 1;
+  if (!state.test) {
+    k.passed += n;
+    return;
+  }
+  k.depth_tests += n;
+  DepthImage& img = *buffer_;
+  const bool w = state.write;
+  switch (state.func) {
+    case DepthFunc::Never: run_block<DepthFunc::Never>(img, plane, x, y, mask, w, fused_, k); break;
+    case DepthFunc::Less: run_block<DepthFunc::Less>(img, plane, x, y, mask, w, fused_, k); break;
+    case DepthFunc::Equal: run_block<DepthFunc::Equal>(img, plane, x, y, mask, w, fused_, k); break;
+    case DepthFunc::Lequal: run_block<DepthFunc::Lequal>(img, plane, x, y, mask, w, fused_, k); break;
+    case DepthFunc::Greater: run_block<DepthFunc::Greater>(img, plane, x, y, mask, w, fused_, k); break;
+    case DepthFunc::NotEqual: run_block<DepthFunc::NotEqual>(img, plane, x, y, mask, w, fused_, k); break;
+    case DepthFunc::Gequal: run_block<DepthFunc::Gequal>(img, plane, x, y, mask, w, fused_, k); break;
+    case DepthFunc::Always: run_block<DepthFunc::Always>(img, plane, x, y, mask, w, fused_, k); break;
+  }
+}
+
+}  // namespace nbsim::raster

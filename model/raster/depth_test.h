@@ -1,0 +1,80 @@
+// Early depth test: the 4x4 blocks of covered pixels from the rasterizer (model/raster/
+// rasterizer.h) tested against, and written to, a float depth buffer (DepthImage, y up, see
+// model/common/depth.h), with the fragment depth interpolated from the triangle's depth plane as
+// llvmpipe does it (model/raster/setup.h DepthPlane).
+//
+// Comparisons are IEEE float comparisons of fragment against stored depth, ordered except
+// NotEqual (which passes NaN), as lp_bld_depth.c builds them. With the test disabled every
+// fragment passes and nothing is written (GL: depth writes need the test enabled).
+#pragma once
+
+#include <cstdint>
+
+#include "model/common/depth.h"
+#include "model/raster/setup.h"
+
+namespace nbsim::raster {
+
+// GL's depth functions in GL's order. Fixed values, equal to trace::DepthFunc.
+enum class DepthFunc : std::uint8_t {
+  Never = 0,
+  Less = 1,
+  Equal = 2,
+  Lequal = 3,
+  Greater = 4,
+  NotEqual = 5,
+  Gequal = 6,
+  Always = 7
+};
+
+// True when a fragment at depth `fragment` passes against `stored` under `func`.
+constexpr bool depth_passes(DepthFunc func, float fragment, float stored) noexcept {
+  switch (func) {
+    case DepthFunc::Never: return false;
+    case DepthFunc::Less: return fragment < stored;
+    case DepthFunc::Equal: return fragment == stored;
+    case DepthFunc::Lequal: return fragment <= stored;
+    case DepthFunc::Greater: return fragment > stored;
+    case DepthFunc::NotEqual: return !(fragment == stored);
+    case DepthFunc::Gequal: return fragment >= stored;
+    case DepthFunc::Always: return true;
+  }
+  return false;
+}
+
+struct DepthState {
+  DepthFunc func = DepthFunc::Less;
+  bool test = true;   // GL_DEPTH_TEST
+  bool write = true;  // glDepthMask
+};
+
+// Per-draw counters of the depth test (added to, never reset, by the unit).
+struct DepthCounters {
+  std::uint64_t fragments = 0;    // rasterized fragments (GL's fragment-shader atomic counter)
+  std::uint64_t depth_tests = 0;  // comparisons against the buffer (ARCHITECTURE.md's unit)
+  std::uint64_t passed = 0;       // GL_SAMPLES_PASSED
+  std::uint64_t written = 0;      // depth values stored
+  std::uint64_t blocks = 0;       // 4x4 blocks with at least one fragment
+  DepthCounters& operator+=(const DepthCounters& o);
+};
+
+class EarlyDepthTest {
+ public:
+  // The unit tests against and writes to `buffer`, which must outlive it. `fused_interpolation`
+  // evaluates the depth plane with FMA as llvmpipe does on FMA hosts (setup.h).
+  explicit EarlyDepthTest(DepthImage& buffer, bool fused_interpolation = true);
+
+  // Tests the pixels of `mask` in the 4x4 block at (x, y) (bit i + 4 j is pixel (x + i, y + j);
+  // they must lie inside the buffer).
+  void test_block(const DepthPlane& plane, int x, int y, std::uint16_t mask, const DepthState& state,
+                  DepthCounters& counters);
+
+  DepthImage& buffer() noexcept { return *buffer_; }
+  bool fused_interpolation() const noexcept { return fused_; }
+
+ private:
+  DepthImage* buffer_;
+  bool fused_;
+};
+
+}  // namespace nbsim::raster

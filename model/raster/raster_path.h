@@ -1,0 +1,61 @@
+// RasterPath: one draw from clip space to depth-tested fragments through the plain C++ cores,
+// geometry (model/geometry) -> setup -> rasterizer -> early depth test (model/raster). It is what
+// the SystemC units wrap one stage at a time, and what the counter comparison replays against GL.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "model/common/depth.h"
+#include "model/geometry/geometry.h"
+#include "model/raster/depth_test.h"
+#include "model/raster/rasterizer.h"
+#include "model/raster/setup.h"
+
+namespace nbsim::raster {
+
+struct RasterPathConfig {
+  int width_px = 0;  // render target and viewport, 1 .. 16384
+  int height_px = 0;
+  int batch_triangles = 85;         // geometry::GeometryConfig::batch_triangles
+  bool fused_viewport = true;       // geometry::GeometryConfig::fused_viewport
+  bool fused_interpolation = true;  // EarlyDepthTest: depth plane evaluated with FMA
+};
+
+// The GL state of one draw that the path reads.
+struct DrawState {
+  geometry::GeometryState geometry;
+  DepthState depth;
+};
+
+// Everything counted for one draw (or summed over many).
+struct DrawCounters {
+  geometry::GeometryCounters geometry;
+  SetupCounters setup;
+  TileCounters tiles;
+  DepthCounters depth;
+  DrawCounters& operator+=(const DrawCounters& o);
+};
+
+class RasterPath {
+ public:
+  // `depth` is the depth buffer the draws test and write; it must be width x height and outlive
+  // the path. Throws InputError for a bad size.
+  RasterPath(const RasterPathConfig& config, DepthImage& depth);
+
+  // Runs one draw (three clip positions a triangle) and returns its counters.
+  DrawCounters draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state);
+
+  const RasterPathConfig& config() const noexcept { return config_; }
+  DepthImage& depth() noexcept { return depth_test_.buffer(); }
+
+ private:
+  RasterPathConfig config_;
+  geometry::GeometryStage geometry_;
+  TriangleSetup setup_;
+  Rasterizer rasterizer_;
+  EarlyDepthTest depth_test_;
+  std::vector<geometry::WindowTriangle> triangles_;  // reused from draw to draw
+};
+
+}  // namespace nbsim::raster

@@ -1,0 +1,36 @@
+// The replay model's top level; see gpu.h.
+#include "pipeline/sim/gpu.h"
+
+namespace nbsim::pipeline {
+
+void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
+  cp::CommandProcessorConfig::describe(s, c.cp);
+  geometry::GeometryUnitConfig::describe(s, c.geometry);
+  raster::RasterUnitConfig::describe(s, c.raster);
+  depth::DepthUnitConfig::describe(s, c.depth);
+  s.add("memory.bandwidth_bytes_per_cycle", c.memory.bandwidth_bytes_per_cycle, "bytes/cycle",
+        "sustained bandwidth shared by every client", 0.01, 1e6);
+  s.add("memory.latency_cycles", c.memory.latency_cycles, "cycles", "from request to data", 0, 100000);
+  s.add("gpu.fifo_depth", c.fifo_depth, "work items", "depth of the fifos between units", 1, 4096);
+}
+
+Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& c, int width_px, int height_px,
+         cp::FrameSource source, float clear_depth, depth::ResultSink& sink)
+    : sc_core::sc_module(name),
+      memory_(c.memory),
+      cp_to_geometry_("cp_to_geometry", c.fifo_depth),
+      geometry_to_raster_("geometry_to_raster", c.fifo_depth),
+      raster_to_depth_("raster_to_depth", c.fifo_depth),
+      cp_("cp", registry, c.cp, std::move(source), clear_depth),
+      geometry_("geometry", registry, c.geometry, width_px, height_px),
+      raster_("raster", registry, c.raster, width_px, height_px),
+      depth_("depth", registry, c.depth, width_px, height_px, memory_, sink) {
+  cp_.out(cp_to_geometry_);
+  geometry_.in(cp_to_geometry_);
+  geometry_.out(geometry_to_raster_);
+  raster_.in(geometry_to_raster_);
+  raster_.out(raster_to_depth_);
+  depth_.in(raster_to_depth_);
+}
+
+}  // namespace nbsim::pipeline

@@ -1,0 +1,51 @@
+// The configurable top level of the replay model: it wires the units (command processor ->
+// geometry -> raster -> depth, with the shared memory channel) with SystemC fifos, like the
+// *_top.cpp of the SystemC TLM examples. It only wires; the units do the work.
+//
+//   trace frames --> [cp] --fifo--> [geometry] --fifo--> [raster] --fifo--> [depth] --> ResultSink
+//                                                                              |
+//                                                                        [memory channel]
+#pragma once
+
+#include <memory>
+
+#include "model/config/schema.h"
+#include "model/cp/unit.h"
+#include "model/depth/unit.h"
+#include "model/geometry/unit.h"
+#include "model/memory/memory.h"
+#include "model/raster/unit.h"
+
+namespace nbsim::pipeline {
+
+struct GpuConfig {
+  cp::CommandProcessorConfig cp;
+  geometry::GeometryUnitConfig geometry;
+  raster::RasterUnitConfig raster;
+  depth::DepthUnitConfig depth;
+  memory::ChannelConfig memory;
+  int fifo_depth = 4;  // work items between two units; tunable
+
+  // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "gpu.").
+  static void describe(config::Schema& s, GpuConfig& c);
+};
+
+class Gpu : public sc_core::sc_module {
+ public:
+  Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& config, int width_px, int height_px,
+      cp::FrameSource source, float clear_depth, depth::ResultSink& sink);
+
+  const memory::Channel& memory() const noexcept { return memory_; }
+
+ private:
+  memory::Channel memory_;
+  sc_core::sc_fifo<cp::WorkPtr> cp_to_geometry_;
+  sc_core::sc_fifo<geometry::TriangleBatchPtr> geometry_to_raster_;
+  sc_core::sc_fifo<raster::BlockBatchPtr> raster_to_depth_;
+  cp::CommandProcessor cp_;
+  geometry::GeometryUnit geometry_;
+  raster::RasterUnit raster_;
+  depth::DepthUnit depth_;
+};
+
+}  // namespace nbsim::pipeline

@@ -1,0 +1,197 @@
+// Trace replay through the SystemC model and the counter comparison; see replay.h.
+#include "pipeline/sim/replay.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+
+#include "model/common/error.h"
+#include "model/sim/kernel.h"
+
+namespace nbsim::pipeline {
+
+namespace {
+
+const char* role_name(trace::DrawRole r) {
+  switch (r) {
+    case trace::DrawRole::Occluder: return "occluder";
+    case trace::DrawRole::BoundsQuery: return "bounds_query";
+    case trace::DrawRole::NodeQuery: return "node_query";
+    case trace::DrawRole::NBufferBuild: return "nbuffer_build";
+    case trace::DrawRole::NBufferQuery: return "nbuffer_query";
+    case trace::DrawRole::Visible: return "visible";
+    case trace::DrawRole::IdBuffer: return "id_buffer";
+  }
+  return "?";
+}
+
+// Collects the depth unit's results, compares them with GL's, and writes the CSV files.
+class Collector : public depth::ResultSink {
+ public:
+  Collector(ReplaySummary& s, const ReplayOptions& o) : s_(s), o_(o) {
+    if (o.out) {
+      draws_.open(*o.out / "draws.csv");
+      frames_.open(*o.out / "frames.csv");
+      if (!draws_ || !frames_) throw InputError(fmt::format("cannot write into '{}'", o.out->string()));
+      draws_ << "frame,draw,object,role,triangles,model_prims_out,gl_prims_out,model_fragments,gl_fragments,"
+                "model_passed,gl_passed,depth_tests,culled,lookups,done_cycle\n";
+      frames_ << "frame,draws,model_fragments,gl_fragments,model_passed,gl_passed,depth_tests,depth_pixels_matching,"
+                 "depth_pixels,end_cycle,cycles\n";
+    }
+  }
+
+  void draw_done(const cp::Work& w, const depth::DrawResult& r) override {
+    const trace::DrawRecord& d = w.record();
+    ++s_.draws;
+    ++frame_.draws;
+    s_.fragments_model += r.depth.fragments;
+    s_.fragments_gl += d.gl.fragments;
+    s_.passed_model += r.depth.passed;
+    s_.passed_gl += d.gl.samples_passed;
+    s_.depth_tests += r.depth.depth_tests;
+    frame_.fragments_model += r.depth.fragments, frame_.fragments_gl += d.gl.fragments;
+    frame_.passed_model += r.depth.passed, frame_.passed_gl += d.gl.samples_passed;
+    frame_.depth_tests += r.depth.depth_tests;
+    if (r.depth.fragments == d.gl.fragments && r.depth.passed == d.gl.samples_passed) ++s_.draws_exact;
+    if (draws_.is_open())
+      draws_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, d.index, d.object,
+                            role_name(d.role), d.clip_positions.size() / 3, r.geometry.prims_out, d.gl.clip_prims_out,
+                            r.depth.fragments, d.gl.fragments, r.depth.passed, d.gl.samples_passed, r.depth.depth_tests,
+                            "none", 0, r.done_cycle);
+  }
+
+  void snapshot(const cp::Work& w, const DepthImage& depth) override {
+    const trace::DepthSnapshot* gl = w.frame->depth(w.which);
+    if (!gl) return;  // GL did not record this one
+    if (gl->width != depth.width || gl->height != depth.height)
+      throw InputError(fmt::format("frame {}: GL's depth snapshot is {}x{}, the viewport {}x{}", w.frame->begin.frame,
+                                   gl->width, gl->height, depth.width, depth.height));
+    for (std::size_t i = 0; i < depth.texels.size(); ++i) {
+      const double e = std::fabs(static_cast<double>(depth.texels[i]) - static_cast<double>(gl->texels[i]));
+      s_.depth_max_abs_error = std::max(s_.depth_max_abs_error, e);
+      if (e <= o_.depth_tolerance) ++frame_.depth_matching;
+    }
+    frame_.depth_pixels += depth.texels.size();
+    s_.depth_pixels += depth.texels.size();
+  }
+
+  void frame_done(const cp::Work& w, std::uint64_t cycle) override {
+    ++s_.frames;
+    s_.depth_pixels_matching += frame_.depth_matching;
+    if (frames_.is_open())
+      frames_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, frame_.draws, frame_.fragments_model,
+                             frame_.fragments_gl, frame_.passed_model, frame_.passed_gl, frame_.depth_tests,
+                             frame_.depth_matching, frame_.depth_pixels, cycle, cycle - last_cycle_);
+    per_frame_.push_back({{"frame", w.frame->begin.frame}, {"draws", frame_.draws}, {"depth_tests", frame_.depth_tests},
+                          {"cycles", cycle - last_cycle_}});
+    last_cycle_ = cycle;
+    for (const auto& d : w.frame->draws)
+      if (d.clip_positions.empty()) ++s_.passes_not_replayed;
+    frame_ = {};
+    if (o_.progress) o_.progress(s_.frames, total_frames);
+  }
+
+  void stopped(std::uint64_t cycle) override { s_.cycles = cycle; }
+
+  std::uint64_t total_frames = 0;
+  nlohmann::ordered_json per_frame_ = nlohmann::ordered_json::array();
+
+ private:
+  struct FrameTotals {
+    std::uint64_t draws = 0, fragments_model = 0, fragments_gl = 0, passed_model = 0, passed_gl = 0, depth_tests = 0;
+    std::uint64_t depth_matching = 0, depth_pixels = 0;
+  };
+  ReplaySummary& s_;
+  const ReplayOptions& o_;
+  std::ofstream draws_, frames_;
+  FrameTotals frame_;
+  std::uint64_t last_cycle_ = 0;
+};
+
+double rel(std::uint64_t a, std::uint64_t b) {
+  if (b == 0) return a == 0 ? 0.0 : 1.0;
+  return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
+}
+
+}  // namespace
+
+double ReplaySummary::fragment_error() const { return rel(fragments_model, fragments_gl); }
+double ReplaySummary::passed_error() const { return rel(passed_model, passed_gl); }
+
+bool ReplaySummary::within_thresholds() const {
+  const bool draws_ok = draws == 0 || static_cast<double>(draws_exact) >= 0.99 * static_cast<double>(draws);
+  const bool depth_ok = depth_pixels == 0 || static_cast<double>(depth_pixels_matching) >= 0.9999 * static_cast<double>(depth_pixels);
+  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok;
+}
+
+nlohmann::ordered_json ReplaySummary::to_json() const {
+  nlohmann::ordered_json j;
+  j["frames"] = frames;
+  j["draws"] = draws;
+  j["draws_exact"] = draws_exact;
+  j["passes_not_replayed"] = passes_not_replayed;
+  j["fragments_model"] = fragments_model;
+  j["fragments_gl"] = fragments_gl;
+  j["fragment_error"] = fragment_error();
+  j["passed_model"] = passed_model;
+  j["passed_gl"] = passed_gl;
+  j["passed_error"] = passed_error();
+  j["depth_tests"] = depth_tests;
+  j["depth_pixels"] = depth_pixels;
+  j["depth_pixels_matching"] = depth_pixels_matching;
+  j["depth_max_abs_error"] = depth_max_abs_error;
+  j["cycles"] = cycles;
+  j["host_seconds"] = host_seconds;
+  j["depth_tests_per_host_second"] = host_seconds > 0 ? static_cast<double>(depth_tests) / host_seconds : 0.0;
+  j["cycles_per_host_second"] = host_seconds > 0 ? static_cast<double>(cycles) / host_seconds : 0.0;
+  j["within_thresholds"] = within_thresholds();
+  return j;
+}
+
+ReplaySummary replay(const ReplayOptions& o) {
+  if (o.out) {
+    std::error_code ec;
+    std::filesystem::create_directories(*o.out, ec);
+    if (ec) throw InputError(fmt::format("cannot create output folder '{}': {}", o.out->string(), ec.message()));
+  }
+  auto frames = std::make_shared<trace::FrameReader>(o.trace);
+  const trace::TraceReader& tr = frames->trace();
+  const std::string* viewport = tr.property("viewport");
+  int w = 0, h = 0;
+  if (!viewport || std::sscanf(viewport->c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1)
+    throw InputError(fmt::format("{}: the header has no valid 'viewport' property", o.trace.string()));
+  const std::string* clear = tr.property("depth_clear");
+  const float clear_depth = clear && *clear == "0" ? 0.0f : 1.0f;
+  const std::string* nframes = tr.property("frames");
+
+  ReplaySummary s;
+  Collector sink(s, o);
+  if (nframes) sink.total_frames = std::strtoull(nframes->c_str(), nullptr, 10);
+  stats::Registry registry;
+  sim::install_report_handler();
+  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink);
+  const auto t0 = std::chrono::steady_clock::now();
+  sc_core::sc_start();
+  s.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.stats = registry.values();
+
+  if (o.out) {
+    nlohmann::ordered_json run;
+    run["nbsim_version"] = NBSIM_VERSION;
+    run["trace"] = o.trace.string();
+    nlohmann::ordered_json props = nlohmann::ordered_json::object();
+    for (const auto& [k, v] : tr.properties()) props[k] = v;
+    run["trace_properties"] = props;
+    run["config"] = o.config_values;
+    run["summary"] = s.to_json();
+    run["stats"] = s.stats;
+    run["stats_described"] = registry.describe();
+    run["frames"] = sink.per_frame_;
+    std::ofstream(*o.out / "run.json") << run.dump(2) << "\n";
+  }
+  return s;
+}
+
+}  // namespace nbsim::pipeline

@@ -1,0 +1,156 @@
+// NBufferUnitConfigTest: the N-buffer unit's and the Hi-Z baselines' config keys (defaults, units,
+// --set) and their refusals of bad keys and values, each with a message naming the key.
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+
+#include "model/common/error.h"
+#include "model/hiz/hiz_config.h"
+#include "model/nbuffer/unit_core.h"
+
+namespace nbsim::nbuffer {
+namespace {
+
+// Every field is a key "nbuffer.<field>" with its default, unit and limits.
+TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
+  NBufferUnitConfig c;
+  config::Schema s;
+  NBufferUnitConfig::describe(s, c);
+  const auto d = s.describe();
+  ASSERT_EQ(d.size(), 12u);
+  auto find = [&](const std::string& key) {
+    for (const auto& e : d)
+      if (e["key"] == key) return e;
+    ADD_FAILURE() << key << " not declared";
+    return nlohmann::ordered_json{};
+  };
+  EXPECT_EQ(find("nbuffer.resolution_divisor")["default"], 1);
+  EXPECT_EQ(find("nbuffer.format")["default"], "f32");
+  EXPECT_EQ(find("nbuffer.level_cap")["default"], -1);
+  EXPECT_EQ(find("nbuffer.update_policy")["default"], "eager");
+  EXPECT_EQ(find("nbuffer.lookup_latency_cycles")["unit"], "cycles");
+  EXPECT_EQ(find("nbuffer.lookups_per_cycle")["default"], 4.0);
+  EXPECT_EQ(find("nbuffer.cache_size_bytes")["default"], 16384);
+  EXPECT_EQ(find("nbuffer.cache_line_bytes")["default"], 256);
+  EXPECT_EQ(find("nbuffer.cache_ways")["default"], 4);
+  for (const auto& e : d) EXPECT_FALSE(e["description"].get<std::string>().empty()) << e["key"];
+  EXPECT_NO_THROW(c.validate()) << "the defaults are valid";
+}
+
+// --set and JSON reach the bound fields, and the validated values parse.
+TEST(NBufferUnitConfigTest, SetReachesTheFields) {
+  NBufferUnitConfig c;
+  config::Schema s;
+  NBufferUnitConfig::describe(s, c);
+  s.set("nbuffer.update_policy=lazy");
+  s.set("nbuffer.format=u16");
+  s.set("nbuffer.lookup_latency_cycles=20");
+  s.apply(nlohmann::json::parse(R"({"nbuffer": {"resolution_divisor": 4, "cache_ways": 8}})"));
+  c.validate();
+  EXPECT_EQ(c.policy(), UpdatePolicy::Lazy);
+  EXPECT_EQ(c.storage_format(), StorageFormat::U16);
+  EXPECT_EQ(c.lookup_latency_cycles, 20);
+  EXPECT_EQ(c.resolution_divisor, 4);
+  EXPECT_EQ(c.cache.ways, 8);
+}
+
+// Bad keys and values set through the schema are refused with the key named.
+TEST(NBufferUnitConfigTest, SchemaRefusesBadKeysAndValues) {
+  struct Row {
+    std::string assignment, message;
+  };
+  const Row rows[] = {
+      {"nbuffer.lookup_latency_cycle=3", "did you mean 'nbuffer.lookup_latency_cycles'"},
+      {"nbuffer.update_policy=sometimes", "must be one of eager, batched, lazy"},
+      {"nbuffer.format=f16", "must be one of f32, u24, u16"},
+      {"nbuffer.resolution_divisor=16", "outside its limits"},
+      {"nbuffer.level_cap=-2", "outside its limits"},
+      {"nbuffer.lookups_per_cycle=0", "outside its limits"},
+      {"nbuffer.cache_ways=0", "outside its limits"},
+      {"nbuffer.update_latency_cycles=1.5", "must be an integer"},
+  };
+  for (const Row& row : rows) {
+    NBufferUnitConfig c;
+    config::Schema s;
+    NBufferUnitConfig::describe(s, c);
+    try {
+      s.set(row.assignment);
+      ADD_FAILURE() << row.assignment << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(row.message), std::string::npos) << row.assignment << ": " << e.what();
+    }
+  }
+}
+
+// Values inside the schema's limits but inconsistent are refused by validate(), with the key named.
+TEST(NBufferUnitConfigTest, ValidateRefusesInconsistentValues) {
+  struct Row {
+    void (*edit)(NBufferUnitConfig&);
+    std::string message;
+  };
+  const Row rows[] = {
+      {[](NBufferUnitConfig& c) { c.resolution_divisor = 3; },
+       "nbuffer.resolution_divisor must be 1, 2, 4 or 8, got 3"},
+      {[](NBufferUnitConfig& c) { c.cache.line_bytes = 96; }, "nbuffer.cache_line_bytes must be a power of two"},
+      {[](NBufferUnitConfig& c) { c.cache.size_bytes = 1000; }, "nbuffer.cache_size_bytes must be 0 or a multiple"},
+      {[](NBufferUnitConfig& c) { c.format = "f64"; }, "nbuffer.format must be one of f32, u24, u16, got 'f64'"},
+      {[](NBufferUnitConfig& c) { c.update_policy = "never"; }, "nbuffer.update_policy must be one of"},
+      {[](NBufferUnitConfig& c) { c.lookups_per_cycle = -1.0; }, "nbuffer.lookups_per_cycle must be"},
+      {[](NBufferUnitConfig& c) { c.update_texels_per_cycle = std::numeric_limits<double>::infinity(); },
+       "nbuffer.update_texels_per_cycle must be"},
+      {[](NBufferUnitConfig& c) { c.lookup_latency_cycles = -1; }, "nbuffer.lookup_latency_cycles must be"},
+      {[](NBufferUnitConfig& c) { c.capped_max_lookups = -1; }, "nbuffer.capped_max_lookups must be"},
+  };
+  for (const Row& row : rows) {
+    NBufferUnitConfig c;
+    row.edit(c);
+    try {
+      c.validate();
+      ADD_FAILURE() << "accepted: expected '" << row.message << "'";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(row.message), std::string::npos) << e.what();
+    }
+    stats::Registry reg;
+    EXPECT_THROW(NBufferUnitCore(c, 8, 8, FarOp::Max, reg.group("u")), InputError) << "the core validates its config";
+  }
+}
+
+// A disabled cache (size 0) is valid: every lookup misses.
+TEST(NBufferUnitConfigTest, ZeroCacheMissesEveryLookup) {
+  NBufferUnitConfig c;
+  c.cache.size_bytes = 0;
+  stats::Registry reg;
+  NBufferUnitCore core(c, 32, 32, FarOp::Max, reg.group("u"));
+  core.query({0, 0, 9, 9}, 0.5f);
+  const QueryAnswer a = core.query({0, 0, 9, 9}, 0.5f);
+  EXPECT_EQ(a.cache_misses, static_cast<std::uint64_t>(a.lookups));
+}
+
+// The Hi-Z keys: defaults, --set, and refusals.
+TEST(NBufferUnitConfigTest, HiZKeys) {
+  HiZUnitConfig c;
+  config::Schema s;
+  HiZUnitConfig::describe(s, c);
+  EXPECT_EQ(s.size(), 2u);
+  EXPECT_EQ(s.values()["hiz"]["tile_px"], 8);
+  EXPECT_EQ(s.values()["hiz"]["format"], "f32");
+  s.set("hiz.tile_px=16");
+  s.set("hiz.format=u24");
+  c.validate();
+  EXPECT_EQ(c.tile(FarOp::Min).tile_px, 16);
+  EXPECT_EQ(c.tile(FarOp::Min).op, FarOp::Min);
+  EXPECT_EQ(c.pyramid(FarOp::Max).format, StorageFormat::U24);
+  EXPECT_THROW(s.set("hiz.tile_px=0"), InputError);
+  EXPECT_THROW(s.set("hiz.tiles_px=4"), InputError);
+  c.format = "f16";
+  try {
+    c.validate();
+    ADD_FAILURE() << "hiz.format f16 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("hiz.format must be one of f32, u24, u16"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace nbsim::nbuffer

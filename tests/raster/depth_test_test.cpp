@@ -1,0 +1,82 @@
+// DepthTestTest: the early depth test (model/raster/depth_test.h): the depth functions, the depth
+// plane's interpolation and clamp, a disabled test.
+#include "model/raster/depth_test.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "model/common/depth.h"
+#include "model/raster/setup.h"
+#include "tests/raster/coverage.h"
+
+namespace nbsim::raster {
+namespace {
+
+using namespace nbsim::raster::testing;
+
+// Each depth function against a stored 0.5 (and NaN-free equality), a table.
+TEST(DepthTestTest, DepthFunctions) {
+  struct Row {
+    DepthFunc f;
+    bool less, equal, greater;
+  };
+  const Row rows[] = {
+      {DepthFunc::Never, false, false, false},  {DepthFunc::Less, true, false, false},
+      {DepthFunc::Equal, false, true, false},   {DepthFunc::Lequal, true, true, false},
+      {DepthFunc::Greater, false, false, true}, {DepthFunc::NotEqual, true, false, true},
+      {DepthFunc::Gequal, false, true, true},   {DepthFunc::Always, true, true, true},
+  };
+  for (const Row& r : rows) {
+    EXPECT_EQ(depth_passes(r.f, 0.25f, 0.5f), r.less) << "func " << static_cast<int>(r.f) << ", fragment nearer";
+    EXPECT_EQ(depth_passes(r.f, 0.5f, 0.5f), r.equal) << "func " << static_cast<int>(r.f) << ", equal depth";
+    EXPECT_EQ(depth_passes(r.f, 0.75f, 0.5f), r.greater) << "func " << static_cast<int>(r.f) << ", fragment farther";
+  }
+  EXPECT_TRUE(depth_passes(DepthFunc::NotEqual, NAN, 0.5f)) << "NOTEQUAL is unordered";
+  EXPECT_FALSE(depth_passes(DepthFunc::Less, NAN, 0.5f)) << "LESS is ordered";
+}
+
+// A constant-depth triangle gives exactly its depth; a sloped one stays within 1e-6 of the plane
+// through its vertices at pixel centres; depth is clamped to [0, 1].
+TEST(DepthTestTest, DepthPlaneInterpolation) {
+  SetupTriangle s;
+  SetupCounters k;
+  const TriangleSetup setup({64, 64});
+  ASSERT_EQ(setup.setup(tri(1, 1, 60, 3, 5, 58, 0.3f), kNoCull, s, k), SetupResult::Accepted);
+  for (int y = 5; y < 40; y += 7)
+    for (int x = 5; x < 40; x += 7) EXPECT_EQ(s.depth.at(x, y), 0.3f) << "constant depth is exact";
+  WindowTriangle t = tri(1, 1, 60, 3, 5, 58);
+  t.v[0].z = 0.1f;
+  t.v[1].z = 0.9f;
+  t.v[2].z = 0.4f;
+  ASSERT_EQ(setup.setup(t, kNoCull, s, k), SetupResult::Accepted);
+  const double det = (60.0 - 1.0) * (58.0 - 1.0) - (5.0 - 1.0) * (3.0 - 1.0);
+  for (int y = 2; y < 30; y += 3)
+    for (int x = 2; x < 30; x += 3) {
+      const double px = x + 0.5, py = y + 0.5;
+      const double b1 = ((px - 1.0) * (58.0 - 1.0) - (py - 1.0) * (5.0 - 1.0)) / det;
+      const double b2 = ((60.0 - 1.0) * (py - 1.0) - (3.0 - 1.0) * (px - 1.0)) / det;
+      const double z = 0.1 + b1 * (0.9 - 0.1) + b2 * (0.4 - 0.1);
+      EXPECT_NEAR(s.depth.at(x, y), z, 1e-6) << "pixel (" << x << "," << y << ")";
+    }
+  DepthPlane p{1.5f, 0.0f, 0.0f};
+  EXPECT_EQ(p.at(0, 0), 1.0f) << "clamped to the far value";
+  p.a0 = -0.5f;
+  EXPECT_EQ(p.at(0, 0), 0.0f) << "clamped to the near value";
+}
+
+// With the depth test disabled every fragment passes and the buffer is left alone.
+TEST(DepthTestTest, DisabledTestPassesWithoutWriting) {
+  DepthImage img(8, 8, 0.25f);
+  EarlyDepthTest unit(img);
+  DepthCounters k;
+  unit.test_block(DepthPlane{0.75f, 0, 0}, 0, 0, 0x0f0f, DepthState{DepthFunc::Less, false, true}, k);
+  EXPECT_EQ(k.fragments, 8u);
+  EXPECT_EQ(k.passed, 8u);
+  EXPECT_EQ(k.depth_tests, 0u) << "no comparison when the test is off";
+  EXPECT_EQ(k.written, 0u);
+  EXPECT_EQ(img.at(0, 0), 0.25f);
+}
+
+}  // namespace
+}  // namespace nbsim::raster
