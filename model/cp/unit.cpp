@@ -33,6 +33,14 @@ void CommandProcessor::send(WorkKind kind, const std::shared_ptr<const trace::Fr
 }
 
 void CommandProcessor::run() {
+  try {
+    issue();
+  } catch (...) {
+    sim::thread_failed(std::current_exception());
+  }
+}
+
+void CommandProcessor::issue() {
   while (std::optional<trace::Frame> next = source_()) {
     const auto f = std::make_shared<const trace::Frame>(std::move(*next));
     ++frames_;

@@ -31,6 +31,7 @@ class CommandProcessor : public sim::Unit {
 
  private:
   void run();
+  void issue();
   void send(WorkKind kind, const std::shared_ptr<const trace::Frame>& f, std::uint32_t draw = 0,
             trace::DepthWhich which = trace::DepthWhich::Final);
   CommandProcessorConfig config_;

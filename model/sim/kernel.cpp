@@ -19,4 +19,23 @@ void handler(const sc_core::sc_report& r, const sc_core::sc_actions&) {
 
 void install_report_handler() { sc_core::sc_report_handler::set_handler(handler); }
 
+namespace {
+std::exception_ptr& failure() {
+  static std::exception_ptr first;
+  return first;
+}
+}  // namespace
+
+void thread_failed(std::exception_ptr e) {
+  if (!failure()) failure() = e;
+  sc_core::sc_stop();
+}
+
+void rethrow_thread_failure() {
+  if (std::exception_ptr e = failure()) {
+    failure() = nullptr;
+    std::rethrow_exception(e);
+  }
+}
+
 }  // namespace nbsim::sim

@@ -6,6 +6,7 @@
 #include <systemc>
 
 #include <cstdint>
+#include <exception>
 
 namespace nbsim::sim {
 
@@ -20,5 +21,11 @@ inline std::uint64_t now_cycles() {
 // SystemC warnings, errors and fatals throw std::runtime_error with SystemC's message instead of
 // printing and carrying on; info messages are dropped. Call once before elaboration.
 void install_report_handler();
+
+// An exception escaping a unit's thread (a damaged trace read mid-run, say) would reach SystemC
+// as an uncaught-exception error. Threads catch it and call thread_failed(), which keeps the first
+// one and stops the simulation; the driver calls rethrow_thread_failure() after sc_start returns.
+void thread_failed(std::exception_ptr e);
+void rethrow_thread_failure();
 
 }  // namespace nbsim::sim

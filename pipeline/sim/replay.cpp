@@ -174,6 +174,7 @@ ReplaySummary replay(const ReplayOptions& o) {
   Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink);
   const auto t0 = std::chrono::steady_clock::now();
   sc_core::sc_start();
+  sim::rethrow_thread_failure();  // a damaged trace read mid-run, as an InputError
   s.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.stats = registry.values();
 
