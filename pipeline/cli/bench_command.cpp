@@ -13,6 +13,7 @@
 
 #include "model/common/error.h"
 #include "pipeline/bench/nbuffer_bench.h"
+#include "pipeline/bench/replay_bench.h"
 #include "pipeline/cli/command.h"
 
 namespace nbsim::cli {
@@ -94,6 +95,22 @@ void add_bench_commands(CLI::App& app, Action& action) {
   cmd->add_option("--json-out", args->json_out, "Also write every line, as one JSON array, to this file");
   cmd->footer(nbuffer_footer);
   cmd->callback([&action, args] { action = [args] { return run_nbuffer_bench(*args); }; });
+  {
+    auto* rep = bench->add_subcommand("replay", "Simulator speed: capture with llvmpipe, replay the same frames, ratio of the two");
+    auto ro = std::make_shared<bench::ReplayBenchOptions>();
+    rep->add_option("--size", ro->size, "Viewport, WxH")->capture_default_str();
+    rep->add_option("--frames", ro->frames, "Frames")->check(CLI::Range(1, 10000))->capture_default_str();
+    rep->add_option("--mode", ro->mode, "Capture test mode")->check(CLI::IsMember({"oq", "oq_hier", "nb", "nb_hier", "none"}))->capture_default_str();
+    rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes), replay_ms (the SystemC model), ratio,\n"
+                "depth_tests_per_s and cycles_per_s of the model, measured in the same run.");
+    rep->callback([&action, ro] {
+      action = [ro] {
+        parse_size(ro->size, "--size");
+        fmt::print("{}\n", bench::run_replay_bench(*ro).dump());
+        return 0;
+      };
+    });
+  }
 }
 
 }  // namespace nbsim::cli
