@@ -22,14 +22,27 @@ CommandProcessor::CommandProcessor(const sc_core::sc_module_name& name, stats::R
 }
 
 void CommandProcessor::send(WorkKind kind, const std::shared_ptr<const trace::Frame>& f, std::uint32_t draw,
-                            trace::DepthWhich which) {
+                            trace::DepthWhich which, std::shared_ptr<const cull::CullReport> report) {
   auto w = std::make_shared<Work>();
   w->kind = kind;
   w->frame = f;
   w->draw = draw;
   w->which = which;
   w->clear_depth = clear_depth_;
+  w->cull_report = std::move(report);
   out.write(w);
+}
+
+void CommandProcessor::issue_draw(std::shared_ptr<Work> w) {
+  ++draws_;
+  work(static_cast<std::uint64_t>(config_.draw_overhead_cycles));
+  w->kind = WorkKind::Draw;
+  w->clear_depth = clear_depth_;
+  out.write(std::move(w));
+}
+
+void CommandProcessor::issue_snapshot(const std::shared_ptr<const trace::Frame>& f, trace::DepthWhich which) {
+  send(WorkKind::Snapshot, f, 0, which);
 }
 
 void CommandProcessor::run() {
@@ -45,6 +58,11 @@ void CommandProcessor::issue() {
     const auto f = std::make_shared<const trace::Frame>(std::move(*next));
     ++frames_;
     send(WorkKind::FrameBegin, f);
+    if (program_) {
+      std::shared_ptr<const cull::CullReport> report = program_->run_frame(f, *this);
+      send(WorkKind::FrameEnd, f, 0, trace::DepthWhich::Final, std::move(report));
+      continue;
+    }
     // GL read the "after occluders" depth right after the last occluder draw.
     std::int64_t last_occluder = -1;
     for (std::size_t i = 0; i < f->draws.size(); ++i)

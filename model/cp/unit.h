@@ -19,6 +19,18 @@ struct CommandProcessorConfig {
   static void describe(config::Schema& s, CommandProcessorConfig& c);
 };
 
+class CommandProcessor;
+
+// What the command processor issues for one frame between FrameBegin and the snapshots/FrameEnd
+// when the model culls (model/cull/unit.h); without one it issues the recorded draws as they are.
+// Returns what it did, attached to the frame's FrameEnd.
+class FrameProgram {
+ public:
+  virtual ~FrameProgram() = default;
+  virtual std::shared_ptr<const cull::CullReport> run_frame(const std::shared_ptr<const trace::Frame>& frame,
+                                                            CommandProcessor& cp) = 0;
+};
+
 // Hands out the trace's frames one at a time (memory stays bounded by a frame); nullopt at the end.
 using FrameSource = std::function<std::optional<trace::Frame>()>;
 
@@ -29,11 +41,20 @@ class CommandProcessor : public sim::Unit {
   CommandProcessor(const sc_core::sc_module_name& name, stats::Registry& registry, const CommandProcessorConfig& config,
                    FrameSource source, float clear_depth);
 
+  // Culling modes: the program that issues each frame's draws (null: the recorded draws).
+  void set_program(FrameProgram* program) noexcept { program_ = program; }
+  // Issues one draw (command processing costs draw_overhead_cycles); from the CP's thread only.
+  void issue_draw(std::shared_ptr<Work> w);
+  // Issues a depth snapshot marker.
+  void issue_snapshot(const std::shared_ptr<const trace::Frame>& f, trace::DepthWhich which);
+
  private:
   void run();
   void issue();
   void send(WorkKind kind, const std::shared_ptr<const trace::Frame>& f, std::uint32_t draw = 0,
-            trace::DepthWhich which = trace::DepthWhich::Final);
+            trace::DepthWhich which = trace::DepthWhich::Final,
+            std::shared_ptr<const cull::CullReport> report = nullptr);
+  FrameProgram* program_ = nullptr;
   CommandProcessorConfig config_;
   FrameSource source_;
   float clear_depth_;

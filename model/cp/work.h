@@ -7,6 +7,7 @@
 #include <memory>
 #include <ostream>
 
+#include "model/cull/bounds.h"
 #include "traces/format/reader.h"
 
 namespace nbsim::cp {
@@ -25,8 +26,15 @@ struct Work {
   std::uint32_t draw = 0;                     // index into frame->draws (Draw)
   trace::DepthWhich which = trace::DepthWhich::Final;  // (Snapshot)
   float clear_depth = 1.0f;                            // (FrameBegin)
+  // Culling modes (model/cull): a draw the cull stage made itself (a bounding box), used instead
+  // of frame->draws[draw]; whether its depth writes feed the cull structure (N-buffer, Hi-Z); a
+  // ticket the cull stage waits on; and, on FrameEnd, what the cull stage did in the frame.
+  std::shared_ptr<const trace::DrawRecord> own;
+  bool feeds_cull = false;
+  std::uint64_t ticket = 0;
+  std::shared_ptr<const cull::CullReport> cull_report;
 
-  const trace::DrawRecord& record() const { return frame->draws[draw]; }
+  const trace::DrawRecord& record() const { return own ? *own : frame->draws[draw]; }
 };
 
 using WorkPtr = std::shared_ptr<const Work>;

@@ -89,13 +89,18 @@ struct CullReport {
   std::uint64_t found_visible = 0;    // candidates found visible
   std::uint64_t culled = 0;           // candidates not found visible
   std::uint64_t undrawable = 0;       // found visible but the trace holds no geometry for them
-  std::uint64_t lookups = 0;          // N-buffer / Hi-Z texels compared against (the query depth tests)
+  std::uint64_t box_depth_tests = 0;  // occlusion queries: depth tests of the rasterized boxes
+  std::uint64_t lookups = 0;          // N-buffer / Hi-Z texels compared against
+  std::uint64_t max_lookups = 0;      // most texels one bounds test compared against
   std::uint64_t update_texels = 0;    // N-buffer / Hi-Z texels recomputed from depth changes or rebuilt
   std::uint64_t clear_texels = 0;     // N-buffer texels filled by the frame's fast clear (not counted as work)
   bool has_truth = false;             // the frame has ground truth; the three below are meaningful
   std::uint64_t candidates_not_visible = 0;  // candidates with no visible pixel
   std::uint64_t false_culls = 0;             // culled candidates with visible pixels
   std::uint64_t crossing_near = 0;           // bounds tests that crossed the near plane (never culled)
+
+  // The depth tests spent on visibility queries (ARCHITECTURE.md: the paper-comparable count).
+  std::uint64_t query_depth_tests() const noexcept { return box_depth_tests + lookups; }
 };
 
 }  // namespace nbsim::cull

@@ -41,19 +41,25 @@ DepthUnit::DepthUnit(const sc_core::sc_module_name& name, stats::Registry& regis
   SC_THREAD(run);
 }
 
-void DepthUnit::test(const raster::BlockBatch& b, DrawResult& r) {
+Rect DepthUnit::test(const raster::BlockBatch& b, DrawResult& r) {
   const trace::DepthState& s = b.work->record().state;
   const raster::DepthState state{static_cast<raster::DepthFunc>(s.func), s.test, s.write && s.test};
   std::uint64_t miss_bytes = 0;
+  int x0 = width_, y0 = height_, x1 = 0, y1 = 0;
   for (const raster::Block& blk : b.blocks) {
     const std::uint64_t before = r.depth.written;
     test_.test_block(b.planes[blk.plane], blk.x, blk.y, blk.mask, state, r.depth);
+    if (r.depth.written != before) {
+      x0 = std::min(x0, blk.x), y0 = std::min(y0, blk.y);
+      x1 = std::max(x1, blk.x + 4), y1 = std::max(y1, blk.y + 4);
+    }
     const std::uint64_t line = static_cast<std::uint64_t>((blk.y >> 3) * tiles_x_ + (blk.x >> 3)) * 256u;
     const memory::Cache::Result c = cache_.access(line, r.depth.written != before);
     if (!c.hit) miss_bytes += 256, ++r.cache_misses;
     if (c.writeback) miss_bytes += 256;
   }
   r.memory_bytes = miss_bytes;
+  return x1 > x0 && y1 > y0 ? clip(Rect{x0, y0, x1 - x0, y1 - y0}, width_, height_) : Rect{};
 }
 
 void DepthUnit::run() {
@@ -65,6 +71,7 @@ void DepthUnit::run() {
         std::fill(buffer_.texels.begin(), buffer_.texels.end(), w.clear_depth);
         cache_.invalidate();  // a fast clear: cached tiles are dropped, not written back
         ++clears_;
+        if (listener_) listener_->depth_cleared(w.clear_depth);
         work(static_cast<std::uint64_t>(config_.clear_cycles));
         break;
       case cp::WorkKind::Draw: {
@@ -73,7 +80,8 @@ void DepthUnit::run() {
         r.setup = b->setup;
         r.tiles = b->tiles;
         const std::uint64_t h0 = cache_.hits(), m0 = cache_.misses(), wb0 = cache_.writebacks();
-        test(*b, r);
+        const Rect dirty = test(*b, r);
+        if (listener_ && !dirty.empty()) listener_->depth_written(w, buffer_, dirty);
         fragments_ += r.depth.fragments;
         tests_ += r.depth.depth_tests;
         passed_ += r.depth.passed;
@@ -91,6 +99,7 @@ void DepthUnit::run() {
           wait(sim::cycles(mem_done - now));
         }
         r.done_cycle = sim::now_cycles();
+        if (listener_) listener_->draw_finished(w, r);
         sink_.draw_done(w, r);
         break;
       }

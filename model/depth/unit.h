@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "model/config/schema.h"
+#include "model/common/rect.h"
 #include "model/memory/memory.h"
 #include "model/raster/depth_test.h"
 #include "model/raster/unit.h"
@@ -45,6 +46,17 @@ class ResultSink {
   virtual void stopped(std::uint64_t cycle) = 0;
 };
 
+// Culling modes: the cull stage (model/cull/unit.h) listens to the depth unit. It hears of every
+// clear, of the rectangle each draw may have changed (the 4x4 blocks that wrote a depth), and of
+// each draw's result before the ResultSink does. Calls come from the depth unit's thread.
+class DepthListener {
+ public:
+  virtual ~DepthListener() = default;
+  virtual void depth_cleared(float depth) = 0;
+  virtual void depth_written(const cp::Work& work, const DepthImage& depth, const Rect& dirty) = 0;
+  virtual void draw_finished(const cp::Work& work, const DrawResult& result) = 0;
+};
+
 class DepthUnit : public sim::Unit {
  public:
   sc_core::sc_fifo_in<raster::BlockBatchPtr> in;
@@ -53,10 +65,13 @@ class DepthUnit : public sim::Unit {
             int height_px, memory::Channel& memory, ResultSink& sink);
 
   const DepthImage& buffer() const noexcept { return buffer_; }
+  void set_listener(DepthListener* l) noexcept { listener_ = l; }
 
  private:
   void run();
-  void test(const raster::BlockBatch& b, DrawResult& r);
+  // Tests one draw's blocks; returns the bounding rectangle of the blocks that wrote a depth.
+  Rect test(const raster::BlockBatch& b, DrawResult& r);
+  DepthListener* listener_ = nullptr;
   DepthUnitConfig config_;
   int width_, height_, tiles_x_;
   DepthImage buffer_;

@@ -28,14 +28,15 @@ void NBufferUnit::wait_until(std::uint64_t done, stats::Counter& counter) {
   wait(sim::cycles(done - now));
 }
 
-void NBufferUnit::post(const UpdateWork& w) {
+UpdateWork NBufferUnit::post(UpdateWork w) {
   const std::uint64_t texels = w.recomputed();
   const std::uint64_t bytes = w.bytes_read + w.bytes_written;
-  if (texels == 0 && bytes == 0) return;
+  if (texels == 0 && bytes == 0) return w;
   queued_texels_ += texels;
   queued_bytes_ += bytes;
   ++posted_seq_;
   posted_.notify();
+  return w;
 }
 
 void NBufferUnit::engine() {
@@ -89,14 +90,16 @@ QueryAnswer NBufferUnit::query(const Rect& r, float nearest_depth, CoveringKind 
   return a;
 }
 
-void NBufferUnit::depth_changed(const DepthImage& depth, const Rect& dirty) { post(core_.depth_changed(depth, dirty)); }
+UpdateWork NBufferUnit::depth_changed(const DepthImage& depth, const Rect& dirty) {
+  return post(core_.depth_changed(depth, dirty));
+}
 
-void NBufferUnit::depth_changed(std::span<const PixelWrite> writes) { post(core_.depth_changed(writes)); }
+UpdateWork NBufferUnit::depth_changed(std::span<const PixelWrite> writes) { return post(core_.depth_changed(writes)); }
 
-void NBufferUnit::depth_cleared(float depth) { post(core_.depth_cleared(depth)); }
+UpdateWork NBufferUnit::depth_cleared(float depth) { return post(core_.depth_cleared(depth)); }
 
-void NBufferUnit::end_of_pass() { post(core_.end_of_pass()); }
+UpdateWork NBufferUnit::end_of_pass() { return post(core_.end_of_pass()); }
 
-void NBufferUnit::end_of_frame() { post(core_.end_of_frame()); }
+UpdateWork NBufferUnit::end_of_frame() { return post(core_.end_of_frame()); }
 
 }  // namespace nbsim::nbuffer

@@ -35,12 +35,13 @@ class NBufferUnit : public sim::Unit {
   // Waits until the update engine is idle.
   void drain();
 
-  // Non-blocking notifications from the depth unit and the command processor.
-  void depth_changed(const DepthImage& depth, const Rect& dirty);
-  void depth_changed(std::span<const PixelWrite> writes);
-  void depth_cleared(float depth);
-  void end_of_pass();
-  void end_of_frame();
+  // Non-blocking notifications from the depth unit and the command processor. Each returns the
+  // update work it handed to the engine (for counters; the engine turns it into cycles).
+  UpdateWork depth_changed(const DepthImage& depth, const Rect& dirty);
+  UpdateWork depth_changed(std::span<const PixelWrite> writes);
+  UpdateWork depth_cleared(float depth);
+  UpdateWork end_of_pass();
+  UpdateWork end_of_frame();
 
   const NBufferUnitCore& core() const noexcept { return core_; }
   NBufferUnitCore& core() noexcept { return core_; }
@@ -48,7 +49,7 @@ class NBufferUnit : public sim::Unit {
 
  private:
   void engine();  // SC_THREAD: the update engine
-  void post(const UpdateWork& w);
+  UpdateWork post(UpdateWork w);
   // Waits until `done` (a cycle), counting the wait in `counter`.
   void wait_until(std::uint64_t done, stats::Counter& counter);
 

@@ -1,8 +1,17 @@
-// `nbsim replay`, `nbsim compare` and `nbsim config`: the SystemC model from the command line.
+// `nbsim replay`, `nbsim compare`, `nbsim table2` and `nbsim config`: the SystemC model from the
+// command line. table2 runs one replay per culling mode, each in a child process of this executable
+// (SystemC allows one elaboration per process), and prints the paper's Table 2 beside ours.
 #include <fmt/format.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <memory>
+#include <optional>
 
 #include "model/common/error.h"
 #include "pipeline/cli/command.h"
@@ -37,6 +46,91 @@ struct ModelOptions {
     values = schema.values();
   }
 };
+
+// Table 2 of Décoret 2005: average depth comparisons per frame, city walkthrough at 512x512 with
+// back-face culling. Fixed by the paper; the Hi-Z baselines have no paper value.
+struct Table2Row {
+  const char* mode;
+  const char* paper_label;
+  std::optional<double> paper;
+};
+constexpr Table2Row kTable2[] = {
+    {"oq_hier", "occlusion queries with hierarchy", 1'100'000.0},
+    {"oq", "occlusion queries", 200'000.0},
+    {"nb_hier", "N-buffer with hierarchy", 350.0},
+    {"nb", "N-buffer", 500.0},
+    {"hiz_tile", "tile Hi-Z (baseline, not in the paper)", std::nullopt},
+    {"hiz_pyramid", "Hi-Z pyramid (baseline, not in the paper)", std::nullopt},
+};
+
+extern "C" char** environ;
+
+// Starts `nbsim replay TRACE --out DIR/MODE [config] --set cull.mode=MODE` with stdout and stderr
+// in DIR/MODE; returns the child's pid.
+pid_t spawn_replay(const std::string& trace, const std::filesystem::path& dir, const std::string& mode,
+                   const ModelOptions& mo) {
+  std::filesystem::create_directories(dir);
+  const std::string exe = std::filesystem::read_symlink("/proc/self/exe").string();
+  std::vector<std::string> args = {exe, "replay", trace, "--out", dir.string()};
+  if (!mo.config_file.empty()) args.insert(args.end(), {"--config", mo.config_file});
+  for (const auto& s : mo.sets) args.insert(args.end(), {"--set", s});
+  args.insert(args.end(), {"--set", "cull.mode=" + mode});
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, (dir / "stdout.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&fa, STDERR_FILENO, (dir / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) throw std::runtime_error(fmt::format("cannot start '{}': {}", exe, std::strerror(rc)));
+  return pid;
+}
+
+// Runs every Table 2 mode, `parallel` children at a time; returns each mode's run.json summary.
+std::vector<nlohmann::json> run_table2(const std::string& trace, const std::filesystem::path& out, const ModelOptions& mo,
+                                       int parallel) {
+  const std::size_t n = std::size(kTable2);
+  std::vector<nlohmann::json> results(n);
+  std::vector<std::pair<pid_t, std::size_t>> running;
+  std::size_t next = 0;
+  std::string failures;
+  const auto reap = [&] {
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, 0);
+    if (pid < 0) throw std::runtime_error("waitpid failed");
+    for (auto it = running.begin(); it != running.end(); ++it) {
+      if (it->first != pid) continue;
+      const std::size_t i = it->second;
+      running.erase(it);
+      const std::filesystem::path dir = out / kTable2[i].mode;
+      if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        std::ifstream e(dir / "stderr.txt");
+        const std::string err((std::istreambuf_iterator<char>(e)), {});
+        failures += fmt::format("cull.mode={}: replay failed: {}\n", kTable2[i].mode, err);
+        return;
+      }
+      std::ifstream in(dir / "run.json");
+      const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+      if (j.is_discarded() || !j.contains("summary") || !j["summary"].contains("cull"))
+        failures += fmt::format("cull.mode={}: {}/run.json has no cull summary\n", kTable2[i].mode, dir.string());
+      else
+        results[i] = j["summary"];
+      return;
+    }
+  };
+  while (next < n || !running.empty()) {
+    while (next < n && static_cast<int>(running.size()) < parallel) {
+      running.emplace_back(spawn_replay(trace, out / kTable2[next].mode, kTable2[next].mode, mo), next);
+      ++next;
+    }
+    reap();
+  }
+  if (!failures.empty()) throw InputError(failures.substr(0, failures.size() - 1));
+  return results;
+}
 
 }  // namespace
 
@@ -101,6 +195,84 @@ void add_model_commands(CLI::App& app, Action& action) {
           fmt::print("  {}\n", s.within_thresholds() ? "within the thresholds" : "OUTSIDE the thresholds");
         }
         return s.within_thresholds() ? 0 : 1;
+      };
+    });
+  }
+  {
+    auto* cmd = app.add_subcommand("table2", "Replay in every culling mode and print the paper's Table 2 beside ours");
+    auto trace = std::make_shared<std::string>();
+    auto out = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    auto jobs = std::make_shared<int>(2);
+    auto mo = std::make_shared<ModelOptions>();
+    cmd->add_option("TRACE", *trace, "Trace file (nbsim capture) with scene objects and ground truth")->required();
+    cmd->add_option("--out", *out, "Keep each mode's replay outputs in OUT/MODE (default: a temporary folder, removed)");
+    cmd->add_flag("--json", *json, "Print a JSON list, one object per mode");
+    cmd->add_option("--jobs", *jobs, "Replays run at a time (one process each)")->check(CLI::Range(1, 16));
+    mo->add_options(cmd);
+    cmd->footer("Modes: oq_hier, oq, nb_hier, nb (the paper's rows), hiz_tile, hiz_pyramid. Query depth tests are the\n"
+                "paper's count (box fragments, or N-buffer/Hi-Z texels compared); the total adds the N-buffer/Hi-Z\n"
+                "update texels and the depth tests of the drawn objects. Exit 1 when any mode has a false cull.");
+    cmd->callback([&action, trace, out, json, jobs, mo] {
+      action = [trace, out, json, jobs, mo] {
+        {  // refuse a bad config here, before any child starts
+          pipeline::GpuConfig c;
+          nlohmann::ordered_json values;
+          mo->apply(c, values);
+        }
+        if (!std::filesystem::exists(*trace)) throw InputError(fmt::format("trace '{}' does not exist", *trace));
+        std::filesystem::path dir;
+        const bool temporary = out->empty();
+        if (temporary) {
+          std::string tmpl = (std::filesystem::temp_directory_path() / "nbsim_table2_XXXXXX").string();
+          if (!mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary folder");
+          dir = tmpl;
+        } else {
+          dir = *out;
+        }
+        std::vector<nlohmann::json> rows;
+        try {
+          rows = run_table2(std::filesystem::absolute(*trace).string(), dir, *mo, *jobs);
+        } catch (...) {
+          if (temporary) std::filesystem::remove_all(dir);
+          throw;
+        }
+        if (temporary) std::filesystem::remove_all(dir);
+        nlohmann::ordered_json list = nlohmann::ordered_json::array();
+        std::uint64_t false_culls = 0;
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+          const nlohmann::json& c = rows[i]["cull"];
+          nlohmann::ordered_json r;
+          r["mode"] = kTable2[i].mode;
+          r["paper"] = kTable2[i].paper_label;
+          r["paper_depth_tests_per_frame"] = kTable2[i].paper ? nlohmann::ordered_json(*kTable2[i].paper) : nullptr;
+          for (const char* k : {"query_depth_tests_per_frame", "update_texels_per_frame", "total_depth_tests_per_frame",
+                                "cycles_per_frame", "false_culls", "culling_efficiency", "frames", "bounds_tests",
+                                "candidates", "culled", "candidates_not_visible", "undrawable", "max_lookups_per_test"})
+            r[k] = c[k];
+          r["host_seconds"] = rows[i]["host_seconds"];
+          false_culls += c["false_culls"].get<std::uint64_t>();
+          list.push_back(std::move(r));
+        }
+        if (*json) {
+          fmt::print("{}\n", list.dump());
+        } else {
+          fmt::print("Table 2: average depth comparisons per frame ({}, {} frames)\n", *trace, list[0]["frames"].get<std::uint64_t>());
+          fmt::print("{:<12} {:>12} {:>14} {:>14} {:>14} {:>12} {:>6} {:>8} {:>7}\n", "mode", "paper", "query tests",
+                     "update texels", "total tests", "cycles", "false", "culling", "undraw");
+          for (const auto& r : list)
+            fmt::print("{:<12} {:>12} {:>14.1f} {:>14.1f} {:>14.1f} {:>12.0f} {:>6} {:>7.1f}% {:>7}\n", r["mode"].get<std::string>(),
+                       r["paper_depth_tests_per_frame"].is_null() ? std::string("-")
+                                                                  : fmt::format("{:.0f}", r["paper_depth_tests_per_frame"].get<double>()),
+                       r["query_depth_tests_per_frame"].get<double>(), r["update_texels_per_frame"].get<double>(),
+                       r["total_depth_tests_per_frame"].get<double>(), r["cycles_per_frame"].get<double>(),
+                       r["false_culls"].get<std::uint64_t>(), 100.0 * r["culling_efficiency"].get<double>(),
+                       r["undrawable"].get<std::uint64_t>());
+          const double oq = list[1]["query_depth_tests_per_frame"].get<double>(), nb = list[3]["query_depth_tests_per_frame"].get<double>();
+          fmt::print("occlusion queries / N-buffer query depth tests: {:.0f}x (paper: 400x); false culls: {}\n",
+                     nb > 0 ? oq / nb : 0.0, false_culls);
+        }
+        return false_culls == 0 ? 0 : 1;
       };
     });
   }

@@ -1,6 +1,8 @@
 // The replay model's top level; see gpu.h.
 #include "pipeline/sim/gpu.h"
 
+#include "model/common/error.h"
+
 namespace nbsim::pipeline {
 
 void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
@@ -11,11 +13,14 @@ void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
   s.add("memory.bandwidth_bytes_per_cycle", c.memory.bandwidth_bytes_per_cycle, "bytes/cycle",
         "sustained bandwidth shared by every client", 0.01, 1e6);
   s.add("memory.latency_cycles", c.memory.latency_cycles, "cycles", "from request to data", 0, 100000);
+  cull::CullUnitConfig::describe(s, c.cull);
+  nbuffer::NBufferUnitConfig::describe(s, c.nbuffer);
+  HiZUnitConfig::describe(s, c.hiz);
   s.add("gpu.fifo_depth", c.fifo_depth, "work items", "depth of the fifos between units", 1, 4096);
 }
 
 Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& c, int width_px, int height_px,
-         cp::FrameSource source, float clear_depth, depth::ResultSink& sink)
+         cp::FrameSource source, float clear_depth, depth::ResultSink& sink, const cull::CullSetup* cull)
     : sc_core::sc_module(name),
       memory_(c.memory),
       cp_to_geometry_("cp_to_geometry", c.fifo_depth),
@@ -31,6 +36,12 @@ Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const G
   raster_.in(geometry_to_raster_);
   raster_.out(raster_to_depth_);
   depth_.in(raster_to_depth_);
+  if (c.cull.parsed_mode() != cull::CullMode::Trace) {
+    NBSIM_CHECK(cull != nullptr, "a culling mode needs the cull setup");
+    cull_ = std::make_unique<cull::CullUnit>("cull", registry, c.cull, c.nbuffer, c.hiz, *cull, memory_, depth_.buffer());
+    cp_.set_program(cull_.get());
+    depth_.set_listener(cull_.get());
+  }
 }
 
 }  // namespace nbsim::pipeline

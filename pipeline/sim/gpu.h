@@ -3,14 +3,18 @@
 // *_top.cpp of the SystemC TLM examples. It only wires; the units do the work.
 //
 //   trace frames --> [cp] --fifo--> [geometry] --fifo--> [raster] --fifo--> [depth] --> ResultSink
-//                                                                              |
-//                                                                        [memory channel]
+//                     ^                                                        |
+//                     |  frame program                 clears, dirty rects,    +- [memory channel]
+//                   [cull] <-------------------------- draw results -----------+        |
+//                     +-- [nbuffer] (nb modes) / tile Hi-Z / Hi-Z pyramid ---------------+
+// The cull stage exists only when cull.mode is not "trace" (model/cull/unit.h).
 #pragma once
 
 #include <memory>
 
 #include "model/config/schema.h"
 #include "model/cp/unit.h"
+#include "model/cull/unit.h"
 #include "model/depth/unit.h"
 #include "model/geometry/unit.h"
 #include "model/memory/memory.h"
@@ -24,18 +28,23 @@ struct GpuConfig {
   raster::RasterUnitConfig raster;
   depth::DepthUnitConfig depth;
   memory::ChannelConfig memory;
+  cull::CullUnitConfig cull;
+  nbuffer::NBufferUnitConfig nbuffer;  // used by the nb culling modes
+  HiZUnitConfig hiz;                   // used by the hiz culling modes
   int fifo_depth = 4;  // work items between two units; tunable
 
-  // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "gpu.").
+  // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.",
+  // "nbuffer.", "hiz.", "gpu.").
   static void describe(config::Schema& s, GpuConfig& c);
 };
 
 class Gpu : public sc_core::sc_module {
  public:
   Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& config, int width_px, int height_px,
-      cp::FrameSource source, float clear_depth, depth::ResultSink& sink);
+      cp::FrameSource source, float clear_depth, depth::ResultSink& sink, const cull::CullSetup* cull = nullptr);
 
   const memory::Channel& memory() const noexcept { return memory_; }
+  const cull::CullUnit* cull() const noexcept { return cull_.get(); }
 
  private:
   memory::Channel memory_;
@@ -46,6 +55,7 @@ class Gpu : public sc_core::sc_module {
   geometry::GeometryUnit geometry_;
   raster::RasterUnit raster_;
   depth::DepthUnit depth_;
+  std::unique_ptr<cull::CullUnit> cull_;  // culling modes only
 };
 
 }  // namespace nbsim::pipeline

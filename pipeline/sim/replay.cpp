@@ -27,6 +27,70 @@ const char* role_name(trace::DrawRole r) {
   return "?";
 }
 
+// What the cull stage did over the whole replay (culling modes).
+struct CullTotals {
+  std::string mode;
+  std::uint64_t frames = 0, frames_with_truth = 0;
+  std::uint64_t query_depth_tests = 0, box_depth_tests = 0, lookups = 0, max_lookups = 0;
+  std::uint64_t update_texels = 0, clear_texels = 0, drawn_depth_tests = 0, cycles = 0;
+  std::uint64_t in_frustum = 0, occluders = 0, candidates = 0, bounds_tests = 0, node_tests = 0, crossing_near = 0;
+  std::uint64_t found_visible = 0, culled = 0, undrawable = 0, candidates_not_visible = 0, false_culls = 0;
+
+  void add(const cull::CullReport& r, std::uint64_t frame_depth_tests, std::uint64_t frame_cycles) {
+    ++frames;
+    frames_with_truth += r.has_truth ? 1 : 0;
+    query_depth_tests += r.query_depth_tests();
+    box_depth_tests += r.box_depth_tests;
+    lookups += r.lookups;
+    max_lookups = std::max(max_lookups, r.max_lookups);
+    update_texels += r.update_texels;
+    clear_texels += r.clear_texels;
+    drawn_depth_tests += frame_depth_tests - r.box_depth_tests;  // occluders and visible objects
+    cycles += frame_cycles;
+    in_frustum += r.in_frustum, occluders += r.occluders, candidates += r.candidates;
+    bounds_tests += r.bounds_tests, node_tests += r.node_tests, crossing_near += r.crossing_near;
+    found_visible += r.found_visible, culled += r.culled, undrawable += r.undrawable;
+    candidates_not_visible += r.candidates_not_visible, false_culls += r.false_culls;
+  }
+
+  std::uint64_t total_depth_tests() const { return query_depth_tests + update_texels + drawn_depth_tests; }
+
+  nlohmann::ordered_json to_json() const {
+    const auto per_frame = [this](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
+    nlohmann::ordered_json j;
+    j["mode"] = mode;
+    j["frames"] = frames;
+    j["query_depth_tests"] = query_depth_tests;
+    j["query_depth_tests_per_frame"] = per_frame(query_depth_tests);
+    j["box_depth_tests"] = box_depth_tests;
+    j["lookups"] = lookups;
+    j["max_lookups_per_test"] = max_lookups;
+    j["update_texels"] = update_texels;
+    j["update_texels_per_frame"] = per_frame(update_texels);
+    j["clear_texels_per_frame"] = per_frame(clear_texels);
+    j["drawn_depth_tests"] = drawn_depth_tests;
+    j["drawn_depth_tests_per_frame"] = per_frame(drawn_depth_tests);
+    j["total_depth_tests"] = total_depth_tests();
+    j["total_depth_tests_per_frame"] = per_frame(total_depth_tests());
+    j["cycles"] = cycles;
+    j["cycles_per_frame"] = per_frame(cycles);
+    j["in_frustum"] = in_frustum;
+    j["occluders"] = occluders;
+    j["candidates"] = candidates;
+    j["bounds_tests"] = bounds_tests;
+    j["node_tests"] = node_tests;
+    j["crossing_near"] = crossing_near;
+    j["found_visible"] = found_visible;
+    j["culled"] = culled;
+    j["undrawable"] = undrawable;
+    j["frames_with_truth"] = frames_with_truth;
+    j["candidates_not_visible"] = candidates_not_visible;
+    j["false_culls"] = false_culls;
+    j["culling_efficiency"] = candidates_not_visible ? static_cast<double>(culled) / static_cast<double>(candidates_not_visible) : 1.0;
+    return j;
+  }
+};
+
 // Collects the depth unit's results, compares them with GL's, and writes the CSV files.
 class Collector : public depth::ResultSink {
  public:
@@ -84,8 +148,21 @@ class Collector : public depth::ResultSink {
       frames_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, frame_.draws, frame_.fragments_model,
                              frame_.fragments_gl, frame_.passed_model, frame_.passed_gl, frame_.depth_tests,
                              frame_.depth_matching, frame_.depth_pixels, cycle, cycle - last_cycle_);
-    per_frame_.push_back({{"frame", w.frame->begin.frame}, {"draws", frame_.draws}, {"depth_tests", frame_.depth_tests},
-                          {"cycles", cycle - last_cycle_}});
+    nlohmann::ordered_json pf = {{"frame", w.frame->begin.frame}, {"draws", frame_.draws}, {"depth_tests", frame_.depth_tests},
+                                 {"cycles", cycle - last_cycle_}};
+    if (const cull::CullReport* r = w.cull_report.get()) {
+      cull.add(*r, frame_.depth_tests, cycle - last_cycle_);
+      pf["query_depth_tests"] = r->query_depth_tests();
+      pf["update_texels"] = r->update_texels;
+      pf["total_depth_tests"] = r->query_depth_tests() + r->update_texels + (frame_.depth_tests - r->box_depth_tests);
+      pf["bounds_tests"] = r->bounds_tests;
+      pf["candidates"] = r->candidates;
+      pf["culled"] = r->culled;
+      pf["candidates_not_visible"] = r->candidates_not_visible;
+      pf["false_culls"] = r->false_culls;
+      pf["undrawable"] = r->undrawable;
+    }
+    per_frame_.push_back(std::move(pf));
     last_cycle_ = cycle;
     for (const auto& d : w.frame->draws)
       if (d.clip_positions.empty()) ++s_.passes_not_replayed;
@@ -96,6 +173,7 @@ class Collector : public depth::ResultSink {
   void stopped(std::uint64_t cycle) override { s_.cycles = cycle; }
 
   std::uint64_t total_frames = 0;
+  CullTotals cull;
   nlohmann::ordered_json per_frame_ = nlohmann::ordered_json::array();
 
  private:
@@ -147,6 +225,7 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   j["depth_tests_per_host_second"] = host_seconds > 0 ? static_cast<double>(depth_tests) / host_seconds : 0.0;
   j["cycles_per_host_second"] = host_seconds > 0 ? static_cast<double>(cycles) / host_seconds : 0.0;
   j["within_thresholds"] = within_thresholds();
+  if (!cull.is_null()) j["cull"] = cull;
   return j;
 }
 
@@ -171,12 +250,30 @@ ReplaySummary replay(const ReplayOptions& o) {
   if (nframes) sink.total_frames = std::strtoull(nframes->c_str(), nullptr, 10);
   stats::Registry registry;
   sim::install_report_handler();
-  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink);
+  // The cull stage's view of the trace (culling modes only read it).
+  const auto number = [&tr](const char* key, double fallback) {
+    const std::string* v = tr.property(key);
+    return v ? std::strtod(v->c_str(), nullptr) : fallback;
+  };
+  const std::string* func = tr.property("depth_func");
+  const std::string* clip_control = tr.property("clip_control");
+  cull::CullSetup setup;
+  setup.width_px = w;
+  setup.height_px = h;
+  setup.op = func && (*func == "GREATER" || *func == "GEQUAL") ? FarOp::Min : FarOp::Max;
+  setup.depth_func = setup.op == FarOp::Min ? trace::DepthFunc::Greater : trace::DepthFunc::Less;
+  setup.near_m = number("near", 0.0);
+  setup.nearest_margin = number("nearest_margin", 0.0);
+  setup.zero_to_one = clip_control && *clip_control == "ZERO_TO_ONE";
+  setup.scene = tr.scene();
+  sink.cull.mode = o.config.cull.mode;
+  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, &setup);
   const auto t0 = std::chrono::steady_clock::now();
   sc_core::sc_start();
   sim::rethrow_thread_failure();  // a damaged trace read mid-run, as an InputError
   s.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.stats = registry.values();
+  if (o.config.cull.parsed_mode() != cull::CullMode::Trace) s.cull = sink.cull.to_json();
 
   if (o.out) {
     nlohmann::ordered_json run;

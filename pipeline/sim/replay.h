@@ -38,6 +38,9 @@ struct ReplaySummary {
   std::uint64_t cycles = 0;
   double host_seconds = 0.0;
   nlohmann::ordered_json stats;  // every unit's statistics
+  // Culling modes (cull.mode other than trace): totals and per-frame averages of the cull stage,
+  // Table 2's columns among them (see CullTotals in replay.cpp); null otherwise.
+  nlohmann::ordered_json cull;
 
   double fragment_error() const;  // |model - gl| / gl over all draws
   double passed_error() const;

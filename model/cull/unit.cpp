@@ -1,0 +1,277 @@
+// CullUnit: the cull stage's frame program, query units and counters; see unit.h.
+#include "model/cull/unit.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "model/common/error.h"
+
+namespace nbsim::cull {
+
+void CullUnitConfig::describe(config::Schema& s, CullUnitConfig& c) {
+  s.add("cull.mode", c.mode,
+        "trace replays the recorded draws; the others cull every candidate object themselves: none (draw all), oq, "
+        "oq_hier (occlusion queries, flat or over the BVH), nb, nb_hier (N-buffer unit), hiz_tile, hiz_pyramid",
+        {"trace", "none", "oq", "oq_hier", "nb", "nb_hier", "hiz_tile", "hiz_pyramid"});
+  s.add("cull.bounds_tests_per_cycle", c.bounds_tests_per_cycle, "tests/cycle", "object or node bounds projected a cycle",
+        0.01, 1024.0);
+  s.add("cull.bounds_latency_cycles", c.bounds_latency_cycles, "cycles", "latency of a batch of bounds tests", 0, 100000);
+  s.add("cull.hiz_lookups_per_cycle", c.hiz_lookups_per_cycle, "texels/cycle", "Hi-Z texels compared a cycle", 0.01, 1024.0);
+  s.add("cull.hiz_lookup_latency_cycles", c.hiz_lookup_latency_cycles, "cycles", "latency of one Hi-Z query", 0, 100000);
+  s.add("cull.hiz_build_texels_per_cycle", c.hiz_build_texels_per_cycle, "texels/cycle",
+        "Hi-Z texels recomputed a cycle (tile updates, pyramid rebuild)", 0.01, 1024.0);
+  s.add("cull.hiz_build_latency_cycles", c.hiz_build_latency_cycles, "cycles", "latency of one Hi-Z update or rebuild", 0,
+        100000);
+}
+
+CullMode CullUnitConfig::parsed_mode() const {
+  const auto m = parse_cull_mode(mode);
+  if (!m) throw InputError(fmt::format("cull.mode: unknown mode '{}'", mode));
+  return *m;
+}
+
+CullUnit::CullUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const CullUnitConfig& config,
+                   const nbuffer::NBufferUnitConfig& nbuffer, const HiZUnitConfig& hiz, const CullSetup& setup,
+                   memory::Channel& memory, const DepthImage& depth_buffer)
+    : sim::Unit(name, registry),
+      config_(config),
+      mode_(config.parsed_mode()),
+      setup_(setup),
+      hiz_(hiz),
+      depth_buffer_(depth_buffer),
+      frames_(stats().counter("frames", "frames", "frames culled")),
+      candidates_(stats().counter("candidates", "objects", "objects in the frustum that are not occluders")),
+      bounds_tests_(stats().counter("bounds_tests", "tests", "object and BVH node bounds tested")),
+      node_tests_(stats().counter("node_tests", "tests", "of those, BVH node bounds")),
+      lookups_(stats().counter("lookups", "texels", "N-buffer or Hi-Z texels compared against (query depth tests)")),
+      box_depth_tests_(stats().counter("box_depth_tests", "tests", "depth tests of occlusion-query boxes")),
+      update_texels_(stats().counter("update_texels", "texels", "N-buffer or Hi-Z texels recomputed or rebuilt")),
+      culled_(stats().counter("culled", "objects", "candidates not found visible")),
+      undrawable_(stats().counter("undrawable", "objects", "found visible but without recorded geometry in the trace")),
+      false_culls_(stats().counter("false_culls", "objects", "culled candidates that ground truth shows visible")) {
+  if (mode_ == CullMode::Trace) throw InputError("cull.mode=trace replays the recorded draws: no cull stage");
+  if (!setup_.scene || setup_.scene->objects.empty())
+    throw InputError(fmt::format("cull.mode={} needs the trace's scene objects (SCEN chunk)", to_string(mode_)));
+  if (mode_ == CullMode::Nb || mode_ == CullMode::NbHier)
+    nb_ = std::make_unique<nbuffer::NBufferUnit>("nbuffer", registry, nbuffer, setup.width_px, setup.height_px, setup.op,
+                                                 &memory);
+  if (mode_ == CullMode::HizTile || mode_ == CullMode::HizPyramid) hiz_.validate();
+  if (mode_ == CullMode::HizTile) tile_.emplace(setup.width_px, setup.height_px, hiz_.tile(setup.op));
+}
+
+CullUnit::~CullUnit() = default;
+
+std::uint64_t CullUnit::issue(cp::CommandProcessor& cp, std::shared_ptr<cp::Work> w, bool wants_result) {
+  w->ticket = ++issued_;
+  if (wants_result) results_[w->ticket] = {};
+  cp.issue_draw(std::move(w));
+  return issued_;
+}
+
+void CullUnit::wait_all() {
+  while (completed_ < issued_ || clears_ < frames_begun_) wait(completed_event_);
+}
+
+void CullUnit::draw_finished(const cp::Work& w, const depth::DrawResult& r) {
+  ++completed_;
+  const auto it = results_.find(w.ticket);
+  if (it != results_.end()) it->second = {r.depth.depth_tests, r.depth.passed};
+  completed_event_.notify(sc_core::SC_ZERO_TIME);
+}
+
+void CullUnit::depth_cleared(float depth) {
+  ++clears_;
+  completed_event_.notify(sc_core::SC_ZERO_TIME);
+  if (nb_) pending_clear_texels_ += nb_->depth_cleared(depth).recomputed();
+  if (tile_) tile_->clear(depth);
+}
+
+void CullUnit::depth_written(const cp::Work& w, const DepthImage& depth, const Rect& dirty) {
+  if (!w.feeds_cull) return;
+  if (nb_) pending_update_texels_ += nb_->depth_changed(depth, dirty).recomputed();
+  if (tile_) pending_update_texels_ += tile_->update(depth, dirty).pixels_read;
+}
+
+void CullUnit::prepare(CullReport& r) {
+  if (nb_) pending_update_texels_ += nb_->end_of_pass().recomputed();
+  if (tile_ && pending_update_texels_)
+    work(sim::batch_cycles(pending_update_texels_, config_.hiz_build_texels_per_cycle, config_.hiz_build_latency_cycles));
+  if (mode_ == CullMode::HizPyramid) {
+    pyramid_.emplace(depth_buffer_, hiz_.pyramid(setup_.op));
+    std::uint64_t texels = 0;
+    for (int k = 0; k < pyramid_->level_count(); ++k)
+      texels += static_cast<std::uint64_t>(pyramid_->level_width(k)) * static_cast<std::uint64_t>(pyramid_->level_height(k));
+    pending_update_texels_ += texels;
+    work(sim::batch_cycles(texels, config_.hiz_build_texels_per_cycle, config_.hiz_build_latency_cycles));
+  }
+  r.update_texels += pending_update_texels_;
+  r.clear_texels += pending_clear_texels_;
+  update_texels_ += pending_update_texels_;
+  pending_update_texels_ = pending_clear_texels_ = 0;
+}
+
+void CullUnit::test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const trace::Frame>& f, const FrameView& v,
+                          const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests, CullReport& r) {
+  const trace::SceneObjects& s = *setup_.scene;
+  std::vector<std::uint64_t> tickets(items.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    auto d = std::make_shared<trace::DrawRecord>();
+    d->role = items[i].node >= 0 ? trace::DrawRole::NodeQuery : trace::DrawRole::BoundsQuery;
+    d->object = items[i].object;
+    d->node = items[i].node;
+    d->state.func = setup_.depth_func;
+    d->state.write = false;
+    d->state.test = true;
+    d->state.cull = trace::CullFace::Back;
+    d->state.front_ccw = true;
+    d->state.clip = setup_.zero_to_one ? trace::ClipControl::ZeroToOne : trace::ClipControl::NegativeOneToOne;
+    const trace::Aabb& b = items[i].node >= 0 ? s.node_bounds[static_cast<std::size_t>(items[i].node)]
+                                              : s.objects[static_cast<std::size_t>(items[i].object)];
+    box_clip_positions(b, v, d->clip_positions);
+    d->has_bounds = true;
+    d->bounds = tests[i];
+    auto w = std::make_shared<cp::Work>();
+    w->frame = f;
+    w->own = std::move(d);
+    tickets[i] = issue(cp, std::move(w), true);
+  }
+  wait_all();  // the occlusion query's round trip: results are needed before the next decision
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const auto it = results_.find(tickets[i]);
+    NBSIM_CHECK(it != results_.end(), "an occlusion query's result went missing");
+    r.box_depth_tests += it->second.depth_tests;
+    tests[i].visible = tests[i].crosses_near || it->second.passed > 0;
+    results_.erase(it);
+  }
+}
+
+void CullUnit::test_lookups(const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests, CullReport& r) {
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    trace::BoundsTest& t = tests[i];
+    if (t.crosses_near) {
+      t.visible = true;
+      continue;
+    }
+    if (t.w <= 0 || t.h <= 0) {  // off-screen bounds: nothing to draw
+      t.visible = false;
+      continue;
+    }
+    const Rect rect{t.x, t.y, t.w, t.h};
+    const std::uint64_t before = r.lookups;
+    if (nb_) {
+      const nbuffer::QueryAnswer a = nb_->query(rect, t.nearest_depth);
+      r.lookups += static_cast<std::uint64_t>(a.lookups);
+      r.update_texels += a.update.recomputed();
+      update_texels_ += a.update.recomputed();
+      t.visible = !a.hidden;
+    } else if (tile_) {
+      const TileHiZAnswer a = tile_->query(rect, t.nearest_depth);
+      r.lookups += static_cast<std::uint64_t>(a.lookups);
+      t.visible = !a.hidden;
+      work(sim::batch_cycles(static_cast<std::uint64_t>(a.lookups), config_.hiz_lookups_per_cycle,
+                             config_.hiz_lookup_latency_cycles));
+    } else {
+      NBSIM_CHECK(pyramid_.has_value(), "Hi-Z pyramid queried before it was built");
+      const QueryResult q = pyramid_->query(rect);
+      r.lookups += static_cast<std::uint64_t>(q.texel_count);
+      t.visible = !(q.complete && nbuffer::hidden_behind(setup_.op, t.nearest_depth, q.value));
+      work(sim::batch_cycles(static_cast<std::uint64_t>(q.texel_count), config_.hiz_lookups_per_cycle,
+                             config_.hiz_lookup_latency_cycles));
+    }
+    r.max_lookups = std::max(r.max_lookups, r.lookups - before);
+  }
+}
+
+std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<const trace::Frame>& f, cp::CommandProcessor& cp) {
+  ++frames_begun_;  // the command processor has sent this frame's FrameBegin (a clear)
+  auto report = std::make_shared<CullReport>();
+  CullReport& r = *report;
+  r.mode = mode_;
+  const trace::SceneObjects& s = *setup_.scene;
+  const FrameView v = FrameView::make(f->begin, setup_.width_px, setup_.height_px, setup_.near_m, setup_.nearest_margin,
+                                      setup_.zero_to_one, setup_.op == FarOp::Min);
+  const std::vector<std::uint32_t> in_frustum = frustum_objects(s, v);
+
+  // The recorded geometry of each object (an Occluder or Visible draw), and this frame's occluders.
+  std::vector<std::int64_t> geometry(s.objects.size(), -1);
+  std::vector<char> is_occluder(s.objects.size(), 0);
+  for (std::size_t i = 0; i < f->draws.size(); ++i) {
+    const trace::DrawRecord& d = f->draws[i];
+    if (d.object < 0 || static_cast<std::size_t>(d.object) >= s.objects.size() || d.clip_positions.empty()) continue;
+    if (d.role != trace::DrawRole::Occluder && d.role != trace::DrawRole::Visible) continue;
+    geometry[static_cast<std::size_t>(d.object)] = static_cast<std::int64_t>(i);
+    if (d.role == trace::DrawRole::Occluder) is_occluder[static_cast<std::size_t>(d.object)] = 1;
+  }
+
+  // 1. The occluders, in the recorded order; their depth writes feed the cull structure.
+  for (std::size_t i = 0; i < f->draws.size(); ++i) {
+    const trace::DrawRecord& d = f->draws[i];
+    if (d.role != trace::DrawRole::Occluder || d.clip_positions.empty()) continue;
+    auto w = std::make_shared<cp::Work>();
+    w->frame = f;
+    w->draw = static_cast<std::uint32_t>(i);
+    w->feeds_cull = true;
+    issue(cp, std::move(w), false);
+  }
+  cp.issue_snapshot(f, trace::DepthWhich::AfterOccluders);
+  wait_all();
+  prepare(r);
+
+  // 2. Bounds tests of the candidates.
+  const BatchTester tester = [&](const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests) {
+    r.bounds_tests += items.size();
+    for (const TestItem& it : items) r.node_tests += it.node >= 0 ? 1 : 0;
+    for (const trace::BoundsTest& t : tests) r.crossing_near += t.crosses_near ? 1 : 0;
+    if (mode_ == CullMode::None) {
+      for (trace::BoundsTest& t : tests) t.visible = true;
+      return;
+    }
+    work(sim::batch_cycles(items.size(), config_.bounds_tests_per_cycle, config_.bounds_latency_cycles));
+    if (mode_ == CullMode::Oq || mode_ == CullMode::OqHier)
+      test_boxes(cp, f, v, items, tests, r);
+    else
+      test_lookups(items, tests, r);
+  };
+  const std::vector<char> visible = find_visible(s, v, in_frustum, is_occluder, hierarchical(mode_), tester);
+
+  // 3. The objects found visible, with the geometry the trace recorded for them.
+  const trace::GroundTruth* truth = f->truth ? &*f->truth : nullptr;
+  r.has_truth = truth && truth->visible_pixels.size() >= s.objects.size();
+  r.in_frustum = in_frustum.size();
+  for (auto o : in_frustum) {
+    if (is_occluder[o]) {
+      ++r.occluders;
+      continue;
+    }
+    ++r.candidates;
+    const bool truly_visible = r.has_truth && truth->visible_pixels[o] > 0;
+    if (r.has_truth && !truly_visible) ++r.candidates_not_visible;
+    if (!visible[o]) {
+      ++r.culled;
+      if (truly_visible) ++r.false_culls;
+      continue;
+    }
+    ++r.found_visible;
+    if (geometry[o] < 0) {
+      ++r.undrawable;
+      continue;
+    }
+    auto w = std::make_shared<cp::Work>();
+    w->frame = f;
+    w->draw = static_cast<std::uint32_t>(geometry[o]);
+    issue(cp, std::move(w), false);
+  }
+  ++frames_;
+  candidates_ += r.candidates;
+  bounds_tests_ += r.bounds_tests;
+  node_tests_ += r.node_tests;
+  lookups_ += r.lookups;
+  box_depth_tests_ += r.box_depth_tests;
+  culled_ += r.culled;
+  undrawable_ += r.undrawable;
+  false_culls_ += r.false_culls;
+  return report;
+}
+
+}  // namespace nbsim::cull
