@@ -35,6 +35,7 @@ void CommandProcessor::send(WorkKind kind, const std::shared_ptr<const trace::Fr
 
 void CommandProcessor::issue_draw(std::shared_ptr<Work> w) {
   ++draws_;
+  label_with([&] { return timeline_label(*w); });
   work(static_cast<std::uint64_t>(config_.draw_overhead_cycles));
   w->kind = WorkKind::Draw;
   w->clear_depth = clear_depth_;
@@ -74,6 +75,7 @@ void CommandProcessor::issue() {
         ++skipped_;
       } else {
         ++draws_;
+        label_with([&] { return fmt::format("frame {} draw {} ({})", f->begin.frame, d.index, trace::to_string(d.role)); });
         work(static_cast<std::uint64_t>(config_.draw_overhead_cycles));
         send(WorkKind::Draw, f, static_cast<std::uint32_t>(i));
       }

@@ -6,8 +6,12 @@
 #include <cstdint>
 #include <memory>
 #include <ostream>
+#include <string>
+
+#include <fmt/format.h>
 
 #include "model/cull/bounds.h"
+#include "traces/format/codec.h"
 #include "traces/format/reader.h"
 
 namespace nbsim::cp {
@@ -38,6 +42,20 @@ struct Work {
 };
 
 using WorkPtr = std::shared_ptr<const Work>;
+
+// The name of a unit's span on a timeline (model/sim/timeline.h): "frame 3 draw 12 (occluder)".
+inline std::string timeline_label(const Work& w) {
+  const std::uint64_t frame = w.frame ? w.frame->begin.frame : 0;
+  switch (w.kind) {
+    case WorkKind::FrameBegin: return fmt::format("frame {} clear", frame);
+    case WorkKind::Draw:
+      return fmt::format("frame {} draw {} ({})", frame, w.record().index, trace::to_string(w.record().role));
+    case WorkKind::Snapshot: return fmt::format("frame {} snapshot", frame);
+    case WorkKind::FrameEnd: return fmt::format("frame {} end", frame);
+    case WorkKind::Stop: return "stop";
+  }
+  return "?";
+}
 
 // sc_fifo needs to print what it carries.
 inline std::ostream& operator<<(std::ostream& os, const WorkPtr& w) {

@@ -99,6 +99,15 @@ struct CullReport {
   std::uint64_t false_culls = 0;             // culled candidates with visible pixels
   std::uint64_t crossing_near = 0;           // bounds tests that crossed the near plane (never culled)
 
+  // Every bounds test of the frame, in order: what was tested, the decision and what it cost.
+  struct Test {
+    std::int32_t object = -1;  // object id, or -1 for a BVH node
+    std::int32_t node = -1;    // BVH node id, or -1 for an object
+    trace::BoundsTest bounds;  // rect, nearest depth, crosses_near, and the decision in .visible
+    std::uint64_t depth_tests = 0;  // box fragments (occlusion queries) or texels compared (N-buffer, Hi-Z)
+  };
+  std::vector<Test> tests;
+
   // The depth tests spent on visibility queries (ARCHITECTURE.md: the paper-comparable count).
   std::uint64_t query_depth_tests() const noexcept { return box_depth_tests + lookups; }
 };

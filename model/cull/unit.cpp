@@ -103,6 +103,7 @@ void CullUnit::prepare(CullReport& r) {
     for (int k = 0; k < pyramid_->level_count(); ++k)
       texels += static_cast<std::uint64_t>(pyramid_->level_width(k)) * static_cast<std::uint64_t>(pyramid_->level_height(k));
     pending_update_texels_ += texels;
+    label("hiz pyramid build");
     work(sim::batch_cycles(texels, config_.hiz_build_texels_per_cycle, config_.hiz_build_latency_cycles));
   }
   r.update_texels += pending_update_texels_;
@@ -112,7 +113,8 @@ void CullUnit::prepare(CullReport& r) {
 }
 
 void CullUnit::test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const trace::Frame>& f, const FrameView& v,
-                          const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests, CullReport& r) {
+                          const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests,
+                          std::vector<std::uint64_t>& cost, CullReport& r) {
   const trace::SceneObjects& s = *setup_.scene;
   std::vector<std::uint64_t> tickets(items.size());
   for (std::size_t i = 0; i < items.size(); ++i) {
@@ -141,12 +143,14 @@ void CullUnit::test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const 
     const auto it = results_.find(tickets[i]);
     NBSIM_CHECK(it != results_.end(), "an occlusion query's result went missing");
     r.box_depth_tests += it->second.depth_tests;
+    cost[i] = it->second.depth_tests;
     tests[i].visible = tests[i].crosses_near || it->second.passed > 0;
     results_.erase(it);
   }
 }
 
-void CullUnit::test_lookups(const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests, CullReport& r) {
+void CullUnit::test_lookups(const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests,
+                            std::vector<std::uint64_t>& cost, CullReport& r) {
   for (std::size_t i = 0; i < items.size(); ++i) {
     trace::BoundsTest& t = tests[i];
     if (t.crosses_near) {
@@ -179,6 +183,7 @@ void CullUnit::test_lookups(const std::vector<TestItem>& items, std::vector<trac
       work(sim::batch_cycles(static_cast<std::uint64_t>(q.texel_count), config_.hiz_lookups_per_cycle,
                              config_.hiz_lookup_latency_cycles));
     }
+    cost[i] = r.lookups - before;
     r.max_lookups = std::max(r.max_lookups, r.lookups - before);
   }
 }
@@ -224,14 +229,20 @@ std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<cons
     for (const TestItem& it : items) r.node_tests += it.node >= 0 ? 1 : 0;
     for (const trace::BoundsTest& t : tests) r.crossing_near += t.crosses_near ? 1 : 0;
     if (mode_ == CullMode::None) {
-      for (trace::BoundsTest& t : tests) t.visible = true;
+      for (std::size_t i = 0; i < items.size(); ++i) {
+        tests[i].visible = true;
+        r.tests.push_back({items[i].object, items[i].node, tests[i], 0});
+      }
       return;
     }
+    label_with([&] { return fmt::format("{} bounds tests", items.size()); });
     work(sim::batch_cycles(items.size(), config_.bounds_tests_per_cycle, config_.bounds_latency_cycles));
+    std::vector<std::uint64_t> cost(items.size(), 0);
     if (mode_ == CullMode::Oq || mode_ == CullMode::OqHier)
-      test_boxes(cp, f, v, items, tests, r);
+      test_boxes(cp, f, v, items, tests, cost, r);
     else
-      test_lookups(items, tests, r);
+      test_lookups(items, tests, cost, r);
+    for (std::size_t i = 0; i < items.size(); ++i) r.tests.push_back({items[i].object, items[i].node, tests[i], cost[i]});
   };
   const std::vector<char> visible = find_visible(s, v, in_frustum, is_occluder, hierarchical(mode_), tester);
 

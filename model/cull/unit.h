@@ -78,8 +78,10 @@ class CullUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthL
   void wait_all();  // until every issued draw and frame clear has left the depth unit
   void prepare(CullReport& r);  // the structure the queries read is current
   void test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const trace::Frame>& f, const FrameView& v,
-                  const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests, CullReport& r);
-  void test_lookups(const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests, CullReport& r);
+                  const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests,
+                  std::vector<std::uint64_t>& cost, CullReport& r);
+  void test_lookups(const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests,
+                  std::vector<std::uint64_t>& cost, CullReport& r);
 
   CullUnitConfig config_;
   CullMode mode_;

@@ -66,6 +66,7 @@ void DepthUnit::run() {
   for (;;) {
     const raster::BlockBatchPtr b = in.read();
     const cp::Work& w = *b->work;
+    label_with([&] { return cp::timeline_label(w); });  // names the clear's or the draw's span
     switch (w.kind) {
       case cp::WorkKind::FrameBegin:
         std::fill(buffer_.texels.begin(), buffer_.texels.end(), w.clear_depth);

@@ -65,6 +65,7 @@ void GeometryUnit::run() {
       rejected_ += k.trivially_rejected;
       culled_ += k.draw_culled;
       ++draws_;
+      label_with([&] { return cp::timeline_label(*w); });
       work(sim::batch_cycles(k.prims_in, config_.triangles_per_cycle, 0));
     }
     delay_.send(batch, w->kind == cp::WorkKind::Draw ? static_cast<std::uint64_t>(config_.latency_cycles) : 0);

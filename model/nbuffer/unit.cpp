@@ -1,6 +1,8 @@
 // The N-buffer unit's SystemC wrapper: cycles for queries and for the update engine; see unit.h.
 #include "model/nbuffer/unit.h"
 
+#include <fmt/format.h>
+
 namespace nbsim::nbuffer {
 
 NBufferUnit::NBufferUnit(const sc_core::sc_module_name& name, stats::Registry& registry,
@@ -50,6 +52,7 @@ void NBufferUnit::engine() {
     const std::uint64_t start = sim::now_cycles();
     const std::uint64_t mem_done = channel_ && bytes ? channel_->transfer(start, bytes, client_) : start;
     const std::uint64_t n = sim::batch_cycles(texels, c.update_texels_per_cycle, c.update_latency_cycles);
+    label_with([&] { return fmt::format("update batch, {} texels", texels); });
     work(n);
     wait_until(mem_done, memory_stall_cycles_);
     update_cycles_ += sim::now_cycles() - start;
@@ -79,6 +82,7 @@ QueryAnswer NBufferUnit::query(const Rect& r, float nearest_depth, CoveringKind 
   const std::uint64_t update_n = sim::batch_cycles(update_texels, c.update_texels_per_cycle, c.update_latency_cycles);
   const std::uint64_t bytes = a.bytes_read + a.update.bytes_read + a.update.bytes_written;
   const std::uint64_t mem_done = channel_ && bytes ? channel_->transfer(start, bytes, client_) : start;
+  label_with([&] { return fmt::format("query, {} lookups, {} texels updated", a.lookups, update_texels); });
   work(update_n +
        sim::batch_cycles(static_cast<std::uint64_t>(a.lookups), c.lookups_per_cycle, c.lookup_latency_cycles));
   wait_until(mem_done, memory_stall_cycles_);

@@ -56,6 +56,7 @@ void RasterUnit::run() {
     tiles_.add(0, b->tiles.tiles_empty);
     tiles_.add(1, b->tiles.tiles_partial);
     tiles_.add(2, b->tiles.tiles_full);
+    label_with([&] { return cp::timeline_label(*b->work); });
     work(sim::batch_cycles(b->setup.triangles, config_.setup_triangles_per_cycle, 0) +
          sim::batch_cycles(b->blocks.size(), config_.blocks_per_cycle, 0));
     const bool stop = b->work->kind == cp::WorkKind::Stop;

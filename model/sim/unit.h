@@ -1,14 +1,17 @@
 // The base of every SystemC unit wrapper: a module with a statistics group named after its place
 // in the hierarchy ("gpu.depth") that counts the cycles it spends working. A unit's thread calls
-// work(n) to spend n cycles; busy cycles and total cycles give its utilisation.
+// work(n) to spend n cycles; busy cycles and total cycles give its utilisation. When a run records a
+// timeline (model/sim/timeline.h), each work(n) is one span on the unit's track.
 #pragma once
 
 #include <deque>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "model/sim/kernel.h"
+#include "model/sim/timeline.h"
 #include "model/stats/stats.h"
 
 namespace nbsim::sim {
@@ -20,18 +23,44 @@ class Unit : public sc_core::sc_module {
         stats_(registry.group(std::string(this->name()))),
         busy_(stats_.counter("busy_cycles", "cycles", "cycles this unit spent working")) {}
 
+  // Reports this unit's spans to `timeline` on `track` (Timeline::attach_units calls it); null: none.
+  void attach_timeline(Timeline* timeline, int track) noexcept { timeline_ = timeline, track_ = track; }
+
  protected:
   // Spends n cycles of work: advances this unit's thread and counts them as busy.
   void work(std::uint64_t n) {
-    if (n == 0) return;
+    if (n == 0) {
+      label_.clear();  // a label names the work it was set for, not the next one
+      return;
+    }
     busy_ += n;
+    if (!timeline_) {
+      wait(cycles(n));
+      return;
+    }
+    const Timeline::Span span = timeline_->begin(track_, n);
+    const std::string span_label = std::move(label_);  // taken now: another thread of the unit may set the next
+    label_.clear();
     wait(cycles(n));
+    timeline_->end(span, span_label);
+  }
+  // Names the next work() span on the timeline ("draw 12"); kept only when a timeline records.
+  void label(std::string_view text) {
+    if (timeline_) label_.assign(text);
+  }
+  // The same with a name built only when a timeline records: label_with([&] { return fmt::format(...); }).
+  template <class MakeLabel>
+  void label_with(MakeLabel&& make) {
+    if (timeline_) label_ = make();
   }
   stats::Group& stats() noexcept { return stats_; }
 
  private:
   stats::Group& stats_;
   stats::Counter& busy_;
+  Timeline* timeline_ = nullptr;
+  int track_ = 0;
+  std::string label_;  // of the next span; empty when no timeline records
 };
 
 // Cycles for `items` of work at `per_cycle` items a cycle after a fixed latency: the time a

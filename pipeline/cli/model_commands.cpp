@@ -142,12 +142,19 @@ void add_model_commands(CLI::App& app, Action& action) {
     auto mo = std::make_shared<ModelOptions>();
     cmd->add_option("TRACE", *trace, "Trace file (nbsim capture)")->required();
     cmd->add_option("--out", *out, "Output folder")->required();
+    auto timeline = std::make_shared<std::string>();
+    auto vcd = std::make_shared<std::string>();
+    cmd->add_option("--timeline", *timeline,
+                    "Write a trace-event JSON of every unit's busy spans (ui.perfetto.dev; ts and dur in cycles)");
+    cmd->add_option("--vcd", *vcd, "Write a VCD of every unit's busy bit (GTKWave; 1 ns = 1 cycle)");
     mo->add_options(cmd);
-    cmd->callback([&action, trace, out, mo] {
-      action = [trace, out, mo] {
+    cmd->callback([&action, trace, out, timeline, vcd, mo] {
+      action = [trace, out, timeline, vcd, mo] {
         pipeline::ReplayOptions o;
         o.trace = *trace;
         o.out = std::filesystem::path(*out);
+        if (!timeline->empty()) o.timeline = std::filesystem::path(*timeline);
+        if (!vcd->empty()) o.vcd = std::filesystem::path(*vcd);
         mo->apply(o.config, o.config_values);
         ProgressBar bar("replay", 1);
         o.progress = [&bar](std::uint64_t done, std::uint64_t total) {
@@ -157,10 +164,14 @@ void add_model_commands(CLI::App& app, Action& action) {
         const pipeline::ReplaySummary s = pipeline::replay(o);
         bar.finish();
         fmt::print("replayed {} frames, {} draws: {} cycles ({:.0f} per frame), {} depth tests, {:.2f} s host "
-                   "({:.1f} M depth tests/s); wrote {}/run.json, frames.csv, draws.csv\n",
+                   "({:.1f} M depth tests/s); wrote {}/run.json, frames.csv, draws.csv, culls.csv\n",
                    s.frames, s.draws, s.cycles, s.frames ? static_cast<double>(s.cycles) / static_cast<double>(s.frames) : 0.0,
                    s.depth_tests, s.host_seconds, s.host_seconds > 0 ? static_cast<double>(s.depth_tests) / s.host_seconds / 1e6 : 0.0,
                    *out);
+        if (o.timeline)
+          fmt::print("timeline: {} spans in {}{}\n", s.timeline_events, o.timeline->string(),
+                     s.timeline_dropped ? fmt::format(" ({} later spans left out: the file's cap)", s.timeline_dropped) : "");
+        if (o.vcd) fmt::print("busy bits: {}\n", o.vcd->string());
         return 0;
       };
     });

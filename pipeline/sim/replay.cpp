@@ -9,6 +9,7 @@
 
 #include "model/common/error.h"
 #include "model/sim/kernel.h"
+#include "model/sim/timeline.h"
 
 namespace nbsim::pipeline {
 
@@ -103,6 +104,10 @@ class Collector : public depth::ResultSink {
                 "model_passed,gl_passed,depth_tests,culled,lookups,done_cycle\n";
       frames_ << "frame,draws,model_fragments,gl_fragments,model_passed,gl_passed,depth_tests,depth_pixels_matching,"
                  "depth_pixels,end_cycle,cycles\n";
+      // Every bounds test a culling mode made (empty with cull.mode=trace, which only replays).
+      culls_.open(*o.out / "culls.csv");
+      if (!culls_) throw InputError(fmt::format("cannot write into '{}'", o.out->string()));
+      culls_ << "frame,mode,object,node,x,y,w,h,nearest_depth,crosses_near,decision,depth_tests,truth_visible_pixels,false_cull\n";
     }
   }
 
@@ -152,6 +157,7 @@ class Collector : public depth::ResultSink {
                                  {"cycles", cycle - last_cycle_}};
     if (const cull::CullReport* r = w.cull_report.get()) {
       cull.add(*r, frame_.depth_tests, cycle - last_cycle_);
+      if (culls_.is_open()) write_tests(w, *r);
       pf["query_depth_tests"] = r->query_depth_tests();
       pf["update_texels"] = r->update_texels;
       pf["total_depth_tests"] = r->query_depth_tests() + r->update_texels + (frame_.depth_tests - r->box_depth_tests);
@@ -172,6 +178,24 @@ class Collector : public depth::ResultSink {
 
   void stopped(std::uint64_t cycle) override { s_.cycles = cycle; }
 
+  // One culls.csv row per bounds test: what was tested, the decision, its cost, the ground truth.
+  void write_tests(const cp::Work& w, const cull::CullReport& r) {
+    const trace::GroundTruth* truth = w.frame->truth ? &*w.frame->truth : nullptr;
+    for (const cull::CullReport::Test& t : r.tests) {
+      std::string pixels = "";
+      bool false_cull = false;
+      if (t.object >= 0 && truth && static_cast<std::size_t>(t.object) < truth->visible_pixels.size()) {
+        const std::uint32_t px = truth->visible_pixels[static_cast<std::size_t>(t.object)];
+        pixels = std::to_string(px);
+        false_cull = px > 0 && !t.bounds.visible;
+      }
+      culls_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, cull::to_string(r.mode),
+                            t.object, t.node, t.bounds.x, t.bounds.y, t.bounds.w, t.bounds.h, t.bounds.nearest_depth,
+                            t.bounds.crosses_near ? 1 : 0, t.bounds.visible ? "visible" : "culled", t.depth_tests, pixels,
+                            false_cull ? 1 : 0);
+    }
+  }
+
   std::uint64_t total_frames = 0;
   CullTotals cull;
   nlohmann::ordered_json per_frame_ = nlohmann::ordered_json::array();
@@ -183,7 +207,7 @@ class Collector : public depth::ResultSink {
   };
   ReplaySummary& s_;
   const ReplayOptions& o_;
-  std::ofstream draws_, frames_;
+  std::ofstream draws_, frames_, culls_;
   FrameTotals frame_;
   std::uint64_t last_cycle_ = 0;
 };
@@ -268,8 +292,16 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.scene = tr.scene();
   sink.cull.mode = o.config.cull.mode;
   Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, &setup);
+  std::optional<sim::Timeline> timeline;  // only when asked: units then report their busy spans
+  if (o.timeline || o.vcd) {
+    sim::TimelineOptions to;
+    to.json = o.timeline, to.vcd = o.vcd;
+    timeline.emplace(std::move(to));
+    timeline->attach_units();
+  }
   const auto t0 = std::chrono::steady_clock::now();
   sc_core::sc_start();
+  if (timeline) s.timeline_events = timeline->close().events, s.timeline_dropped = timeline->summary().dropped;
   sim::rethrow_thread_failure();  // a damaged trace read mid-run, as an InputError
   s.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.stats = registry.values();

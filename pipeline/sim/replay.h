@@ -21,6 +21,8 @@ struct ReplayOptions {
   GpuConfig config;
   nlohmann::ordered_json config_values;   // the schema's values, for run.json
   std::optional<std::filesystem::path> out;  // run.json, frames.csv, draws.csv
+  std::optional<std::filesystem::path> timeline;  // trace-event JSON of unit activity (model/sim/timeline.h)
+  std::optional<std::filesystem::path> vcd;       // busy bit per unit, a VCD
   double depth_tolerance = 1e-6;
   std::function<void(std::uint64_t frames_done, std::uint64_t frames_total)> progress;
 };
@@ -37,6 +39,7 @@ struct ReplaySummary {
   double depth_max_abs_error = 0.0;
   std::uint64_t cycles = 0;
   double host_seconds = 0.0;
+  std::uint64_t timeline_events = 0, timeline_dropped = 0;  // spans written to / left out of the timeline
   nlohmann::ordered_json stats;  // every unit's statistics
   // Culling modes (cull.mode other than trace): totals and per-frame averages of the cull stage,
   // Table 2's columns among them (see CullTotals in replay.cpp); null otherwise.

@@ -6,9 +6,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <vector>
 #include <string>
 
 #include "tests/common/run_nbsim.h"
+#include "traces/format/writer.h"
 
 namespace {
 
@@ -100,6 +103,65 @@ TEST(ReplayCliTest, ConfigKeysAndRefusals) {
   const CliResult r = run_nbsim("compare " + t + " --config " + bad.string());
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(has(r.err, "must be a number")) << r.err;
+}
+
+// In a culling mode, culls.csv lists every bounds test with its decision, cost and ground truth;
+// the N-buffer compares at most four texels a test and culls nothing visible.
+// Bounds that cross the near plane are never culled, in any mode.
+TEST(ReplayCliTest, CullModeWritesEveryBoundsTest) {
+  for (const char* mode : {"nb", "oq", "hiz_pyramid"}) {
+  const fs::path out = scratch(mode);
+  const CliResult r = run_nbsim("replay " + sample("city_small_oq.nbt") + " --set cull.mode=" + mode + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream csv(out / "culls.csv");
+  std::string line;
+  std::getline(csv, line);
+  ASSERT_TRUE(has(line, "decision,depth_tests,truth_visible_pixels,false_cull")) << line;
+  int rows = 0, culled = 0, near = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 14u) << line;
+    EXPECT_EQ(f[1], mode);
+    if (std::string(mode) == "nb") {
+      EXPECT_LE(std::stoi(f[11]), 4) << "at most four lookups: " << line;
+    }
+    EXPECT_EQ(f[13], "0") << "false cull: " << line;
+    if (f[9] == "1") {
+      EXPECT_EQ(f[10], "visible") << "bounds crossing the near plane were culled: " << line;
+    }
+    culled += f[10] == "culled";
+    near += f[9] == "1";
+  }
+  EXPECT_GT(rows, 100) << mode;
+  EXPECT_GT(culled, 0) << mode << " culled nothing";
+  EXPECT_GT(near, 0) << "the sample has bounds crossing the near plane (the ground)";
+  }
+}
+
+// A trace whose frames have no draws replays to zero counts, not a crash or a hang.
+TEST(ReplayCliTest, EmptyFramesReplay) {
+  const fs::path t = scratch("empty.nbt");
+  {
+    nbsim::trace::TraceWriter w(t, {{"viewport", "8x8"}, {"depth_func", "LESS"}, {"depth_clear", "1"}, {"frames", "2"}});
+    for (std::uint32_t f = 0; f < 2; ++f) {
+      nbsim::trace::FrameBegin b;
+      b.frame = f;
+      w.begin_frame(b);
+      nbsim::trace::FrameEnd e;
+      e.frame = f;
+      w.end_frame(e);
+    }
+    w.close();
+  }
+  const CliResult r = run_nbsim("compare " + t.string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["frames"], 2);
+  EXPECT_EQ(j["draws"], 0);
+  EXPECT_TRUE(j["within_thresholds"].get<bool>());
 }
 
 // A damaged trace is refused by replay with exit 2 and the chunk named.
