@@ -1,6 +1,8 @@
 // The replay model's top level; see gpu.h.
 #include "pipeline/sim/gpu.h"
 
+#include <string>
+
 #include "model/common/error.h"
 
 namespace nbsim::pipeline {
@@ -42,6 +44,15 @@ Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const G
     cp_.set_program(cull_.get());
     depth_.set_listener(cull_.get());
   }
+  // The shared memory channel: bytes per client (every client has registered by now) and busy cycles.
+  stats::Group& mem = registry.group(std::string(this->name()) + ".memory");
+  for (std::size_t i = 0; i < memory_.clients().size(); ++i) {
+    const std::string& client = memory_.clients()[i];  // "depth", or a module's full name
+    mem.formula("bytes_" + client.substr(client.rfind('.') + 1), "bytes", "bytes moved for " + client,
+                [this, i] { return static_cast<double>(memory_.bytes(static_cast<int>(i))); });
+  }
+  mem.formula("busy_cycles", "cycles", "cycles the channel spent transferring",
+              [this] { return static_cast<double>(memory_.busy_cycles()); });
 }
 
 }  // namespace nbsim::pipeline
