@@ -51,7 +51,7 @@ Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const G
     mem.formula("bytes_" + client.substr(client.rfind('.') + 1), "bytes", "bytes moved for " + client,
                 [this, i] { return static_cast<double>(memory_.bytes(static_cast<int>(i))); });
   }
-  mem.formula("busy_cycles", "cycles", "cycles the channel spent transferring",
+  mem.formula("transfer_cycles", "cycles", "cycles the channel spent transferring (not a unit's busy_cycles)",
               [this] { return static_cast<double>(memory_.busy_cycles()); });
 }
 
