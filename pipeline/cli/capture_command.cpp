@@ -36,8 +36,8 @@ void add_capture_command(CLI::App& app, Action& action) {
   cmd->add_option("-o,--out", o->out, "Trace file to write")->required();
   cmd->footer("Per frame: occluders (last frame's visible objects), bounds tests of every other object in the\n"
               "view frustum, visible objects, depth after occluders and at the end, ground truth from an ID buffer.");
-  cmd->callback([&action, o, &app] {
-    action = [o, &app] {
+  cmd->callback([&action, o] {
+    action = [o] {
       capture::CaptureOptions c;
       std::tie(c.width, c.height) = parse_size(o->size, "--size");
       c.frames = o->frames;
@@ -51,7 +51,6 @@ void add_capture_command(CLI::App& app, Action& action) {
                        o->path + " --seed " + std::to_string(o->seed) + " --objects " + std::to_string(o->objects) +
                        " --mode " + o->mode + " --levels-every " + std::to_string(o->levels_every) +
                        (o->reversed_z ? " --reversed-z" : "") + " -o " + o->out;
-      (void)app;
       ProgressBar bar("capture", c.frames);
       const auto s = capture::capture_city(c, o->out, [&](int done, int) { bar.update(done); });
       bar.finish();
