@@ -2,10 +2,6 @@
 // command line. table2 runs one replay per culling mode, each in a child process of this executable
 // (SystemC allows one elaboration per process), and prints the paper's Table 2 beside ours.
 #include <fmt/format.h>
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <cstring>
@@ -16,6 +12,7 @@
 #include "model/common/error.h"
 #include "pipeline/cli/command.h"
 #include "pipeline/cli/progress.h"
+#include "pipeline/explore/child.h"
 #include "pipeline/sim/replay.h"
 
 namespace nbsim::cli {
@@ -63,71 +60,34 @@ constexpr Table2Row kTable2[] = {
     {"hiz_pyramid", "Hi-Z pyramid (baseline, not in the paper)", std::nullopt},
 };
 
-extern "C" char** environ;
-
-// Starts `nbsim replay TRACE --out DIR/MODE [config] --set cull.mode=MODE` with stdout and stderr
-// in DIR/MODE; returns the child's pid.
-pid_t spawn_replay(const std::string& trace, const std::filesystem::path& dir, const std::string& mode,
-                   const ModelOptions& mo) {
-  std::filesystem::create_directories(dir);
-  const std::string exe = std::filesystem::read_symlink("/proc/self/exe").string();
-  std::vector<std::string> args = {exe, "replay", trace, "--out", dir.string()};
-  if (!mo.config_file.empty()) args.insert(args.end(), {"--config", mo.config_file});
-  for (const auto& s : mo.sets) args.insert(args.end(), {"--set", s});
-  args.insert(args.end(), {"--set", "cull.mode=" + mode});
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, (dir / "stdout.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&fa, STDERR_FILENO, (dir / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) throw std::runtime_error(fmt::format("cannot start '{}': {}", exe, std::strerror(rc)));
-  return pid;
-}
-
-// Runs every Table 2 mode, `parallel` children at a time; returns each mode's run.json summary.
+// Runs every Table 2 mode as `nbsim replay TRACE --out DIR/MODE [config] --set cull.mode=MODE`, in
+// child processes (pipeline/explore/child.h), `parallel` at a time; returns each mode's run.json summary.
 std::vector<nlohmann::json> run_table2(const std::string& trace, const std::filesystem::path& out, const ModelOptions& mo,
                                        int parallel) {
   const std::size_t n = std::size(kTable2);
+  std::vector<explore::ChildJob> jobs;
+  for (const Table2Row& row : kTable2) {
+    const std::filesystem::path dir = out / row.mode;
+    std::vector<std::string> args = {"replay", trace, "--out", dir.string()};
+    if (!mo.config_file.empty()) args.insert(args.end(), {"--config", mo.config_file});
+    for (const auto& s : mo.sets) args.insert(args.end(), {"--set", s});
+    args.insert(args.end(), {"--set", std::string("cull.mode=") + row.mode});
+    jobs.push_back({std::move(args), dir});
+  }
   std::vector<nlohmann::json> results(n);
-  std::vector<std::pair<pid_t, std::size_t>> running;
-  std::size_t next = 0;
   std::string failures;
-  const auto reap = [&] {
-    int status = 0;
-    const pid_t pid = waitpid(-1, &status, 0);
-    if (pid < 0) throw std::runtime_error("waitpid failed");
-    for (auto it = running.begin(); it != running.end(); ++it) {
-      if (it->first != pid) continue;
-      const std::size_t i = it->second;
-      running.erase(it);
-      const std::filesystem::path dir = out / kTable2[i].mode;
-      if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        std::ifstream e(dir / "stderr.txt");
-        const std::string err((std::istreambuf_iterator<char>(e)), {});
-        failures += fmt::format("cull.mode={}: replay failed: {}\n", kTable2[i].mode, err);
-        return;
-      }
-      std::ifstream in(dir / "run.json");
-      const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-      if (j.is_discarded() || !j.contains("summary") || !j["summary"].contains("cull"))
-        failures += fmt::format("cull.mode={}: {}/run.json has no cull summary\n", kTable2[i].mode, dir.string());
-      else
-        results[i] = j["summary"];
+  explore::run_children(explore::self_executable(), jobs, parallel, [&](std::size_t i, const explore::ChildOutcome& outcome) {
+    if (!outcome.ok) {
+      failures += fmt::format("cull.mode={}: replay failed: {}\n", kTable2[i].mode, outcome.error);
       return;
     }
-  };
-  while (next < n || !running.empty()) {
-    while (next < n && static_cast<int>(running.size()) < parallel) {
-      running.emplace_back(spawn_replay(trace, out / kTable2[next].mode, kTable2[next].mode, mo), next);
-      ++next;
-    }
-    reap();
-  }
+    std::ifstream in(jobs[i].dir / "run.json");
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.contains("summary") || !j["summary"].contains("cull"))
+      failures += fmt::format("cull.mode={}: {}/run.json has no cull summary\n", kTable2[i].mode, jobs[i].dir.string());
+    else
+      results[i] = j["summary"];
+  });
   if (!failures.empty()) throw InputError(failures.substr(0, failures.size() - 1));
   return results;
 }

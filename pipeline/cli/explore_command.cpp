@@ -1,0 +1,127 @@
+// `nbsim explore SWEEP.json --out DIR`: architecture exploration runs. Validates the whole sweep
+// file against the config schema, then replays every point in a child process (pipeline/explore/)
+// and writes DIR/points/<id>/, DIR/sweep.json and the tidy DIR/results.csv.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <thread>
+
+#include "model/common/error.h"
+#include "pipeline/cli/command.h"
+#include "pipeline/cli/progress.h"
+#include "pipeline/explore/child.h"
+#include "pipeline/explore/results.h"
+#include "pipeline/explore/runner.h"
+#include "pipeline/explore/sweep.h"
+#include "pipeline/sim/gpu.h"
+
+namespace nbsim::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The real config check: the settings on a default GpuConfig, then the units' own validation;
+// returns every key's effective value, flat.
+nlohmann::json check_config(const nlohmann::json& settings, const std::string& origin) {
+  pipeline::GpuConfig c;
+  config::Schema schema;
+  pipeline::GpuConfig::describe(schema, c);
+  schema.apply(settings, origin);
+  try {
+    c.nbuffer.validate();
+    c.hiz.validate();
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", origin, e.what()));
+  }
+  nlohmann::json flat = nlohmann::json::object();
+  const nlohmann::ordered_json values = schema.values();  // kept alive for the loop
+  for (const auto& [unit, fields] : values.items())
+    for (const auto& [field, v] : fields.items()) flat[unit + "." + field] = v;
+  return flat;
+}
+
+struct ExploreOptions {
+  std::string sweep, out;
+  int jobs = 0;
+  bool dry_run = false;
+};
+
+int run_explore(const ExploreOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  std::ifstream in(o.sweep);
+  if (!in) throw InputError(fmt::format("sweep file '{}' cannot be read", o.sweep));
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(in, nullptr, false, true);
+  if (j.is_discarded()) throw InputError(fmt::format("sweep file '{}' is not valid JSON", o.sweep));
+
+  // Everything is checked before the first child starts.
+  const explore::SweepSpec spec = explore::parse_sweep(j, o.sweep);
+  std::map<std::string, explore::TraceFile> traces;
+  for (const auto& t : spec.traces) {
+    try {
+      traces.emplace(t, explore::inspect_trace(t));
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: traces: {}", o.sweep, e.what()));
+    }
+  }
+  std::vector<explore::Point> points = explore::expand(spec);
+  explore::check_points(spec, points, check_config, o.sweep);
+  const std::vector<std::string> parameters = explore::parameter_keys(spec);
+
+  const fs::path out(o.out);
+  fs::create_directories(out / "points");
+  explore::write_sweep_json(out / "sweep.json", o.sweep, spec, points, parameters, traces, NBSIM_VERSION);
+  if (o.dry_run) {
+    for (const auto& p : points) fmt::print("{} {} {}\n", p.id, p.trace, p.settings.dump());
+    fmt::print("explore: {} points, none run (--dry-run); wrote {}\n", points.size(), (out / "sweep.json").string());
+    return 0;
+  }
+
+  explore::RunOptions ro;
+  ro.out = out;
+  ro.exe = explore::self_executable();
+  ro.jobs = o.jobs > 0 ? o.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  std::optional<ProgressBar> bar;
+  ro.progress = [&bar](std::size_t done, std::size_t total) {
+    if (!bar) bar.emplace("explore", static_cast<long long>(total));
+    bar->update(static_cast<long long>(done));
+  };
+  const explore::RunReport r = explore::run_points(points, traces, ro);
+  if (bar) bar->finish();
+  explore::write_results_csv(out / "results.csv", out, points, parameters, traces, NBSIM_VERSION);
+
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const auto& p : points) {
+    const fs::path err = explore::point_dir(out, p) / "error.txt";
+    if (!explore::point_done(out, p) && fs::exists(err)) {
+      std::string first = explore::tail_lines(err, 1);
+      fmt::print("failed: {} ({} {}): {}\n", p.id, p.trace, p.settings.dump(), first);
+    }
+  }
+  fmt::print("explore: {} points: {} run, {} resumed, {} failed, {:.1f} s with {} jobs; wrote {}\n", points.size(), r.ran,
+             r.resumed, r.failed, seconds, ro.jobs, (out / "results.csv").string());
+  return r.failed == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+void add_explore_command(CLI::App& app, Action& action) {
+  auto* cmd = app.add_subcommand("explore", "Architecture exploration: replay every point of a sweep file, write results.csv");
+  auto o = std::make_shared<ExploreOptions>();
+  cmd->add_option("SWEEP", o->sweep, "Sweep file (JSON): traces, set, and axes or points (pipeline/sweeps/)")->required();
+  cmd->add_option("--out", o->out, "Output folder: points/<id>/, sweep.json, results.csv; points done there are not run again")
+      ->required();
+  cmd->add_option("--jobs", o->jobs, "Replays run at a time, one process each (default: the number of cores)")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_flag("--dry-run", o->dry_run, "Validate and expand the sweep, write sweep.json and list the points; run nothing");
+  cmd->footer("Sweep file: {\"traces\": [...], \"set\": {key: value}, \"axes\": {key: [values]}} (every combination)\n"
+              "or {\"traces\": [...], \"points\": [{key: value, \"trace\": optional}, ...]}; keys as `nbsim config\n"
+              "--defaults` lists them. Exit 0 when every point ran, 1 when some failed (see results.csv), 2 on a bad sweep.");
+  cmd->callback([&action, o] { action = [o] { return run_explore(*o); }; });
+}
+
+}  // namespace nbsim::cli

@@ -1,0 +1,48 @@
+// Runs the points of a sweep (`nbsim explore`): one `nbsim replay` child per point, N at a time,
+// into OUT/points/<id>/, skipping points whose run.json is already there, and recording failures
+// in OUT/points/<id>/error.txt. Then writes OUT/results.csv and OUT/sweep.json (results.h).
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "pipeline/explore/sweep.h"
+
+namespace nbsim::explore {
+
+// A trace of the sweep: where it is and its checksum (zlib crc32 of the whole file, 8 hex digits).
+struct TraceFile {
+  std::filesystem::path path;  // absolute
+  std::string crc32;
+};
+
+// Resolves a trace named in a sweep (relative: from the current directory) and checksums it;
+// throws InputError when it does not exist or cannot be read.
+TraceFile inspect_trace(const std::string& as_written);
+
+struct RunOptions {
+  std::filesystem::path out;   // the sweep's folder
+  std::filesystem::path exe;   // the nbsim executable that runs `replay`
+  int jobs = 1;                // children at a time
+  std::function<void(std::size_t done, std::size_t total)> progress;  // after each child ends
+};
+
+struct RunReport {
+  std::size_t ran = 0;      // children started this time (including failures)
+  std::size_t resumed = 0;  // points done before, not run again
+  std::size_t failed = 0;   // points that failed this time
+};
+
+// The folder of one point.
+std::filesystem::path point_dir(const std::filesystem::path& out, const Point& p);
+// True when the point's run.json exists and holds a summary: such a point is not run again.
+bool point_done(const std::filesystem::path& out, const Point& p);
+
+// Runs every point that is not done. `traces` maps each trace as written to its file.
+RunReport run_points(const std::vector<Point>& points, const std::map<std::string, TraceFile>& traces, const RunOptions& o);
+
+}  // namespace nbsim::explore

@@ -1,0 +1,194 @@
+// Sweep files of `nbsim explore`; see sweep.h.
+#include "pipeline/explore/sweep.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <set>
+
+#include "model/common/error.h"
+
+namespace nbsim::explore {
+
+namespace {
+
+// {"unit": {"field": v}} and {"unit.field": v} -> {"unit.field": v}; `skip` keys stay as they are.
+nlohmann::ordered_json flatten(const nlohmann::ordered_json& j, const std::string& where, const std::set<std::string>& skip = {}) {
+  if (!j.is_object()) throw InputError(fmt::format("{}: expected an object of config keys, got {}", where, j.type_name()));
+  nlohmann::ordered_json flat = nlohmann::ordered_json::object();
+  const auto put = [&](const std::string& key, const nlohmann::ordered_json& v) {
+    if (v.is_object() || v.is_array() || v.is_null())
+      throw InputError(fmt::format("{}: {} must be a single value, got {}", where, key, v.dump()));
+    if (flat.contains(key)) throw InputError(fmt::format("{}: {} is given twice", where, key));
+    flat[key] = v;
+  };
+  for (const auto& [name, value] : j.items()) {
+    if (skip.count(name)) {
+      flat[name] = value;
+    } else if (name.find('.') == std::string::npos && value.is_object()) {
+      for (const auto& [field, v] : value.items()) put(name + "." + field, v);
+    } else {
+      put(name, value);
+    }
+  }
+  return flat;
+}
+
+std::string describe_settings(const std::string& trace, const nlohmann::json& settings) {
+  std::string s = "trace " + trace;
+  for (const auto& [k, v] : settings.items()) s += fmt::format(", {}={}", k, v.is_string() ? v.get<std::string>() : v.dump());
+  return s;
+}
+
+// A single JSON value from the ordered (file) form to the sorted form used for settings.
+nlohmann::json sorted(const nlohmann::ordered_json& v) { return nlohmann::json::parse(v.dump()); }
+
+}  // namespace
+
+SweepSpec parse_sweep(const nlohmann::ordered_json& j, const std::string& origin) {
+  if (!j.is_object()) throw InputError(fmt::format("{}: a sweep is a JSON object, got {}", origin, j.type_name()));
+  static const std::set<std::string> known = {"name", "description", "traces", "set", "axes", "points"};
+  for (const auto& [k, v] : j.items())
+    if (!known.count(k))
+      throw InputError(fmt::format("{}: unknown sweep entry '{}' (expected name, description, traces, set, axes or points)", origin, k));
+  SweepSpec s;
+  for (const char* k : {"name", "description"}) {
+    if (!j.contains(k)) continue;
+    if (!j[k].is_string()) throw InputError(fmt::format("{}: {} must be a string", origin, k));
+    (std::string(k) == "name" ? s.name : s.description) = j[k].get<std::string>();
+  }
+  if (!j.contains("traces") || !j["traces"].is_array() || j["traces"].empty())
+    throw InputError(fmt::format("{}: traces must be a non-empty list of trace files", origin));
+  for (const auto& t : j["traces"]) {
+    if (!t.is_string() || t.get<std::string>().empty())
+      throw InputError(fmt::format("{}: traces: every entry must be a file name, got {}", origin, t.dump()));
+    if (std::find(s.traces.begin(), s.traces.end(), t.get<std::string>()) != s.traces.end())
+      throw InputError(fmt::format("{}: traces: '{}' is listed twice", origin, t.get<std::string>()));
+    s.traces.push_back(t.get<std::string>());
+  }
+  if (j.contains("set")) s.set = flatten(j["set"], origin + ": set");
+  if (j.contains("axes") == j.contains("points"))
+    throw InputError(fmt::format("{}: give exactly one of axes (a cartesian product) and points (a listed set)", origin));
+  if (j.contains("axes")) {
+    const auto& axes = j["axes"];
+    if (!axes.is_object() || axes.empty()) throw InputError(fmt::format("{}: axes must be a non-empty object of key: [values]", origin));
+    for (const auto& [key, values] : axes.items()) {
+      if (!values.is_array() || values.empty())
+        throw InputError(fmt::format("{}: axes.{} must be a non-empty list of values", origin, key));
+      if (s.set.contains(key)) throw InputError(fmt::format("{}: {} is both in set and in axes", origin, key));
+      std::vector<nlohmann::json> list;
+      for (const auto& v : values) {
+        if (v.is_object() || v.is_array() || v.is_null())
+          throw InputError(fmt::format("{}: axes.{}: {} is not a single value", origin, key, v.dump()));
+        list.push_back(sorted(v));
+      }
+      s.axes.emplace_back(key, std::move(list));
+    }
+  } else {
+    const auto& points = j["points"];
+    if (!points.is_array() || points.empty()) throw InputError(fmt::format("{}: points must be a non-empty list of objects", origin));
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const std::string where = fmt::format("{}: points[{}]", origin, i);
+      nlohmann::ordered_json p = flatten(points[i], where, {"trace"});
+      if (p.contains("trace")) {
+        if (!p["trace"].is_string()) throw InputError(fmt::format("{}: trace must be a file name", where));
+        if (std::find(s.traces.begin(), s.traces.end(), p["trace"].get<std::string>()) == s.traces.end())
+          throw InputError(fmt::format("{}: trace '{}' is not one of traces", where, p["trace"].get<std::string>()));
+      }
+      s.points.push_back(std::move(p));
+    }
+  }
+  return s;
+}
+
+std::vector<Point> expand(const SweepSpec& spec) {
+  std::vector<nlohmann::json> combos;  // flat settings, with "trace" when a listed point names one
+  if (!spec.axes.empty()) {
+    std::vector<std::size_t> index(spec.axes.size(), 0);
+    for (;;) {
+      nlohmann::json c = sorted(spec.set);
+      for (std::size_t a = 0; a < spec.axes.size(); ++a) c[spec.axes[a].first] = spec.axes[a].second[index[a]];
+      combos.push_back(std::move(c));
+      std::size_t a = spec.axes.size();
+      while (a > 0 && ++index[a - 1] == spec.axes[a - 1].second.size()) index[--a] = 0;
+      if (a == 0) break;
+    }
+  } else {
+    for (const auto& p : spec.points) {
+      nlohmann::json c = sorted(spec.set);
+      for (const auto& [k, v] : p.items()) c[k] = sorted(v);
+      combos.push_back(std::move(c));
+    }
+  }
+  std::vector<Point> points;
+  for (const auto& trace : spec.traces) {
+    for (const auto& c : combos) {
+      if (c.contains("trace") && c["trace"].get<std::string>() != trace) continue;
+      Point p;
+      p.trace = trace;
+      p.settings = c;
+      p.settings.erase("trace");
+      p.id = point_id(p.trace, p.settings);
+      points.push_back(std::move(p));
+    }
+  }
+  return points;
+}
+
+std::string point_id(const std::string& trace, const nlohmann::json& settings) {
+  // nlohmann::json (not ordered_json) keeps object keys sorted, so the dump is canonical.
+  const std::string canonical = trace + '\n' + settings.dump();
+  std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV-1a 64: fixed by the id format, never change
+  for (const unsigned char ch : canonical) {
+    h ^= ch;
+    h *= 0x100000001b3ULL;
+  }
+  return fmt::format("{:016x}", h);
+}
+
+std::vector<std::string> parameter_keys(const SweepSpec& spec) {
+  std::vector<std::string> keys;
+  const auto add = [&keys](const std::string& k) {
+    if (k != "trace" && std::find(keys.begin(), keys.end(), k) == keys.end()) keys.push_back(k);
+  };
+  for (const auto& [k, v] : spec.set.items()) add(k);
+  for (const auto& [k, v] : spec.axes) add(k);
+  for (const auto& p : spec.points)
+    for (const auto& [k, v] : p.items()) add(k);
+  return keys;
+}
+
+void check_points(const SweepSpec& spec, std::vector<Point>& points, const ConfigCheck& check, const std::string& origin) {
+  check(sorted(spec.set), origin + ": set");
+  for (const auto& [key, values] : spec.axes)
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      nlohmann::json one = sorted(spec.set);
+      one[key] = values[i];
+      check(one, fmt::format("{}: axes.{}[{}]", origin, key, i));
+    }
+  for (std::size_t i = 0; i < spec.points.size(); ++i) {
+    nlohmann::json one = sorted(spec.set);
+    for (const auto& [k, v] : spec.points[i].items())
+      if (k != "trace") one[k] = sorted(v);
+    check(one, fmt::format("{}: points[{}]", origin, i));
+  }
+  const std::vector<std::string> keys = parameter_keys(spec);
+  std::set<std::string> seen;
+  for (Point& p : points) {
+    const nlohmann::json effective = check(p.settings, fmt::format("{}: point ({})", origin, describe_settings(p.trace, p.settings)));
+    for (auto& [k, v] : p.settings.items()) {
+      NBSIM_CHECK(effective.contains(k), "the config check returned no value for '" + k + "'");
+      v = effective[k];
+    }
+    for (const auto& k : keys) {
+      NBSIM_CHECK(effective.contains(k), "the config check returned no value for '" + k + "'");
+      p.parameters[k] = effective[k];
+    }
+    p.id = point_id(p.trace, p.settings);
+    if (!seen.insert(p.id).second)
+      throw InputError(fmt::format("{}: the point ({}) is listed twice", origin, describe_settings(p.trace, p.settings)));
+  }
+}
+
+}  // namespace nbsim::explore

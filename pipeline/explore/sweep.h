@@ -1,0 +1,63 @@
+// Sweep files of `nbsim explore`: parsing, expansion into points (the cartesian product of the
+// axes, or a listed set) and their stable ids. Plain C++: the config check is handed in.
+//
+// Format (JSON object; keys are config keys "unit.field" as `nbsim config --defaults` lists them):
+//   "name", "description"  optional strings
+//   "traces"   non-empty list of trace files (relative paths: from the current directory)
+//   "set"      optional {key: value}: settings shared by every point
+//   "axes"     {key: [value, ...]}: every combination, the last axis varying fastest
+//   "points"   [{key: value, ..., "trace": optional one trace instead of all}, ...]: a listed set
+// Exactly one of "axes" and "points". "set" and points may also nest keys: {"unit": {"field": v}}.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace nbsim::explore {
+
+struct SweepSpec {
+  std::string name, description;
+  std::vector<std::string> traces;
+  nlohmann::ordered_json set = nlohmann::ordered_json::object();              // flat {key: value}, file order
+  std::vector<std::pair<std::string, std::vector<nlohmann::json>>> axes;      // in file order
+  std::vector<nlohmann::ordered_json> points;                                 // flat, may hold "trace"
+};
+
+// One run: a trace with its settings. `settings` is flat and sorted by key ("set" merged with the
+// axis or listed values); `parameters` holds the effective value of every key any point of the
+// sweep sets (defaults filled in), which results.csv prints one column each.
+struct Point {
+  std::string id;
+  std::string trace;  // as written in the sweep file
+  nlohmann::json settings = nlohmann::json::object();
+  nlohmann::json parameters = nlohmann::json::object();
+};
+
+// Checks the structure of a sweep file (parsed keeping its key order); throws InputError naming
+// `origin` and the bad entry.
+SweepSpec parse_sweep(const nlohmann::ordered_json& sweep, const std::string& origin);
+
+// Every point, trace-major, in file order (ids set from the raw values; check_points normalizes).
+std::vector<Point> expand(const SweepSpec& spec);
+
+// A stable id: 16 hex digits of the FNV-1a 64-bit hash of the trace and the sorted settings.
+std::string point_id(const std::string& trace, const nlohmann::json& settings);
+
+// Applies flat settings to a default config and returns every key's effective value, flat
+// ({"unit.field": value}); throws InputError naming the key when one is unknown or bad. `origin`
+// prefixes the message.
+using ConfigCheck = std::function<nlohmann::json(const nlohmann::json& settings, const std::string& origin)>;
+
+// Validates every point before anything runs: each axis value on its own (so the message names
+// it), then each point whole. Replaces each setting by its typed value (2 -> 2.0 for a float key),
+// recomputes the ids, fills `parameters`, and refuses two points with the same id.
+void check_points(const SweepSpec& spec, std::vector<Point>& points, const ConfigCheck& check, const std::string& origin);
+
+// The keys of `parameters`, in the order of first appearance in the sweep file.
+std::vector<std::string> parameter_keys(const SweepSpec& spec);
+
+}  // namespace nbsim::explore

@@ -1,0 +1,211 @@
+// ExploreCliTest: `nbsim explore` from the outside: bad sweeps exit 2 before anything runs, a small
+// sweep on the sample trace writes results.csv, a second run resumes without running a child, a
+// failing point is recorded while the others complete, and the sample sweep files are valid.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "tests/common/run_nbsim.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nbsim::testing::CliResult;
+using nbsim::testing::has;
+using nbsim::testing::run_nbsim;
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("nbsim_explore_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+const std::string kSample = (fs::path(NBSIM_SAMPLES) / "city_small_oq.nbt").string();
+
+fs::path write_sweep(const std::string& name, const nlohmann::json& j) {
+  const fs::path f = scratch(name);
+  std::ofstream(f) << j.dump(2);
+  return f;
+}
+
+// results.csv as rows of header -> cell (RFC 4180 quoting).
+std::vector<std::map<std::string, std::string>> read_csv(const fs::path& file, std::vector<std::string>* header_out = nullptr) {
+  std::ifstream in(file);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  std::vector<std::vector<std::string>> rows(1);
+  std::string field;
+  bool quoted = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char ch = text[i];
+    if (quoted) {
+      if (ch == '"' && i + 1 < text.size() && text[i + 1] == '"') field += '"', ++i;
+      else if (ch == '"') quoted = false;
+      else field += ch;
+    } else if (ch == '"') {
+      quoted = true;
+    } else if (ch == ',') {
+      rows.back().push_back(std::move(field));
+      field.clear();
+    } else if (ch == '\n') {
+      rows.back().push_back(std::move(field));
+      field.clear();
+      rows.emplace_back();
+    } else {
+      field += ch;
+    }
+  }
+  if (rows.back().empty()) rows.pop_back();
+  std::vector<std::map<std::string, std::string>> out;
+  if (rows.empty()) return out;
+  if (header_out) *header_out = rows[0];
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    EXPECT_EQ(rows[r].size(), rows[0].size()) << "row " << r << " has as many cells as the header";
+    std::map<std::string, std::string> m;
+    for (std::size_t c = 0; c < std::min(rows[r].size(), rows[0].size()); ++c) m[rows[0][c]] = rows[r][c];
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+// Bad sweeps exit 2 naming the problem, and no point runs.
+TEST(ExploreCliTest, RefusedBeforeAnythingRuns) {
+  struct Case {
+    nlohmann::json sweep;
+    const char* message;
+  };
+  const Case cases[] = {
+      {{{"traces", {kSample}}, {"axes", {{"nbuffer.resolution_divisr", {1, 2}}}}}, "unknown config key 'nbuffer.resolution_divisr'"},
+      {{{"traces", {kSample}}, {"axes", {{"nbuffer.format", {"f32", "u12"}}}}}, "axes.nbuffer.format[1]"},
+      {{{"traces", {kSample}}, {"set", {{"nbuffer.cache_size_bytes", 1000}}}, {"axes", {{"cull.mode", {"nb"}}}}},
+       "nbuffer.cache_size_bytes"},
+      {{{"traces", {kSample, "/nonexistent/x.nbt"}}, {"axes", {{"cull.mode", {"nb"}}}}}, "trace '/nonexistent/x.nbt' does not exist"},
+  };
+  int n = 0;
+  for (const auto& c : cases) {
+    const fs::path out = scratch("refused_out_" + std::to_string(n));
+    const fs::path f = write_sweep("refused_" + std::to_string(n++) + ".json", c.sweep);
+    const CliResult r = run_nbsim("explore " + f.string() + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << c.message << ": " << r.out << r.err;
+    EXPECT_TRUE(has(r.err, c.message)) << "expected '" << c.message << "' in: " << r.err;
+    EXPECT_TRUE(has(r.err, f.string())) << "the message names the sweep file: " << r.err;
+    EXPECT_FALSE(fs::exists(out / "points")) << "nothing may run on a bad sweep";
+  }
+  fs::path bad = scratch("not_json.json");
+  std::ofstream(bad) << "{\"traces\": [";
+  const CliResult r = run_nbsim("explore " + bad.string() + " --out " + scratch("nj").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "is not valid JSON")) << r.err;
+}
+
+// A real sweep of three points on the sample trace: rows, columns, values; then a second run
+// resumes every point (no child runs, run.json untouched) and a grown sweep runs only the new point.
+TEST(ExploreCliTest, SmallSweepAndResume) {
+  const fs::path out = scratch("small");
+  nlohmann::json sweep = {{"traces", {kSample}},
+                          {"set", {{"nbuffer.format", "u16"}}},
+                          {"axes", nlohmann::json::object()}};
+  sweep["axes"]["cull.mode"] = {"nb_hier"};
+  sweep["axes"]["nbuffer.resolution_divisor"] = {1, 2};
+  sweep["axes"]["nbuffer.lookup_latency_cycles"] = {8};
+  const fs::path f = write_sweep("small.json", sweep);
+  CliResult r = run_nbsim("explore " + f.string() + " --jobs 2 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "2 points: 2 run, 0 resumed, 0 failed")) << r.out;
+
+  std::vector<std::string> header;
+  auto rows = read_csv(out / "results.csv", &header);
+  ASSERT_EQ(rows.size(), 2u);
+  for (const char* col : {"point_id", "trace", "trace_crc32", "nbsim_version", "nbuffer.format", "cull.mode",
+                          "nbuffer.resolution_divisor", "nbuffer.lookup_latency_cycles", "status", "frames", "cycles_per_frame",
+                          "depth_tests_per_frame", "query_depth_tests_per_frame", "total_depth_tests_per_frame", "false_culls",
+                          "culling_efficiency", "memory_bytes_per_frame", "nbuffer_bytes_per_frame", "host_seconds", "error"})
+    EXPECT_NE(std::find(header.begin(), header.end(), col), header.end()) << "results.csv lacks column " << col;
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "ok") << row.at("error");
+    EXPECT_EQ(row.at("frames"), "8");
+    EXPECT_EQ(row.at("nbuffer.format"), "u16") << "set reaches every row";
+    EXPECT_EQ(row.at("cull.mode"), "nb_hier");
+    EXPECT_EQ(row.at("false_culls"), "0") << "N-buffer culling is conservative";
+    EXPECT_EQ(row.at("trace_crc32").size(), 8u);
+    EXPECT_EQ(row.at("nbsim_version"), "0.1.0");
+    EXPECT_GT(std::stod(row.at("query_depth_tests_per_frame")), 0.0);
+    EXPECT_GT(std::stod(row.at("memory_bytes_per_frame")), 0.0);
+    EXPECT_TRUE(fs::exists(out / "points" / row.at("point_id") / "run.json"));
+    EXPECT_TRUE(fs::exists(out / "points" / row.at("point_id") / "stderr.txt"));
+  }
+  EXPECT_EQ(rows[0].at("nbuffer.resolution_divisor"), "1");
+  EXPECT_EQ(rows[1].at("nbuffer.resolution_divisor"), "2");
+  const auto run0 = nlohmann::json::parse(std::ifstream(out / "points" / rows[0].at("point_id") / "run.json"));
+  EXPECT_EQ(run0["config"]["nbuffer"]["format"], "u16") << "the child ran the point's settings";
+  EXPECT_EQ(run0["config"]["cull"]["mode"], "nb_hier");
+  const auto sj = nlohmann::json::parse(std::ifstream(out / "sweep.json"));
+  EXPECT_EQ(sj["points"].size(), 2u);
+  EXPECT_EQ(sj["points"][0]["id"], rows[0].at("point_id"));
+
+  const fs::path done = out / "points" / rows[0].at("point_id") / "run.json";
+  const auto mtime = fs::last_write_time(done);
+  r = run_nbsim("explore " + f.string() + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "2 points: 0 run, 2 resumed, 0 failed")) << r.out;
+  EXPECT_EQ(fs::last_write_time(done), mtime) << "a done point is not run again";
+  EXPECT_EQ(read_csv(out / "results.csv").size(), 2u);
+
+  sweep["axes"]["nbuffer.resolution_divisor"] = {1, 2, 4};
+  r = run_nbsim("explore " + write_sweep("small3.json", sweep).string() + " --jobs 2 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "3 points: 1 run, 2 resumed, 0 failed")) << r.out;
+  rows = read_csv(out / "results.csv");
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[2].at("nbuffer.resolution_divisor"), "4");
+  EXPECT_EQ(rows[2].at("status"), "ok");
+}
+
+// A point whose replay fails (a corrupt trace passes the sweep's checks) is recorded with its
+// message; the other point completes and the exit status is 1.
+TEST(ExploreCliTest, FailingPointRecorded) {
+  const fs::path corrupt = scratch("corrupt.nbt");
+  std::ofstream(corrupt) << "not a trace at all";
+  const fs::path out = scratch("failing");
+  const nlohmann::json sweep = {{"traces", {kSample, corrupt.string()}},
+                                {"points", {{{"cull.mode", "nb"}, {"trace", kSample}}, {{"cull.mode", "nb"}, {"trace", corrupt.string()}}}}};
+  const CliResult r = run_nbsim("explore " + write_sweep("failing.json", sweep).string() + " --jobs 2 --out " + out.string());
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "2 points: 2 run, 0 resumed, 1 failed")) << r.out;
+  EXPECT_TRUE(has(r.out, "failed: ")) << r.out;
+  const auto rows = read_csv(out / "results.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("status"), "ok");
+  EXPECT_EQ(rows[0].at("frames"), "8");
+  EXPECT_EQ(rows[1].at("status"), "failed");
+  EXPECT_FALSE(rows[1].at("error").empty()) << "the failure's message is in the row";
+  EXPECT_TRUE(rows[1].at("frames").empty());
+  EXPECT_TRUE(fs::exists(out / "points" / rows[1].at("point_id") / "error.txt"));
+  EXPECT_FALSE(fs::exists(out / "points" / rows[1].at("point_id") / "run.json"));
+}
+
+// Every sample sweep in pipeline/sweeps/ is valid (real keys, real traces): --dry-run runs nothing.
+TEST(ExploreCliTest, SampleSweepsAreValid) {
+  const fs::path dir = fs::path(NBSIM_SOURCE_DIR) / "pipeline" / "sweeps";
+  const fs::path cwd = fs::current_path();
+  fs::current_path(NBSIM_SOURCE_DIR);  // sweep files name traces from the repository's root
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() != ".json") continue;
+    ++n;
+    const fs::path out = scratch("dry_" + e.path().stem().string());
+    const CliResult r = run_nbsim("explore " + e.path().string() + " --dry-run --out " + out.string());
+    EXPECT_EQ(r.status, 0) << e.path() << ": " << r.err;
+    EXPECT_TRUE(has(r.out, "none run (--dry-run)")) << r.out;
+    EXPECT_FALSE(fs::exists(out / "results.csv"));
+  }
+  fs::current_path(cwd);
+  EXPECT_GE(n, 8) << "the sample sweeps are missing";
+}
+
+}  // namespace

@@ -1,0 +1,148 @@
+// SweepTest: sweep files of `nbsim explore` without running anything: the cartesian product and
+// listed points, stable ids, type normalization through the config schema, and refused files.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "model/common/error.h"
+#include "model/config/schema.h"
+#include "pipeline/explore/results.h"
+#include "pipeline/explore/sweep.h"
+
+namespace {
+
+using nbsim::InputError;
+using nbsim::explore::Point;
+using nlohmann::json;
+using ojson = nlohmann::ordered_json;  // sweep files keep their key order
+namespace ex = nbsim::explore;
+
+// A small stand-in for GpuConfig: three keys of the three kinds, checked by the real Schema.
+json toy_check(const json& settings, const std::string& origin) {
+  struct {
+    std::string mode = "trace";
+    int divisor = 1;
+    double bandwidth = 32.0;
+  } c;
+  nbsim::config::Schema s;
+  s.add("cull.mode", c.mode, "culling mode", {"trace", "nb", "nb_hier"});
+  s.add("nbuffer.resolution_divisor", c.divisor, "", "divisor", 1, 8);
+  s.add("memory.bandwidth_bytes_per_cycle", c.bandwidth, "bytes/cycle", "bandwidth", 0.01, 1e6);
+  s.apply(settings, origin);
+  json flat = json::object();
+  const nlohmann::ordered_json values = s.values();  // kept alive for the loop
+  for (const auto& [unit, fields] : values.items())
+    for (const auto& [field, v] : fields.items()) flat[unit + "." + field] = v;
+  return flat;
+}
+
+std::vector<Point> expand_checked(const ojson& j) {
+  const ex::SweepSpec spec = ex::parse_sweep(j, "sweep.json");
+  std::vector<Point> points = ex::expand(spec);
+  ex::check_points(spec, points, toy_check, "sweep.json");
+  return points;
+}
+
+std::string error_of(const ojson& j) {
+  try {
+    expand_checked(j);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// Axes give every combination per trace, the last axis fastest, with "set" in every point.
+TEST(SweepTest, CartesianProductInFileOrder) {
+  const ojson j = ojson::parse(R"({"traces": ["a.nbt", "b.nbt"], "set": {"memory.bandwidth_bytes_per_cycle": 16},
+    "axes": {"cull.mode": ["nb", "nb_hier"], "nbuffer.resolution_divisor": [1, 2, 4]}})");
+  const auto points = expand_checked(j);
+  ASSERT_EQ(points.size(), 12u) << "2 traces x 2 modes x 3 divisors";
+  EXPECT_EQ(points[0].trace, "a.nbt");
+  EXPECT_EQ(points[6].trace, "b.nbt") << "trace-major order";
+  EXPECT_EQ(points[1].settings["nbuffer.resolution_divisor"], 2) << "the last axis varies fastest";
+  EXPECT_EQ(points[3].settings["cull.mode"], "nb_hier");
+  EXPECT_EQ(points[3].settings["nbuffer.resolution_divisor"], 1);
+  for (const auto& p : points) {
+    EXPECT_EQ(p.settings["memory.bandwidth_bytes_per_cycle"], 16.0) << "set applies to every point";
+    EXPECT_EQ(p.settings.size(), 3u);
+  }
+  const auto keys = ex::parameter_keys(ex::parse_sweep(j, "s"));
+  EXPECT_EQ(keys, (std::vector<std::string>{"memory.bandwidth_bytes_per_cycle", "cull.mode", "nbuffer.resolution_divisor"}));
+}
+
+// Listed points run on every trace unless one names its trace; parameters are filled with defaults.
+TEST(SweepTest, ListedPoints) {
+  const auto points = expand_checked(ojson::parse(R"({"traces": ["a.nbt", "b.nbt"], "points": [
+    {"cull.mode": "nb"}, {"cull": {"mode": "nb_hier"}, "nbuffer.resolution_divisor": 2, "trace": "b.nbt"}]})"));
+  ASSERT_EQ(points.size(), 3u) << "point 0 on both traces, point 1 on b.nbt only";
+  EXPECT_EQ(points[0].trace, "a.nbt");
+  EXPECT_EQ(points[1].trace, "b.nbt");
+  EXPECT_EQ(points[2].trace, "b.nbt");
+  EXPECT_EQ(points[2].settings, json::parse(R"({"cull.mode": "nb_hier", "nbuffer.resolution_divisor": 2})")) << "nested keys flatten";
+  EXPECT_EQ(points[0].parameters["nbuffer.resolution_divisor"], 1) << "a key another point sets gets its default";
+  EXPECT_FALSE(points[0].settings.contains("nbuffer.resolution_divisor")) << "defaults are not settings: the id stays put";
+}
+
+// Ids depend on the trace and the settings only, not on their order in the file, and are fixed.
+TEST(SweepTest, StableIds) {
+  const auto a = expand_checked(ojson::parse(R"({"traces": ["t.nbt"], "points": [{"cull.mode": "nb", "nbuffer.resolution_divisor": 2}]})"));
+  const auto b = expand_checked(ojson::parse(R"({"traces": ["t.nbt"], "points": [{"nbuffer.resolution_divisor": 2, "cull.mode": "nb"}]})"));
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].id, b[0].id) << "key order must not change the id";
+  EXPECT_EQ(a[0].id.size(), 16u);
+  EXPECT_EQ(a[0].id, ex::point_id("t.nbt", json::parse(R"({"cull.mode": "nb", "nbuffer.resolution_divisor": 2})")));
+  EXPECT_NE(a[0].id, ex::point_id("u.nbt", a[0].settings)) << "the trace is part of the id";
+  // Golden value: changing it makes every existing sweep folder run again.
+  EXPECT_EQ(ex::point_id("traces/samples/city_small_oq.nbt", json::object()), "2fd8ffe3aeac73ec") << "FNV-1a 64 of the trace, a line break and the sorted settings";
+}
+
+// A float key given as an integer is the same point as the float: the schema's typed value counts.
+TEST(SweepTest, ValuesNormalizedBySchema) {
+  const auto a = expand_checked(ojson::parse(R"({"traces": ["t.nbt"], "axes": {"memory.bandwidth_bytes_per_cycle": [2]}})"));
+  const auto b = expand_checked(ojson::parse(R"({"traces": ["t.nbt"], "axes": {"memory.bandwidth_bytes_per_cycle": [2.0]}})"));
+  EXPECT_EQ(a[0].id, b[0].id);
+  EXPECT_TRUE(a[0].settings["memory.bandwidth_bytes_per_cycle"].is_number_float());
+}
+
+// Refused sweep files: each message names what is wrong (one row per rule).
+TEST(SweepTest, RefusedFiles) {
+  struct Case {
+    const char* sweep;
+    const char* message;
+    const char* why;
+  };
+  const Case cases[] = {
+      {R"([1])", "a sweep is a JSON object", "not an object"},
+      {R"({"axes": {"cull.mode": ["nb"]}})", "traces must be a non-empty list", "no traces"},
+      {R"({"traces": ["t"], "axes": {"cull.mode": ["nb"]}, "points": [{}]})", "exactly one of axes", "both forms"},
+      {R"({"traces": ["t"]})", "exactly one of axes", "neither form"},
+      {R"({"traces": ["t"], "axes": {"cull.mode": []}})", "axes.cull.mode must be a non-empty list", "empty axis"},
+      {R"({"traces": ["t"], "axes": {"cull.mode": [["nb"]]}})", "is not a single value", "nested value"},
+      {R"({"traces": ["t"], "axis": {}})", "unknown sweep entry 'axis'", "typo at the top"},
+      {R"({"traces": ["t"], "points": [{"trace": "u"}]})", "trace 'u' is not one of traces", "unlisted trace"},
+      {R"({"traces": ["t", "t"], "points": [{}]})", "listed twice", "same trace twice"},
+      {R"({"traces": ["t"], "set": {"cull.mode": "nb"}, "axes": {"cull.mode": ["nb"]}})", "both in set and in axes", "key twice"},
+      {R"({"traces": ["t"], "axes": {"cull.mdoe": ["nb"]}})", "unknown config key 'cull.mdoe'; did you mean 'cull.mode'", "unknown key"},
+      {R"({"traces": ["t"], "axes": {"nbuffer.resolution_divisor": [1, 9]}})", "axes.nbuffer.resolution_divisor[1]", "value out of limits"},
+      {R"({"traces": ["t"], "axes": {"cull.mode": ["nb", "xx"]}})", "cull.mode must be one of", "bad enum"},
+      {R"({"traces": ["t"], "points": [{"cull.mode": "nb"}, {"cull.mode": "nb"}]})", "listed twice", "duplicate point"},
+      {R"({"traces": ["t"], "axes": {"memory.bandwidth_bytes_per_cycle": [2, 2.0]}})", "listed twice", "same after normalization"},
+  };
+  for (const auto& c : cases) {
+    const std::string e = error_of(ojson::parse(c.sweep));
+    EXPECT_NE(e.find(c.message), std::string::npos) << c.why << ": got '" << e << "'";
+    EXPECT_EQ(e.rfind("sweep.json", 0), 0u) << c.why << ": the message starts with the file: " << e;
+  }
+}
+
+// CSV fields with commas, quotes or line breaks are quoted; others are left alone.
+TEST(SweepTest, CsvFieldQuoting) {
+  EXPECT_EQ(ex::csv_field("nb_hier"), "nb_hier");
+  EXPECT_EQ(ex::csv_field("a,b"), "\"a,b\"");
+  EXPECT_EQ(ex::csv_field("say \"x\""), "\"say \"\"x\"\"\"");
+  EXPECT_EQ(ex::csv_field("two\nlines"), "\"two\nlines\"");
+}
+
+}  // namespace
