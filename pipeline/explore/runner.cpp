@@ -40,7 +40,7 @@ bool point_done(const fs::path& out, const Point& p) {
 
 RunReport run_points(const std::vector<Point>& points, const std::map<std::string, TraceFile>& traces, const RunOptions& o) {
   RunReport report;
-  std::vector<const Point*> todo;
+  std::vector<const Point*> pending;
   std::vector<ChildJob> jobs;
   for (const Point& p : points) {
     if (point_done(o.out, p)) {
@@ -58,13 +58,13 @@ RunReport run_points(const std::vector<Point>& points, const std::map<std::strin
     const auto t = traces.find(p.trace);
     NBSIM_CHECK(t != traces.end(), "no trace file for '" + p.trace + "'");
     jobs.push_back({{"replay", t->second.path.string(), "--out", dir.string(), "--config", (dir / "config.json").string()}, dir});
-    todo.push_back(&p);
+    pending.push_back(&p);
   }
   std::size_t done = 0;
   if (o.progress) o.progress(0, jobs.size());
   run_children(o.exe, jobs, o.jobs, [&](std::size_t i, const ChildOutcome& outcome) {
     ++report.ran;
-    const Point& p = *todo[i];
+    const Point& p = *pending[i];
     std::string error = outcome.error;
     if (outcome.ok && !point_done(o.out, p)) error = "the replay ended without writing a run.json with a summary";
     if (!error.empty()) {

@@ -36,6 +36,14 @@ inline CliResult run_nbsim(const std::string& args) {
   return r;
 }
 
+// A per-process scratch folder under the test temp dir: <prefix>_<pid>/<name>.
+inline std::filesystem::path scratch_path(const std::string& prefix, const std::string& name) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / (prefix + "_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
 inline bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace nbsim::testing

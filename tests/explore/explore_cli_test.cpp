@@ -20,11 +20,7 @@ using nbsim::testing::CliResult;
 using nbsim::testing::has;
 using nbsim::testing::run_nbsim;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("nbsim_explore_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path scratch(const std::string& name) { return nbsim::testing::scratch_path("nbsim_explore", name); }
 
 const std::string kSample = (fs::path(NBSIM_SAMPLES) / "city_small_oq.nbt").string();
 

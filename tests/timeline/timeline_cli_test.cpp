@@ -20,11 +20,7 @@ using nbsim::testing::CliResult;
 using nbsim::testing::has;
 using nbsim::testing::run_nbsim;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("nbsim_timeline_cli_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path scratch(const std::string& name) { return nbsim::testing::scratch_path("nbsim_timeline_cli", name); }
 
 std::string read_text(const fs::path& f) {
   std::ifstream in(f);
