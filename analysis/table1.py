@@ -2,8 +2,9 @@
 """Table 1 of Décoret 2005 (N-buffer build cost) beside ours, from `nbsim bench nbuffer` output.
 
 Usage: nbsim bench nbuffer --only build | /usr/bin/python3 analysis/table1.py [--csv OUT.csv]
-Reads JSON lines (one object per line; lines with "bench" other than "build" are skipped) from
-stdin or from the file given with --input. Prints a Markdown table.
+Reads JSON lines (one object per line), or the JSON array `--json-out FILE` writes, from stdin or
+from the file given with --input; objects with "bench" other than "build" are skipped. Prints a
+Markdown table. analysis/report.py imports read_rows, table_rows and PAPER.
 """
 import argparse
 import csv
@@ -14,9 +15,23 @@ import sys
 PAPER = {"256x256": (8, 2.0), "512x512": (9, 8.0), "640x480": (10, 10.0), "1024x1024": (10, 31.0)}
 
 
+def _is_build(obj):
+    return isinstance(obj, dict) and obj.get("bench", "build") == "build" and "build_ms" in obj
+
+
 def read_rows(stream):
+    """Build results from JSON lines or from one JSON array (nbsim bench --json-out)."""
+    text = stream.read()
+    if text.lstrip().startswith("["):
+        try:
+            objs = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise ValueError(f"not a JSON array: {e}") from e
+        if not isinstance(objs, list):
+            raise ValueError("not a JSON array")
+        return [o for o in objs if _is_build(o)]
     rows = []
-    for n, line in enumerate(stream, 1):
+    for n, line in enumerate(text.splitlines(), 1):
         line = line.strip()
         if not line:
             continue
@@ -24,9 +39,24 @@ def read_rows(stream):
             obj = json.loads(line)
         except json.JSONDecodeError as e:
             raise ValueError(f"line {n} is not JSON: {e}") from e
-        if obj.get("bench", "build") == "build" and "build_ms" in obj:
+        if _is_build(obj):
             rows.append(obj)
     return rows
+
+
+def table_rows(rows):
+    """One dict per size: ours beside the paper's levels and ms (None where the paper has no row)."""
+    table = []
+    for r in rows:
+        try:
+            paper_levels, paper_ms = PAPER.get(r["size"], (None, None))
+            table.append({
+                "size": r["size"], "levels": r["levels"], "paper_levels": paper_levels, "paper_ms_2005_gpu": paper_ms,
+                "build_ms": float(r["build_ms"]), "copy_ms": float(r["copy_ms"]), "ratio": float(r["ratio"]),
+            })
+        except (KeyError, TypeError, ValueError) as e:
+            raise ValueError(f"build result without a usable {e}: {r}") from e
+    return table
 
 
 def main(argv):
@@ -37,19 +67,13 @@ def main(argv):
     try:
         with (open(a.input) if a.input else sys.stdin) as f:
             rows = read_rows(f)
+        table = table_rows(rows)
     except (OSError, ValueError) as e:
         print(f"table1: {e}", file=sys.stderr)
         return 2
     if not rows:
         print("table1: no build results in the input", file=sys.stderr)
         return 2
-    table = []
-    for r in rows:
-        paper_levels, paper_ms = PAPER.get(r["size"], (None, None))
-        table.append({
-            "size": r["size"], "levels": r["levels"], "paper_levels": paper_levels, "paper_ms_2005_gpu": paper_ms,
-            "build_ms": r["build_ms"], "copy_ms": r["copy_ms"], "ratio": r["ratio"],
-        })
     print("| size | levels (paper) | paper, 2005 GPU (ms) | nbsim core, 1 CPU core (ms) | level-by-level copy (ms) | build / copy |")
     print("|---|---|---|---|---|---|")
     for t in table:

@@ -61,6 +61,14 @@ class CullUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthL
 
   CullMode mode() const noexcept { return mode_; }
   const nbuffer::NBufferUnit* nbuffer_unit() const noexcept { return nb_.get(); }
+  // Bytes the mode's query structure occupies in memory: the N-buffer levels, the tile Hi-Z or the
+  // Hi-Z pyramid; 0 for the occlusion-query modes, which query the depth buffer itself.
+  long long structure_bytes() const noexcept {
+    if (nb_) return nb_->core().levels().storage_bytes();
+    if (tile_) return tile_->storage_bytes();
+    if (pyramid_) return pyramid_->storage_bytes();
+    return 0;
+  }
 
   // cp::FrameProgram (from the command processor's thread).
   std::shared_ptr<const CullReport> run_frame(const std::shared_ptr<const trace::Frame>& f, cp::CommandProcessor& cp) override;

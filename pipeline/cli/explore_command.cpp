@@ -71,13 +71,16 @@ int run_explore(const ExploreOptions& o) {
   std::vector<explore::Point> points = explore::expand(spec);
   explore::check_points(spec, points, check_config, o.sweep);
   const std::vector<std::string> parameters = explore::parameter_keys(spec);
+  const std::size_t sweep_points = points.size();
+  explore::add_reference_points(points, parameters, check_config, o.sweep);
 
   const fs::path out(o.out);
   fs::create_directories(out / "points");
   explore::write_sweep_json(out / "sweep.json", o.sweep, spec, points, parameters, traces, NBSIM_VERSION);
   if (o.dry_run) {
-    for (const auto& p : points) fmt::print("{} {} {}\n", p.id, p.trace, p.settings.dump());
-    fmt::print("explore: {} points, none run (--dry-run); wrote {}\n", points.size(), (out / "sweep.json").string());
+    for (const auto& p : points) fmt::print("{} {} {} {}\n", p.id, p.role, p.trace, p.settings.dump());
+    fmt::print("explore: {} points and {} reference points, none run (--dry-run); wrote {}\n", sweep_points,
+               points.size() - sweep_points, (out / "sweep.json").string());
     return 0;
   }
 
@@ -102,8 +105,9 @@ int run_explore(const ExploreOptions& o) {
       fmt::print("failed: {} ({} {}): {}\n", p.id, p.trace, p.settings.dump(), first);
     }
   }
-  fmt::print("explore: {} points: {} run, {} resumed, {} failed, {:.1f} s with {} jobs; wrote {}\n", points.size(), r.ran,
-             r.resumed, r.failed, seconds, ro.jobs, (out / "results.csv").string());
+  fmt::print("explore: {} points ({} of them references): {} run, {} resumed, {} failed, {:.1f} s with {} jobs; wrote {}\n",
+             points.size(), points.size() - sweep_points, r.ran, r.resumed, r.failed, seconds, ro.jobs,
+             (out / "results.csv").string());
   return r.failed == 0 ? 0 : 1;
 }
 

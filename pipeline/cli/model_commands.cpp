@@ -13,6 +13,7 @@
 #include "pipeline/cli/command.h"
 #include "pipeline/cli/progress.h"
 #include "pipeline/explore/child.h"
+#include "pipeline/explore/runner.h"
 #include "pipeline/sim/replay.h"
 
 namespace nbsim::cli {
@@ -177,7 +178,7 @@ void add_model_commands(CLI::App& app, Action& action) {
     auto jobs = std::make_shared<int>(2);
     auto mo = std::make_shared<ModelOptions>();
     cmd->add_option("TRACE", *trace, "Trace file (nbsim capture) with scene objects and ground truth")->required();
-    cmd->add_option("--out", *out, "Keep each mode's replay outputs in OUT/MODE (default: a temporary folder, removed)");
+    cmd->add_option("--out", *out, "Keep each mode's replay outputs in OUT/MODE and the table in OUT/table2.json (default: a temporary folder, removed)");
     cmd->add_flag("--json", *json, "Print a JSON list, one object per mode");
     cmd->add_option("--jobs", *jobs, "Replays run at a time (one process each)")->check(CLI::Range(1, 16));
     mo->add_options(cmd);
@@ -224,6 +225,18 @@ void add_model_commands(CLI::App& app, Action& action) {
           r["host_seconds"] = rows[i]["host_seconds"];
           false_culls += c["false_culls"].get<std::uint64_t>();
           list.push_back(std::move(r));
+        }
+        if (!temporary) {  // the report (analysis/report.py) reads it: rows plus what produced them
+          nlohmann::ordered_json t;
+          t["trace"] = *trace;
+          t["trace_crc32"] = explore::inspect_trace(*trace).crc32;
+          t["nbsim_version"] = NBSIM_VERSION;
+          t["config_file"] = mo->config_file;
+          t["settings"] = mo->sets;
+          t["rows"] = list;
+          std::ofstream f(dir / "table2.json");
+          f << t.dump(2) << "\n";
+          if (!f) throw InputError(fmt::format("cannot write '{}'", (dir / "table2.json").string()));
         }
         if (*json) {
           fmt::print("{}\n", list.dump());

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <optional>
@@ -45,9 +46,12 @@ std::map<std::string, std::string> metrics_of(const nlohmann::json& run) {
   if (s.contains("depth_tests")) m["depth_tests_per_frame"] = per_frame(s["depth_tests"].get<double>());
   if (const auto* c = find(s, {"cull"})) {
     for (const char* k : {"query_depth_tests_per_frame", "update_texels_per_frame", "total_depth_tests_per_frame", "false_culls",
-                          "culling_efficiency", "culled", "candidates_not_visible", "max_lookups_per_test"})
+                          "culling_efficiency", "culled", "candidates_not_visible", "max_lookups_per_test",
+                          "nbuffer_memory_bytes", "structure_memory_bytes"})
       if (c->contains(k)) m[k] = cell((*c)[k]);
   }
+  if (s.contains("fragment_error") && s.contains("passed_error"))
+    m["counter_error"] = number(std::max(s["fragment_error"].get<double>(), s["passed_error"].get<double>()));
   if (const auto* mem = find(run, {"stats", "gpu.memory"}); mem && mem->is_object()) {
     double total = 0;
     for (const auto& [k, v] : mem->items())
@@ -74,8 +78,9 @@ const std::vector<std::string>& metric_columns() {
       "frames", "draws", "cycles", "cycles_per_frame", "depth_tests", "depth_tests_per_frame", "query_depth_tests_per_frame",
       "update_texels_per_frame", "total_depth_tests_per_frame", "false_culls", "culling_efficiency", "culled",
       "candidates_not_visible", "max_lookups_per_test", "memory_bytes_per_frame", "depth_bytes_per_frame",
-      "nbuffer_bytes_per_frame", "fragment_error", "passed_error", "within_thresholds", "host_seconds",
-      "cycles_per_host_second"};
+      "nbuffer_bytes_per_frame", "nbuffer_memory_bytes", "structure_memory_bytes", "fragment_error", "passed_error",
+      "counter_error", "within_thresholds", "host_seconds", "cycles_per_host_second", "culling_reference",
+      "reference_culling_efficiency", "efficiency_lost", "timing_reference", "reference_cycles", "cycle_error"};
   return columns;
 }
 
@@ -91,7 +96,32 @@ void write_results_csv(const fs::path& file, const fs::path& out, const std::vec
                        const std::string& version) {
   std::ofstream csv(file);
   if (!csv) throw std::runtime_error(fmt::format("cannot write {}", file.string()));
-  std::vector<std::string> header = {"point_id", "trace", "trace_crc32", "nbsim_version"};
+  // Every finished run first: the error columns compare a point with its reference points.
+  std::map<std::string, nlohmann::json> summaries;
+  for (const Point& p : points)
+    if (point_done(out, p))
+      if (const auto run = read_json(point_dir(out, p) / "run.json")) summaries[p.id] = (*run)["summary"];
+  const auto reference_value = [&summaries](const std::string& id, std::initializer_list<const char*> path) -> std::optional<double> {
+    const auto it = summaries.find(id);
+    if (id.empty() || it == summaries.end()) return std::nullopt;
+    const nlohmann::json* v = find(it->second, path);
+    if (!v || !v->is_number()) return std::nullopt;
+    return v->get<double>();
+  };
+  const auto errors = [&](const Point& p, std::map<std::string, std::string>& m) {
+    m["culling_reference"] = p.culling_reference;
+    m["timing_reference"] = p.timing_reference;
+    const auto eff = reference_value(p.id, {"cull", "culling_efficiency"});
+    const auto ref_eff = reference_value(p.culling_reference, {"cull", "culling_efficiency"});
+    if (ref_eff) m["reference_culling_efficiency"] = number(*ref_eff);
+    if (eff && ref_eff) m["efficiency_lost"] = number(*ref_eff - *eff);
+    const auto cycles = reference_value(p.id, {"cycles"});
+    const auto ref_cycles = reference_value(p.timing_reference, {"cycles"});
+    if (ref_cycles) m["reference_cycles"] = number(*ref_cycles);
+    if (cycles && ref_cycles && *ref_cycles > 0) m["cycle_error"] = number((*cycles - *ref_cycles) / *ref_cycles);
+  };
+
+  std::vector<std::string> header = {"point_id", "role", "trace", "trace_crc32", "nbsim_version"};
   header.insert(header.end(), parameters.begin(), parameters.end());
   header.push_back("status");
   header.insert(header.end(), metric_columns().begin(), metric_columns().end());
@@ -101,12 +131,13 @@ void write_results_csv(const fs::path& file, const fs::path& out, const std::vec
   for (const Point& p : points) {
     const fs::path dir = point_dir(out, p);
     const auto run = point_done(out, p) ? read_json(dir / "run.json") : std::nullopt;
-    std::vector<std::string> row = {p.id, p.trace, traces.at(p.trace).crc32,
+    std::vector<std::string> row = {p.id, p.role, p.trace, traces.at(p.trace).crc32,
                                     run && run->contains("nbsim_version") ? cell((*run)["nbsim_version"]) : version};
     for (const auto& k : parameters) row.push_back(cell(p.parameters.value(k, nlohmann::json())));
     if (run) {
       row.push_back("ok");
-      const auto m = metrics_of(*run);
+      auto m = metrics_of(*run);
+      errors(p, m);
       for (const auto& c : metric_columns()) row.push_back(m.count(c) ? m.at(c) : "");
       row.emplace_back();
     } else {
@@ -132,8 +163,11 @@ void write_sweep_json(const fs::path& file, const std::string& sweep_file, const
   j["parameters"] = parameters;
   j["points"] = nlohmann::ordered_json::array();
   for (const Point& p : points)
-    j["points"].push_back({{"id", p.id}, {"trace", p.trace}, {"trace_file", traces.at(p.trace).path.string()},
-                           {"trace_crc32", traces.at(p.trace).crc32}, {"settings", p.settings}, {"parameters", p.parameters}});
+    j["points"].push_back({{"id", p.id}, {"role", p.role}, {"trace", p.trace}, {"trace_file", traces.at(p.trace).path.string()},
+                           {"trace_crc32", traces.at(p.trace).crc32}, {"settings", p.settings}, {"parameters", p.parameters},
+                           {"culling_reference", p.culling_reference}, {"timing_reference", p.timing_reference}});
+  j["culling_reference_settings"] = culling_reference_settings();
+  j["timing_reference_settings"] = timing_reference_settings();
   std::ofstream f(file);
   f << j.dump(2) << '\n';
   if (!f) throw std::runtime_error(fmt::format("cannot write {}", file.string()));

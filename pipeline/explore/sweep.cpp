@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <map>
 #include <set>
 
 #include "model/common/error.h"
@@ -185,9 +186,67 @@ void check_points(const SweepSpec& spec, std::vector<Point>& points, const Confi
       NBSIM_CHECK(effective.contains(k), "the config check returned no value for '" + k + "'");
       p.parameters[k] = effective[k];
     }
+    p.effective = effective;
     p.id = point_id(p.trace, p.settings);
     if (!seen.insert(p.id).second)
       throw InputError(fmt::format("{}: the point ({}) is listed twice", origin, describe_settings(p.trace, p.settings)));
+  }
+}
+
+const nlohmann::json& culling_reference_settings() {
+  static const nlohmann::json s = {{"nbuffer.resolution_divisor", 1}, {"nbuffer.format", "f32"}, {"nbuffer.level_cap", -1}};
+  return s;
+}
+
+const nlohmann::json& timing_reference_settings() {
+  static const nlohmann::json s = {{"gpu.quantum_cycles", 0},
+                                   {"geometry.batch_triangles", 85},
+                                   {"geometry.fused_viewport", true},
+                                   {"depth.fused_interpolation", true}};
+  return s;
+}
+
+void add_reference_points(std::vector<Point>& points, const std::vector<std::string>& parameters, const ConfigCheck& check,
+                          const std::string& origin) {
+  const auto config_key = [](const Point& p) { return p.trace + '\n' + p.effective.dump(); };
+  std::map<std::string, std::size_t> by_config;
+  for (std::size_t i = 0; i < points.size(); ++i) by_config.emplace(config_key(points[i]), i);
+
+  // The id of the point whose config is `p`'s with `overrides`, added when the sweep lacks it.
+  const auto reference = [&](std::size_t i, const nlohmann::json& overrides) -> std::string {
+    Point r;
+    r.trace = points[i].trace;
+    r.settings = points[i].settings;
+    bool changed = false;
+    for (const auto& [k, v] : overrides.items()) {
+      if (!points[i].effective.contains(k)) continue;  // a key this build does not have
+      if (points[i].effective[k] == v) continue;
+      r.settings[k] = v;
+      changed = true;
+    }
+    if (!changed) return points[i].id;
+    r.effective = check(r.settings, fmt::format("{}: reference point ({})", origin, describe_settings(r.trace, r.settings)));
+    for (auto& [k, v] : r.settings.items()) v = r.effective[k];
+    if (const auto found = by_config.find(config_key(r)); found != by_config.end()) return points[found->second].id;
+    for (const auto& k : parameters) r.parameters[k] = r.effective[k];
+    r.id = point_id(r.trace, r.settings);
+    r.role = "reference";
+    by_config.emplace(config_key(r), points.size());
+    points.push_back(std::move(r));
+    const std::size_t added = points.size() - 1;
+    points[added].culling_reference = points[added].timing_reference = points[added].id;  // errors of a reference: none
+    return points[added].id;
+  };
+
+  const std::size_t sweep_points = points.size();
+  for (std::size_t i = 0; i < sweep_points; ++i) {
+    const std::string mode = points[i].effective.value("cull.mode", std::string("trace"));
+    if (mode != "trace" && mode != "none") {
+      nlohmann::json overrides = culling_reference_settings();
+      if (mode != "nb" && mode != "nb_hier") overrides["cull.mode"] = "nb_hier";
+      points[i].culling_reference = reference(i, overrides);
+    }
+    points[i].timing_reference = reference(i, timing_reference_settings());
   }
 }
 

@@ -35,6 +35,11 @@ struct Point {
   std::string trace;  // as written in the sweep file
   nlohmann::json settings = nlohmann::json::object();
   nlohmann::json parameters = nlohmann::json::object();
+  nlohmann::json effective = nlohmann::json::object();  // every config key's value (check_points fills it)
+  std::string role = "sweep";  // "reference": added by add_reference_points, not in the sweep file
+  // Ids of the points this one's errors are measured against (itself when it is its own
+  // reference; empty when there is none): see add_reference_points.
+  std::string culling_reference, timing_reference;
 };
 
 // Checks the structure of a sweep file (parsed keeping its key order); throws InputError naming
@@ -59,5 +64,23 @@ void check_points(const SweepSpec& spec, std::vector<Point>& points, const Confi
 
 // The keys of `parameters`, in the order of first appearance in the sweep file.
 std::vector<std::string> parameter_keys(const SweepSpec& spec);
+
+// The settings each point's errors are measured against (results.csv):
+//  - culling: the full-resolution float32 N-buffer with every level (culling_reference_settings());
+//    a point in a mode that is not an N-buffer mode (oq, oq_hier, hiz_*) is measured against
+//    cull.mode=nb_hier with those settings; points in the trace and none modes cull nothing and have
+//    no culling reference. efficiency_lost = reference culling efficiency - the point's.
+//  - timing: the model's most detailed fidelity (timing_reference_settings(): no temporal
+//    decoupling, llvmpipe's batch size, fused multiply-adds as llvmpipe on FMA hosts).
+//    cycle_error = (cycles - reference cycles) / reference cycles.
+// Keys the config does not have are left out.
+const nlohmann::json& culling_reference_settings();
+const nlohmann::json& timing_reference_settings();
+
+// Sets each point's culling_reference and timing_reference, appending a point with role
+// "reference" for every reference configuration the sweep does not already hold (compared on the
+// effective config, so {} and an explicit default are the same point). Call after check_points.
+void add_reference_points(std::vector<Point>& points, const std::vector<std::string>& parameters, const ConfigCheck& check,
+                          const std::string& origin);
 
 }  // namespace nbsim::explore

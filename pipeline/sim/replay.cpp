@@ -305,7 +305,12 @@ ReplaySummary replay(const ReplayOptions& o) {
   sim::rethrow_thread_failure();  // a damaged trace read mid-run, as an InputError
   s.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.stats = registry.values();
-  if (o.config.cull.parsed_mode() != cull::CullMode::Trace) s.cull = sink.cull.to_json();
+  if (o.config.cull.parsed_mode() != cull::CullMode::Trace) {
+    s.cull = sink.cull.to_json();
+    const long long bytes = gpu.cull() ? gpu.cull()->structure_bytes() : 0;
+    s.cull["structure_memory_bytes"] = bytes;  // N-buffer levels, tile Hi-Z or pyramid
+    s.cull["nbuffer_memory_bytes"] = gpu.cull() && gpu.cull()->nbuffer_unit() ? nlohmann::ordered_json(bytes) : nullptr;
+  }
 
   if (o.out) {
     nlohmann::ordered_json run;

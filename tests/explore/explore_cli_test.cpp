@@ -112,20 +112,23 @@ TEST(ExploreCliTest, SmallSweepAndResume) {
   const fs::path f = write_sweep("small.json", sweep);
   CliResult r = run_nbsim("explore " + f.string() + " --jobs 2 --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  EXPECT_TRUE(has(r.out, "2 points: 2 run, 0 resumed, 0 failed")) << r.out;
+  // The culling reference (float32 levels, full resolution) is not in the sweep: one point is added.
+  EXPECT_TRUE(has(r.out, "3 points (1 of them references): 3 run, 0 resumed, 0 failed")) << r.out;
 
   std::vector<std::string> header;
   auto rows = read_csv(out / "results.csv", &header);
-  ASSERT_EQ(rows.size(), 2u);
+  ASSERT_EQ(rows.size(), 3u);
   for (const char* col : {"point_id", "trace", "trace_crc32", "nbsim_version", "nbuffer.format", "cull.mode",
                           "nbuffer.resolution_divisor", "nbuffer.lookup_latency_cycles", "status", "frames", "cycles_per_frame",
                           "depth_tests_per_frame", "query_depth_tests_per_frame", "total_depth_tests_per_frame", "false_culls",
-                          "culling_efficiency", "memory_bytes_per_frame", "nbuffer_bytes_per_frame", "host_seconds", "error"})
+                          "culling_efficiency", "memory_bytes_per_frame", "nbuffer_bytes_per_frame", "host_seconds", "error", "role",
+                          "nbuffer_memory_bytes", "counter_error", "efficiency_lost", "cycle_error", "culling_reference",
+                          "timing_reference"})
     EXPECT_NE(std::find(header.begin(), header.end(), col), header.end()) << "results.csv lacks column " << col;
   for (const auto& row : rows) {
     EXPECT_EQ(row.at("status"), "ok") << row.at("error");
     EXPECT_EQ(row.at("frames"), "8");
-    EXPECT_EQ(row.at("nbuffer.format"), "u16") << "set reaches every row";
+    EXPECT_EQ(row.at("nbuffer.format"), row.at("role") == "sweep" ? "u16" : "f32") << "set reaches every sweep row";
     EXPECT_EQ(row.at("cull.mode"), "nb_hier");
     EXPECT_EQ(row.at("false_culls"), "0") << "N-buffer culling is conservative";
     EXPECT_EQ(row.at("trace_crc32").size(), 8u);
@@ -137,27 +140,46 @@ TEST(ExploreCliTest, SmallSweepAndResume) {
   }
   EXPECT_EQ(rows[0].at("nbuffer.resolution_divisor"), "1");
   EXPECT_EQ(rows[1].at("nbuffer.resolution_divisor"), "2");
+  // Errors against the reference: culling efficiency lost (exactly the difference), cycles against
+  // the same point at the most detailed timing (here the point itself: 0).
+  const auto& ref = rows[2];
+  EXPECT_EQ(ref.at("role"), "reference");
+  EXPECT_EQ(ref.at("nbuffer.resolution_divisor"), "1");
+  EXPECT_EQ(ref.at("efficiency_lost"), "0");
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(rows[i].at("role"), "sweep");
+    EXPECT_EQ(rows[i].at("culling_reference"), ref.at("point_id"));
+    EXPECT_EQ(rows[i].at("timing_reference"), rows[i].at("point_id"));
+    EXPECT_EQ(rows[i].at("cycle_error"), "0");
+    EXPECT_DOUBLE_EQ(std::stod(rows[i].at("efficiency_lost")),
+                     std::stod(ref.at("culling_efficiency")) - std::stod(rows[i].at("culling_efficiency")));
+    EXPECT_EQ(rows[i].at("counter_error"), "0") << "replays are bit-exact with GL";
+  }
+  // Level memory: levels x (128/d)x(96/d) texels x 2 bytes (u16) or 4 (f32).
+  EXPECT_EQ(std::stoll(rows[0].at("nbuffer_memory_bytes")), 7LL * 128 * 96 * 2);
+  EXPECT_EQ(std::stoll(rows[1].at("nbuffer_memory_bytes")), 6LL * 64 * 48 * 2);
+  EXPECT_EQ(std::stoll(ref.at("nbuffer_memory_bytes")), 7LL * 128 * 96 * 4);
   const auto run0 = nlohmann::json::parse(std::ifstream(out / "points" / rows[0].at("point_id") / "run.json"));
   EXPECT_EQ(run0["config"]["nbuffer"]["format"], "u16") << "the child ran the point's settings";
   EXPECT_EQ(run0["config"]["cull"]["mode"], "nb_hier");
   const auto sj = nlohmann::json::parse(std::ifstream(out / "sweep.json"));
-  EXPECT_EQ(sj["points"].size(), 2u);
+  EXPECT_EQ(sj["points"].size(), 3u);
   EXPECT_EQ(sj["points"][0]["id"], rows[0].at("point_id"));
 
   const fs::path done = out / "points" / rows[0].at("point_id") / "run.json";
   const auto mtime = fs::last_write_time(done);
   r = run_nbsim("explore " + f.string() + " --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  EXPECT_TRUE(has(r.out, "2 points: 0 run, 2 resumed, 0 failed")) << r.out;
+  EXPECT_TRUE(has(r.out, "3 points (1 of them references): 0 run, 3 resumed, 0 failed")) << r.out;
   EXPECT_EQ(fs::last_write_time(done), mtime) << "a done point is not run again";
-  EXPECT_EQ(read_csv(out / "results.csv").size(), 2u);
+  EXPECT_EQ(read_csv(out / "results.csv").size(), 3u);
 
   sweep["axes"]["nbuffer.resolution_divisor"] = {1, 2, 4};
   r = run_nbsim("explore " + write_sweep("small3.json", sweep).string() + " --jobs 2 --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  EXPECT_TRUE(has(r.out, "3 points: 1 run, 2 resumed, 0 failed")) << r.out;
+  EXPECT_TRUE(has(r.out, "4 points (1 of them references): 1 run, 3 resumed, 0 failed")) << r.out;
   rows = read_csv(out / "results.csv");
-  ASSERT_EQ(rows.size(), 3u);
+  ASSERT_EQ(rows.size(), 4u);
   EXPECT_EQ(rows[2].at("nbuffer.resolution_divisor"), "4");
   EXPECT_EQ(rows[2].at("status"), "ok");
 }
@@ -172,7 +194,7 @@ TEST(ExploreCliTest, FailingPointRecorded) {
                                 {"points", {{{"cull.mode", "nb"}, {"trace", kSample}}, {{"cull.mode", "nb"}, {"trace", corrupt.string()}}}}};
   const CliResult r = run_nbsim("explore " + write_sweep("failing.json", sweep).string() + " --jobs 2 --out " + out.string());
   EXPECT_EQ(r.status, 1) << r.out << r.err;
-  EXPECT_TRUE(has(r.out, "2 points: 2 run, 0 resumed, 1 failed")) << r.out;
+  EXPECT_TRUE(has(r.out, "2 points (0 of them references): 2 run, 0 resumed, 1 failed")) << r.out;
   EXPECT_TRUE(has(r.out, "failed: ")) << r.out;
   const auto rows = read_csv(out / "results.csv");
   ASSERT_EQ(rows.size(), 2u);

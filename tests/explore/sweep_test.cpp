@@ -26,7 +26,7 @@ json toy_check(const json& settings, const std::string& origin) {
     double bandwidth = 32.0;
   } c;
   nbsim::config::Schema s;
-  s.add("cull.mode", c.mode, "culling mode", {"trace", "nb", "nb_hier"});
+  s.add("cull.mode", c.mode, "culling mode", {"trace", "nb", "nb_hier", "oq"});
   s.add("nbuffer.resolution_divisor", c.divisor, "", "divisor", 1, 8);
   s.add("memory.bandwidth_bytes_per_cycle", c.bandwidth, "bytes/cycle", "bandwidth", 0.01, 1e6);
   s.apply(settings, origin);
@@ -96,6 +96,33 @@ TEST(SweepTest, StableIds) {
   EXPECT_NE(a[0].id, ex::point_id("u.nbt", a[0].settings)) << "the trace is part of the id";
   // Golden value: changing it makes every existing sweep folder run again.
   EXPECT_EQ(ex::point_id("traces/samples/city_small_oq.nbt", json::object()), "2fd8ffe3aeac73ec") << "FNV-1a 64 of the trace, a line break and the sorted settings";
+}
+
+// Reference points: the culling reference is the full-resolution N-buffer (nb_hier for a mode that
+// is not an N-buffer mode), found among the sweep's points by effective config or added once; the
+// trace mode has none; keys the config lacks (here the timing knobs) are left out.
+TEST(SweepTest, ReferencePoints) {
+  const ojson j = ojson::parse(R"({"traces": ["t.nbt"], "points": [
+    {"cull.mode": "nb"}, {"cull.mode": "nb", "nbuffer.resolution_divisor": 4}, {"cull.mode": "nb", "nbuffer.resolution_divisor": 2},
+    {"cull.mode": "oq"}, {"cull.mode": "oq", "nbuffer.resolution_divisor": 8}, {}]})");
+  const ex::SweepSpec spec = ex::parse_sweep(j, "s");
+  std::vector<Point> points = ex::expand(spec);
+  ex::check_points(spec, points, toy_check, "s");
+  ex::add_reference_points(points, ex::parameter_keys(spec), toy_check, "s");
+  ASSERT_EQ(points.size(), 7u) << "one reference added: nb_hier at full resolution";
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(points[i].culling_reference, points[0].id) << "point " << i << ": {} and divisor 1 are one config";
+  const Point& added = points[6];
+  EXPECT_EQ(added.role, "reference");
+  EXPECT_EQ(added.settings, json::parse(R"({"cull.mode": "nb_hier"})")) << "only what differs is set";
+  EXPECT_EQ(added.parameters["nbuffer.resolution_divisor"], 1);
+  EXPECT_EQ(added.culling_reference, added.id);
+  EXPECT_EQ(points[3].culling_reference, added.id);
+  EXPECT_EQ(points[4].culling_reference, added.id) << "the divisor goes back to 1 as well";
+  EXPECT_TRUE(points[5].culling_reference.empty()) << "the trace mode culls nothing";
+  for (const Point& p : points) {
+    EXPECT_EQ(p.timing_reference, p.id) << "no timing key in this config: every point is its own";
+    EXPECT_EQ(p.role, &p == &added ? "reference" : "sweep");
+  }
 }
 
 // A float key given as an integer is the same point as the float: the schema's typed value counts.

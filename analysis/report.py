@@ -1,0 +1,929 @@
+#!/usr/bin/python3
+"""The exploration report: Table 1, Figure 4, Table 2, the walkthrough and every sweep, as one HTML page.
+
+Usage: /usr/bin/python3 analysis/report.py DIR
+Reads only the CSV/JSON outputs found under DIR and writes DIR/report/index.html with its PNG plots,
+a CSV copy of every table, and DIR/report/<sweep>_pareto.csv (every row of the sweep plus its Pareto
+marks). The inputs, and the nbsim commands that write them:
+  DIR/table1.jsonl                   nbsim bench nbuffer --only build --json-out DIR/table1.jsonl
+  DIR/figure4_map.csv                nbsim nbuffer coverage --size 256x256 --out DIR/figure4_map.png
+  DIR/table2/table2.json             nbsim table2 TRACE --out DIR/table2  (and DIR/table2/MODE/run.json)
+  DIR/sweeps/NAME/results.csv        nbsim explore SWEEP.json --out DIR/sweeps/NAME  (and sweep.json)
+Every section whose inputs exist is rendered; the page names the inputs the others were missing.
+Exit 0 when at least one section rendered; 2 when DIR does not exist or holds nothing usable, or when
+an input is malformed (the message names the file; the other sections are still written).
+"""
+import argparse
+import csv
+import html
+import json
+import math
+import os
+import sys
+from pathlib import Path
+
+sys.dont_write_bytecode = True  # no __pycache__ next to the scripts
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.transforms  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.ticker import MaxNLocator, StrMethodFormatter  # noqa: E402
+
+import plot_coverage  # noqa: E402
+import table1  # noqa: E402
+
+DPI = 110
+THOUSANDS = StrMethodFormatter("{x:,.0f}")
+FIGSIZE = (7, 4.5)
+MODE_ORDER = ["oq_hier", "oq", "nb_hier", "nb", "hiz_tile", "hiz_pyramid"]
+MODE_STYLE = {  # colour, line style, marker: a hierarchical mode is the darker, solid one of its pair
+    "oq_hier": ("#1f4e96", "-", "s"), "oq": ("#6fa8dc", "--", "s"),
+    "nb_hier": ("#b2182b", "-", "o"), "nb": ("#f4a582", "--", "o"),
+    "hiz_tile": ("#1b7837", "-", "^"), "hiz_pyramid": ("#a6dba0", "--", "v"),
+}
+# The paper's ratios of depth tests per frame (Table 2: 200 000 / 500 and 1 100 000 / 350).
+RATIO_PAIRS = [("oq", "nb"), ("oq_hier", "nb_hier")]
+# Knobs that change how closely the model follows llvmpipe, not the design under study.
+FIDELITY_KNOBS = ["geometry.batch_triangles", "geometry.fused_viewport", "depth.fused_interpolation",
+                  "gpu.quantum_cycles", "gpu.fifo_depth"]
+# Short names for point labels; "" shows the value alone (it names itself: nb_hier, u16, eager).
+SHORT = {
+    "cull.mode": "", "nbuffer.format": "", "nbuffer.update_policy": "", "cull.granularity": "",
+    "nbuffer.resolution_divisor": "div", "nbuffer.level_cap": "cap", "nbuffer.capped_max_lookups": "maxlk",
+    "nbuffer.cache_size_bytes": "nb$", "depth.cache_size_bytes": "z$", "nbuffer.lookup_latency_cycles": "lat",
+    "nbuffer.lookups_per_cycle": "lk/c", "geometry.batch_triangles": "batch", "geometry.fused_viewport": "fma-vp",
+    "depth.fused_interpolation": "fma-z", "gpu.fifo_depth": "fifo", "gpu.quantum_cycles": "quantum",
+    "hiz.tile_px": "tile", "hiz.format": "hiz",
+}
+# Sweep metric columns the report reads as numbers (when present).
+NUMERIC = ["cycles_per_frame", "depth_tests_per_frame", "query_depth_tests_per_frame", "update_texels_per_frame",
+           "total_depth_tests_per_frame", "false_culls", "culling_efficiency", "memory_bytes_per_frame",
+           "nbuffer_bytes_per_frame", "fragment_error", "passed_error", "host_seconds", "cycles_per_host_second",
+           "nbuffer_memory_bytes", "efficiency_lost", "cycle_error", "counter_error"]
+
+
+class BadInput(Exception):
+    """A malformed input; str() starts with the file's path."""
+
+
+class Missing(Exception):
+    """A section's inputs are absent; args[0] lists them (paths relative to DIR)."""
+
+
+# ----------------------------------------------------------------------------------------- helpers
+
+def fmt(v, digits=4):
+    """Numbers for tables: thousands separators, a few significant digits, '-' for nothing."""
+    if v is None or v == "" or (isinstance(v, float) and math.isnan(v)):
+        return "-"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, int):
+        return f"{v:,}"
+    if isinstance(v, float):
+        if v == int(v) and abs(v) < 1e15:
+            return f"{int(v):,}"
+        if abs(v) >= 1000:
+            return f"{v:,.0f}"
+        return f"{v:.{digits}g}"
+    return str(v)
+
+
+def pct(v, digits=1):
+    return "-" if v is None else f"{100 * v:.{digits}f}%"
+
+
+def number(s):
+    """A CSV cell as a float, None when empty; ValueError otherwise."""
+    s = s.strip()
+    if s == "" or s.lower() in ("null", "none", "nan"):
+        return None
+    return float(s)
+
+
+def load_json(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except json.JSONDecodeError as e:
+        raise BadInput(f"{path}: broken JSON: {e}") from e
+    except (OSError, UnicodeDecodeError) as e:
+        raise BadInput(f"{path}: cannot read: {e}") from e
+
+
+def read_csv(path, required):
+    """Rows of a CSV as dicts; a header without the required columns or a ragged row is a BadInput."""
+    try:
+        with open(path, newline="") as f:
+            reader = csv.DictReader(f)
+            header = reader.fieldnames or []
+            lacking = [c for c in required if c not in header]
+            if lacking:
+                raise BadInput(f"{path}: the header lacks column(s) {', '.join(lacking)} "
+                               f"(header: {','.join(header)[:200] or 'empty file'})")
+            rows = []
+            for r in reader:
+                if None in r or any(v is None for v in r.values()):
+                    raise BadInput(f"{path}: line {reader.line_num} has {len(r) - (None in r) + len(r.get(None) or [])} "
+                                   f"fields, the header {len(header)}")
+                rows.append(r)
+            return header, rows
+    except csv.Error as e:
+        raise BadInput(f"{path}: not a valid CSV: {e}") from e
+    except (OSError, UnicodeDecodeError) as e:
+        raise BadInput(f"{path}: cannot read: {e}") from e
+
+
+def short_value(key, v):
+    s = str(v)
+    if key.endswith("_bytes"):
+        try:
+            b = int(float(s))
+            return f"{b // 1024}K" if b >= 1024 and b % 1024 == 0 else str(b)
+        except ValueError:
+            return s
+    if s in ("true", "false"):
+        return "on" if s == "true" else "off"
+    if s.endswith(".0"):
+        s = s[:-2]
+    return s
+
+
+def short_label(params, keys):
+    """'nb_hier div=2 u16': the values of the given parameters, keys abbreviated."""
+    parts = []
+    for k in keys:
+        abbr = SHORT.get(k, k.split(".")[-1])
+        v = short_value(k, params.get(k, ""))
+        if v == "":
+            continue
+        parts.append(v if abbr == "" else f"{abbr}={v}")
+    return " ".join(parts)
+
+
+def mode_style(mode):
+    return MODE_STYLE.get(mode, ("#555555", "-", "x"))
+
+
+def sorted_modes(modes):
+    return sorted(modes, key=lambda m: (MODE_ORDER.index(m) if m in MODE_ORDER else len(MODE_ORDER), m))
+
+
+def spans_decades(values, decades=1.0):
+    v = [x for x in values if x is not None and x > 0]
+    return len(v) > 1 and math.log10(max(v) / min(v)) >= decades
+
+
+def trace_name(t):
+    return os.path.basename(t).removesuffix(".nbt")
+
+
+# ---------------------------------------------------------------------------------------- Pareto
+
+def pareto_flags(points):
+    """For (cost, error) pairs (None: left out) whether each is Pareto-optimal when minimising both: no
+    other point is <= in both and < in one. Equal points do not dominate each other (both stay)."""
+    flags = []
+    for p in points:
+        if p is None:
+            flags.append(None)
+            continue
+        dominated = any(q is not None and q[0] <= p[0] and q[1] <= p[1] and (q[0] < p[0] or q[1] < p[1])
+                        for q in points)
+        flags.append(not dominated)
+    return flags
+
+
+def mark_pareto(rows, cost, error):
+    """Pareto flags per trace (different traces are different scenes): True/False for ok sweep rows
+    with both values, None for failed rows, reference rows and rows without the values."""
+    flags = [None] * len(rows)
+    by_trace = {}
+    for i, r in enumerate(rows):
+        by_trace.setdefault(r.get("trace", ""), []).append(i)
+    for idx in by_trace.values():
+        pts = []
+        for i in idx:
+            r = rows[i]
+            c, e = r.get(cost), r.get(error)
+            usable = (r.get("status", "ok") == "ok" and r.get("role", "sweep") != "reference"
+                      and isinstance(c, float) and isinstance(e, float) and math.isfinite(c) and math.isfinite(e))
+            pts.append((c, e) if usable else None)
+        for i, f in zip(idx, pareto_flags(pts)):
+            flags[i] = f
+    return flags
+
+
+def table2_ratios(rows):
+    """Query depth tests per frame of occlusion queries over the N-buffer's, ours beside the paper's."""
+    by = {r["mode"]: r for r in rows}
+    out = []
+    for a, b in RATIO_PAIRS:
+        if a in by and b in by:
+            qa, qb = by[a].get("query_depth_tests_per_frame"), by[b].get("query_depth_tests_per_frame")
+            pa, pb = by[a].get("paper_depth_tests_per_frame"), by[b].get("paper_depth_tests_per_frame")
+            out.append({"ratio": f"{a} / {b}", "ours": qa / qb if qa is not None and qb else None,
+                        "paper": pa / pb if pa is not None and pb else None})
+    return out
+
+
+# ------------------------------------------------------------------------------------ plot labels
+
+def place_labels(ax, xs, ys, labels, colors=None, fontsize=7):
+    """Annotate points, trying offsets around each until the label overlaps no marker, no earlier label
+    and not the axes' border; points at the same place (and colour) share one label. Call after the
+    layout is fixed (freeze_layout)."""
+    renderer = ax.figure.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    colors = colors or ["#222222"] * len(xs)
+    groups = {}
+    placed = []  # display boxes to keep clear: the markers first, then each label placed
+    for x, y, lab, c in zip(xs, ys, labels, colors):
+        px, py = ax.transData.transform((x, y))
+        placed.append(matplotlib.transforms.Bbox.from_extents(px - 4, py - 4, px + 4, py + 4))
+        groups.setdefault((round(px / 4), round(py / 4), c), [x, y, c, []])[3].append(lab)
+    offsets = [(5, 4), (5, -12), (-5, 4), (-5, -12), (6, 14), (6, -22), (-6, 14), (-6, -22),
+               (10, -4), (-10, -4), (6, 26), (6, -34), (-6, 26), (-6, -34), (14, 38), (-14, 38)]
+    for x, y, c, labs in groups.values():
+        labs = list(dict.fromkeys(labs))
+        text = "\n".join(labs) if len(labs) <= 3 else "\n".join(labs[:2] + [f"+{len(labs) - 2} more"])
+        for k, (dx, dy) in enumerate(offsets):
+            t = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=fontsize,
+                            ha="left" if dx >= 0 else "right", va="bottom", color=c)
+            bb = t.get_window_extent(renderer)
+            inside = frame.x0 <= bb.x0 and bb.x1 <= frame.x1 and frame.y0 <= bb.y0 and bb.y1 <= frame.y1
+            if inside and not any(bb.overlaps(p) for p in placed):
+                break
+            if k < len(offsets) - 1:
+                t.remove()
+            else:  # nowhere free: back to the first place, with a leader line
+                t.remove()
+                t = ax.annotate(text, (x, y), xytext=offsets[0], textcoords="offset points", fontsize=fontsize,
+                                ha="left", va="bottom", color=c, arrowprops={"arrowstyle": "-", "color": "#999", "lw": 0.5})
+                bb = t.get_window_extent(renderer)
+        placed.append(bb)
+
+
+def freeze_layout(fig):
+    """Run the constrained layout once and keep it, so labels placed afterwards stay where they were put."""
+    fig.canvas.draw()
+    fig.set_layout_engine("none")
+
+
+# ---------------------------------------------------------------------------------------- report
+
+class Report:
+    def __init__(self, root):
+        self.root = Path(root)
+        self.out = self.root / "report"
+        self.sections = []   # (anchor, title, html)
+        self.missing = []    # (title, [paths])
+        self.errors = []     # messages
+        self.inputs = []     # (relative path, section)
+        self.versions = set()
+
+    def rel(self, p):
+        return os.path.relpath(p, self.root)
+
+    def used(self, path, section):
+        self.inputs.append((self.rel(path), section))
+
+    def save(self, fig, name):
+        fig.savefig(self.out / name, dpi=DPI)
+        plt.close(fig)
+        return name
+
+    def figure(self, name, caption):
+        return (f'<figure><img src="{html.escape(name)}" alt="{html.escape(caption[:80])}">'
+                f"<figcaption>{caption}</figcaption></figure>")
+
+    def table(self, name, columns, rows, row_class=None, note=""):
+        """columns: (header, key, formatter or None); rows: dicts. Writes name.csv with the raw values."""
+        with open(self.out / f"{name}.csv", "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow([k for _, k, _ in columns])
+            for r in rows:
+                w.writerow(["" if r.get(k) is None else r.get(k) for _, k, _ in columns])
+        h = ['<table><thead><tr>' + "".join(f"<th>{html.escape(c)}</th>" for c, _, _ in columns) + "</tr></thead><tbody>"]
+        for i, r in enumerate(rows):
+            cls = row_class(r) if row_class else ""
+            cells = []
+            for _, k, f in columns:
+                v = r.get(k)
+                s = f(v) if f else fmt(v)
+                num = isinstance(v, (int, float)) and not isinstance(v, bool)
+                cells.append(f'<td class="n">{html.escape(s)}</td>' if num else f"<td>{html.escape(s)}</td>")
+            h.append(f'<tr class="{cls}">' + "".join(cells) + "</tr>" if cls else "<tr>" + "".join(cells) + "</tr>")
+        h.append("</tbody></table>")
+        h.append(f'<p class="small">{note}Also as <a href="{name}.csv">{name}.csv</a>.</p>')
+        return "\n".join(h)
+
+    def run(self, anchor, title, build, main_input):
+        try:
+            body = build()
+        except Missing as m:
+            self.missing.append((title, m.args[0]))
+            return
+        except BadInput as e:
+            self.errors.append(str(e))
+            self.sections.append((anchor, title, f'<p class="error">Not rendered: {html.escape(str(e))}</p>'))
+            return
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError, ZeroDivisionError) as e:
+            msg = f"{main_input}: unexpected content ({type(e).__name__}: {e})"
+            self.errors.append(msg)
+            self.sections.append((anchor, title, f'<p class="error">Not rendered: {html.escape(msg)}</p>'))
+            return
+        finally:
+            plt.close("all")
+        self.sections.append((anchor, title, body))
+        self.rendered = getattr(self, "rendered", 0) + 1
+
+    # ------------------------------------------------------------------------------ Table 1
+    def table1(self):
+        path = self.root / "table1.jsonl"
+        if not path.exists():
+            raise Missing(["table1.jsonl"])
+        try:
+            with open(path) as f:
+                rows = table1.read_rows(f)
+            t = table1.table_rows(rows)
+        except (OSError, UnicodeDecodeError, ValueError) as e:
+            raise BadInput(f"{path}: {e}") from e
+        if not t:
+            raise BadInput(f"{path}: no build results (objects with \"bench\": \"build\" and build_ms)")
+        self.used(path, "Table 1")
+        cols = [("size", "size", None), ("levels", "levels", None), ("paper levels", "paper_levels", None),
+                ("paper, 2005 GPU (ms)", "paper_ms_2005_gpu", None), ("nbsim core, 1 CPU core (ms)", "build_ms", None),
+                ("level-by-level copy (ms)", "copy_ms", None), ("build / copy", "ratio", lambda v: f"{v:.2f}")]
+        tab = self.table("table1", cols, t)
+
+        fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
+        x = np.arange(len(t))
+        wd = 0.27
+        paper = [r["paper_ms_2005_gpu"] or np.nan for r in t]
+        ax.bar(x - wd, paper, wd, label="paper, 2005 GPU", color="#999999", hatch="//", edgecolor="white")
+        ax.bar(x, [r["build_ms"] for r in t], wd, label="nbsim build, 1 CPU core", color="#b2182b")
+        ax.bar(x + wd, [r["copy_ms"] for r in t], wd, label="level-by-level copy (baseline)", color="#6fa8dc")
+        for i, r in enumerate(t):
+            ax.annotate(f"{r['ratio']:.2f}x copy", (x[i], r["build_ms"]), xytext=(0, 3), textcoords="offset points",
+                        ha="center", va="bottom", fontsize=8)
+        ax.set_yscale("log")
+        ax.set_xticks(x, [f"{r['size']}\n{r['levels']} levels" for r in t])
+        ax.set_xlabel("depth map size")
+        ax.set_ylabel("full N-buffer build time (ms, log scale)")
+        ax.set_title("N-buffer build cost (Décoret 2005, Table 1)")
+        ax.grid(axis="y", which="both", alpha=0.3)
+        ax.legend(loc="upper left", fontsize=8)
+        img = self.save(fig, "table1.png")
+        worst = max(t, key=lambda r: r["ratio"])
+        return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim bench nbuffer --only build</code>). "
+                "The copy baseline moves exactly the bytes a naive level-by-level build reads and writes; "
+                "the paper's times are for its 2005 GPU, ours for one CPU core, so compare the shape, and "
+                f"build/copy (worst here: {worst['ratio']:.2f} at {worst['size']}).</p>" + tab +
+                self.figure(img, "Build time per size, log scale. Read off: how build time grows with the "
+                            "number of texels (the paper's and ours), and the label above each red bar: the "
+                            "build's cost in units of a plain copy of the same bytes (1.0 would be as cheap as copying)."))
+
+    # ------------------------------------------------------------------------------ Figure 4
+    def figure4(self):
+        path = self.root / "figure4_map.csv"
+        if not path.exists():
+            raise Missing(["figure4_map.csv"])
+        try:
+            W, H, one, four = plot_coverage.load(path)
+        except (OSError, UnicodeDecodeError, csv.Error, KeyError, ValueError) as e:
+            msg = str(e)
+            raise BadInput(msg if msg.startswith(str(path)) else f"{path}: {type(e).__name__}: {msg}") from e
+        self.used(path, "Figure 4")
+        s = plot_coverage.summary(one, four)
+        rows = [{"covering": "one square (1 lookup)", "mean_extra": s["one_mean_extra"], "worst_extra": s["one_worst_extra"],
+                 "exact": float(np.count_nonzero(one == 0) / s["sizes"])},
+                {"covering": "four squares (at most 4 lookups)", "mean_extra": s["four_mean_extra"],
+                 "worst_extra": s["four_worst_extra"], "exact": s["four_exact_fraction"]}]
+        cols = [("covering", "covering", None), ("mean extra pixels read (% of the box)", "mean_extra", lambda v: pct(v, 0)),
+                ("worst (x the box)", "worst_extra", lambda v: f"{v:.0f}x"),
+                ("exact for (% of box sizes)", "exact", pct)]
+        tab = self.table("figure4", cols, rows)
+        plot_coverage.plot(W, H, one, four, self.out / "figure4.png")
+        return (f"<p>From <code>{self.rel(path)}</code>: every box size from 1x1 to {W}x{H} "
+                f"({s['sizes']:,} sizes), how many pixels beyond the box the covering squares read.</p>" + tab +
+                self.figure("figure4.png", "Extra pixels read over the box area, log colour scale, x = box width, "
+                            "y = box height. Read off: four squares are exact (darkest) on the bands where "
+                            "floor(log2 w) = floor(log2 h), and worst for thin boxes along the axes; one square is "
+                            "looser everywhere."))
+
+    # ------------------------------------------------------------------------------ Table 2
+    def load_table2(self):
+        path = self.root / "table2" / "table2.json"
+        if not path.exists():
+            return path, None
+        t = load_json(path)
+        if not isinstance(t, dict) or not isinstance(t.get("rows"), list) or not t["rows"]:
+            raise BadInput(f"{path}: expected an object with a non-empty \"rows\" list (nbsim table2 --out)")
+        need = ["mode", "query_depth_tests_per_frame", "total_depth_tests_per_frame", "cycles_per_frame",
+                "false_culls", "culling_efficiency"]
+        for i, r in enumerate(t["rows"]):
+            if not isinstance(r, dict):
+                raise BadInput(f"{path}: rows[{i}] is not an object")
+            lacking = [k for k in need if k not in r]
+            if lacking:
+                raise BadInput(f"{path}: rows[{i}] lacks {', '.join(lacking)}")
+            for k in need[1:] + ["paper_depth_tests_per_frame", "update_texels_per_frame", "undrawable"]:
+                if r.get(k) is not None and not isinstance(r[k], (int, float)):
+                    raise BadInput(f"{path}: rows[{i}].{k} is not a number: {r[k]!r}")
+        return path, t
+
+    def table2(self):
+        path, t = self.load_table2()
+        if t is None:
+            raise Missing(["table2/table2.json"])
+        self.used(path, "Table 2")
+        if t.get("nbsim_version"):
+            self.versions.add(str(t["nbsim_version"]))
+        rows = []
+        for r in t["rows"]:
+            rr = dict(r)
+            p = r.get("paper_depth_tests_per_frame")
+            rr["ours_over_paper"] = r["query_depth_tests_per_frame"] / p if p else None
+            rows.append(rr)
+        cols = [("mode", "mode", None), ("paper row", "paper", lambda v: v or "-"),
+                ("paper depth tests/frame", "paper_depth_tests_per_frame", None),
+                ("query depth tests/frame", "query_depth_tests_per_frame", None),
+                ("ours / paper", "ours_over_paper", lambda v: "-" if v is None else f"{v:.3g}"),
+                ("update texels/frame", "update_texels_per_frame", None),
+                ("total depth tests/frame", "total_depth_tests_per_frame", None),
+                ("cycles/frame", "cycles_per_frame", None), ("false culls", "false_culls", None),
+                ("culling efficiency", "culling_efficiency", pct), ("undrawable", "undrawable", None)]
+        tab = self.table("table2", cols, rows, row_class=lambda r: "bad" if r.get("false_culls") else "")
+        ratios = table2_ratios(t["rows"])
+        rtab = self.table("table2_ratios", [("ratio of query depth tests", "ratio", None),
+                                            ("ours", "ours", lambda v: "-" if v is None else f"{v:,.0f}x"),
+                                            ("paper", "paper", lambda v: "-" if v is None else f"{v:,.0f}x")], ratios)
+        settings = t.get("settings") or []
+        sets = ", ".join(f"<code>{html.escape(str(s))}</code>" for s in settings) or "none (the defaults)"
+        cfg = f", config file <code>{html.escape(str(t['config_file']))}</code>" if t.get("config_file") else ""
+        crc = f" (CRC-32 {html.escape(str(t['trace_crc32']))})" if t.get("trace_crc32") else ""
+        # the paper against ours, per mode
+        modes = [r["mode"] for r in rows]
+        fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
+        x = np.arange(len(rows))
+        wd = 0.27
+        ax.bar(x - wd, [r.get("paper_depth_tests_per_frame") or np.nan for r in rows], wd,
+               label="paper (512x512 city)", color="#999999", hatch="//", edgecolor="white")
+        ax.bar(x, [r["query_depth_tests_per_frame"] for r in rows], wd, label="ours: query depth tests", color="#b2182b")
+        ax.bar(x + wd, [r["total_depth_tests_per_frame"] for r in rows], wd,
+               label="ours: total (+ updates + drawing)", color="#6fa8dc")
+        for i, r in enumerate(rows):
+            if not r.get("paper_depth_tests_per_frame"):
+                ax.annotate("no paper row", (x[i] - wd, 0), xycoords=("data", "axes fraction"), xytext=(0, 4),
+                            textcoords="offset points", rotation=90, ha="center", va="bottom", fontsize=7, color="#777")
+        ax.set_yscale("log")
+        ax.set_xticks(x, modes)
+        ax.set_xlabel("culling mode")
+        ax.set_ylabel("depth tests per frame (log scale)")
+        ax.set_title(f"Depth tests per frame: paper vs nbsim ({trace_name(str(t.get('trace', '?')))})")
+        ax.grid(axis="y", which="both", alpha=0.3)
+        ax.legend(fontsize=8, loc="upper right")
+        img = self.save(fig, "table2.png")
+        rt = "; ".join(f"{r['ratio']}: {'-' if r['ours'] is None else format(r['ours'], ',.0f')}x "
+                       f"(paper {'-' if r['paper'] is None else format(r['paper'], ',.0f')}x)" for r in ratios)
+        fc = sum(int(r.get("false_culls") or 0) for r in rows)
+        return (f"<p>Trace <code>{html.escape(str(t.get('trace', '?')))}</code>{crc}, settings: {sets}{cfg}; "
+                f"from <code>{self.rel(path)}</code>. Query depth tests are the paper's count; the total adds the "
+                "N-buffer/Hi-Z update texels and the drawn objects' depth tests. "
+                f"{'<b class=bad>' + str(fc) + ' false culls.</b>' if fc else 'No false culls.'} "
+                f"Ratios: {html.escape(rt) or 'none (a mode of each pair is missing)'}.</p>" + tab +
+                "<h3>Occlusion queries over N-buffer</h3>" + rtab +
+                self.figure(img, "Per culling mode, log scale: the paper's depth tests per frame (grey), ours for "
+                            "the queries alone (red, the paper's count) and in total (blue). Read off: the "
+                            "N-buffer modes' query cost is orders of magnitude below the occlusion queries', as in the "
+                            "paper, while their total is dominated by keeping the levels up to date."))
+
+    # ------------------------------------------------------------------------------ walkthrough
+    def walkthrough(self):
+        _, t = self.load_table2() if (self.root / "table2" / "table2.json").exists() else (None, None)
+        base = self.root / "table2"
+        if t is not None:
+            modes = [r["mode"] for r in t["rows"]]
+        elif base.is_dir():
+            modes = sorted_modes(d.name for d in base.iterdir() if (d / "run.json").exists())
+        else:
+            modes = []
+        present = [m for m in modes if (base / m / "run.json").exists()]
+        if not present:
+            raise Missing([f"table2/{m}/run.json" for m in modes] or ["table2/MODE/run.json"])
+        series = {}
+        for m in present:
+            p = base / m / "run.json"
+            run = load_json(p)
+            frames = run.get("frames") if isinstance(run, dict) else None
+            if not isinstance(frames, list) or not frames:
+                raise BadInput(f"{p}: no \"frames\" list (nbsim replay's run.json)")
+            for i, f in enumerate(frames):
+                if not isinstance(f, dict) or not all(isinstance(f.get(k), (int, float))
+                                                      for k in ("frame", "query_depth_tests", "total_depth_tests")):
+                    raise BadInput(f"{p}: frames[{i}] lacks a number for frame, query_depth_tests or total_depth_tests")
+            if isinstance(run.get("nbsim_version"), str):
+                self.versions.add(run["nbsim_version"])
+            self.used(p, "walkthrough")
+            series[m] = frames
+        with open(self.out / "walkthrough.csv", "w", newline="") as f:
+            keys = ["frame", "query_depth_tests", "total_depth_tests", "depth_tests", "update_texels", "cycles"]
+            w = csv.writer(f)
+            w.writerow(["mode"] + keys)
+            for m, frames in series.items():
+                for fr in frames:
+                    w.writerow([m] + [fr.get(k, "") for k in keys])
+        fig, axes = plt.subplots(2, 1, figsize=(8.5, 7), sharex=True, constrained_layout=True)
+        zeros = []
+        for m, frames in series.items():
+            c, ls, mk = mode_style(m)
+            fx = [f["frame"] for f in frames]
+            q = [f["query_depth_tests"] for f in frames]
+            if any(v <= 0 for v in q):
+                zeros.append(m)
+            axes[0].plot(fx, [v if v > 0 else np.nan for v in q], color=c, ls=ls, marker=mk, ms=4, label=m)
+            axes[1].plot(fx, [f["total_depth_tests"] for f in frames], color=c, ls=ls, marker=mk, ms=4, label=m)
+        axes[0].set_yscale("log")
+        axes[0].set_ylabel("query depth tests (log scale)")
+        axes[0].set_title("Visibility queries: the paper's count per frame")
+        if spans_decades([f["total_depth_tests"] for fr in series.values() for f in fr]):
+            axes[1].set_yscale("log")
+            axes[1].set_ylabel("total depth tests (log scale)")
+        else:
+            axes[1].set_ylabel("total depth tests")
+            axes[1].yaxis.set_major_formatter(THOUSANDS)
+        axes[1].set_title("Total: queries + N-buffer/Hi-Z updates + drawn objects")
+        axes[1].set_xlabel("frame of the walkthrough")
+        for ax in axes:
+            ax.grid(which="both", alpha=0.3)
+        axes[0].xaxis.set_major_locator(MaxNLocator(integer=True))
+        axes[0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1), title="culling mode", title_fontsize=8)
+        fig.suptitle("Depth tests per frame along the walkthrough, per culling mode")
+        img = self.save(fig, "walkthrough.png")
+        absent = [m for m in modes if m not in present]
+        note = (f" Missing: {', '.join(f'table2/{m}/run.json' for m in absent)}." if absent else "")
+        note += (f" Frames with no query depth test ({', '.join(zeros)}) are gaps on the log scale." if zeros else "")
+        return (f"<p>Per frame, from <code>table2/MODE/run.json</code> ({len(present)} modes).{html.escape(note)} "
+                'The plotted values are in <a href="walkthrough.csv">walkthrough.csv</a>.</p>' +
+                self.figure(img, "Top: query depth tests per frame (log scale), one line per culling mode; bottom: "
+                            "total depth tests per frame. Read off: the gap between the occlusion-query modes "
+                            "(blue) and the N-buffer modes (red) frame by frame, and which frames of the walk "
+                            "cost the most."))
+
+    # ------------------------------------------------------------------------------ sweeps
+    def sweep_dirs(self):
+        d = self.root / "sweeps"
+        return sorted(p for p in d.iterdir() if p.is_dir()) if d.is_dir() else []
+
+    def sweep(self, d):
+        path = d / "results.csv"
+        if not path.exists():
+            raise Missing([f"sweeps/{d.name}/results.csv"])
+        meta, params = {}, None
+        if (d / "sweep.json").exists():
+            meta = load_json(d / "sweep.json")
+            if not isinstance(meta, dict) or not isinstance(meta.get("parameters", []), list):
+                raise BadInput(f"{d / 'sweep.json'}: expected an object with a \"parameters\" list (nbsim explore)")
+            params = [str(p) for p in meta.get("parameters", [])]
+            self.used(d / "sweep.json", f"sweep {d.name}")
+            if meta.get("nbsim_version"):
+                self.versions.add(str(meta["nbsim_version"]))
+        header, raw = read_csv(path, ["trace", "status", "cycles_per_frame"])
+        has_eff = "efficiency_lost" in header
+        if not has_eff and "culling_efficiency" not in header:
+            raise BadInput(f"{path}: the header lacks culling_efficiency (or efficiency_lost)")
+        if params is None:  # without sweep.json: the columns between nbsim_version and status
+            i0 = header.index("nbsim_version") + 1 if "nbsim_version" in header else header.index("trace") + 1
+            params = header[i0:header.index("status")]
+        lacking = [p for p in params if p not in header]
+        if lacking:
+            raise BadInput(f"{path}: no column for parameter(s) {', '.join(lacking)} that sweep.json lists")
+        self.used(path, f"sweep {d.name}")
+        rows = []
+        for n, r in enumerate(raw, 2):
+            rr = dict(r)
+            for k in NUMERIC:
+                if k in r:
+                    try:
+                        rr[k] = number(r[k])
+                    except ValueError:
+                        if r["status"] == "ok":
+                            raise BadInput(f"{path}: line {n}: {k} is not a number: {r[k]!r}")
+                        rr[k] = None
+            rr["status"] = r["status"].strip() or "?"
+            rr["role"] = r.get("role", "").strip() or "sweep"
+            rows.append(rr)
+        if not rows:
+            raise BadInput(f"{path}: no rows")
+        ok = [r for r in rows if r["status"] == "ok"]
+        traces = list(dict.fromkeys(r["trace"] for r in rows))
+        varying = [p for p in params if len({r[p] for r in rows}) > 1]
+        fixed = [p for p in params if p not in varying]
+        # Labels: a grid (every combination) names every varying value; a list of points names what
+        # differs from the trace's first point.
+        combos = {tuple(r[p] for p in varying) for r in rows if r["role"] == "sweep"}
+        grid = len(combos) == math.prod(len({r[p] for r in rows if r["role"] == "sweep"}) for p in varying) if varying else True
+        first = {}
+        for r in rows:
+            if r["role"] == "sweep":
+                first.setdefault(r["trace"], r)
+        for r in rows:
+            first.setdefault(r["trace"], r)
+        for r in rows:
+            keys = varying
+            if not grid:
+                keys = [p for p in varying if r[p] != first[r["trace"]][p]]
+            r["label"] = (short_label(r, keys) if keys else "baseline") if varying else r.get("point_id", "")[:8]
+            if r["role"] == "reference":
+                r["label"] = "ref " + r["label"]
+        # Error: culling efficiency lost against the reference N-buffer, or the hidden objects not culled.
+        use_eff = has_eff and any(r.get("efficiency_lost") is not None for r in ok)
+        if use_eff:
+            for r in rows:
+                e = r.get("efficiency_lost")
+                r["error_axis"] = None if e is None else 100 * e
+            err_label = "culling efficiency lost vs full-res f32 N-buffer (points of %)"
+            err_text = "culling efficiency lost against the full-resolution float32 N-buffer (efficiency_lost)"
+        else:
+            for r in rows:
+                ce = r.get("culling_efficiency")
+                r["error_axis"] = None if ce is None else 100 * (1 - ce)
+            err_label = "hidden objects not culled (%, = 1 - culling efficiency)"
+            err_text = "hidden objects left unculled, 1 - culling efficiency (no efficiency_lost column)"
+        no_err = sum(1 for r in ok if r["error_axis"] is None)
+        for r in rows:
+            fe, pe = r.get("fragment_error"), r.get("passed_error")
+            r["counter_err"] = r.get("counter_error") if r.get("counter_error") is not None else (
+                None if fe is None and pe is None else max(abs(fe or 0), abs(pe or 0)))
+        costs = [("cycles_per_frame", "pareto", "cycles per frame", "cycles"),
+                 ("total_depth_tests_per_frame", "pareto_depth_tests", "total depth tests per frame", "tests")]
+        if "nbuffer_memory_bytes" in header and any(r.get("nbuffer_memory_bytes") is not None for r in ok):
+            for r in rows:
+                b = r.get("nbuffer_memory_bytes")
+                r["nbuffer_memory_kib"] = None if b is None else b / 1024
+            costs.append(("nbuffer_memory_kib", "pareto_memory", "N-buffer memory (KiB)", "memory"))
+        for key, col, _, _ in costs:
+            for r, f in zip(rows, mark_pareto(rows, key, "error_axis")):
+                r[col] = f
+        # The Pareto CSV: every column of results.csv, then the label, the error and the marks.
+        extra = ["label", "error_axis"] + [c for _, c, _, _ in costs]
+        with open(self.out / f"{d.name}_pareto.csv", "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(header + extra)
+            for r, rr in zip(raw, rows):
+                w.writerow([r[h] for h in header] + [rr["label"], "" if rr["error_axis"] is None else rr["error_axis"]] +
+                           ["" if rr[c] is None else ("yes" if rr[c] else "no") for _, c, _, _ in costs])
+        # The table of points.
+        for r in rows:
+            r["trace_short"] = trace_name(r["trace"])
+            r["status_text"] = r["status"] + (f": {r['error'][:80]}" if r["status"] != "ok" and r.get("error") else "")
+            r["pareto_marks"] = ", ".join(short for _, c, _, short in costs if r.get(c)) or ""
+        cols = [("label", "label", None)]
+        if len(traces) > 1:
+            cols.append(("trace", "trace_short", None))
+        if "role" in header:
+            cols.append(("role", "role", None))
+        cols += [(p, p, None) for p in varying]
+        cols += [("status", "status_text", None), ("cycles/frame", "cycles_per_frame", None),
+                 ("total depth tests/frame", "total_depth_tests_per_frame", None)]
+        if any(c[0] == "nbuffer_memory_kib" for c in costs):
+            cols.append(("N-buffer memory (KiB)", "nbuffer_memory_kib", None))
+        cols += [("memory bytes/frame", "memory_bytes_per_frame", None),
+                 ("culling efficiency", "culling_efficiency", pct),
+                 ("efficiency lost (points)" if use_eff else "not culled (%)", "error_axis", lambda v: "-" if v is None else f"{v:.2f}"),
+                 ("false culls", "false_culls", None),
+                 ("counter error", "counter_err", lambda v: "-" if v is None else f"{v:.2%}")]
+        if "cycle_error" in header:
+            cols.append(("cycle error", "cycle_error", lambda v: "-" if v is None else f"{v:+.3%}" if abs(v) >= 5e-6 else "0.000%"))
+        cols += [("host s", "host_seconds", lambda v: "-" if v is None else f"{v:.3f}"),
+                 ("Pareto (cost vs error)", "pareto_marks", None)]
+        tab = self.table(f"{d.name}_points", cols, rows,
+                         row_class=lambda r: "bad" if r["status"] != "ok" or (r.get("false_culls") or 0) > 0
+                         else ("pareto" if r["pareto_marks"] else ("ref" if r["role"] == "reference" else "")),
+                         note=f"Pareto marks ({', '.join(s for *_, s in costs)}): optimal for that cost against the "
+                         f"error, per trace. Every row with its marks: <a href=\"{d.name}_pareto.csv\">{d.name}_pareto.csv</a>. ")
+        parts = []
+        desc = meta.get("description")
+        failed = [r for r in rows if r["status"] != "ok"]
+        parts.append(
+            f"<p>{html.escape(str(desc)) + ' ' if desc else ''}From <code>{self.rel(path)}</code>"
+            f"{' and sweep.json' if meta else ' (no sweep.json: parameters taken from the columns before status)'}: "
+            f"{len(rows)} rows over {len(traces)} trace(s) ({', '.join(trace_name(t) for t in traces)}); varying: "
+            f"{', '.join(f'<code>{html.escape(p)}</code>' for p in varying) or 'nothing'}"
+            f"{'; fixed: ' + ', '.join(f'<code>{html.escape(p)}</code> = {html.escape(str(rows[0][p]))}' for p in fixed) if fixed else ''}. "
+            f"Error axis: {err_text}."
+            f"{f' {no_err} ok row(s) without it are left out of the plots.' if no_err else ''}"
+            f"{'' if grid else ' A list of points: labels name what differs from the baseline, the first point of each trace.'}"
+            f"{' <b class=bad>' + str(len(failed)) + ' failed point(s)</b>, listed below, left out of the plots.' if failed else ''}</p>")
+        parts.append(tab)
+        for key, col, label, short in costs:
+            parts.append(self.figure(self.pareto_plot(d.name, rows, traces, key, col, label, err_label, short),
+                                     f"{label[0].upper() + label[1:]} against the error, one panel per trace. Pareto-optimal points "
+                                     "(no other point of the trace is as cheap and as accurate, and strictly better in one) are "
+                                     "filled red and joined by the front; grey circles are dominated"
+                                     f"{'; stars are reference runs, not in the front' if any(r['role'] == 'reference' for r in rows) else ''}. "
+                                     "Read off: the cheapest design for an accepted loss, and what each step down the front costs."))
+        speed = self.speed_plot(d.name, rows, params, header)
+        if speed:
+            parts.append(speed)
+        return "\n".join(parts)
+
+    def panels(self, n):
+        if n == 1:
+            return plt.subplots(figsize=FIGSIZE, constrained_layout=True, squeeze=False)
+        cols = min(n, 2)
+        nrows = math.ceil(n / cols)
+        return plt.subplots(nrows, cols, figsize=(12, 4.8 * nrows), constrained_layout=True, squeeze=False)
+
+    def pareto_plot(self, name, rows, traces, key, col, label, err_label, short):
+        fig, axes = self.panels(len(traces))
+        flat = axes.ravel()
+        todo = []
+        for ax, tr in zip(flat, traces):
+            pts = [r for r in rows if r["trace"] == tr and r["status"] == "ok"
+                   and r.get(key) is not None and r.get("error_axis") is not None]
+            front = sorted((r for r in pts if r.get(col)), key=lambda r: (r[key], -r["error_axis"]))
+            dom = [r for r in pts if r.get(col) is False]
+            ref = [r for r in pts if r["role"] == "reference"]
+            if dom:
+                ax.scatter([r[key] for r in dom], [r["error_axis"] for r in dom], s=30, facecolors="none",
+                           edgecolors="#777777", label="dominated", zorder=2)
+            if front:
+                ax.plot([r[key] for r in front], [r["error_axis"] for r in front], drawstyle="steps-post",
+                        color="#b2182b", lw=1.2, alpha=0.7, zorder=1)
+                ax.scatter([r[key] for r in front], [r["error_axis"] for r in front], s=40, color="#b2182b",
+                           edgecolors="black", linewidths=0.6, label="Pareto-optimal", zorder=3)
+            if ref:
+                ax.scatter([r[key] for r in ref], [r["error_axis"] for r in ref], s=90, marker="*", color="#1f4e96",
+                           label="reference run", zorder=3)
+            bad = [r for r in pts if (r.get("false_culls") or 0) > 0]
+            if bad:
+                ax.scatter([r[key] for r in bad], [r["error_axis"] for r in bad], s=110, marker="x", color="red",
+                           label="false culls", zorder=4)
+            if spans_decades([r[key] for r in pts]):
+                ax.set_xscale("log")
+            else:
+                ax.xaxis.set_major_locator(MaxNLocator(nbins=6, integer=True))
+                ax.xaxis.set_major_formatter(THOUSANDS)
+            ax.set_xlabel(label + (" (log scale)" if ax.get_xscale() == "log" else ""))
+            ax.set_ylabel(err_label, fontsize=9)
+            ax.set_title(trace_name(tr), fontsize=10)
+            ax.grid(which="both", alpha=0.3)
+            ax.margins(x=0.15, y=0.15)
+            if pts:
+                ax.legend(fontsize=7, loc="best")
+            else:
+                ax.text(0.5, 0.5, "no ok point with both values", transform=ax.transAxes, ha="center")
+            todo.append((ax, pts))
+        for ax in flat[len(traces):]:
+            ax.set_visible(False)
+        fig.suptitle(f"Sweep {name}: {label} against error (Pareto front per trace)")
+        freeze_layout(fig)
+        for ax, pts in todo:
+            if pts:
+                labs = [r["label"] + (f" ({int(r['false_culls'])} false culls)" if (r.get("false_culls") or 0) > 0 else "")
+                        for r in pts]
+                place_labels(ax, [r[key] for r in pts], [r["error_axis"] for r in pts], labs)
+        return self.save(fig, f"{name}_{short}_vs_error.png")
+
+    def speed_plot(self, name, rows, params, header):
+        """Simulator speed against cycle error, for sweeps of fidelity knobs or with a cycle_error column."""
+        knobs = [p for p in params if p in FIDELITY_KNOBS]
+        has_ce = "cycle_error" in header and any((r.get("cycle_error") or 0) != 0 for r in rows)
+        if not knobs and not has_ce:
+            return ""
+        ok = [r for r in rows if r["status"] == "ok"]
+        if "cycle_error" in header and any(r.get("cycle_error") is not None for r in ok):
+            for r in ok:
+                r["_ce"] = None if r.get("cycle_error") is None else 100 * abs(r["cycle_error"])
+            src = "the cycle_error column (against the same point at the most detailed fidelity settings)"
+        else:
+            base = {}
+            for r in ok:
+                base.setdefault(r["trace"], r)
+            for r in ok:
+                b = base[r["trace"]]["cycles_per_frame"]
+                r["_ce"] = None if not b or r["cycles_per_frame"] is None else 100 * abs(r["cycles_per_frame"] / b - 1)
+            src = ("cycles per frame against each trace's first point of the sweep (there is no cycle_error column "
+                   "yet: this is the change a knob makes, not an error against the most detailed settings)")
+        if any(r.get("cycles_per_host_second") is not None for r in ok):
+            ykey, ylabel, scale = "cycles_per_host_second", "simulator speed (M simulated cycles per host second)", 1e-6
+        else:
+            ykey, ylabel, scale = "host_seconds", "host seconds per run (lower is faster)", 1
+        pts = [r for r in ok if r.get("_ce") is not None and r.get(ykey) is not None]
+        if not pts:
+            return ""
+        traces = list(dict.fromkeys(r["trace"] for r in pts))
+        fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
+        markers = ["o", "s", "^", "D", "v", "P"]
+        for i, tr in enumerate(traces):
+            tp = [r for r in pts if r["trace"] == tr]
+            ax.scatter([r["_ce"] for r in tp], [r[ykey] * scale for r in tp], marker=markers[i % len(markers)],
+                       s=40, color=f"C{i}", edgecolors="black", linewidths=0.5, label=trace_name(tr), zorder=3)
+        xs = [r["_ce"] for r in pts]
+        pos = [x for x in xs if x > 0]
+        if pos and max(pos) / min(pos) >= 30:
+            ax.set_xscale("symlog", linthresh=min(pos))
+        if spans_decades([r[ykey] for r in pts]):
+            ax.set_yscale("log")
+        ax.set_xlabel("|cycle error| (% of cycles per frame)")
+        ax.set_ylabel(ylabel)
+        ax.set_title(f"Sweep {name}: simulator speed against its cycle error")
+        ax.grid(which="both", alpha=0.3)
+        ax.margins(x=0.2, y=0.2)
+        ax.legend(fontsize=8, loc="best", title="trace", title_fontsize=8)
+        freeze_layout(fig)
+        labs = [r["label"] + (f" (counters {r['counter_err']:.1%} off)" if r.get("counter_err") else "") for r in pts]
+        place_labels(ax, xs, [r[ykey] * scale for r in pts], labs, [f"C{traces.index(r['trace'])}" for r in pts])
+        img = self.save(fig, f"{name}_speed_vs_cycle_error.png")
+        for r in ok:
+            r.pop("_ce", None)
+        return self.figure(img, f"One marker per point and trace: x = |cycle error|, from {src}; y = "
+                           f"{ylabel}. Read off: which fidelity knobs buy speed for how much cycle error; the "
+                           "best are up and to the left. Host speed is measured on a shared machine: compare "
+                           "points of one run only, and expect noise of tens of percent.")
+
+    # ------------------------------------------------------------------------------ page
+    def write_html(self):
+        css = """
+body { font-family: -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; max-width: 1200px; margin: 2em auto;
+       padding: 0 1em; color: #222; line-height: 1.45; }
+h1 { margin-bottom: 0.2em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 2em; }
+code { background: #f3f3f3; padding: 0 0.25em; border-radius: 3px; font-size: 90%; }
+table { border-collapse: collapse; margin: 0.8em 0; font-size: 13px; }
+th, td { border: 1px solid #d0d0d0; padding: 3px 7px; } th { background: #eef1f5; text-align: left; vertical-align: bottom; }
+td.n { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+tr.pareto td { background: #fff3d6; } tr.bad td { background: #fde0e0; } tr.ref td { background: #e6eefb; }
+figure { margin: 1.2em 0; } figure img { max-width: 100%; border: 1px solid #e3e3e3; }
+figcaption { color: #444; font-size: 90%; max-width: 900px; }
+.small { font-size: 85%; color: #555; } .missing { background: #fff8e6; border: 1px solid #f0d9a0; padding: 0.5em 1em; }
+.error, .bad { color: #a00; }
+"""
+        versions = ", ".join(sorted(self.versions)) or "unknown (no input names it)"
+        h = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
+             "<title>nbsim exploration report</title>", f"<style>{css}</style></head><body>",
+             "<h1>nbsim exploration report</h1>",
+             f"<p>nbsim version {html.escape(versions)}; inputs read from <code>{html.escape(str(self.root.resolve()))}</code>"
+             " (paths below are relative to it). Written by <code>analysis/report.py</code> from CSV/JSON outputs only.</p>"]
+        h.append("<details><summary>Inputs read</summary><ul>" + "".join(
+            f"<li><code>{html.escape(p)}</code> ({html.escape(s)})</li>" for p, s in self.inputs) + "</ul></details>")
+        h.append("<ul>" + "".join(f'<li><a href="#{a}">{html.escape(t)}</a></li>' for a, t, _ in self.sections) + "</ul>")
+        if self.missing:
+            h.append('<div class="missing"><b>Sections not rendered, inputs missing:</b><ul>' + "".join(
+                f"<li>{html.escape(t)}: {', '.join(f'<code>{html.escape(p)}</code>' for p in ps)}</li>"
+                for t, ps in self.missing) + "</ul></div>")
+        for a, t, body in self.sections:
+            h.append(f'<h2 id="{a}">{html.escape(t)}</h2>')
+            h.append(body)
+        h.append("</body></html>")
+        (self.out / "index.html").write_text("\n".join(h) + "\n")
+
+
+def main(argv):
+    ap = argparse.ArgumentParser(
+        description=__doc__.splitlines()[0], epilog="\n".join(__doc__.splitlines()[2:]),
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dir", metavar="DIR", help="folder holding the nbsim outputs (the demo's out/demo)")
+    a = ap.parse_args(argv)
+    root = Path(a.dir)
+    if not root.is_dir():
+        print(f"report: {a.dir}: no such folder", file=sys.stderr)
+        return 2
+    rep = Report(root)
+    try:
+        rep.out.mkdir(exist_ok=True)
+    except OSError as e:
+        print(f"report: cannot create {rep.out}: {e}", file=sys.stderr)
+        return 2
+    rep.run("table1", "Table 1: N-buffer build cost", rep.table1, root / "table1.jsonl")
+    rep.run("figure4", "Figure 4: covering tightness", rep.figure4, root / "figure4_map.csv")
+    rep.run("table2", "Table 2: depth tests per frame in the walkthrough", rep.table2, root / "table2/table2.json")
+    rep.run("walkthrough", "Depth tests per frame along the walkthrough", rep.walkthrough, root / "table2")
+    dirs = rep.sweep_dirs()
+    if not dirs:
+        rep.missing.append(("Sweeps (architecture exploration)", ["sweeps/NAME/results.csv"]))
+    for d in dirs:
+        rep.run(f"sweep-{d.name}", f"Sweep {d.name}", lambda d=d: rep.sweep(d), d / "results.csv")
+    rendered = getattr(rep, "rendered", 0)
+    for e in rep.errors:
+        print(f"report: {e}", file=sys.stderr)
+    if rendered == 0 and not rep.errors:
+        try:
+            rep.out.rmdir()  # nothing written into it
+        except OSError:
+            pass
+        print(f"report: nothing usable in {a.dir}: looked for table1.jsonl, figure4_map.csv, table2/table2.json, "
+              "table2/MODE/run.json, sweeps/NAME/results.csv", file=sys.stderr)
+        return 2
+    rep.write_html()
+    print(f"report: wrote {rep.out / 'index.html'} ({rendered} sections"
+          f"{'; missing inputs: ' + '; '.join(t for t, _ in rep.missing) if rep.missing else ''})")
+    return 2 if rep.errors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,64 @@
+#!/bin/sh
+# Regenerates tests/analysis/fixture/, the input folder of analysis/report.py's tests, from real nbsim
+# outputs on the small samples (city_small_oq.nbt, and city_small_nb_reversed.nbt for a second trace
+# in two sweeps). Big files are trimmed to what the report reads. About a minute on 2 cores.
+# Usage: tests/analysis/make_fixture.sh [NBSIM]   (default: build/pipeline/nbsim; run from anywhere)
+set -eu
+root=$(cd "$(dirname "$0")/../.." && pwd)
+nbsim=$(realpath "${1:-$root/build/pipeline/nbsim}")
+py=/usr/bin/python3
+out=$root/tests/analysis/fixture
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$root"  # sweep files name traces relative to the repository
+
+rm -rf "$out"
+mkdir -p "$out/table2" "$out/sweeps"
+
+# Table 1: the four build sizes (the file --json-out writes is one JSON array).
+"$nbsim" bench nbuffer --only build --json-out "$out/table1.jsonl" >/dev/null
+
+# Figure 4 at 32x32 (the demo uses 256x256: a 2.4 MB CSV).
+"$nbsim" nbuffer coverage --size 32x32 --out "$tmp/figure4_map.png" >/dev/null
+cp "$tmp/figure4_map.csv" "$out/figure4_map.csv"
+
+# Table 2: table2.json plus each mode's run.json cut down to what the report reads.
+"$nbsim" table2 traces/samples/city_small_oq.nbt --jobs 2 --json --out "$tmp/table2" >"$tmp/table2_rows.json"
+$py - "$tmp/table2" "$out/table2" "$tmp/table2_rows.json" <<'EOF'
+import json, os, sys
+src, dst, rows = sys.argv[1:]
+if os.path.exists(os.path.join(src, "table2.json")):
+    table = json.load(open(os.path.join(src, "table2.json")))
+else:  # an nbsim older than table2.json: rebuild it from --json
+    version = json.load(open(os.path.join(src, "nb", "run.json")))["nbsim_version"]
+    table = {"trace": "traces/samples/city_small_oq.nbt", "trace_crc32": "818900a2",
+             "nbsim_version": version, "settings": [], "rows": json.load(open(rows))}
+json.dump(table, open(os.path.join(dst, "table2.json"), "w"), indent=2)
+for r in table["rows"]:
+    run = json.load(open(os.path.join(src, r["mode"], "run.json")))
+    keep = {k: run[k] for k in ("nbsim_version", "trace", "config", "summary", "frames") if k in run}
+    os.makedirs(os.path.join(dst, r["mode"]))
+    json.dump(keep, open(os.path.join(dst, r["mode"], "run.json"), "w"), indent=1)
+EOF
+
+# Sweeps: small.json as it is; nbuffer_resolution and fidelity on the two small samples only.
+sweep() {  # name, sweep file
+  "$nbsim" explore "$2" --jobs 2 --out "$tmp/sweeps/$1" >/dev/null
+  mkdir -p "$out/sweeps/$1"
+  cp "$tmp/sweeps/$1/results.csv" "$tmp/sweeps/$1/sweep.json" "$out/sweeps/$1/"
+}
+small_traces() {  # sweep file -> the same sweep over the small samples, in $tmp
+  $py - "$1" "$tmp/$(basename "$1")" <<'EOF'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["traces"] = ["traces/samples/city_small_oq.nbt", "traces/samples/city_small_nb_reversed.nbt"]
+json.dump(s, open(sys.argv[2], "w"), indent=2)
+EOF
+  echo "$tmp/$(basename "$1")"
+}
+sweep small pipeline/sweeps/small.json
+sweep nbuffer_resolution "$(small_traces pipeline/sweeps/nbuffer_resolution.json)"
+sweep fidelity "$(small_traces pipeline/sweeps/fidelity.json)"
+
+du -sh "$out"
+echo "wrote $out"

@@ -1,0 +1,335 @@
+"""AnalysisTest: analysis/report.py on a fixture of real nbsim outputs (tests/analysis/fixture, refreshed by
+make_fixture.sh) and on hand-made inputs. Run: /usr/bin/python3 -m unittest discover -s tests/analysis -v
+"""
+import csv
+import json
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+sys.dont_write_bytecode = True
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent.parent
+SCRIPT = ROOT / "analysis" / "report.py"
+FIXTURE = HERE / "fixture"
+PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
+sys.path.insert(0, str(ROOT / "analysis"))
+import report  # noqa: E402
+import table1  # noqa: E402
+
+
+def run_report(d):
+    p = subprocess.run([PYTHON, str(SCRIPT), str(d)], capture_output=True, text=True, timeout=300)
+    return p.returncode, p.stdout, p.stderr
+
+
+def png_size(path):
+    """(width, height) from the IHDR chunk; AssertionError when the file is not a PNG."""
+    data = Path(path).read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG"
+    assert data[12:16] == b"IHDR", f"{path} has no IHDR chunk first"
+    assert data.rstrip(b"\x00").endswith(b"IEND\xaeB`\x82"), f"{path} is truncated"
+    return struct.unpack(">II", data[16:24])
+
+
+def write_sweep(d, name, header, rows, parameters):
+    s = Path(d) / "sweeps" / name
+    s.mkdir(parents=True)
+    with open(s / "results.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        w.writerows(rows)
+    (s / "sweep.json").write_text(json.dumps({"name": name, "nbsim_version": "test", "parameters": parameters}))
+    return s
+
+
+class FixtureReport(unittest.TestCase):
+    """The report on the fixture: every section, every image, the CSV copies."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.dir = Path(cls.tmp.name) / "out"
+        shutil.copytree(FIXTURE, cls.dir)
+        cls.rc, cls.out, cls.err = run_report(cls.dir)
+        cls.version = json.loads((FIXTURE / "table2" / "table2.json").read_text())["nbsim_version"]
+        cls.html = (cls.dir / "report" / "index.html").read_text() if (cls.dir / "report" / "index.html").exists() else ""
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_exit_zero_and_no_missing_inputs(self):
+        # a complete fixture renders with exit 0 and reports nothing missing
+        self.assertEqual(self.rc, 0, f"report failed on the fixture: {self.err}")
+        self.assertNotIn("inputs missing", self.html, "the fixture has every input")
+        self.assertNotIn("Not rendered", self.html)
+
+    def test_every_section_is_there(self):
+        # one heading per section, one per sweep, and the speed plot of the fidelity sweep
+        for title in ["Table 1: N-buffer build cost", "Figure 4: covering tightness", "Table 2: depth tests per frame",
+                      "Depth tests per frame along the walkthrough", "Sweep small", "Sweep nbuffer_resolution",
+                      "Sweep fidelity", "simulator speed", f"nbsim version {self.version}"]:
+            self.assertIn(title, self.html, f"index.html lacks '{title}'")
+        self.assertIn("fidelity_speed_vs_cycle_error.png", self.html, "a fidelity sweep must get the speed plot")
+        self.assertNotIn("small_speed_vs_cycle_error.png", self.html, "small.json has no fidelity knob")
+
+    def test_images_exist_and_are_valid_pngs(self):
+        # every <img> points at a real PNG of a readable size
+        srcs = [s.split('"')[0] for s in self.html.split('<img src="')[1:]]
+        self.assertGreaterEqual(len(srcs), 11, f"too few images: {srcs}")
+        for s in srcs:
+            p = self.dir / "report" / s
+            self.assertTrue(p.exists(), f"{s} is referenced but not written")
+            w, h = png_size(p)
+            self.assertTrue(500 <= w <= 2000 and 300 <= h <= 1500, f"{s} is {w}x{h} pixels")
+            self.assertGreater(p.stat().st_size, 10_000, f"{s} is suspiciously small")
+
+    def test_tables_have_csv_copies_and_thousands_separators(self):
+        # each table links its CSV copy, which exists; big numbers are grouped
+        links = [s.split('"')[0] for s in self.html.split('<a href="')[1:] if s.split('"')[0].endswith(".csv")]
+        for name in ["table1.csv", "figure4.csv", "table2.csv", "table2_ratios.csv", "small_points.csv"]:
+            self.assertIn(name, links)
+        for link in links:
+            self.assertTrue((self.dir / "report" / link).exists(), f"{link} is linked but not written")
+        self.assertRegex(self.html, r">\d{1,3},\d{3}<", "no number with a thousands separator")
+
+    def test_pareto_csv_written_per_sweep(self):
+        # <sweep>_pareto.csv holds every results.csv row plus a pareto column, and some points are on the front
+        for name in ["small", "nbuffer_resolution", "fidelity"]:
+            with open(self.dir / "sweeps" / name / "results.csv") as f:
+                n = len(list(csv.DictReader(f)))
+            with open(self.dir / "report" / f"{name}_pareto.csv") as f:
+                rows = list(csv.DictReader(f))
+            self.assertEqual(len(rows), n, f"{name}_pareto.csv lost rows")
+            self.assertIn("pareto", rows[0])
+            self.assertTrue(any(r["pareto"] == "yes" for r in rows), f"{name}: nothing on the front")
+            self.assertTrue(all(r["pareto"] in ("yes", "no", "") for r in rows))
+
+    def test_table2_names_trace_and_ratio(self):
+        # the trace and the oq/nb ratio beside the paper's 400x
+        self.assertIn("traces/samples/city_small_oq.nbt", self.html)
+        t = json.loads((FIXTURE / "table2" / "table2.json").read_text())
+        by = {r["mode"]: r for r in t["rows"]}
+        ours = by["oq"]["query_depth_tests_per_frame"] / by["nb"]["query_depth_tests_per_frame"]
+        self.assertIn(f"oq / nb: {ours:,.0f}x (paper 400x)", self.html)
+
+
+class Pareto(unittest.TestCase):
+    """Pareto marks on hand-made points: minimise cost and error, per trace, ok sweep rows only."""
+
+    def test_flags_known_points(self):
+        # dominated, non-dominated and tied points (equal points stay on the front together)
+        pts = [(1, 5), (2, 3), (2, 3), (3, 3), (4, 1), (5, 1), (0.5, 10), (2, 5), None]
+        self.assertEqual(report.pareto_flags(pts), [True, True, True, False, True, False, True, False, None])
+
+    def test_equal_cost_lower_error_dominates(self):
+        # same cost, strictly lower error: the other is dominated (<= in both, < in one)
+        self.assertEqual(report.pareto_flags([(1, 2), (1, 1)]), [False, True])
+        self.assertEqual(report.pareto_flags([(7, 7)]), [True])
+
+    def test_report_marks_per_trace_and_skips_failed_and_reference(self):
+        # through the whole script: a tiny results.csv with two traces, a failed and a reference row
+        header = ["point_id", "trace", "nbuffer.resolution_divisor", "status", "role", "cycles_per_frame",
+                  "total_depth_tests_per_frame", "culling_efficiency", "efficiency_lost", "false_culls", "host_seconds"]
+        rows = [
+            ["a", "t1.nbt", 1, "ok", "sweep", 100, 1000, 0.9, 0.00, 0, 0.1],   # best error: front
+            ["b", "t1.nbt", 2, "ok", "sweep", 50, 900, 0.8, 0.10, 0, 0.1],     # cheaper, worse: front
+            ["c", "t1.nbt", 4, "ok", "sweep", 60, 800, 0.7, 0.20, 0, 0.1],     # dominated by b in cycles
+            ["d", "t1.nbt", 8, "ok", "sweep", 50, 950, 0.8, 0.10, 1, 0.1],     # ties b in cycles: front
+            ["e", "t1.nbt", 16, "failed", "sweep", "", "", "", "", "", ""],    # failed: not considered
+            ["f", "t1.nbt", 1, "ok", "reference", 1, 1, 1.0, 0.0, 0, 0.1],     # reference: never dominates
+            ["g", "t2.nbt", 4, "ok", "sweep", 500, 5000, 0.5, 0.40, 0, 0.1],   # alone on its trace: front
+        ]
+        with tempfile.TemporaryDirectory() as d:
+            write_sweep(d, "tiny", header, rows, ["nbuffer.resolution_divisor"])
+            rc, _, err = run_report(d)
+            self.assertEqual(rc, 0, err)
+            with open(Path(d) / "report" / "tiny_pareto.csv") as f:
+                got = {r["point_id"]: (r["pareto"], r["pareto_depth_tests"]) for r in csv.DictReader(f)}
+            html = (Path(d) / "report" / "index.html").read_text()
+        self.assertEqual({k: v[0] for k, v in got.items()},
+                         {"a": "yes", "b": "yes", "c": "no", "d": "yes", "e": "", "f": "", "g": "yes"})
+        # total depth tests: c (800, 20%) is cheapest, a has the least error, b (900, 10%) in between
+        self.assertEqual({k: v[1] for k, v in got.items()},
+                         {"a": "yes", "b": "yes", "c": "yes", "d": "no", "e": "", "f": "", "g": "yes"})
+        self.assertIn("efficiency lost", html)
+        self.assertIn('<tr class="bad">', html, "the row with a false cull (d) must be flagged")
+
+
+class FutureColumns(unittest.TestCase):
+    """Columns results.csv is getting (role, nbuffer_memory_bytes, efficiency_lost, cycle_error,
+    counter_error), added here to a real results.csv of the fixture."""
+
+    def test_reference_rows_memory_plot_and_cycle_error(self):
+        # reference rows stay out of the fronts, N-buffer memory gets its plot, cycle_error the speed plot
+        with open(FIXTURE / "sweeps" / "nbuffer_resolution" / "results.csv") as f:
+            rows = list(csv.DictReader(f))
+        header = list(rows[0]) + ["role", "nbuffer_memory_bytes", "efficiency_lost", "cycle_error", "counter_error"]
+        ref = dict(rows[0], point_id="reference")
+        ref["cull.mode"] = "nb"  # at the reference settings: culls better than any point of the sweep
+        ref_ce = max(float(r["culling_efficiency"]) for r in rows) + 0.01
+        ref["culling_efficiency"] = str(ref_ce)
+        out = []
+        for k, r in enumerate([ref] + rows):
+            d = int(r["nbuffer.resolution_divisor"])
+            out.append(dict(r, role="reference" if r is ref else "sweep",
+                            nbuffer_memory_bytes=str(49152 * 7 // (d * d)),
+                            efficiency_lost=str(ref_ce - float(r["culling_efficiency"])),
+                            cycle_error=str(0.001 * (k % 4)), counter_error="0"))
+        with tempfile.TemporaryDirectory() as d:
+            s = Path(d) / "sweeps" / "res"
+            s.mkdir(parents=True)
+            shutil.copy(FIXTURE / "sweeps" / "nbuffer_resolution" / "sweep.json", s)
+            with open(s / "results.csv", "w", newline="") as f:
+                w = csv.DictWriter(f, fieldnames=header)
+                w.writeheader()
+                w.writerows(out)
+            rc, _, err = run_report(d)
+            self.assertEqual(rc, 0, err)
+            html = (Path(d) / "report" / "index.html").read_text()
+            with open(Path(d) / "report" / "res_pareto.csv") as f:
+                got = {r["point_id"]: r for r in csv.DictReader(f)}
+            for png in ["res_memory_vs_error.png", "res_speed_vs_cycle_error.png", "res_cycles_vs_error.png"]:
+                self.assertIn(png, html)
+                png_size(Path(d) / "report" / png)
+        self.assertEqual(got["reference"]["pareto"], "", "a reference row is never on a front")
+        self.assertIn("pareto_memory", got["reference"])
+        self.assertIn("efficiency lost", html)
+        self.assertIn("cycle_error column", html)
+
+
+class Table2Ratio(unittest.TestCase):
+    def test_ratio_against_paper(self):
+        # oq/nb and oq_hier/nb_hier from query depth tests, beside the paper's 400x and 3143x
+        rows = [{"mode": "oq", "query_depth_tests_per_frame": 20000.0, "paper_depth_tests_per_frame": 200000.0},
+                {"mode": "nb", "query_depth_tests_per_frame": 400.0, "paper_depth_tests_per_frame": 500.0},
+                {"mode": "oq_hier", "query_depth_tests_per_frame": 3000.0, "paper_depth_tests_per_frame": 1100000.0},
+                {"mode": "nb_hier", "query_depth_tests_per_frame": 300.0, "paper_depth_tests_per_frame": 350.0},
+                {"mode": "hiz_tile", "query_depth_tests_per_frame": 700.0, "paper_depth_tests_per_frame": None}]
+        r = {x["ratio"]: x for x in report.table2_ratios(rows)}
+        self.assertAlmostEqual(r["oq / nb"]["ours"], 50.0)
+        self.assertAlmostEqual(r["oq / nb"]["paper"], 400.0)
+        self.assertAlmostEqual(r["oq_hier / nb_hier"]["ours"], 10.0)
+        self.assertAlmostEqual(r["oq_hier / nb_hier"]["paper"], 1100000 / 350)
+
+    def test_ratio_needs_both_modes(self):
+        # without nb there is no oq/nb ratio (not a division by a missing row)
+        self.assertEqual(report.table2_ratios([{"mode": "oq", "query_depth_tests_per_frame": 1.0}]), [])
+
+
+class MissingAndBroken(unittest.TestCase):
+    """Missing inputs are named in the page; malformed ones exit 2 naming the file, without a traceback."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = Path(self.tmp.name)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_missing_inputs_are_reported(self):
+        # only Table 1 present: exit 0, the page names what the other sections lacked
+        shutil.copy(FIXTURE / "table1.jsonl", self.dir)
+        rc, out, err = run_report(self.dir)
+        self.assertEqual(rc, 0, err)
+        html = (self.dir / "report" / "index.html").read_text()
+        self.assertIn("Table 1: N-buffer build cost", html)
+        for missing in ["figure4_map.csv", "table2/table2.json", "sweeps/NAME/results.csv"]:
+            self.assertIn(missing, html, f"the page does not say {missing} is missing")
+        self.assertIn("missing inputs", out)
+
+    def test_walkthrough_without_table2_json(self):
+        # run.json files alone still give the walkthrough plot; Table 2 is reported missing
+        shutil.copytree(FIXTURE / "table2", self.dir / "table2")
+        (self.dir / "table2" / "table2.json").unlink()
+        rc, _, err = run_report(self.dir)
+        self.assertEqual(rc, 0, err)
+        html = (self.dir / "report" / "index.html").read_text()
+        self.assertIn("walkthrough.png", html)
+        self.assertIn("table2/table2.json", html)
+
+    def test_empty_and_absent_dir_exit_2(self):
+        # nothing usable, or no folder at all: exit 2 with a message
+        rc, _, err = run_report(self.dir)
+        self.assertEqual(rc, 2)
+        self.assertIn("nothing usable", err)
+        rc, _, err = run_report(self.dir / "nope")
+        self.assertEqual(rc, 2)
+        self.assertIn("no such folder", err)
+
+    def assertBroken(self, rc, err, name):
+        self.assertEqual(rc, 2, f"a malformed {name} must exit 2")
+        self.assertIn(name, err, "the message must name the file")
+        self.assertNotIn("Traceback", err)
+
+    def test_bad_results_csv_header(self):
+        # a results.csv without the columns of nbsim explore: exit 2, file named, other sections still written
+        shutil.copytree(FIXTURE, self.dir / "out")
+        (self.dir / "out" / "sweeps" / "small" / "results.csv").write_text("foo,bar\n1,2\n")
+        rc, _, err = run_report(self.dir / "out")
+        self.assertBroken(rc, err, "sweeps/small/results.csv")
+        self.assertIn("trace", err, "the message should say which column is missing")
+        self.assertTrue((self.dir / "out" / "report" / "table1.png").exists(), "the other sections are still rendered")
+
+    def test_ragged_and_non_numeric_results_csv(self):
+        # a short row, then a non-number in a metric column
+        header = ["point_id", "trace", "nbsim_version", "x.y", "status", "cycles_per_frame", "culling_efficiency"]
+        s = write_sweep(self.dir, "r", header, [["a", "t.nbt", "0", "1", "ok", "10", "0.5"], ["b", "t.nbt"]], ["x.y"])
+        rc, _, err = run_report(self.dir)
+        self.assertBroken(rc, err, str(Path("sweeps") / "r" / "results.csv"))
+        self.assertIn("line 3", err)
+        with open(s / "results.csv", "w") as f:
+            f.write(",".join(header) + "\na,t.nbt,0,1,ok,fast,0.5\n")
+        rc, _, err = run_report(self.dir)
+        self.assertBroken(rc, err, "results.csv")
+        self.assertIn("cycles_per_frame", err)
+
+    def test_broken_json(self):
+        # table2.json and sweep.json that are not JSON
+        shutil.copytree(FIXTURE / "table2", self.dir / "table2")
+        (self.dir / "table2" / "table2.json").write_text('{"rows": [')
+        rc, _, err = run_report(self.dir)
+        self.assertBroken(rc, err, "table2.json")
+        shutil.rmtree(self.dir / "table2")
+        s = write_sweep(self.dir, "s", ["trace", "status", "cycles_per_frame", "culling_efficiency"],
+                        [["t", "ok", "1", "0.5"]], [])
+        (s / "sweep.json").write_text("not json")
+        rc, _, err = run_report(self.dir)
+        self.assertBroken(rc, err, "sweep.json")
+
+    def test_bad_table1_and_coverage(self):
+        # a broken Table 1 file and a coverage CSV without its columns
+        (self.dir / "table1.jsonl").write_text('{"bench": "build", "size": \n')
+        (self.dir / "figure4_map.csv").write_text("a,b\n1,2\n")
+        rc, _, err = run_report(self.dir)
+        self.assertBroken(rc, err, "table1.jsonl")
+        self.assertIn("figure4_map.csv", err)
+
+    def test_help(self):
+        # --help works and describes the inputs
+        p = subprocess.run([PYTHON, str(SCRIPT), "--help"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(p.returncode, 0)
+        self.assertIn("results.csv", p.stdout)
+
+
+class Table1Input(unittest.TestCase):
+    def test_reads_lines_and_the_json_out_array(self):
+        # nbsim bench prints JSON lines; --json-out writes one array: both give the same rows
+        import io
+        objs = [{"bench": "build", "size": "256x256", "levels": 8, "build_ms": 0.1, "copy_ms": 0.05, "ratio": 2.0},
+                {"bench": "query", "size": "256x256"}]
+        lines = table1.read_rows(io.StringIO("\n".join(json.dumps(o) for o in objs)))
+        array = table1.read_rows(io.StringIO(json.dumps(objs, indent=2)))
+        self.assertEqual(lines, array)
+        self.assertEqual(len(array), 1)
+        self.assertEqual(table1.table_rows(array)[0]["paper_ms_2005_gpu"], 2.0)
+
+
+if __name__ == "__main__":
+    unittest.main()
