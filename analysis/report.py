@@ -275,6 +275,47 @@ def freeze_layout(fig):
 
 # ---------------------------------------------------------------------------------------- report
 
+def headline_table2(t, rows, ratios):
+    """Table 2 beside the paper, as Markdown."""
+    lines = [f"Table 2 ({trace_name(str(t.get('trace', '?')))}, settings: {', '.join(t.get('settings') or []) or 'defaults'}): "
+             "depth tests per frame",
+             "",
+             "| mode | paper | query depth tests | total depth tests | cycles | culling efficiency | false culls |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        p = r.get("paper_depth_tests_per_frame")
+        lines.append(f"| {r['mode']} | {'-' if not p else format(p, ',.0f')} | {r['query_depth_tests_per_frame']:,.0f} | "
+                     f"{r['total_depth_tests_per_frame']:,.0f} | {r['cycles_per_frame']:,.0f} | "
+                     f"{100 * r['culling_efficiency']:.1f}% | {int(r.get('false_culls') or 0)} |")
+    rt = "; ".join(f"{r['ratio']} {r['ours']:,.0f}x (paper {r['paper']:,.0f}x)" for r in ratios
+                   if r["ours"] is not None and r["paper"] is not None)
+    if rt:
+        lines += ["", f"Occlusion queries over N-buffer, query depth tests: {rt}."]
+    return "\n".join(lines)
+
+
+def headline_sweep(name, rows, traces, err_label):
+    """The Pareto-optimal points of a sweep (cycles per frame against its error), as Markdown."""
+    lines = [f"Sweep {name}: Pareto-optimal points, cycles per frame against {err_label}", ""]
+    for t in traces:
+        ok = [r for r in rows if r["trace"] == t and r["status"] == "ok" and r["role"] == "sweep"]
+        errs = {r["error_axis"] for r in ok if r.get("error_axis") is not None}
+        if ok and len(errs) <= 1:  # no culling trade-off here (a fidelity sweep): timing error and speed instead
+            ce = [abs(r["cycle_error"]) for r in ok if r.get("cycle_error") is not None]
+            hs = [r["host_seconds"] for r in ok if r.get("host_seconds") is not None]
+            lines.append(f"- {trace_name(t)}: every point culls alike; cycles per frame "
+                         f"{min(r['cycles_per_frame'] for r in ok):,.0f} to {max(r['cycles_per_frame'] for r in ok):,.0f}"
+                         + (f", largest |cycle error| {max(ce):.3%}" if ce else "")
+                         + (f", host {min(hs):.2f} to {max(hs):.2f} s" if hs else ""))
+            continue
+        front = sorted((r for r in rows if r["trace"] == t and r.get("pareto")), key=lambda r: r["cycles_per_frame"])
+        if not front:
+            continue
+        lines.append(f"- {trace_name(t)}: " + "; ".join(
+            f"{r['label']} ({r['cycles_per_frame']:,.0f} cycles, error {r['error_axis']:.2f})" for r in front))
+    return "\n".join(lines)
+
+
 class Report:
     def __init__(self, root):
         self.root = Path(root)
@@ -284,6 +325,7 @@ class Report:
         self.errors = []     # messages
         self.inputs = []     # (relative path, section)
         self.versions = set()
+        self.headline = []   # Markdown blocks for report/headline.md (what scripts/demo prints)
 
     def rel(self, p):
         return os.path.relpath(p, self.root)
@@ -491,6 +533,7 @@ class Report:
         rt = "; ".join(f"{r['ratio']}: {'-' if r['ours'] is None else format(r['ours'], ',.0f')}x "
                        f"(paper {'-' if r['paper'] is None else format(r['paper'], ',.0f')}x)" for r in ratios)
         fc = sum(int(r.get("false_culls") or 0) for r in rows)
+        self.headline.append(headline_table2(t, rows, ratios))
         return (f"<p>Trace <code>{html.escape(str(t.get('trace', '?')))}</code>{crc}, settings: {sets}{cfg}; "
                 f"from <code>{self.rel(path)}</code>. Query depth tests are the paper's count; the total adds the "
                 "N-buffer/Hi-Z update texels and the drawn objects' depth tests. "
@@ -727,6 +770,7 @@ class Report:
                                      "filled red and joined by the front; grey circles are dominated"
                                      f"{'; stars are reference runs, not in the front' if any(r['role'] == 'reference' for r in rows) else ''}. "
                                      "Read off: the cheapest design for an accepted loss, and what each step down the front costs."))
+        self.headline.append(headline_sweep(d.name, rows, traces, err_label))
         speed = self.speed_plot(d.name, rows, params, header)
         if speed:
             parts.append(speed)
@@ -881,6 +925,7 @@ figcaption { color: #444; font-size: 90%; max-width: 900px; }
             h.append(body)
         h.append("</body></html>")
         (self.out / "index.html").write_text("\n".join(h) + "\n")
+        (self.out / "headline.md").write_text("\n\n".join(self.headline) + "\n")
 
 
 def main(argv):

@@ -24,11 +24,13 @@ json toy_check(const json& settings, const std::string& origin) {
     std::string mode = "trace";
     int divisor = 1;
     double bandwidth = 32.0;
+    int tile = 8;
   } c;
   nbsim::config::Schema s;
   s.add("cull.mode", c.mode, "culling mode", {"trace", "nb", "nb_hier", "oq"});
   s.add("nbuffer.resolution_divisor", c.divisor, "", "divisor", 1, 8);
   s.add("memory.bandwidth_bytes_per_cycle", c.bandwidth, "bytes/cycle", "bandwidth", 0.01, 1e6);
+  s.add("hiz.tile_px", c.tile, "pixels", "tile", 1, 256);
   s.apply(settings, origin);
   json flat = json::object();
   const nlohmann::ordered_json values = s.values();  // kept alive for the loop
@@ -104,14 +106,15 @@ TEST(SweepTest, StableIds) {
 TEST(SweepTest, ReferencePoints) {
   const ojson j = ojson::parse(R"({"traces": ["t.nbt"], "points": [
     {"cull.mode": "nb"}, {"cull.mode": "nb", "nbuffer.resolution_divisor": 4}, {"cull.mode": "nb", "nbuffer.resolution_divisor": 2},
-    {"cull.mode": "oq"}, {"cull.mode": "oq", "nbuffer.resolution_divisor": 8}, {}]})");
+    {"cull.mode": "oq"}, {"cull.mode": "oq", "nbuffer.resolution_divisor": 8}, {}, {"cull.mode": "oq", "hiz.tile_px": 4}]})");
   const ex::SweepSpec spec = ex::parse_sweep(j, "s");
   std::vector<Point> points = ex::expand(spec);
   ex::check_points(spec, points, toy_check, "s");
   ex::add_reference_points(points, ex::parameter_keys(spec), toy_check, "s");
-  ASSERT_EQ(points.size(), 7u) << "one reference added: nb_hier at full resolution";
+  ASSERT_EQ(points.size(), 8u) << "one reference added: nb_hier at full resolution";
   for (int i = 0; i < 3; ++i) EXPECT_EQ(points[i].culling_reference, points[0].id) << "point " << i << ": {} and divisor 1 are one config";
-  const Point& added = points[6];
+  const Point& added = points[7];
+  EXPECT_EQ(points[6].culling_reference, added.id) << "Hi-Z keys go back to their defaults: one reference";
   EXPECT_EQ(added.role, "reference");
   EXPECT_EQ(added.settings, json::parse(R"({"cull.mode": "nb_hier"})")) << "only what differs is set";
   EXPECT_EQ(added.parameters["nbuffer.resolution_divisor"], 1);
