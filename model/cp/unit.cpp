@@ -30,7 +30,7 @@ void CommandProcessor::send(WorkKind kind, const std::shared_ptr<const trace::Fr
   w->which = which;
   w->clear_depth = clear_depth_;
   w->cull_report = std::move(report);
-  out.write(w);
+  sim::blocking([&] { out.write(w); });
 }
 
 void CommandProcessor::issue_draw(std::shared_ptr<Work> w) {
@@ -39,7 +39,7 @@ void CommandProcessor::issue_draw(std::shared_ptr<Work> w) {
   work(static_cast<std::uint64_t>(config_.draw_overhead_cycles));
   w->kind = WorkKind::Draw;
   w->clear_depth = clear_depth_;
-  out.write(std::move(w));
+  sim::blocking([&] { out.write(std::move(w)); });
 }
 
 void CommandProcessor::issue_snapshot(const std::shared_ptr<const trace::Frame>& f, trace::DepthWhich which) {

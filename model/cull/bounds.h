@@ -98,6 +98,16 @@ struct CullReport {
   std::uint64_t candidates_not_visible = 0;  // candidates with no visible pixel
   std::uint64_t false_culls = 0;             // culled candidates with visible pixels
   std::uint64_t crossing_near = 0;           // bounds tests that crossed the near plane (never culled)
+  // cull.granularity=primitive (model/cull/primitive.h): the triangles of the drawn candidates,
+  // tested between setup and the tile walk. The raster unit fills these in after run_frame returned
+  // and before the frame's FrameEnd passes it (the pipeline is in order), so they are final when
+  // the FrameEnd reaches the end of the pipeline.
+  std::uint64_t primitive_tests = 0;             // triangles tested (accepted by setup, on screen)
+  std::uint64_t primitives_culled = 0;           // of those, found hidden and dropped
+  std::uint64_t primitive_lookups = 0;           // N-buffer / Hi-Z texels compared against for them
+  std::uint64_t primitive_fragments_culled = 0;  // fragments the dropped triangles would have rasterized
+  std::uint64_t primitive_false_culls = 0;       // dropped triangles with a fragment that passes against
+                                                 // the occluders' depth (an upper bound on real ones)
 
   // Every bounds test of the frame, in order: what was tested, the decision and what it cost.
   struct Test {
@@ -108,8 +118,9 @@ struct CullReport {
   };
   std::vector<Test> tests;
 
-  // The depth tests spent on visibility queries (ARCHITECTURE.md: the paper-comparable count).
-  std::uint64_t query_depth_tests() const noexcept { return box_depth_tests + lookups; }
+  // The depth tests spent on visibility queries (ARCHITECTURE.md: the paper-comparable count),
+  // bounds and per-primitive queries alike.
+  std::uint64_t query_depth_tests() const noexcept { return box_depth_tests + lookups + primitive_lookups; }
 };
 
 }  // namespace nbsim::cull

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "model/common/error.h"
+#include "model/raster/depth_test.h"
 
 namespace nbsim::cull {
 
@@ -14,6 +15,10 @@ void CullUnitConfig::describe(config::Schema& s, CullUnitConfig& c) {
         "trace replays the recorded draws; the others cull every candidate object themselves: none (draw all), oq, "
         "oq_hier (occlusion queries, flat or over the BVH), nb, nb_hier (N-buffer unit), hiz_tile, hiz_pyramid",
         {"trace", "none", "oq", "oq_hier", "nb", "nb_hier", "hiz_tile", "hiz_pyramid"});
+  s.add("cull.granularity", c.granularity,
+        "object tests the bounds of candidate objects; primitive also tests every triangle of the objects drawn, "
+        "between setup and the tile walk, and drops the hidden ones (modes nb, nb_hier, hiz_tile, hiz_pyramid only)",
+        {"object", "primitive"});
   s.add("cull.bounds_tests_per_cycle", c.bounds_tests_per_cycle, "tests/cycle", "object or node bounds projected a cycle",
         0.01, 1024.0);
   s.add("cull.bounds_latency_cycles", c.bounds_latency_cycles, "cycles", "latency of a batch of bounds tests", 0, 100000);
@@ -31,12 +36,24 @@ CullMode CullUnitConfig::parsed_mode() const {
   return *m;
 }
 
+Granularity CullUnitConfig::parsed_granularity() const {
+  const auto g = parse_granularity(granularity);
+  if (!g) throw InputError(fmt::format("cull.granularity: unknown granularity '{}' (object or primitive)", granularity));
+  if (*g == Granularity::Primitive && !supports_primitive_granularity(parsed_mode()))
+    throw InputError(fmt::format(
+        "cull.granularity=primitive needs a depth-query structure to test triangles against: cull.mode nb, nb_hier, "
+        "hiz_tile or hiz_pyramid, not '{}'",
+        mode));
+  return *g;
+}
+
 CullUnit::CullUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const CullUnitConfig& config,
                    const nbuffer::NBufferUnitConfig& nbuffer, const HiZUnitConfig& hiz, const CullSetup& setup,
                    memory::Channel& memory, const DepthImage& depth_buffer)
     : sim::Unit(name, registry),
       config_(config),
       mode_(config.parsed_mode()),
+      granularity_(config.parsed_granularity()),
       setup_(setup),
       hiz_(hiz),
       depth_buffer_(depth_buffer),
@@ -49,7 +66,17 @@ CullUnit::CullUnit(const sc_core::sc_module_name& name, stats::Registry& registr
       update_texels_(stats().counter("update_texels", "texels", "N-buffer or Hi-Z texels recomputed or rebuilt")),
       culled_(stats().counter("culled", "objects", "candidates not found visible")),
       undrawable_(stats().counter("undrawable", "objects", "found visible but without recorded geometry in the trace")),
-      false_culls_(stats().counter("false_culls", "objects", "culled candidates that ground truth shows visible")) {
+      false_culls_(stats().counter("false_culls", "objects", "culled candidates that ground truth shows visible")),
+      check_raster_(setup.width_px, setup.height_px),
+      primitive_tests_(stats().counter("primitive_tests", "triangles",
+                                       "triangles of drawn candidates tested before the tile walk (cull.granularity=primitive)")),
+      primitives_culled_(stats().counter("primitives_culled", "triangles", "of those, found hidden and dropped")),
+      primitive_lookups_(stats().counter("primitive_lookups", "texels",
+                                         "N-buffer or Hi-Z texels compared against for the triangles (query depth tests)")),
+      primitive_fragments_culled_(stats().counter("primitive_fragments_culled", "fragments",
+                                                  "fragments (and depth tests) the dropped triangles would have cost")),
+      primitive_false_culls_(stats().counter("primitive_false_culls", "triangles",
+                                             "dropped triangles with a fragment passing against the occluders' depth")) {
   if (mode_ == CullMode::Trace) throw InputError("cull.mode=trace replays the recorded draws: no cull stage");
   if (!setup_.scene || setup_.scene->objects.empty())
     throw InputError(fmt::format("cull.mode={} needs the trace's scene objects (SCEN chunk)", to_string(mode_)));
@@ -70,17 +97,22 @@ std::uint64_t CullUnit::issue(cp::CommandProcessor& cp, std::shared_ptr<cp::Work
 }
 
 void CullUnit::wait_all() {
-  while (completed_ < issued_ || clears_ < frames_begun_) wait(completed_event_);
+  sim::blocking([&] {
+    while (completed_ < issued_ || clears_ < frames_begun_) wait(completed_event_);
+  });
+  sim::catch_up(heard_cycle_);  // decoupled: not before the depth unit's local time of the last result
 }
 
 void CullUnit::draw_finished(const cp::Work& w, const depth::DrawResult& r) {
   ++completed_;
   const auto it = results_.find(w.ticket);
   if (it != results_.end()) it->second = {r.depth.depth_tests, r.depth.passed};
+  heard_cycle_ = std::max(heard_cycle_, r.done_cycle);
   completed_event_.notify(sc_core::SC_ZERO_TIME);
 }
 
 void CullUnit::depth_cleared(float depth) {
+  heard_cycle_ = std::max(heard_cycle_, sim::local_cycles());  // the depth unit's thread
   ++clears_;
   completed_event_.notify(sc_core::SC_ZERO_TIME);
   if (nb_) pending_clear_texels_ += nb_->depth_cleared(depth).recomputed();
@@ -188,6 +220,93 @@ void CullUnit::test_lookups(const std::vector<TestItem>& items, std::vector<trac
   }
 }
 
+bool CullUnit::tests_primitives(const cp::Work& w) const {
+  if (granularity_ != Granularity::Primitive || w.kind != cp::WorkKind::Draw || w.own || w.feeds_cull) return false;
+  const trace::DrawRecord& d = w.record();
+  if (d.role != trace::DrawRole::Visible || !d.state.test) return false;
+  // "Strictly farther than all the depth stored" proves that the fragments fail only these tests.
+  using F = trace::DepthFunc;
+  return setup_.op == FarOp::Max ? d.state.func == F::Less || d.state.func == F::Lequal
+                                 : d.state.func == F::Greater || d.state.func == F::Gequal;
+}
+
+void CullUnit::test_primitives(const cp::Work& w, std::span<const raster::SetupPrimitive> prims, std::vector<char>& hidden) {
+  const auto it = reports_.find(w.frame.get());
+  NBSIM_CHECK(it != reports_.end(), "a triangle was tested after its frame's report was dropped");
+  CullReport& r = *it->second;
+  prim_index_.clear(), prim_rects_.clear(), prim_nearest_.clear();
+  for (std::size_t i = 0; i < prims.size(); ++i) {
+    const PrimitiveQuery q = primitive_query(*prims[i].window, prims[i].setup, setup_.op, setup_.fused_interpolation);
+    if (!q.testable) continue;
+    prim_index_.push_back(i);
+    prim_rects_.push_back(q.rect);
+    prim_nearest_.push_back(q.nearest);
+  }
+  std::uint64_t lookups = 0;
+  if (nb_) {
+    nb_->query_batch(prim_rects_, prim_nearest_, prim_answers_);
+    std::uint64_t update = 0;
+    for (std::size_t k = 0; k < prim_index_.size(); ++k) {
+      const nbuffer::QueryAnswer& a = prim_answers_[k];
+      lookups += static_cast<std::uint64_t>(a.lookups);
+      update += a.update.recomputed();
+      hidden[prim_index_[k]] = a.hidden ? 1 : 0;
+    }
+    r.update_texels += update;
+    update_texels_ += update;
+  } else {
+    for (std::size_t k = 0; k < prim_index_.size(); ++k) {
+      bool h = false;
+      if (tile_) {
+        const TileHiZAnswer a = tile_->query(prim_rects_[k], prim_nearest_[k]);
+        lookups += static_cast<std::uint64_t>(a.lookups);
+        h = a.hidden;
+      } else {
+        NBSIM_CHECK(pyramid_.has_value(), "Hi-Z pyramid queried before it was built");
+        const QueryResult q = pyramid_->query(prim_rects_[k]);
+        lookups += static_cast<std::uint64_t>(q.texel_count);
+        h = q.complete && nbuffer::hidden_behind(setup_.op, prim_nearest_[k], q.value);
+      }
+      hidden[prim_index_[k]] = h ? 1 : 0;
+    }
+    // No other work of this unit overlaps: the next frame's queries wait for this frame's draws.
+    label_with([&] { return fmt::format("{} primitive tests", prim_index_.size()); });
+    work(sim::batch_cycles(lookups, config_.hiz_lookups_per_cycle, config_.hiz_lookup_latency_cycles));
+  }
+
+  // The check, off the clock: a dropped triangle's fragments against the occluders' depth. The
+  // depth buffer only moves nearer after them (the drawn candidates test and write with the same
+  // func), so a fragment that fails here fails when the triangle would have been drawn.
+  const auto func = static_cast<raster::DepthFunc>(w.record().state.func);
+  std::uint64_t culled = 0, fragments = 0, false_culls = 0;
+  raster::TileCounters ignored;
+  for (std::size_t i = 0; i < prims.size(); ++i) {
+    if (!hidden[i]) continue;
+    ++culled;
+    bool passes = false;
+    const raster::SetupTriangle& t = prims[i].setup;
+    check_raster_.rasterize(t, ignored, [&](int x, int y, std::uint16_t mask) {
+      for (int b = 0; b < 16; ++b) {
+        if (!(mask & (1u << b))) continue;
+        const int px = x + (b & 3), py = y + (b >> 2);
+        ++fragments;
+        passes = passes || raster::depth_passes(func, t.depth.at(px, py, setup_.fused_interpolation), occluder_depth_.at(px, py));
+      }
+    });
+    false_culls += passes ? 1 : 0;
+  }
+  r.primitive_tests += prim_index_.size();
+  r.primitives_culled += culled;
+  r.primitive_lookups += lookups;
+  r.primitive_fragments_culled += fragments;
+  r.primitive_false_culls += false_culls;
+  primitive_tests_ += prim_index_.size();
+  primitives_culled_ += culled;
+  primitive_lookups_ += lookups;
+  primitive_fragments_culled_ += fragments;
+  primitive_false_culls_ += false_culls;
+}
+
 std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<const trace::Frame>& f, cp::CommandProcessor& cp) {
   ++frames_begun_;  // the command processor has sent this frame's FrameBegin (a clear)
   auto report = std::make_shared<CullReport>();
@@ -222,6 +341,13 @@ std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<cons
   cp.issue_snapshot(f, trace::DepthWhich::AfterOccluders);
   wait_all();
   prepare(r);
+  // Every earlier frame's draws have left the pipeline: from here on the raster unit tests only
+  // this frame's triangles, against the occluders' depth.
+  reports_.clear();
+  if (granularity_ == Granularity::Primitive) {
+    reports_[f.get()] = report;
+    occluder_depth_ = depth_buffer_;
+  }
 
   // 2. Bounds tests of the candidates.
   const BatchTester tester = [&](const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests) {

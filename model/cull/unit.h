@@ -8,6 +8,10 @@
 //                    rectangles of the occluder draws; four lookups at most per test;
 //   hiz_tile         a single-level tile Hi-Z (model/hiz/tile_hiz.h), fed the same way;
 //   hiz_pyramid      a Hi-Z pyramid (model/hiz/pyramid.h) rebuilt from the depth after the occluders.
+// With cull.granularity=primitive (nb, nb_hier and the hiz modes) it also tests, as the raster
+// unit's PrimitiveTester (model/raster/primitive_tester.h), every triangle of the objects it draws
+// as visible candidates, between setup and the tile walk, against the same query unit and its
+// timing (the N-buffer's query port; the Hi-Z lookups as this unit's work): see test_primitives().
 // It listens to the depth unit (clears, dirty rectangles, draw results) and reports per frame a
 // CullReport (model/cull/bounds.h) that rides on the frame's FrameEnd work item.
 #pragma once
@@ -20,14 +24,18 @@
 #include "model/config/schema.h"
 #include "model/cp/unit.h"
 #include "model/cull/bounds.h"
+#include "model/cull/primitive.h"
 #include "model/depth/unit.h"
 #include "model/hiz/hiz_config.h"
 #include "model/nbuffer/unit.h"
+#include "model/raster/primitive_tester.h"
+#include "model/raster/rasterizer.h"
 
 namespace nbsim::cull {
 
 struct CullUnitConfig {
   std::string mode = "trace";            // see CullMode; "trace" replays the recorded draws
+  std::string granularity = "object";    // see Granularity; "primitive" needs a depth-query mode
   double bounds_tests_per_cycle = 1.0;   // bounds (8 corner transforms, rectangle) a cycle; tunable
   int bounds_latency_cycles = 20;        // per batch of bounds tests; tunable
   double hiz_lookups_per_cycle = 4.0;    // Hi-Z texels compared a cycle (as the N-buffer's 4); tunable
@@ -38,6 +46,9 @@ struct CullUnitConfig {
   // Declares "cull.<field>".
   static void describe(config::Schema& s, CullUnitConfig& c);
   CullMode parsed_mode() const;  // throws InputError for an unknown mode
+  // Throws InputError for an unknown granularity, and for "primitive" with a mode that has no
+  // depth-query structure (trace, none, oq, oq_hier): refused rather than silently run as object.
+  Granularity parsed_granularity() const;
 };
 
 // What the cull stage needs to know about the trace and the render target.
@@ -48,9 +59,13 @@ struct CullSetup {
   bool zero_to_one = false;
   trace::DepthFunc depth_func = trace::DepthFunc::Less;
   const trace::SceneObjects* scene = nullptr;  // must outlive the unit; required
+  bool fused_interpolation = true;  // the depth unit's (depth.fused_interpolation): per-primitive depth bounds
 };
 
-class CullUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthListener {
+class CullUnit : public sim::Unit,
+                 public cp::FrameProgram,
+                 public depth::DepthListener,
+                 public raster::PrimitiveTester {
  public:
   // `depth_buffer` is the depth unit's buffer (read to rebuild the Hi-Z pyramid once the occluders
   // are done). Throws InputError for a trace the mode cannot cull (no scene).
@@ -60,6 +75,7 @@ class CullUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthL
   ~CullUnit() override;
 
   CullMode mode() const noexcept { return mode_; }
+  Granularity granularity() const noexcept { return granularity_; }
   const nbuffer::NBufferUnit* nbuffer_unit() const noexcept { return nb_.get(); }
   // Bytes the mode's query structure occupies in memory: the N-buffer levels, the tile Hi-Z or the
   // Hi-Z pyramid; 0 for the occlusion-query modes, which query the depth buffer itself.
@@ -78,6 +94,21 @@ class CullUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthL
   void depth_written(const cp::Work& w, const DepthImage& depth, const Rect& dirty) override;
   void draw_finished(const cp::Work& w, const depth::DrawResult& r) override;
 
+  // raster::PrimitiveTester (from the raster unit's thread), cull.granularity=primitive. Tested:
+  // the Visible draws this stage issues (its drawn candidates) whose depth test can be proved to
+  // fail (LESS/LEQUAL, or GREATER/GEQUAL under reversed Z). Not tested: the occluders, whose depth
+  // is what the structure holds (a triangle would mostly be tested against its own object's and
+  // earlier occluders' depth, for lookups and little gain, and the answer would depend on how far
+  // the depth unit lags behind), and the occlusion-query boxes.
+  bool tests_primitives(const cp::Work& w) const override;
+  // One query per triangle (model/cull/primitive.h), as one batch per draw: the N-buffer's query
+  // port streams the batch's lookups (NBufferUnit::query_batch); the Hi-Z modes spend
+  // batch_cycles(lookups, hiz_lookups_per_cycle, hiz_lookup_latency_cycles) of this unit's time.
+  // The structure then holds exactly the occluders' depth: every earlier frame has left the
+  // pipeline, and the visible draws do not feed it. Each culled triangle is also checked, off the
+  // clock, by rasterizing it against the occluders' depth (primitive_false_culls).
+  void test_primitives(const cp::Work& w, std::span<const raster::SetupPrimitive> prims, std::vector<char>& hidden) override;
+
  private:
   struct Outcome {
     std::uint64_t depth_tests = 0, passed = 0;
@@ -93,6 +124,7 @@ class CullUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthL
 
   CullUnitConfig config_;
   CullMode mode_;
+  Granularity granularity_;
   CullSetup setup_;
   HiZUnitConfig hiz_;
   const DepthImage& depth_buffer_;
@@ -103,12 +135,26 @@ class CullUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthL
   std::uint64_t issued_ = 0, completed_ = 0;
   std::uint64_t frames_begun_ = 0, clears_ = 0;
   sc_core::sc_event completed_event_;
+  std::uint64_t heard_cycle_ = 0;  // the depth unit's local time of the last result heard of (model/sim/unit.h)
   std::unordered_map<std::uint64_t, Outcome> results_;
   // Work heard from the depth unit since the last frame's queries started.
   std::uint64_t pending_update_texels_ = 0, pending_clear_texels_ = 0;
 
   stats::Counter &frames_, &candidates_, &bounds_tests_, &node_tests_, &lookups_, &box_depth_tests_, &update_texels_,
       &culled_, &undrawable_, &false_culls_;
+
+  // cull.granularity=primitive: the report each triangle's frame adds to (this frame's, and the
+  // previous frame's while its last draws are still in the raster unit); the depth buffer after
+  // this frame's occluders, for the false-cull check; scratch of test_primitives().
+  std::unordered_map<const trace::Frame*, std::shared_ptr<CullReport>> reports_;
+  DepthImage occluder_depth_;
+  raster::Rasterizer check_raster_;
+  std::vector<std::size_t> prim_index_;
+  std::vector<Rect> prim_rects_;
+  std::vector<float> prim_nearest_;
+  std::vector<nbuffer::QueryAnswer> prim_answers_;
+  stats::Counter &primitive_tests_, &primitives_culled_, &primitive_lookups_, &primitive_fragments_culled_,
+      &primitive_false_culls_;
 };
 
 }  // namespace nbsim::cull

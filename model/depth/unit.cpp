@@ -64,7 +64,7 @@ Rect DepthUnit::test(const raster::BlockBatch& b, DrawResult& r) {
 
 void DepthUnit::run() {
   for (;;) {
-    const raster::BlockBatchPtr b = in.read();
+    const raster::BlockBatchPtr b = sim::blocking([&] { return in.read(); });
     const cp::Work& w = *b->work;
     label_with([&] { return cp::timeline_label(w); });  // names the clear's or the draw's span
     switch (w.kind) {
@@ -90,23 +90,19 @@ void DepthUnit::run() {
         hits_ += cache_.hits() - h0;
         misses_ += cache_.misses() - m0;
         writebacks_ += cache_.writebacks() - wb0;
-        const std::uint64_t start = sim::now_cycles();
+        const std::uint64_t start = sim::local_cycles();
         const std::uint64_t compute = sim::batch_cycles(r.depth.depth_tests, config_.tests_per_cycle, config_.latency_cycles);
         const std::uint64_t mem_done = r.memory_bytes ? memory_.transfer(start, r.memory_bytes, client_) : start;
         work(compute);
-        const std::uint64_t now = sim::now_cycles();
-        if (mem_done > now) {
-          stall_ += mem_done - now;
-          wait(sim::cycles(mem_done - now));
-        }
-        r.done_cycle = sim::now_cycles();
+        stall_ += sim::spend_until(mem_done);
+        r.done_cycle = sim::local_cycles();
         if (listener_) listener_->draw_finished(w, r);
         sink_.draw_done(w, r);
         break;
       }
       case cp::WorkKind::Snapshot: sink_.snapshot(w, buffer_); break;
-      case cp::WorkKind::FrameEnd: sink_.frame_done(w, sim::now_cycles()); break;
-      case cp::WorkKind::Stop: sink_.stopped(sim::now_cycles()); return;
+      case cp::WorkKind::FrameEnd: sink_.frame_done(w, sim::local_cycles()); break;
+      case cp::WorkKind::Stop: sink_.stopped(sim::local_cycles()); return;
     }
   }
 }

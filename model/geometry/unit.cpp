@@ -52,7 +52,7 @@ GeometryUnit::GeometryUnit(const sc_core::sc_module_name& name, stats::Registry&
 
 void GeometryUnit::run() {
   for (;;) {
-    const cp::WorkPtr w = in.read();
+    const cp::WorkPtr w = sim::blocking([&] { return in.read(); });
     auto batch = std::make_shared<TriangleBatch>();
     batch->work = w;
     if (w->kind == cp::WorkKind::Draw) {

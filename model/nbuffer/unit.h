@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "model/memory/memory.h"
 #include "model/nbuffer/unit_core.h"
@@ -32,6 +33,11 @@ class NBufferUnit : public sim::Unit {
 
   // Blocking calls: only from an SC_THREAD.
   QueryAnswer query(const Rect& r, float nearest_depth, CoveringKind kind = CoveringKind::Four);
+  // A batch of queries (rects[i] with nearest[i]) through the query port as one pipelined stream:
+  // the same waits as query(), then batch_cycles(total lookups, lookups_per_cycle,
+  // lookup_latency_cycles) plus any lazy update work, one latency for the whole batch (the
+  // per-triangle queries of one draw, model/cull/primitive.h). Answers in order into `answers`.
+  void query_batch(std::span<const Rect> rects, std::span<const float> nearest, std::vector<QueryAnswer>& answers);
   // Waits until the update engine is idle.
   void drain();
 
@@ -58,6 +64,7 @@ class NBufferUnit : public sim::Unit {
   int client_ = -1;
   std::uint64_t queued_texels_ = 0, queued_bytes_ = 0;
   std::uint64_t posted_seq_ = 0, done_seq_ = 0;  // work handed to the engine, and finished, by count
+  std::uint64_t posted_cycle_ = 0, done_cycle_ = 0;  // local times of the last post and the last batch done
   bool port_busy_ = false;
   sc_core::sc_event posted_, batch_done_, port_free_;
 

@@ -30,7 +30,7 @@ RasterUnit::RasterUnit(const sc_core::sc_module_name& name, stats::Registry& reg
 
 void RasterUnit::run() {
   for (;;) {
-    const geometry::TriangleBatchPtr in_batch = in.read();
+    const geometry::TriangleBatchPtr in_batch = sim::blocking([&] { return in.read(); });
     auto b = std::make_shared<BlockBatch>();
     b->work = in_batch->work;
     b->geometry = in_batch->counters;
@@ -40,14 +40,28 @@ void RasterUnit::run() {
                                                                b->work->record().state.front_ccw}
                                          : geometry::FaceState{};
     std::uint64_t pixels = 0;
-    for (const geometry::WindowTriangle& w : in_batch->triangles) {
-      if (setup_.setup(w, face, t, b->setup) != SetupResult::Accepted) continue;
+    const auto walk = [&](const SetupTriangle& s) {
       const auto plane = static_cast<std::uint32_t>(b->planes.size());
-      b->planes.push_back(t.depth);
-      rasterizer_.rasterize(t, b->tiles, [&](int x, int y, std::uint16_t mask) {
+      b->planes.push_back(s.depth);
+      rasterizer_.rasterize(s, b->tiles, [&](int x, int y, std::uint16_t mask) {
         b->blocks.push_back({x, y, mask, plane});
         pixels += static_cast<std::uint64_t>(std::popcount(mask));
       });
+    };
+    if (tester_ && b->work->kind == cp::WorkKind::Draw && tester_->tests_primitives(*b->work)) {
+      // Per-primitive culling: set up the whole draw, have the tester query its triangles (this
+      // thread waits for the query unit), walk the survivors in their order. Setup cycles are
+      // still spent on the dropped triangles; their tile walk and depth tests are saved.
+      prims_.clear();
+      for (const geometry::WindowTriangle& w : in_batch->triangles)
+        if (setup_.setup(w, face, t, b->setup) == SetupResult::Accepted) prims_.push_back({&w, t});
+      hidden_.assign(prims_.size(), 0);
+      tester_->test_primitives(*b->work, prims_, hidden_);
+      for (std::size_t i = 0; i < prims_.size(); ++i)
+        if (!hidden_[i]) walk(prims_[i].setup);
+    } else {
+      for (const geometry::WindowTriangle& w : in_batch->triangles)
+        if (setup_.setup(w, face, t, b->setup) == SetupResult::Accepted) walk(t);
     }
     triangles_ += b->setup.triangles;
     accepted_ += b->setup.accepted;

@@ -9,6 +9,7 @@
 
 #include "model/config/schema.h"
 #include "model/geometry/unit.h"
+#include "model/raster/primitive_tester.h"
 #include "model/raster/rasterizer.h"
 #include "model/raster/setup.h"
 #include "model/sim/unit.h"
@@ -52,12 +53,19 @@ class RasterUnit : public sim::Unit {
   RasterUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const RasterUnitConfig& config, int width_px,
              int height_px);
 
+  // cull.granularity=primitive: the draws `tester` asks for have their accepted triangles tested
+  // between setup and the tile walk, and the hidden ones dropped (primitive_tester.h). Null: none.
+  void set_primitive_tester(PrimitiveTester* tester) noexcept { tester_ = tester; }
+
  private:
   void run();
   RasterUnitConfig config_;
   sim::DelayLine<BlockBatchPtr> delay_;
   TriangleSetup setup_;
   Rasterizer rasterizer_;
+  PrimitiveTester* tester_ = nullptr;
+  std::vector<SetupPrimitive> prims_;  // one draw's accepted triangles, when a tester tests them
+  std::vector<char> hidden_;
   stats::Counter &triangles_, &accepted_, &blocks_, &pixels_;
   stats::VectorCounter& tiles_;
 };

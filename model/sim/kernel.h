@@ -14,6 +14,8 @@ namespace nbsim::sim {
 // cycles; nothing depends on the absolute frequency.
 inline sc_core::sc_time cycles(std::uint64_t n) { return sc_core::sc_time(static_cast<double>(n), sc_core::SC_NS); }
 
+// SystemC's time in cycles. Units compute with sim::local_cycles() (model/sim/quantum.h), which is
+// this plus how far the calling thread runs ahead when gpu.quantum_cycles decouples it.
 inline std::uint64_t now_cycles() {
   return static_cast<std::uint64_t>(sc_core::sc_time_stamp().to_seconds() * 1e9 + 0.5);
 }

@@ -86,7 +86,7 @@ void Timeline::attach_units() {
 
 Timeline::Span Timeline::begin(int track, std::uint64_t cycles) {
   Track& t = tracks_[static_cast<std::size_t>(track)];
-  const std::uint64_t now = now_cycles();
+  const std::uint64_t now = local_cycles();  // the unit's thread's time, ahead of SystemC's when decoupled
   std::size_t lane = 0;
   while (lane < t.lanes.size() && t.lanes[lane].end > now) ++lane;
   if (lane == t.lanes.size()) {

@@ -2,6 +2,35 @@
 // in the hierarchy ("gpu.depth") that counts the cycles it spends working. A unit's thread calls
 // work(n) to spend n cycles; busy cycles and total cycles give its utilisation. When a run records a
 // timeline (model/sim/timeline.h), each work(n) is one span on the unit's track.
+//
+// Timing granularity (config key gpu.quantum_cycles; model/sim/quantum.h). TLM-2.0 temporal
+// decoupling: a global quantum and one tlm_utils::tlm_quantumkeeper per SystemC THREAD, not per
+// unit, because the local time belongs to the thread that runs the work (the cull stage and the
+// N-buffer unit's query port work on the command processor's thread, in primitive granularity on
+// the raster unit's; the N-buffer update engine and each DelayLine have threads of their own).
+// - Quantum 0 (the default): every helper below is the plain SystemC call; every work item waits.
+// - work(n) adds n cycles to the thread's local time (SystemC time + the keeper's offset) and
+//   waits only when the keeper says the local time reached the end of the quantum (the next
+//   multiple of the quantum).
+// - Every cycle the model computes is local time, sim::local_cycles(), never now_cycles():
+//   memory request starts, completion and done cycles, DelayLine timestamps, timeline spans.
+//   Waiting for such a completion (memory, a DelayLine's latency) is sim::spend_until().
+// - A call that may block (a fifo read or write, a wait on an event) goes through sim::blocking():
+//   the thread does not synchronise first; it resumes at the later of its local time and the time
+//   the call returned. A fifo that has data (or room) does not block: no context switch at all.
+// - A thread that waited for another thread's result moves its local time up to the producer's
+//   local time of the result (sim::catch_up): the cull stage to the last draw or clear it heard
+//   of, a query to the update engine's last batch, the engine to the last work posted to it.
+// - Nothing functional depends on time: the units see the same work in the same order whatever
+//   the quantum (fifos, and the cull stage waits for every result before it reads one), so every
+//   count is the same and only cycles change (and the N-buffer engine's update_batches: a batch
+//   is whatever was queued when the engine got free, a matter of timing). The cycle error: a
+//   consumer may take a fifo item before the producer's local time of sending it, and the shared
+//   memory channel serves requests in the order threads make them, not in local-time order; each
+//   such error is below a quantum.
+// - Timeline JSON spans are in local time; the VCD busy bits follow SystemC time, so they mean
+//   little when decoupled.
+// Quantum 1 goes through the keepers but synchronises after every work item: the same cycles as 0.
 #pragma once
 
 #include <deque>
@@ -11,6 +40,7 @@
 #include <utility>
 
 #include "model/sim/kernel.h"
+#include "model/sim/quantum.h"
 #include "model/sim/timeline.h"
 #include "model/stats/stats.h"
 
@@ -27,7 +57,8 @@ class Unit : public sc_core::sc_module {
   void attach_timeline(Timeline* timeline, int track) noexcept { timeline_ = timeline, track_ = track; }
 
  protected:
-  // Spends n cycles of work: advances this unit's thread and counts them as busy.
+  // Spends n cycles of work: advances the calling thread (its local time when decoupled) and
+  // counts them as busy.
   void work(std::uint64_t n) {
     if (n == 0) {
       label_.clear();  // a label names the work it was set for, not the next one
@@ -35,13 +66,13 @@ class Unit : public sc_core::sc_module {
     }
     busy_ += n;
     if (!timeline_) {
-      wait(cycles(n));
+      spend(n);
       return;
     }
     const Timeline::Span span = timeline_->begin(track_, n);
     const std::string span_label = std::move(label_);  // taken now: another thread of the unit may set the next
     label_.clear();
-    wait(cycles(n));
+    spend(n);
     timeline_->end(span, span_label);
   }
   // Names the next work() span on the timeline ("draw 12"); kept only when a timeline records.
@@ -85,16 +116,18 @@ class DelayLine : public sc_core::sc_module {
     SC_HAS_PROCESS(DelayLine);
     SC_THREAD(run);
   }
-  // Sends v so that it leaves `latency_cycles` from now.
-  void send(const T& v, std::uint64_t latency_cycles) { queue_.write({v, now_cycles() + latency_cycles}); }
+  // Sends v so that it leaves `latency_cycles` from now (the sending thread's local time).
+  void send(const T& v, std::uint64_t latency_cycles) {
+    const Item item{v, local_cycles() + latency_cycles};
+    blocking([&] { queue_.write(item); });
+  }
 
  private:
   void run() {
     for (;;) {
-      const auto item = queue_.read();
-      const std::uint64_t now = now_cycles();
-      if (item.second > now) wait(cycles(item.second - now));
-      out.write(item.first);
+      const auto item = blocking([&] { return queue_.read(); });
+      spend_until(item.second);
+      blocking([&] { out.write(item.first); });
     }
   }
   struct Item : std::pair<T, std::uint64_t> {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "model/common/error.h"
+#include "model/sim/quantum.h"
 
 namespace nbsim::pipeline {
 
@@ -19,6 +20,10 @@ void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
   nbuffer::NBufferUnitConfig::describe(s, c.nbuffer);
   HiZUnitConfig::describe(s, c.hiz);
   s.add("gpu.fifo_depth", c.fifo_depth, "work items", "depth of the fifos between units", 1, 4096);
+  s.add("gpu.quantum_cycles", c.quantum_cycles, "cycles",
+        "temporal decoupling quantum: a unit runs ahead of simulated time by up to this many cycles before it "
+        "synchronises (0: every work item synchronises, the most detailed timing)",
+        0, 10'000'000);
 }
 
 Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& c, int width_px, int height_px,
@@ -32,17 +37,22 @@ Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const G
       geometry_("geometry", registry, c.geometry, width_px, height_px),
       raster_("raster", registry, c.raster, width_px, height_px),
       depth_("depth", registry, c.depth, width_px, height_px, memory_, sink) {
+  sim::set_quantum_cycles(static_cast<std::uint64_t>(c.quantum_cycles));  // before sc_start; 0: no decoupling
   cp_.out(cp_to_geometry_);
   geometry_.in(cp_to_geometry_);
   geometry_.out(geometry_to_raster_);
   raster_.in(geometry_to_raster_);
   raster_.out(raster_to_depth_);
   depth_.in(raster_to_depth_);
+  // Refuses cull.granularity=primitive in a mode without a depth-query structure (trace included).
+  const cull::Granularity granularity = c.cull.parsed_granularity();
   if (c.cull.parsed_mode() != cull::CullMode::Trace) {
     NBSIM_CHECK(cull != nullptr, "a culling mode needs the cull setup");
     cull_ = std::make_unique<cull::CullUnit>("cull", registry, c.cull, c.nbuffer, c.hiz, *cull, memory_, depth_.buffer());
     cp_.set_program(cull_.get());
     depth_.set_listener(cull_.get());
+    // Per-primitive culling: the cull stage tests the raster unit's triangles between setup and the tile walk.
+    if (granularity == cull::Granularity::Primitive) raster_.set_primitive_tester(cull_.get());
   }
   // The shared memory channel: bytes per client (every client has registered by now) and busy cycles.
   stats::Group& mem = registry.group(std::string(this->name()) + ".memory");

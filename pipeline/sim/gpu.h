@@ -32,6 +32,10 @@ struct GpuConfig {
   nbuffer::NBufferUnitConfig nbuffer;  // used by the nb culling modes
   HiZUnitConfig hiz;                   // used by the hiz culling modes
   int fifo_depth = 4;  // work items between two units; tunable
+  // Timing granularity, a fidelity knob: how many cycles a unit's thread may run ahead of SystemC
+  // time before it synchronises (TLM-2.0 temporal decoupling, model/sim/unit.h). 0: every work
+  // item synchronises (the most detailed timing). Counts never depend on it; cycles do.
+  int quantum_cycles = 0;
 
   // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.",
   // "nbuffer.", "hiz.", "gpu.").

@@ -30,12 +30,20 @@ const char* role_name(trace::DrawRole r) {
 
 // What the cull stage did over the whole replay (culling modes).
 struct CullTotals {
-  std::string mode;
+  std::string mode, granularity;
   std::uint64_t frames = 0, frames_with_truth = 0;
   std::uint64_t query_depth_tests = 0, box_depth_tests = 0, lookups = 0, max_lookups = 0;
   std::uint64_t update_texels = 0, clear_texels = 0, drawn_depth_tests = 0, cycles = 0;
   std::uint64_t in_frustum = 0, occluders = 0, candidates = 0, bounds_tests = 0, node_tests = 0, crossing_near = 0;
   std::uint64_t found_visible = 0, culled = 0, undrawable = 0, candidates_not_visible = 0, false_culls = 0;
+  // cull.granularity=primitive: per-triangle tests of the drawn candidates (model/cull/primitive.h);
+  // their lookups are in query_depth_tests and lookups are not.
+  std::uint64_t primitive_tests = 0, primitives_culled = 0, primitive_lookups = 0, primitive_fragments_culled = 0;
+  std::uint64_t primitive_false_culls = 0;
+  // Drawn candidates (Visible draws) whose passed samples are fewer than GL recorded for the same
+  // draw: a triangle culled with a visible fragment shows up here, GL's counters being the ground
+  // truth (the model's other draws are bit-exact with GL's; see Collector::draw_done).
+  std::uint64_t visible_draws_passed_below_gl = 0;
 
   void add(const cull::CullReport& r, std::uint64_t frame_depth_tests, std::uint64_t frame_cycles) {
     ++frames;
@@ -52,6 +60,9 @@ struct CullTotals {
     bounds_tests += r.bounds_tests, node_tests += r.node_tests, crossing_near += r.crossing_near;
     found_visible += r.found_visible, culled += r.culled, undrawable += r.undrawable;
     candidates_not_visible += r.candidates_not_visible, false_culls += r.false_culls;
+    primitive_tests += r.primitive_tests, primitives_culled += r.primitives_culled;
+    primitive_lookups += r.primitive_lookups, primitive_fragments_culled += r.primitive_fragments_culled;
+    primitive_false_culls += r.primitive_false_culls;
   }
 
   std::uint64_t total_depth_tests() const { return query_depth_tests + update_texels + drawn_depth_tests; }
@@ -88,6 +99,17 @@ struct CullTotals {
     j["candidates_not_visible"] = candidates_not_visible;
     j["false_culls"] = false_culls;
     j["culling_efficiency"] = candidates_not_visible ? static_cast<double>(culled) / static_cast<double>(candidates_not_visible) : 1.0;
+    j["granularity"] = granularity;
+    j["primitive_tests"] = primitive_tests;
+    j["primitive_tests_per_frame"] = per_frame(primitive_tests);
+    j["primitives_culled"] = primitives_culled;
+    j["primitives_culled_per_frame"] = per_frame(primitives_culled);
+    j["primitive_lookups"] = primitive_lookups;
+    j["primitive_lookups_per_frame"] = per_frame(primitive_lookups);
+    j["primitive_fragments_culled"] = primitive_fragments_culled;
+    j["primitive_fragments_culled_per_frame"] = per_frame(primitive_fragments_culled);
+    j["primitive_false_culls"] = primitive_false_culls;
+    j["visible_draws_passed_below_gl"] = visible_draws_passed_below_gl;
     return j;
   }
 };
@@ -124,6 +146,7 @@ class Collector : public depth::ResultSink {
     frame_.passed_model += r.depth.passed, frame_.passed_gl += d.gl.samples_passed;
     frame_.depth_tests += r.depth.depth_tests;
     if (r.depth.fragments == d.gl.fragments && r.depth.passed == d.gl.samples_passed) ++s_.draws_exact;
+    if (d.role == trace::DrawRole::Visible && r.depth.passed < d.gl.samples_passed) ++cull.visible_draws_passed_below_gl;
     if (draws_.is_open())
       draws_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, d.index, d.object,
                             role_name(d.role), d.clip_positions.size() / 3, r.geometry.prims_out, d.gl.clip_prims_out,
@@ -167,6 +190,11 @@ class Collector : public depth::ResultSink {
       pf["candidates_not_visible"] = r->candidates_not_visible;
       pf["false_culls"] = r->false_culls;
       pf["undrawable"] = r->undrawable;
+      pf["primitive_tests"] = r->primitive_tests;
+      pf["primitives_culled"] = r->primitives_culled;
+      pf["primitive_lookups"] = r->primitive_lookups;
+      pf["primitive_fragments_culled"] = r->primitive_fragments_culled;
+      pf["primitive_false_culls"] = r->primitive_false_culls;
     }
     per_frame_.push_back(std::move(pf));
     last_cycle_ = cycle;
@@ -290,7 +318,9 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.nearest_margin = number("nearest_margin", 0.0);
   setup.zero_to_one = clip_control && *clip_control == "ZERO_TO_ONE";
   setup.scene = tr.scene();
+  setup.fused_interpolation = o.config.depth.fused_interpolation;
   sink.cull.mode = o.config.cull.mode;
+  sink.cull.granularity = o.config.cull.granularity;
   Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, &setup);
   std::optional<sim::Timeline> timeline;  // only when asked: units then report their busy spans
   if (o.timeline || o.vcd) {
