@@ -786,7 +786,7 @@ class Report:
     def pareto_plot(self, name, rows, traces, key, col, label, err_label, short):
         fig, axes = self.panels(len(traces))
         flat = axes.ravel()
-        todo = []
+        label_jobs = []
         for ax, tr in zip(flat, traces):
             pts = [r for r in rows if r["trace"] == tr and r["status"] == "ok"
                    and r.get(key) is not None and r.get("error_axis") is not None]
@@ -822,12 +822,12 @@ class Report:
                 ax.legend(fontsize=7, loc="best")
             else:
                 ax.text(0.5, 0.5, "no ok point with both values", transform=ax.transAxes, ha="center")
-            todo.append((ax, pts))
+            label_jobs.append((ax, pts))
         for ax in flat[len(traces):]:
             ax.set_visible(False)
         fig.suptitle(f"Sweep {name}: {label} against error (Pareto front per trace)")
         freeze_layout(fig)
-        for ax, pts in todo:
+        for ax, pts in label_jobs:
             if pts:
                 labs = [r["label"] + (f" ({int(r['false_culls'])} false culls)" if (r.get("false_culls") or 0) > 0 else "")
                         for r in pts]

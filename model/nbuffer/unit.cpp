@@ -72,10 +72,10 @@ void NBufferUnit::drain() {
   sim::catch_up(done_cycle_);
 }
 
-QueryAnswer NBufferUnit::query(const Rect& r, float nearest_depth, CoveringKind kind) {
+std::uint64_t NBufferUnit::acquire_port() {
   const std::uint64_t arrived = sim::local_cycles();
   // Only once the engine has done the work posted before this query arrived (later work does not
-  // hold it up), and one query at a time.
+  // hold it up), and one query (or batch) at a time.
   const std::uint64_t needed = posted_seq_;
   sim::blocking([&] {
     while (done_seq_ < needed) wait(batch_done_);
@@ -84,6 +84,11 @@ QueryAnswer NBufferUnit::query(const Rect& r, float nearest_depth, CoveringKind 
   sim::catch_up(done_cycle_);  // the engine's work it waited for is done by then
   port_busy_ = true;
   query_wait_cycles_ += sim::local_cycles() - arrived;
+  return arrived;
+}
+
+QueryAnswer NBufferUnit::query(const Rect& r, float nearest_depth, CoveringKind kind) {
+  const std::uint64_t arrived = acquire_port();
 
   const NBufferUnitConfig& c = core_.config();
   QueryAnswer a = core_.query(r, nearest_depth, kind);
@@ -109,15 +114,7 @@ void NBufferUnit::query_batch(std::span<const Rect> rects, std::span<const float
   NBSIM_CHECK(rects.size() == nearest.size(), "a query batch needs one nearest depth per rectangle");
   answers.clear();
   if (rects.empty()) return;
-  const std::uint64_t arrived = sim::local_cycles();
-  const std::uint64_t needed = posted_seq_;  // as query(): the work posted before the batch arrived
-  sim::blocking([&] {
-    while (done_seq_ < needed) wait(batch_done_);
-    while (port_busy_) wait(port_free_);
-  });
-  sim::catch_up(done_cycle_);  // the engine's work it waited for is done by then
-  port_busy_ = true;
-  query_wait_cycles_ += sim::local_cycles() - arrived;
+  const std::uint64_t arrived = acquire_port();
 
   const NBufferUnitConfig& c = core_.config();
   std::uint64_t lookups = 0, update_texels = 0, bytes = 0;

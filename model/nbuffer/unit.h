@@ -54,6 +54,9 @@ class NBufferUnit : public sim::Unit {
   bool engine_idle() const noexcept { return done_seq_ == posted_seq_; }
 
  private:
+  // Waits until the engine has done the work posted before the caller arrived and the query port
+  // is free, then takes the port; returns the arrival cycle (the wait is counted).
+  std::uint64_t acquire_port();
   void engine();  // SC_THREAD: the update engine
   UpdateWork post(UpdateWork w);
   // Waits until `done` (a cycle), counting the wait in `counter`.
