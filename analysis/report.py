@@ -234,37 +234,55 @@ def table2_ratios(rows):
 
 def place_labels(ax, xs, ys, labels, colors=None, fontsize=7):
     """Annotate points, trying offsets around each until the label overlaps no marker, no earlier label
-    and not the axes' border; points at the same place (and colour) share one label. Call after the
-    layout is fixed (freeze_layout)."""
+    and not the axes' border, and sits nearer its own marker than any other; points within a few pixels
+    of each other (and of one colour) share one label. Where no offset keeps the label nearest its own
+    marker, it gets a leader line to it. Call after the layout is fixed (freeze_layout)."""
     renderer = ax.figure.canvas.get_renderer()
     frame = ax.get_window_extent(renderer)
     colors = colors or ["#222222"] * len(xs)
-    groups = {}
+    groups = []  # [display x, display y, data x, data y, colour, labels]
     placed = []  # display boxes to keep clear: the markers first, then each label placed
     for x, y, lab, c in zip(xs, ys, labels, colors):
         px, py = ax.transData.transform((x, y))
         placed.append(matplotlib.transforms.Bbox.from_extents(px - 4, py - 4, px + 4, py + 4))
-        groups.setdefault((round(px / 4), round(py / 4), c), [x, y, c, []])[3].append(lab)
+        near = next((g for g in groups if g[4] == c and math.hypot(g[0] - px, g[1] - py) <= 5), None)
+        if near is None:
+            groups.append([px, py, x, y, c, [lab]])
+        else:
+            near[5].append(lab)
+
+    def distance(bb, px, py):
+        return math.hypot(max(bb.x0 - px, 0.0, px - bb.x1), max(bb.y0 - py, 0.0, py - bb.y1))
+
+    def nearest_is_own(bb, g):
+        mine = distance(bb, g[0], g[1])
+        return all(distance(bb, o[0], o[1]) > mine for o in groups if o is not g)
+
     offsets = [(5, 4), (5, -12), (-5, 4), (-5, -12), (6, 14), (6, -22), (-6, 14), (-6, -22),
                (10, -4), (-10, -4), (6, 26), (6, -34), (-6, 26), (-6, -34), (14, 38), (-14, 38)]
-    for x, y, c, labs in groups.values():
-        labs = list(dict.fromkeys(labs))
+    for g in groups:
+        x, y, c = g[2], g[3], g[4]
+        labs = list(dict.fromkeys(g[5]))
         text = "\n".join(labs) if len(labs) <= 3 else "\n".join(labs[:2] + [f"+{len(labs) - 2} more"])
-        for k, (dx, dy) in enumerate(offsets):
-            t = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=fontsize,
-                            ha="left" if dx >= 0 else "right", va="bottom", color=c)
-            bb = t.get_window_extent(renderer)
-            inside = frame.x0 <= bb.x0 and bb.x1 <= frame.x1 and frame.y0 <= bb.y0 and bb.y1 <= frame.y1
-            if inside and not any(bb.overlaps(p) for p in placed):
-                break
-            if k < len(offsets) - 1:
-                t.remove()
-            else:  # nowhere free: back to the first place, with a leader line
-                t.remove()
-                t = ax.annotate(text, (x, y), xytext=offsets[0], textcoords="offset points", fontsize=fontsize,
-                                ha="left", va="bottom", color=c, arrowprops={"arrowstyle": "-", "color": "#999", "lw": 0.5})
+        chosen = None
+        for strict in (True, False):  # second pass: let the label sit nearer another marker, with a leader
+            for dx, dy in offsets:
+                t = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=fontsize,
+                                ha="left" if dx >= 0 else "right", va="bottom", color=c)
                 bb = t.get_window_extent(renderer)
-        placed.append(bb)
+                inside = frame.x0 <= bb.x0 and bb.x1 <= frame.x1 and frame.y0 <= bb.y0 and bb.y1 <= frame.y1
+                t.remove()
+                if inside and not any(bb.overlaps(p) for p in placed) and (not strict or nearest_is_own(bb, g)):
+                    chosen = (dx, dy, strict)
+                    break
+            if chosen:
+                break
+        dx, dy, clear = chosen or (offsets[0][0], offsets[0][1], False)
+        far = abs(dx) + abs(dy) > 20  # a label this far from its marker gets a leader line too
+        leader = {} if clear and not far else {"arrowprops": {"arrowstyle": "-", "color": "#999", "lw": 0.5}}
+        t = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=fontsize,
+                        ha="left" if dx >= 0 else "right", va="bottom", color=c, **leader)
+        placed.append(t.get_window_extent(renderer))
 
 
 def freeze_layout(fig):
@@ -295,25 +313,37 @@ def headline_table2(t, rows, ratios):
 
 
 def headline_sweep(name, rows, traces, err_label):
-    """The Pareto-optimal points of a sweep (cycles per frame against its error), as Markdown."""
-    lines = [f"Sweep {name}: Pareto-optimal points, cycles per frame against {err_label}", ""]
+    """The Pareto-optimal points of a sweep (cycles per frame against its error), as a Markdown table;
+    a sweep whose points all cull alike (a fidelity sweep) gets its cycle error and host time instead."""
+    lines = [f"Sweep {name}: Pareto-optimal points, cycles per frame against {err_label}", "",
+             "| trace | point | cycles per frame | error | total depth tests per frame | N-buffer memory (KiB) | host s |",
+             "|---|---|---:|---:|---:|---:|---:|"]
+    alike = []
     for t in traces:
         ok = [r for r in rows if r["trace"] == t and r["status"] == "ok" and r["role"] == "sweep"]
         errs = {r["error_axis"] for r in ok if r.get("error_axis") is not None}
-        if ok and len(errs) <= 1:  # no culling trade-off here (a fidelity sweep): timing error and speed instead
+        if ok and len(errs) <= 1:  # no culling trade-off here: timing error and speed instead
             ce = [abs(r["cycle_error"]) for r in ok if r.get("cycle_error") is not None]
             hs = [r["host_seconds"] for r in ok if r.get("host_seconds") is not None]
-            lines.append(f"- {trace_name(t)}: every point culls alike; cycles per frame "
+            alike.append(f"- {trace_name(t)}: every point culls alike; cycles per frame "
                          f"{min(r['cycles_per_frame'] for r in ok):,.0f} to {max(r['cycles_per_frame'] for r in ok):,.0f}"
                          + (f", largest |cycle error| {max(ce):.3%}" if ce else "")
                          + (f", host {min(hs):.2f} to {max(hs):.2f} s" if hs else ""))
             continue
         front = sorted((r for r in rows if r["trace"] == t and r.get("pareto")), key=lambda r: r["cycles_per_frame"])
-        if not front:
-            continue
-        lines.append(f"- {trace_name(t)}: " + "; ".join(
-            f"{r['label']} ({r['cycles_per_frame']:,.0f} cycles, error {r['error_axis']:.2f})" for r in front))
-    return "\n".join(lines)
+        def cell(r, key, spec):
+            v = r.get(key)
+            return "-" if v is None else format(v, spec)
+
+        for r in front:
+            lines.append(f"| {trace_name(t)} | {r['label']} | {cell(r, 'cycles_per_frame', ',.0f')} | "
+                         f"{cell(r, 'error_axis', '.2f')} | {cell(r, 'total_depth_tests_per_frame', ',.0f')} | "
+                         f"{cell(r, 'nbuffer_memory_kib', ',.0f')} | {cell(r, 'host_seconds', '.2f')} |")
+    if len(lines) == 4:  # no front anywhere: the fidelity summary alone
+        lines = lines[:2]
+    elif alike:
+        lines.append("")
+    return "\n".join(lines + alike)
 
 
 class Report:
@@ -680,7 +710,9 @@ class Report:
             keys = varying
             if not grid:
                 keys = [p for p in varying if r[p] != first[r["trace"]][p]]
-            r["label"] = (short_label(r, keys) if keys else "baseline") if varying else r.get("point_id", "")[:8]
+            if not keys:  # the first point itself: its mode when the modes differ, else "baseline"
+                keys = ["cull.mode"] if "cull.mode" in varying else []
+            r["label"] = (short_label(r, keys) or "baseline") if varying else r.get("point_id", "")[:8]
             if r["role"] == "reference":
                 r["label"] = "ref " + r["label"]
         # Error: culling efficiency lost against the reference N-buffer, or the hidden objects not culled.

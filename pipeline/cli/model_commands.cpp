@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "model/common/error.h"
+#include "model/cull/primitive.h"
 #include "pipeline/cli/command.h"
 #include "pipeline/cli/progress.h"
 #include "pipeline/explore/child.h"
@@ -66,6 +67,10 @@ constexpr Table2Row kTable2[] = {
 std::vector<nlohmann::json> run_table2(const std::string& trace, const std::filesystem::path& out, const ModelOptions& mo,
                                        int parallel) {
   const std::size_t n = std::size(kTable2);
+  pipeline::GpuConfig config;
+  nlohmann::ordered_json values;
+  mo.apply(config, values);
+  const bool primitive = cull::parse_granularity(config.cull.granularity) == cull::Granularity::Primitive;
   std::vector<explore::ChildJob> jobs;
   for (const Table2Row& row : kTable2) {
     const std::filesystem::path dir = out / row.mode;
@@ -73,6 +78,11 @@ std::vector<nlohmann::json> run_table2(const std::string& trace, const std::file
     if (!mo.config_file.empty()) args.insert(args.end(), {"--config", mo.config_file});
     for (const auto& s : mo.sets) args.insert(args.end(), {"--set", s});
     args.insert(args.end(), {"--set", std::string("cull.mode=") + row.mode});
+    // Per-primitive culling where the mode has a depth-query structure; the occlusion-query rows stay
+    // at object granularity (a query per triangle would rasterize it), so one setting runs every row.
+    config.cull.mode = row.mode;
+    if (primitive && !cull::supports_primitive_granularity(config.cull.parsed_mode()))
+      args.insert(args.end(), {"--set", "cull.granularity=object"});
     jobs.push_back({std::move(args), dir});
   }
   std::vector<nlohmann::json> results(n);
@@ -220,7 +230,7 @@ void add_model_commands(CLI::App& app, Action& action) {
           r["paper_depth_tests_per_frame"] = kTable2[i].paper ? nlohmann::ordered_json(*kTable2[i].paper) : nullptr;
           for (const char* k : {"query_depth_tests_per_frame", "update_texels_per_frame", "total_depth_tests_per_frame",
                                 "cycles_per_frame", "false_culls", "culling_efficiency", "frames", "bounds_tests",
-                                "candidates", "culled", "candidates_not_visible", "undrawable", "max_lookups_per_test"})
+                                "candidates", "culled", "candidates_not_visible", "undrawable", "max_lookups_per_test", "granularity"})
             r[k] = c[k];
           r["host_seconds"] = rows[i]["host_seconds"];
           false_culls += c["false_culls"].get<std::uint64_t>();
@@ -255,6 +265,8 @@ void add_model_commands(CLI::App& app, Action& action) {
           const double oq = list[1]["query_depth_tests_per_frame"].get<double>(), nb = list[3]["query_depth_tests_per_frame"].get<double>();
           fmt::print("occlusion queries / N-buffer query depth tests: {:.0f}x (paper: 400x); false culls: {}\n",
                      nb > 0 ? oq / nb : 0.0, false_culls);
+          if (list[2]["granularity"] == "primitive")
+            fmt::print("cull.granularity=primitive in nb_hier, nb, hiz_tile and hiz_pyramid; oq_hier and oq test objects only\n");
         }
         return false_culls == 0 ? 0 : 1;
       };

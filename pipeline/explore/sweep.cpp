@@ -243,13 +243,12 @@ void add_reference_points(std::vector<Point>& points, const std::vector<std::str
   for (std::size_t i = 0; i < sweep_points; ++i) {
     const std::string mode = points[i].effective.value("cull.mode", std::string("trace"));
     if (mode != "trace" && mode != "none") {
+      // One reference for every mode: the hierarchical query on the full N-buffer, so the flat nb
+      // query's loss shows too. The Hi-Z keys mean nothing to it: one reference for every Hi-Z variant.
       nlohmann::json overrides = culling_reference_settings();
-      if (mode != "nb" && mode != "nb_hier") {
-        overrides["cull.mode"] = "nb_hier";
-        // The Hi-Z keys mean nothing to the N-buffer: one reference for every Hi-Z variant.
-        for (const auto& [k, v] : defaults.items())
-          if (k.rfind("hiz.", 0) == 0) overrides[k] = v;
-      }
+      overrides["cull.mode"] = "nb_hier";
+      for (const auto& [k, v] : defaults.items())
+        if (k.rfind("hiz.", 0) == 0) overrides[k] = v;
       points[i].culling_reference = reference(i, overrides);
     }
     points[i].timing_reference = reference(i, timing_reference_settings());

@@ -119,6 +119,25 @@ class FixtureReport(unittest.TestCase):
         ours = by["oq"]["query_depth_tests_per_frame"] / by["nb"]["query_depth_tests_per_frame"]
         self.assertIn(f"oq / nb: {ours:,.0f}x (paper 400x)", self.html)
 
+    def test_headline_tables(self):
+        # headline.md: Table 2 beside the paper, then per sweep a Markdown table of its Pareto front (one
+        # row per point marked on the cycles front), or the cycle-error summary of a sweep that culls alike
+        text = (self.dir / "report" / "headline.md").read_text()
+        self.assertIn("| mode | paper | query depth tests |", text)
+        for name in ["small", "nbuffer_resolution", "fidelity"]:
+            self.assertIn(f"Sweep {name}: Pareto-optimal points", text)
+        block = text.split("Sweep nbuffer_resolution:")[1].split("Sweep ")[0]
+        table = [line for line in block.splitlines() if line.startswith("| ") and not line.startswith("| trace")]
+        with open(self.dir / "report" / "nbuffer_resolution_pareto.csv") as f:
+            front = [r for r in csv.DictReader(f) if r["pareto"] == "yes"]
+        self.assertGreater(len(front), 1, "the fixture sweep has a trade-off")
+        self.assertEqual(len(table), len(front), block)
+        for line in table:
+            self.assertEqual(line.count("|"), 8, line)
+        fidelity = text.split("Sweep fidelity:")[1].split("Sweep ")[0]
+        self.assertIn("every point culls alike", fidelity)
+        self.assertIn("largest |cycle error|", fidelity)
+
 
 class Pareto(unittest.TestCase):
     """Pareto marks on hand-made points: minimise cost and error, per trace, ok sweep rows only."""

@@ -1,7 +1,7 @@
 // CullReplayTest: `nbsim replay --set cull.mode=MODE` on the sample traces, one replay (one SystemC
 // elaboration) per process: no mode ever culls a visible object, the N-buffer spends at most four
 // lookups per bounds test, the occlusion-query boxes cost exactly GL's recorded fragments, and
-// `nbsim table2` runs every mode and prints its JSON list.
+// `nbsim table2` runs every mode and prints its JSON list, at either granularity.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -108,12 +108,18 @@ TEST(CullReplayTest, UnknownModeIsRefused) {
 }
 
 // `nbsim table2 --json` runs the six modes and lists Table 2's columns, with no false culls.
-TEST(CullReplayTest, Table2PrintsJson) {
-  const auto r = run_nbsim("table2 " + sample("city_small_oq.nbt") + " --json");
-  ASSERT_EQ(r.status, 0) << r.err;
+// `nbsim table2 city_small_oq.nbt --json EXTRA`: the list of rows, or null (with a test failure).
+nlohmann::json table2_rows(const std::string& extra = "") {
+  const auto r = run_nbsim("table2 " + sample("city_small_oq.nbt") + " --json" + extra);
+  EXPECT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out, nullptr, false);
-  ASSERT_TRUE(j.is_array()) << r.out;
-  ASSERT_EQ(j.size(), 6u);
+  EXPECT_TRUE(j.is_array() && j.size() == 6u) << r.out;
+  return j.is_array() && j.size() == 6u ? j : nlohmann::json();
+}
+
+TEST(CullReplayTest, Table2PrintsJson) {
+  const nlohmann::json j = table2_rows();
+  ASSERT_FALSE(j.is_null());
   std::set<std::string> modes;
   for (const auto& row : j) {
     modes.insert(row["mode"].get<std::string>());
@@ -126,6 +132,18 @@ TEST(CullReplayTest, Table2PrintsJson) {
   EXPECT_EQ(modes, (std::set<std::string>{"oq_hier", "oq", "nb_hier", "nb", "hiz_tile", "hiz_pyramid"}));
   EXPECT_LT(j[3]["query_depth_tests_per_frame"].get<double>(), j[1]["query_depth_tests_per_frame"].get<double>())
       << "the N-buffer should need fewer query depth tests than occlusion queries";
+}
+
+// `nbsim table2 --set cull.granularity=primitive` runs every row: the modes with a depth-query structure
+// test triangles, the occlusion-query rows stay at object granularity, and no row culls a visible object.
+TEST(CullReplayTest, Table2PrimitiveGranularity) {
+  const nlohmann::json j = table2_rows(" --set cull.granularity=primitive");
+  ASSERT_FALSE(j.is_null());
+  for (const auto& row : j) {
+    const std::string mode = row["mode"].get<std::string>();
+    EXPECT_EQ(row["granularity"], mode.starts_with("oq") ? "object" : "primitive") << mode;
+    EXPECT_EQ(row["false_culls"], 0u) << mode;
+  }
 }
 
 }  // namespace

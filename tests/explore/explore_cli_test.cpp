@@ -191,7 +191,7 @@ TEST(ExploreCliTest, FailingPointRecorded) {
   std::ofstream(corrupt) << "not a trace at all";
   const fs::path out = scratch("failing");
   const nlohmann::json sweep = {{"traces", {kSample, corrupt.string()}},
-                                {"points", {{{"cull.mode", "nb"}, {"trace", kSample}}, {{"cull.mode", "nb"}, {"trace", corrupt.string()}}}}};
+                                {"points", {{{"cull.mode", "nb_hier"}, {"trace", kSample}}, {{"cull.mode", "nb_hier"}, {"trace", corrupt.string()}}}}};
   const CliResult r = run_nbsim("explore " + write_sweep("failing.json", sweep).string() + " --jobs 2 --out " + out.string());
   EXPECT_EQ(r.status, 1) << r.out << r.err;
   EXPECT_TRUE(has(r.out, "2 points (0 of them references): 2 run, 0 resumed, 1 failed")) << r.out;

@@ -100,9 +100,9 @@ TEST(SweepTest, StableIds) {
   EXPECT_EQ(ex::point_id("traces/samples/city_small_oq.nbt", json::object()), "2fd8ffe3aeac73ec") << "FNV-1a 64 of the trace, a line break and the sorted settings";
 }
 
-// Reference points: the culling reference is the full-resolution N-buffer (nb_hier for a mode that
-// is not an N-buffer mode), found among the sweep's points by effective config or added once; the
-// trace mode has none; keys the config lacks (here the timing knobs) are left out.
+// Reference points: the culling reference of every mode is nb_hier on the full-resolution N-buffer,
+// found among the sweep's points by effective config or added once; the trace mode has none; keys the
+// config lacks (here the timing knobs) are left out.
 TEST(SweepTest, ReferencePoints) {
   const ojson j = ojson::parse(R"({"traces": ["t.nbt"], "points": [
     {"cull.mode": "nb"}, {"cull.mode": "nb", "nbuffer.resolution_divisor": 4}, {"cull.mode": "nb", "nbuffer.resolution_divisor": 2},
@@ -112,8 +112,8 @@ TEST(SweepTest, ReferencePoints) {
   ex::check_points(spec, points, toy_check, "s");
   ex::add_reference_points(points, ex::parameter_keys(spec), toy_check, "s");
   ASSERT_EQ(points.size(), 8u) << "one reference added: nb_hier at full resolution";
-  for (int i = 0; i < 3; ++i) EXPECT_EQ(points[i].culling_reference, points[0].id) << "point " << i << ": {} and divisor 1 are one config";
   const Point& added = points[7];
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(points[i].culling_reference, added.id) << "point " << i << ": the flat nb query is measured too";
   EXPECT_EQ(points[6].culling_reference, added.id) << "Hi-Z keys go back to their defaults: one reference";
   EXPECT_EQ(added.role, "reference");
   EXPECT_EQ(added.settings, json::parse(R"({"cull.mode": "nb_hier"})")) << "only what differs is set";
