@@ -553,12 +553,15 @@ class Report:
                 ax.annotate("no paper row", (x[i] - wd, 0), xycoords=("data", "axes fraction"), xytext=(0, 4),
                             textcoords="offset points", rotation=90, ha="center", va="bottom", fontsize=7, color="#777")
         ax.set_yscale("log")
+        tallest = max(max(r["total_depth_tests_per_frame"], r["query_depth_tests_per_frame"],
+                          r.get("paper_depth_tests_per_frame") or 0) for r in rows)
+        ax.set_ylim(top=tallest * 30)  # headroom: the legend sits above the bars
         ax.set_xticks(x, modes)
         ax.set_xlabel("culling mode")
         ax.set_ylabel("depth tests per frame (log scale)")
         ax.set_title(f"Depth tests per frame: paper vs nbsim ({trace_name(str(t.get('trace', '?')))})")
         ax.grid(axis="y", which="both", alpha=0.3)
-        ax.legend(fontsize=8, loc="upper right")
+        ax.legend(fontsize=8, loc="upper right", ncols=3)
         img = self.save(fig, "table2.png")
         rt = "; ".join(f"{r['ratio']}: {'-' if r['ours'] is None else format(r['ours'], ',.0f')}x "
                        f"(paper {'-' if r['paper'] is None else format(r['paper'], ',.0f')}x)" for r in ratios)
