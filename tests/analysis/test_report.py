@@ -19,7 +19,7 @@ SCRIPT = ROOT / "analysis" / "report.py"
 FIXTURE = HERE / "fixture"
 PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
 sys.path.insert(0, str(ROOT / "analysis"))
-import report  # noqa: E402
+import report_data  # noqa: E402
 import table1  # noqa: E402
 
 
@@ -145,12 +145,12 @@ class Pareto(unittest.TestCase):
     def test_flags_known_points(self):
         # dominated, non-dominated and tied points (equal points stay on the front together)
         pts = [(1, 5), (2, 3), (2, 3), (3, 3), (4, 1), (5, 1), (0.5, 10), (2, 5), None]
-        self.assertEqual(report.pareto_flags(pts), [True, True, True, False, True, False, True, False, None])
+        self.assertEqual(report_data.pareto_flags(pts), [True, True, True, False, True, False, True, False, None])
 
     def test_equal_cost_lower_error_dominates(self):
         # same cost, strictly lower error: the other is dominated (<= in both, < in one)
-        self.assertEqual(report.pareto_flags([(1, 2), (1, 1)]), [False, True])
-        self.assertEqual(report.pareto_flags([(7, 7)]), [True])
+        self.assertEqual(report_data.pareto_flags([(1, 2), (1, 1)]), [False, True])
+        self.assertEqual(report_data.pareto_flags([(7, 7)]), [True])
 
     def test_report_marks_per_trace_and_skips_failed_and_reference(self):
         # through the whole script: a tiny results.csv with two traces, a failed and a reference row
@@ -231,7 +231,7 @@ class Table2Ratio(unittest.TestCase):
                 {"mode": "oq_hier", "query_depth_tests_per_frame": 3000.0, "paper_depth_tests_per_frame": 1100000.0},
                 {"mode": "nb_hier", "query_depth_tests_per_frame": 300.0, "paper_depth_tests_per_frame": 350.0},
                 {"mode": "hiz_tile", "query_depth_tests_per_frame": 700.0, "paper_depth_tests_per_frame": None}]
-        r = {x["ratio"]: x for x in report.table2_ratios(rows)}
+        r = {x["ratio"]: x for x in report_data.table2_ratios(rows)}
         self.assertAlmostEqual(r["oq / nb"]["ours"], 50.0)
         self.assertAlmostEqual(r["oq / nb"]["paper"], 400.0)
         self.assertAlmostEqual(r["oq_hier / nb_hier"]["ours"], 10.0)
@@ -239,7 +239,7 @@ class Table2Ratio(unittest.TestCase):
 
     def test_ratio_needs_both_modes(self):
         # without nb there is no oq/nb ratio (not a division by a missing row)
-        self.assertEqual(report.table2_ratios([{"mode": "oq", "query_depth_tests_per_frame": 1.0}]), [])
+        self.assertEqual(report_data.table2_ratios([{"mode": "oq", "query_depth_tests_per_frame": 1.0}]), [])
 
 
 class MissingAndBroken(unittest.TestCase):

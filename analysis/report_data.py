@@ -1,0 +1,240 @@
+"""The data side of nbsim's exploration report (report.py): reading the CSV/JSON outputs, point labels,
+Pareto marks, and the Markdown headline. No plotting here: report_plots.py has that.
+"""
+import csv
+import json
+import math
+import os
+
+MODE_ORDER = ["oq_hier", "oq", "nb_hier", "nb", "hiz_tile", "hiz_pyramid"]
+# The paper's ratios of depth tests per frame (Table 2: 200 000 / 500 and 1 100 000 / 350).
+RATIO_PAIRS = [("oq", "nb"), ("oq_hier", "nb_hier")]
+# Knobs that change how closely the model follows llvmpipe, not the design under study.
+FIDELITY_KNOBS = ["geometry.batch_triangles", "geometry.fused_viewport", "depth.fused_interpolation",
+                  "gpu.quantum_cycles", "gpu.fifo_depth"]
+# Short names for point labels; "" shows the value alone (it names itself: nb_hier, u16, eager).
+SHORT = {
+    "cull.mode": "", "nbuffer.format": "", "nbuffer.update_policy": "", "cull.granularity": "",
+    "nbuffer.resolution_divisor": "div", "nbuffer.level_cap": "cap", "nbuffer.capped_max_lookups": "maxlk",
+    "nbuffer.cache_size_bytes": "nb$", "depth.cache_size_bytes": "z$", "nbuffer.lookup_latency_cycles": "lat",
+    "nbuffer.lookups_per_cycle": "lk/c", "geometry.batch_triangles": "batch", "geometry.fused_viewport": "fma-vp",
+    "depth.fused_interpolation": "fma-z", "gpu.fifo_depth": "fifo", "gpu.quantum_cycles": "quantum",
+    "hiz.tile_px": "tile", "hiz.format": "hiz",
+}
+# Sweep metric columns the report reads as numbers (when present).
+NUMERIC = ["cycles_per_frame", "depth_tests_per_frame", "query_depth_tests_per_frame", "update_texels_per_frame",
+           "total_depth_tests_per_frame", "false_culls", "culling_efficiency", "memory_bytes_per_frame",
+           "nbuffer_bytes_per_frame", "fragment_error", "passed_error", "host_seconds", "cycles_per_host_second",
+           "nbuffer_memory_bytes", "efficiency_lost", "cycle_error", "counter_error"]
+
+
+
+class BadInput(Exception):
+    """A malformed input; str() starts with the file's path."""
+
+
+class Missing(Exception):
+    """A section's inputs are absent; args[0] lists them (paths relative to DIR)."""
+
+
+# ----------------------------------------------------------------------------------------- helpers
+
+def fmt(v, digits=4):
+    """Numbers for tables: thousands separators, a few significant digits, '-' for nothing."""
+    if v is None or v == "" or (isinstance(v, float) and math.isnan(v)):
+        return "-"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, int):
+        return f"{v:,}"
+    if isinstance(v, float):
+        if v == int(v) and abs(v) < 1e15:
+            return f"{int(v):,}"
+        if abs(v) >= 1000:
+            return f"{v:,.0f}"
+        return f"{v:.{digits}g}"
+    return str(v)
+
+
+def pct(v, digits=1):
+    return "-" if v is None else f"{100 * v:.{digits}f}%"
+
+
+def number(s):
+    """A CSV cell as a float, None when empty; ValueError otherwise."""
+    s = s.strip()
+    if s == "" or s.lower() in ("null", "none", "nan"):
+        return None
+    return float(s)
+
+
+def load_json(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except json.JSONDecodeError as e:
+        raise BadInput(f"{path}: broken JSON: {e}") from e
+    except (OSError, UnicodeDecodeError) as e:
+        raise BadInput(f"{path}: cannot read: {e}") from e
+
+
+def read_csv(path, required):
+    """Rows of a CSV as dicts; a header without the required columns or a ragged row is a BadInput."""
+    try:
+        with open(path, newline="") as f:
+            reader = csv.DictReader(f)
+            header = reader.fieldnames or []
+            lacking = [c for c in required if c not in header]
+            if lacking:
+                raise BadInput(f"{path}: the header lacks column(s) {', '.join(lacking)} "
+                               f"(header: {','.join(header)[:200] or 'empty file'})")
+            rows = []
+            for r in reader:
+                if None in r or any(v is None for v in r.values()):
+                    raise BadInput(f"{path}: line {reader.line_num} has {len(r) - (None in r) + len(r.get(None) or [])} "
+                                   f"fields, the header {len(header)}")
+                rows.append(r)
+            return header, rows
+    except csv.Error as e:
+        raise BadInput(f"{path}: not a valid CSV: {e}") from e
+    except (OSError, UnicodeDecodeError) as e:
+        raise BadInput(f"{path}: cannot read: {e}") from e
+
+
+def short_value(key, v):
+    s = str(v)
+    if key.endswith("_bytes"):
+        try:
+            b = int(float(s))
+            return f"{b // 1024}K" if b >= 1024 and b % 1024 == 0 else str(b)
+        except ValueError:
+            return s
+    if s in ("true", "false"):
+        return "on" if s == "true" else "off"
+    if s.endswith(".0"):
+        s = s[:-2]
+    return s
+
+
+def short_label(params, keys):
+    """'nb_hier div=2 u16': the values of the given parameters, keys abbreviated."""
+    parts = []
+    for k in keys:
+        abbr = SHORT.get(k, k.split(".")[-1])
+        v = short_value(k, params.get(k, ""))
+        if v == "":
+            continue
+        parts.append(v if abbr == "" else f"{abbr}={v}")
+    return " ".join(parts)
+
+
+def sorted_modes(modes):
+    return sorted(modes, key=lambda m: (MODE_ORDER.index(m) if m in MODE_ORDER else len(MODE_ORDER), m))
+
+
+def trace_name(t):
+    return os.path.basename(t).removesuffix(".nbt")
+
+
+# ---------------------------------------------------------------------------------------- Pareto
+
+def pareto_flags(points):
+    """For (cost, error) pairs (None: left out) whether each is Pareto-optimal when minimising both: no
+    other point is <= in both and < in one. Equal points do not dominate each other (both stay)."""
+    flags = []
+    for p in points:
+        if p is None:
+            flags.append(None)
+            continue
+        dominated = any(q is not None and q[0] <= p[0] and q[1] <= p[1] and (q[0] < p[0] or q[1] < p[1])
+                        for q in points)
+        flags.append(not dominated)
+    return flags
+
+
+def mark_pareto(rows, cost, error):
+    """Pareto flags per trace (different traces are different scenes): True/False for ok sweep rows
+    with both values, None for failed rows, reference rows and rows without the values."""
+    flags = [None] * len(rows)
+    by_trace = {}
+    for i, r in enumerate(rows):
+        by_trace.setdefault(r.get("trace", ""), []).append(i)
+    for idx in by_trace.values():
+        pts = []
+        for i in idx:
+            r = rows[i]
+            c, e = r.get(cost), r.get(error)
+            usable = (r.get("status", "ok") == "ok" and r.get("role", "sweep") != "reference"
+                      and isinstance(c, float) and isinstance(e, float) and math.isfinite(c) and math.isfinite(e))
+            pts.append((c, e) if usable else None)
+        for i, f in zip(idx, pareto_flags(pts)):
+            flags[i] = f
+    return flags
+
+
+def table2_ratios(rows):
+    """Query depth tests per frame of occlusion queries over the N-buffer's, ours beside the paper's."""
+    by = {r["mode"]: r for r in rows}
+    out = []
+    for a, b in RATIO_PAIRS:
+        if a in by and b in by:
+            qa, qb = by[a].get("query_depth_tests_per_frame"), by[b].get("query_depth_tests_per_frame")
+            pa, pb = by[a].get("paper_depth_tests_per_frame"), by[b].get("paper_depth_tests_per_frame")
+            out.append({"ratio": f"{a} / {b}", "ours": qa / qb if qa is not None and qb else None,
+                        "paper": pa / pb if pa is not None and pb else None})
+    return out
+
+
+# -------------------------------------------------------------------------------------- headline
+
+def headline_table2(t, rows, ratios):
+    """Table 2 beside the paper, as Markdown."""
+    lines = [f"Table 2 ({trace_name(str(t.get('trace', '?')))}, settings: {', '.join(t.get('settings') or []) or 'defaults'}): "
+             "depth tests per frame",
+             "",
+             "| mode | paper | query depth tests | total depth tests | cycles | culling efficiency | false culls |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        p = r.get("paper_depth_tests_per_frame")
+        lines.append(f"| {r['mode']} | {'-' if not p else format(p, ',.0f')} | {r['query_depth_tests_per_frame']:,.0f} | "
+                     f"{r['total_depth_tests_per_frame']:,.0f} | {r['cycles_per_frame']:,.0f} | "
+                     f"{100 * r['culling_efficiency']:.1f}% | {int(r.get('false_culls') or 0)} |")
+    rt = "; ".join(f"{r['ratio']} {r['ours']:,.0f}x (paper {r['paper']:,.0f}x)" for r in ratios
+                   if r["ours"] is not None and r["paper"] is not None)
+    if rt:
+        lines += ["", f"Occlusion queries over N-buffer, query depth tests: {rt}."]
+    return "\n".join(lines)
+
+
+def headline_sweep(name, rows, traces, err_label):
+    """The Pareto-optimal points of a sweep (cycles per frame against its error), as a Markdown table;
+    a sweep whose points all cull alike (a fidelity sweep) gets its cycle error and host time instead."""
+    lines = [f"Sweep {name}: Pareto-optimal points, cycles per frame against {err_label}", "",
+             "| trace | point | cycles per frame | error | total depth tests per frame | N-buffer memory (KiB) | host s |",
+             "|---|---|---:|---:|---:|---:|---:|"]
+    alike = []
+    for t in traces:
+        ok = [r for r in rows if r["trace"] == t and r["status"] == "ok" and r["role"] == "sweep"]
+        errs = {r["error_axis"] for r in ok if r.get("error_axis") is not None}
+        if ok and len(errs) <= 1:  # no culling trade-off here: timing error and speed instead
+            ce = [abs(r["cycle_error"]) for r in ok if r.get("cycle_error") is not None]
+            hs = [r["host_seconds"] for r in ok if r.get("host_seconds") is not None]
+            alike.append(f"- {trace_name(t)}: every point culls alike; cycles per frame "
+                         f"{min(r['cycles_per_frame'] for r in ok):,.0f} to {max(r['cycles_per_frame'] for r in ok):,.0f}"
+                         + (f", largest |cycle error| {max(ce):.3%}" if ce else "")
+                         + (f", host {min(hs):.2f} to {max(hs):.2f} s" if hs else ""))
+            continue
+        front = sorted((r for r in rows if r["trace"] == t and r.get("pareto")), key=lambda r: r["cycles_per_frame"])
+        def cell(r, key, spec):
+            v = r.get(key)
+            return "-" if v is None else format(v, spec)
+
+        for r in front:
+            lines.append(f"| {trace_name(t)} | {r['label']} | {cell(r, 'cycles_per_frame', ',.0f')} | "
+                         f"{cell(r, 'error_axis', '.2f')} | {cell(r, 'total_depth_tests_per_frame', ',.0f')} | "
+                         f"{cell(r, 'nbuffer_memory_kib', ',.0f')} | {cell(r, 'host_seconds', '.2f')} |")
+    if len(lines) == 4:  # no front anywhere: the fidelity summary alone
+        lines = lines[:2]
+    elif alike:
+        lines.append("")
+    return "\n".join(lines + alike)
