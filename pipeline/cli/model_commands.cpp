@@ -117,7 +117,7 @@ void add_model_commands(CLI::App& app, Action& action) {
     auto vcd = std::make_shared<std::string>();
     cmd->add_option("--timeline", *timeline,
                     "Write a trace-event JSON of every unit's busy spans (ui.perfetto.dev; ts and dur in cycles)");
-    cmd->add_option("--vcd", *vcd, "Write a VCD of every unit's busy bit (GTKWave; 1 ns = 1 cycle)");
+    cmd->add_option("--vcd", *vcd, "Write a VCD of every unit's busy bit (GTKWave; 1 ns = 1 cycle; needs gpu.quantum_cycles=0)");
     mo->add_options(cmd);
     cmd->callback([&action, trace, out, timeline, vcd, mo] {
       action = [trace, out, timeline, vcd, mo] {

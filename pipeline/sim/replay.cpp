@@ -282,6 +282,12 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
 }
 
 ReplaySummary replay(const ReplayOptions& o) {
+  // The VCD samples SystemC time, which decoupled units run ahead of: its busy bits would be wrong.
+  if (o.vcd && o.config.quantum_cycles > 0)
+    throw InputError(fmt::format(
+        "--vcd records SystemC time, which the units run ahead of with gpu.quantum_cycles={}: use --timeline "
+        "(it records each unit's own time) or gpu.quantum_cycles=0",
+        o.config.quantum_cycles));
   if (o.out) {
     std::error_code ec;
     std::filesystem::create_directories(*o.out, ec);

@@ -1,7 +1,7 @@
 // QuantumCliTest: the timing-granularity knob gpu.quantum_cycles (temporal decoupling,
 // model/sim/unit.h) from the outside: quantum 1 runs through the quantum keepers yet gives the
-// same run as no decoupling, bit for bit; a large quantum changes cycles but no count; bad values
-// are refused.
+// same run as no decoupling, bit for bit; a large quantum changes cycles but no count; bad values,
+// and a VCD (which samples SystemC time) with a quantum, are refused.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -123,6 +123,22 @@ TEST(QuantumCliTest, RefusesBadQuantum) {
     EXPECT_EQ(r.status, 2) << value << ": " << r.err;
     EXPECT_TRUE(has(r.err, "gpu.quantum_cycles")) << value << ": " << r.err;
   }
+}
+
+// --vcd samples SystemC time, which decoupled units run ahead of: refused with a quantum, with the
+// way out named; the trace-event timeline (each unit's own time) is still written.
+TEST(QuantumCliTest, VcdRefusedWithQuantum) {
+  const fs::path vcd = scratch("q.vcd");
+  fs::remove(vcd);
+  const CliResult r = run_nbsim("replay " + kTrace + " --out " + scratch("vcd").string() +
+                                " --set gpu.quantum_cycles=1000 --vcd " + vcd.string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "--vcd")) << r.err;
+  EXPECT_TRUE(has(r.err, "--timeline")) << r.err;
+  EXPECT_FALSE(fs::exists(vcd));
+  const fs::path json = scratch("q_timeline.json");
+  replay("timeline", "--set gpu.quantum_cycles=1000 --timeline " + json.string());
+  EXPECT_GT(fs::file_size(json), 1000u);
 }
 
 }  // namespace
