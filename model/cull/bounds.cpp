@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "model/common/error.h"
+#include "model/common/names.h"
 
 namespace nbsim::cull {
 
@@ -26,16 +27,9 @@ std::array<double, 3> corner(const trace::Aabb& b, int i) {
 
 }  // namespace
 
-std::string_view to_string(CullMode m) noexcept {
-  const auto i = static_cast<std::size_t>(m);
-  return i < kModeNames.size() ? kModeNames[i] : "?";
-}
+std::string_view to_string(CullMode m) noexcept { return enum_name(kModeNames, m); }
 
-std::optional<CullMode> parse_cull_mode(std::string_view s) noexcept {
-  for (std::size_t i = 0; i < kModeNames.size(); ++i)
-    if (kModeNames[i] == s) return static_cast<CullMode>(i);
-  return std::nullopt;
-}
+std::optional<CullMode> parse_cull_mode(std::string_view s) noexcept { return parse_enum_name<CullMode>(kModeNames, s); }
 
 bool hierarchical(CullMode m) noexcept { return m == CullMode::OqHier || m == CullMode::NbHier; }
 

@@ -5,6 +5,8 @@
 #include <array>
 #include <cmath>
 
+#include "model/common/names.h"
+
 namespace nbsim::cull {
 
 namespace {
@@ -18,15 +20,10 @@ constexpr double kPlaneRounding = 0x1p-20;
 
 }  // namespace
 
-std::string_view to_string(Granularity g) noexcept {
-  const auto i = static_cast<std::size_t>(g);
-  return i < kGranularityNames.size() ? kGranularityNames[i] : "?";
-}
+std::string_view to_string(Granularity g) noexcept { return enum_name(kGranularityNames, g); }
 
 std::optional<Granularity> parse_granularity(std::string_view s) noexcept {
-  for (std::size_t i = 0; i < kGranularityNames.size(); ++i)
-    if (kGranularityNames[i] == s) return static_cast<Granularity>(i);
-  return std::nullopt;
+  return parse_enum_name<Granularity>(kGranularityNames, s);
 }
 
 bool supports_primitive_granularity(CullMode m) noexcept {
