@@ -25,7 +25,8 @@ from pathlib import Path
 sys.dont_write_bytecode = True  # no __pycache__ next to the scripts
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 # report_plots first: it selects matplotlib's headless backend before pyplot loads.
-from report_plots import DPI, FIGSIZE, THOUSANDS, freeze_layout, mode_style, place_labels, spans_decades  # noqa: E402
+from report_plots import (DPI, FIGSIZE, MAX_LABELLED_POINTS, THOUSANDS, freeze_layout, mode_style,  # noqa: E402
+                          place_labels, spans_decades)
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
@@ -554,10 +555,20 @@ class Report:
         fig.suptitle(f"Sweep {name}: {label} against error (Pareto front per trace)")
         freeze_layout(fig)
         for ax, pts in label_jobs:
-            if pts:
+            # A crowded panel labels only the points worth naming (the front, references, false culls);
+            # the sweep's points table names every point.
+            crowded = len(pts) > MAX_LABELLED_POINTS
+            named = [r for r in pts if not crowded or r.get(col) or r["role"] == "reference"
+                     or (r.get("false_culls") or 0) > 0]
+            rest = [r for r in pts if not any(r is n for n in named)]
+            if named:
                 labs = [r["label"] + (f" ({int(r['false_culls'])} false culls)" if (r.get("false_culls") or 0) > 0 else "")
-                        for r in pts]
-                place_labels(ax, [r[key] for r in pts], [r["error_axis"] for r in pts], labs)
+                        for r in named]
+                place_labels(ax, [r[key] for r in named], [r["error_axis"] for r in named], labs,
+                             avoid=[(r[key], r["error_axis"]) for r in rest])
+            if rest:
+                ax.text(0.01, 0.01, "dominated points unlabelled: see the points table", transform=ax.transAxes,
+                        fontsize=7, color="#777777", ha="left", va="bottom")
         return self.save(fig, f"{name}_{short}_vs_error.png")
 
     def speed_plot(self, name, rows, params, header):

@@ -12,6 +12,8 @@ from matplotlib.ticker import StrMethodFormatter  # noqa: E402
 DPI = 110
 THOUSANDS = StrMethodFormatter("{x:,.0f}")
 FIGSIZE = (7, 4.5)
+# A cost-against-error panel with more points than this labels only its front (readability).
+MAX_LABELLED_POINTS = 12
 MODE_STYLE = {  # colour, line style, marker: a hierarchical mode is the darker, solid one of its pair
     "oq_hier": ("#1f4e96", "-", "s"), "oq": ("#6fa8dc", "--", "s"),
     "nb_hier": ("#b2182b", "-", "o"), "nb": ("#f4a582", "--", "o"),
@@ -30,11 +32,12 @@ def spans_decades(values, decades=1.0):
 
 # ------------------------------------------------------------------------------------ plot labels
 
-def place_labels(ax, xs, ys, labels, colors=None, fontsize=7):
+def place_labels(ax, xs, ys, labels, colors=None, fontsize=7, avoid=()):
     """Annotate points, trying offsets around each until the label overlaps no marker, no earlier label
     and not the axes' border, and sits nearer its own marker than any other; points within a few pixels
     of each other (and of one colour) share one label. Where no offset keeps the label nearest its own
-    marker, it gets a leader line to it. Call after the layout is fixed (freeze_layout)."""
+    marker, it gets a leader line to it. `avoid`: (x, y) of markers left unlabelled, kept clear as well.
+    Call after the layout is fixed (freeze_layout)."""
     renderer = ax.figure.canvas.get_renderer()
     frame = ax.get_window_extent(renderer)
     colors = colors or ["#222222"] * len(xs)
@@ -48,13 +51,19 @@ def place_labels(ax, xs, ys, labels, colors=None, fontsize=7):
             groups.append([px, py, x, y, c, [lab]])
         else:
             near[5].append(lab)
+    others = []  # display positions of the unlabelled markers
+    for x, y in avoid:
+        px, py = ax.transData.transform((x, y))
+        placed.append(matplotlib.transforms.Bbox.from_extents(px - 4, py - 4, px + 4, py + 4))
+        others.append((px, py))
 
     def distance(bb, px, py):
         return math.hypot(max(bb.x0 - px, 0.0, px - bb.x1), max(bb.y0 - py, 0.0, py - bb.y1))
 
     def nearest_is_own(bb, g):
         mine = distance(bb, g[0], g[1])
-        return all(distance(bb, o[0], o[1]) > mine for o in groups if o is not g)
+        return (all(distance(bb, o[0], o[1]) > mine for o in groups if o is not g)
+                and all(distance(bb, px, py) > mine for px, py in others))
 
     offsets = [(5, 4), (5, -12), (-5, 4), (-5, -12), (6, 14), (6, -22), (-6, 14), (-6, -22),
                (10, -4), (-10, -4), (6, 26), (6, -34), (-6, 26), (-6, -34), (14, 38), (-14, 38)]

@@ -223,6 +223,34 @@ class FutureColumns(unittest.TestCase):
         self.assertIn("cycle_error column", html)
 
 
+class Labels(unittest.TestCase):
+    """place_labels: one annotation per place, clear of every marker, labelled or not."""
+
+    def test_labels_clear_of_markers_and_each_other(self):
+        import report_plots
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
+        xs = [1, 2, 3, 3.02, 4, 5]
+        ys = [5, 3, 1, 1.0, 0.5, 0.2]
+        unlabelled = [(x + 0.08, y + 0.15) for x, y in zip(xs, ys)]  # where the first-choice labels would go
+        ax.scatter(xs + [p[0] for p in unlabelled], ys + [p[1] for p in unlabelled])
+        report_plots.freeze_layout(fig)
+        report_plots.place_labels(ax, xs, ys, [f"p{i}" for i in range(len(xs))], avoid=unlabelled)
+        texts = ax.texts
+        self.assertEqual(len(texts), 5, "the two points at one place share one label")
+        self.assertIn("p2\np3", [t.get_text() for t in texts])
+        r = fig.canvas.get_renderer()
+        boxes = [t.get_window_extent(r) for t in texts]
+        for x, y in list(zip(xs, ys)) + unlabelled:
+            px, py = ax.transData.transform((x, y))
+            for t, b in zip(texts, boxes):
+                self.assertFalse(b.x0 < px < b.x1 and b.y0 < py < b.y1, f"label {t.get_text()!r} covers ({x}, {y})")
+        for i in range(len(boxes)):
+            for j in range(i):
+                self.assertFalse(boxes[i].overlaps(boxes[j]), f"{texts[i].get_text()!r} overlaps {texts[j].get_text()!r}")
+        plt.close(fig)
+
+
 class Table2Ratio(unittest.TestCase):
     def test_ratio_against_paper(self):
         # oq/nb and oq_hier/nb_hier from query depth tests, beside the paper's 400x and 3143x
