@@ -9,6 +9,7 @@ marks). The inputs, and the nbsim commands that write them:
   DIR/figure4_map.csv                nbsim nbuffer coverage --size 256x256 --out DIR/figure4_map.png
   DIR/table2/table2.json             nbsim table2 TRACE --out DIR/table2  (and DIR/table2/MODE/run.json)
   DIR/sweeps/NAME/results.csv        nbsim explore SWEEP.json --out DIR/sweeps/NAME  (and sweep.json)
+  DIR/results.csv                    nbsim explore SWEEP.json --out DIR  (DIR is then one sweep, named after it)
 The data side (reading, Pareto marks, labels, headline.md) is in report_data.py; plot helpers in
 report_plots.py. Every section whose inputs exist is rendered; the page names the inputs the others were missing.
 Exit 0 when at least one section rendered; 2 when DIR does not exist or holds nothing usable, or when
@@ -344,6 +345,9 @@ class Report:
 
     # ------------------------------------------------------------------------------ sweeps
     def sweep_dirs(self):
+        """DIR/sweeps/* (the demo's layout), or DIR itself when it is one `nbsim explore --out` folder."""
+        if (self.root / "results.csv").is_file():
+            return [self.root.resolve()]  # named after the folder ("." resolved)
         d = self.root / "sweeps"
         return sorted(p for p in d.iterdir() if p.is_dir()) if d.is_dir() else []
 
@@ -699,7 +703,7 @@ def main(argv):
         except OSError:
             pass
         print(f"report: nothing usable in {a.dir}: looked for table1.jsonl, figure4_map.csv, table2/table2.json, "
-              "table2/MODE/run.json, sweeps/NAME/results.csv", file=sys.stderr)
+              "table2/MODE/run.json, sweeps/NAME/results.csv, results.csv", file=sys.stderr)
         return 2
     rep.write_html()
     print(f"report: wrote {rep.out / 'index.html'} ({rendered} sections"

@@ -124,7 +124,10 @@ void add_explore_command(CLI::App& app, Action& action) {
   cmd->add_flag("--dry-run", o->dry_run, "Validate and expand the sweep, write sweep.json and list the points; run nothing");
   cmd->footer("Sweep file: {\"traces\": [...], \"set\": {key: value}, \"axes\": {key: [values]}} (every combination)\n"
               "or {\"traces\": [...], \"points\": [{key: value, \"trace\": optional}, ...]}; keys as `nbsim config\n"
-              "--defaults` lists them. Exit 0 when every point ran, 1 when some failed (see results.csv), 2 on a bad sweep.");
+              "--defaults` lists them. Exit 0 when every point ran, 1 when some failed (see results.csv), 2 on a bad sweep.\n"
+              "Errors in results.csv: efficiency_lost against nb_hier on the full-resolution float32 N-buffer (every\n"
+              "level), cycle_error against gpu.quantum_cycles=0, batch 85, FMA on, counter_error against GL's counters;\n"
+              "a reference the sweep lacks is run as an extra point (role=reference). Plots and Pareto fronts: nbsim report DIR.");
   cmd->callback([&action, o] { action = [o] { return run_explore(*o); }; });
 }
 

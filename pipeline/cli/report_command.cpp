@@ -63,7 +63,7 @@ void add_report_command(CLI::App& app, Action& action) {
   auto* cmd = app.add_subcommand("report", "Write DIR/report/index.html: tables and plots from the outputs under DIR");
   auto o = std::make_shared<ReportOptions>();
   cmd->add_option("DIR", o->dir, "Folder holding any of: table1.jsonl, figure4_map.csv, table2/ (nbsim table2 --out), "
-                                 "sweeps/<name>/ (nbsim explore --out)")
+                                 "sweeps/<name>/ (nbsim explore --out); or one nbsim explore --out folder itself")
       ->required();
   cmd->add_option("--python", o->python, "Python 3 interpreter with matplotlib")->capture_default_str();
   cmd->add_option("--analysis", o->analysis, "Folder of the analysis scripts (default: $NBSIM_ANALYSIS_DIR or the source tree's)");

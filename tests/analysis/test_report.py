@@ -223,6 +223,19 @@ class FutureColumns(unittest.TestCase):
         self.assertIn("cycle_error column", html)
 
 
+class OneSweepFolder(unittest.TestCase):
+    def test_report_on_an_explore_out_folder(self):
+        # `nbsim report DIR` on DIR = `nbsim explore --out DIR`: the sweep alone, named after the folder
+        with tempfile.TemporaryDirectory() as t:
+            d = Path(t) / "mysweep"
+            shutil.copytree(FIXTURE / "sweeps" / "small", d)
+            rc, out, err = run_report(d)
+            self.assertEqual(rc, 0, err)
+            self.assertIn("Sweep mysweep", (d / "report" / "index.html").read_text())
+            self.assertTrue((d / "report" / "mysweep_pareto.csv").exists())
+            self.assertIn("Sweep mysweep: Pareto-optimal points", (d / "report" / "headline.md").read_text())
+
+
 class Labels(unittest.TestCase):
     """place_labels: one annotation per place, clear of every marker, labelled or not."""
 
