@@ -1,6 +1,5 @@
 // `nbsim info`: versions of nbsim and of every library it runs on, and (with --gl) the headless GL
 // renderer Mesa gives us. The first thing to attach to a bug report.
-#include <OpenImageIO/oiioversion.h>
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -10,6 +9,8 @@
 #include <systemc>
 
 #include "pipeline/cli/command.h"
+#include "model/common/error.h"
+#include "pipeline/io/image_io.h"
 #include "traces/gl/context.h"
 
 #include <glm/detail/setup.hpp>
@@ -25,7 +26,11 @@ void add_info_command(CLI::App& app, Action& action) {
       nlohmann::ordered_json j;
       j["nbsim"] = NBSIM_VERSION;
       j["systemc"] = sc_core::sc_release();
-      j["openimageio"] = OIIO_VERSION_STRING;
+      try {
+        j["openimageio"] = io::openimageio_version();
+      } catch (const InputError& e) {
+        j["openimageio"] = std::string("unavailable: ") + e.what();
+      }
       j["fmt"] = fmt::format("{}.{}.{}", FMT_VERSION / 10000, FMT_VERSION / 100 % 100, FMT_VERSION % 100);
       j["nlohmann_json"] = fmt::format("{}.{}.{}", NLOHMANN_JSON_VERSION_MAJOR, NLOHMANN_JSON_VERSION_MINOR,
                                        NLOHMANN_JSON_VERSION_PATCH);

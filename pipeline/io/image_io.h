@@ -1,9 +1,12 @@
-// Image files in and out of nbsim, all through OpenImageIO (EXR, TIFF, PFM, PNG, ...).
-// Files are top-down; nbsim images are y up (model/common/depth.h): rows are flipped here.
+// Image files in and out of nbsim, all through OpenImageIO (EXR, TIFF, PFM, PNG, ...), in a backend
+// library loaded on first use (oiio_backend.h says why). Files are top-down; nbsim images are y up
+// (model/common/depth.h): rows are flipped here. Every function throws InputError when the backend
+// cannot be loaded, naming where it looked.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "model/common/depth.h"
@@ -20,6 +23,9 @@ void write_depth(const DepthImage& image, const std::filesystem::path& file);
 
 // Writes a 16-bit greyscale PNG preview that stretches [lo, hi] to black..white (lo == hi: grey).
 void write_preview(const DepthImage& image, const std::filesystem::path& file, float lo, float hi);
+
+// The OpenImageIO version the backend was built with.
+std::string openimageio_version();
 
 // Writes 8-bit RGB pixels (y up, row-major, 3 bytes a pixel) to any format OpenImageIO writes.
 void write_rgb8(int width, int height, const std::vector<std::uint8_t>& rgb, const std::filesystem::path& file);

@@ -163,6 +163,21 @@ TEST(NBufferCliTest, RefusesUnreadableFiles) {
   EXPECT_TRUE(has(r.err, empty.string())) << r.err;
 }
 
+// The OpenImageIO backend is loaded only when an image is touched: without it, a query on the
+// built-in scene still runs, and an image read names the missing backend (exit 2, no crash).
+TEST(NBufferCliTest, ImageBackendLoadedOnlyWhenNeeded) {
+  const fs::path f = small_depth("backend.exr");
+  CliResult r = nbsim("nbuffer query --scene city --size 64x64 --rect 0,0,8,8");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string missing = "NBSIM_IMAGE_IO=/nonexistent/libnbsim_oiio.so ";
+  CliResult without = nbsim::testing::run_nbsim_env(missing, "nbuffer query --scene city --size 64x64 --rect 0,0,8,8");
+  EXPECT_EQ(without.status, 0) << without.err;
+  EXPECT_EQ(without.out, r.out);
+  without = nbsim::testing::run_nbsim_env(missing, "nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(without.status, 2);
+  EXPECT_TRUE(has(without.err, "libnbsim_oiio.so") && has(without.err, "/nonexistent/libnbsim_oiio.so")) << without.err;
+}
+
 // Bad arguments exit 2 with a message naming the problem; no output is half-written.
 TEST(NBufferCliTest, RefusesBadArguments) {
   const fs::path f = small_depth("args.exr");

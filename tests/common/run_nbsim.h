@@ -20,10 +20,11 @@ struct CliResult {
   std::string err;  // stderr
 };
 
-inline CliResult run_nbsim(const std::string& args) {
+// Runs `env NBSIM_EXE args` through the shell; `env` is "" or "NAME=value ..." (a space at the end).
+inline CliResult run_nbsim_env(const std::string& env, const std::string& args) {
   CliResult r;
   const std::filesystem::path err = std::filesystem::temp_directory_path() / ("nbsim_stderr_" + std::to_string(::getpid()) + ".txt");
-  const std::string cmd = std::string(NBSIM_EXE) + " " + args + " 2>" + err.string();
+  const std::string cmd = env + std::string(NBSIM_EXE) + " " + args + " 2>" + err.string();
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
   std::array<char, 4096> buf;
@@ -35,6 +36,8 @@ inline CliResult run_nbsim(const std::string& args) {
   std::filesystem::remove(err);
   return r;
 }
+
+inline CliResult run_nbsim(const std::string& args) { return run_nbsim_env("", args); }
 
 // A per-process scratch folder under the test temp dir: <prefix>_<pid>/<name>.
 inline std::filesystem::path scratch_path(const std::string& prefix, const std::string& name) {
