@@ -206,6 +206,12 @@ def headline_table2(t, rows, ratios):
     return "\n".join(lines)
 
 
+def cell(r, key, spec):
+    """A Markdown table cell: r[key] formatted with `spec`, '-' when absent."""
+    v = r.get(key)
+    return "-" if v is None else format(v, spec)
+
+
 def headline_sweep(name, rows, traces, err_label):
     """The Pareto-optimal points of a sweep (cycles per frame against its error), as a Markdown table;
     a sweep whose points all cull alike (a fidelity sweep) gets its cycle error and host time instead."""
@@ -225,10 +231,6 @@ def headline_sweep(name, rows, traces, err_label):
                          + (f", host {min(hs):.2f} to {max(hs):.2f} s" if hs else ""))
             continue
         front = sorted((r for r in rows if r["trace"] == t and r.get("pareto")), key=lambda r: r["cycles_per_frame"])
-        def cell(r, key, spec):
-            v = r.get(key)
-            return "-" if v is None else format(v, spec)
-
         for r in front:
             lines.append(f"| {trace_name(t)} | {r['label']} | {cell(r, 'cycles_per_frame', ',.0f')} | "
                          f"{cell(r, 'error_axis', '.2f')} | {cell(r, 'total_depth_tests_per_frame', ',.0f')} | "

@@ -64,12 +64,10 @@ constexpr Table2Row kTable2[] = {
 
 // Runs every Table 2 mode as `nbsim replay TRACE --out DIR/MODE [config] --set cull.mode=MODE`, in
 // child processes (pipeline/explore/child.h), `parallel` at a time; returns each mode's run.json summary.
+// `config` is the checked config the options give (its cull.mode is overwritten per row).
 std::vector<nlohmann::json> run_table2(const std::string& trace, const std::filesystem::path& out, const ModelOptions& mo,
-                                       int parallel) {
+                                       pipeline::GpuConfig config, int parallel) {
   const std::size_t n = std::size(kTable2);
-  pipeline::GpuConfig config;
-  nlohmann::ordered_json values;
-  mo.apply(config, values);
   const bool primitive = cull::parse_granularity(config.cull.granularity) == cull::Granularity::Primitive;
   std::vector<explore::ChildJob> jobs;
   for (const Table2Row& row : kTable2) {
@@ -197,10 +195,10 @@ void add_model_commands(CLI::App& app, Action& action) {
                 "update texels and the depth tests of the drawn objects. Exit 1 when any mode has a false cull.");
     cmd->callback([&action, trace, out, json, jobs, mo] {
       action = [trace, out, json, jobs, mo] {
-        {  // refuse a bad config here, before any child starts
-          pipeline::GpuConfig c;
+        pipeline::GpuConfig config;  // a bad config is refused here, before any child starts
+        {
           nlohmann::ordered_json values;
-          mo->apply(c, values);
+          mo->apply(config, values);
         }
         if (!std::filesystem::exists(*trace)) throw InputError(fmt::format("trace '{}' does not exist", *trace));
         std::filesystem::path dir;
@@ -214,7 +212,7 @@ void add_model_commands(CLI::App& app, Action& action) {
         }
         std::vector<nlohmann::json> rows;
         try {
-          rows = run_table2(std::filesystem::absolute(*trace).string(), dir, *mo, *jobs);
+          rows = run_table2(std::filesystem::absolute(*trace).string(), dir, *mo, config, *jobs);
         } catch (...) {
           if (temporary) std::filesystem::remove_all(dir);
           throw;

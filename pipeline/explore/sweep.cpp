@@ -194,7 +194,8 @@ void check_points(const SweepSpec& spec, std::vector<Point>& points, const Confi
 }
 
 const nlohmann::json& culling_reference_settings() {
-  static const nlohmann::json s = {{"nbuffer.resolution_divisor", 1}, {"nbuffer.format", "f32"}, {"nbuffer.level_cap", -1}};
+  static const nlohmann::json s = {
+      {"cull.mode", "nb_hier"}, {"nbuffer.resolution_divisor", 1}, {"nbuffer.format", "f32"}, {"nbuffer.level_cap", -1}};
   return s;
 }
 
@@ -243,10 +244,9 @@ void add_reference_points(std::vector<Point>& points, const std::vector<std::str
   for (std::size_t i = 0; i < sweep_points; ++i) {
     const std::string mode = points[i].effective.value("cull.mode", std::string("trace"));
     if (mode != "trace" && mode != "none") {
-      // One reference for every mode: the hierarchical query on the full N-buffer, so the flat nb
-      // query's loss shows too. The Hi-Z keys mean nothing to it: one reference for every Hi-Z variant.
+      // One reference for every mode (the flat nb query's loss shows too). The Hi-Z keys mean
+      // nothing to it: one reference for every Hi-Z variant.
       nlohmann::json overrides = culling_reference_settings();
-      overrides["cull.mode"] = "nb_hier";
       for (const auto& [k, v] : defaults.items())
         if (k.rfind("hiz.", 0) == 0) overrides[k] = v;
       points[i].culling_reference = reference(i, overrides);

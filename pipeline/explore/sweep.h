@@ -66,10 +66,10 @@ void check_points(const SweepSpec& spec, std::vector<Point>& points, const Confi
 std::vector<std::string> parameter_keys(const SweepSpec& spec);
 
 // The settings each point's errors are measured against (results.csv):
-//  - culling: the full-resolution float32 N-buffer with every level (culling_reference_settings());
-//    a point in a mode that is not an N-buffer mode (oq, oq_hier, hiz_*) is measured against
-//    cull.mode=nb_hier with those settings; points in the trace and none modes cull nothing and have
-//    no culling reference. efficiency_lost = reference culling efficiency - the point's.
+//  - culling: cull.mode=nb_hier on the full-resolution float32 N-buffer with every level
+//    (culling_reference_settings(), the Hi-Z keys at their defaults), for a point in any mode; points
+//    in the trace and none modes cull nothing and have no culling reference.
+//    efficiency_lost = reference culling efficiency - the point's.
 //  - timing: the model's most detailed fidelity (timing_reference_settings(): no temporal
 //    decoupling, llvmpipe's batch size, fused multiply-adds as llvmpipe on FMA hosts).
 //    cycle_error = (cycles - reference cycles) / reference cycles.
