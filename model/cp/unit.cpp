@@ -21,8 +21,8 @@ CommandProcessor::CommandProcessor(const sc_core::sc_module_name& name, stats::R
   SC_THREAD(run);
 }
 
-void CommandProcessor::send(WorkKind kind, const std::shared_ptr<const trace::Frame>& f, std::uint32_t draw,
-                            trace::DepthWhich which, std::shared_ptr<const cull::CullReport> report) {
+void CommandProcessor::send(WorkKind kind, const std::shared_ptr<const scene::Frame>& f, std::uint32_t draw,
+                            scene::DepthWhich which, std::shared_ptr<const cull::CullReport> report) {
   auto w = std::make_shared<Work>();
   w->kind = kind;
   w->frame = f;
@@ -42,7 +42,7 @@ void CommandProcessor::issue_draw(std::shared_ptr<Work> w) {
   sim::blocking([&] { out.write(std::move(w)); });
 }
 
-void CommandProcessor::issue_snapshot(const std::shared_ptr<const trace::Frame>& f, trace::DepthWhich which) {
+void CommandProcessor::issue_snapshot(const std::shared_ptr<const scene::Frame>& f, scene::DepthWhich which) {
   send(WorkKind::Snapshot, f, 0, which);
 }
 
@@ -55,33 +55,33 @@ void CommandProcessor::run() {
 }
 
 void CommandProcessor::issue() {
-  while (std::optional<trace::Frame> next = source_()) {
-    const auto f = std::make_shared<const trace::Frame>(std::move(*next));
+  while (std::optional<scene::Frame> next = source_()) {
+    const auto f = std::make_shared<const scene::Frame>(std::move(*next));
     ++frames_;
     send(WorkKind::FrameBegin, f);
     if (program_) {
       std::shared_ptr<const cull::CullReport> report = program_->run_frame(f, *this);
-      send(WorkKind::FrameEnd, f, 0, trace::DepthWhich::Final, std::move(report));
+      send(WorkKind::FrameEnd, f, 0, scene::DepthWhich::Final, std::move(report));
       continue;
     }
     // GL read the "after occluders" depth right after the last occluder draw.
     std::int64_t last_occluder = -1;
     for (std::size_t i = 0; i < f->draws.size(); ++i)
-      if (f->draws[i].role == trace::DrawRole::Occluder) last_occluder = static_cast<std::int64_t>(i);
-    if (last_occluder < 0) send(WorkKind::Snapshot, f, 0, trace::DepthWhich::AfterOccluders);
+      if (f->draws[i].role == scene::DrawRole::Occluder) last_occluder = static_cast<std::int64_t>(i);
+    if (last_occluder < 0) send(WorkKind::Snapshot, f, 0, scene::DepthWhich::AfterOccluders);
     for (std::size_t i = 0; i < f->draws.size(); ++i) {
-      const trace::DrawRecord& d = f->draws[i];
+      const scene::DrawRecord& d = f->draws[i];
       if (d.clip_positions.empty()) {
         ++skipped_;
       } else {
         ++draws_;
-        label_with([&] { return fmt::format("frame {} draw {} ({})", f->begin.frame, d.index, trace::to_string(d.role)); });
+        label_with([&] { return fmt::format("frame {} draw {} ({})", f->begin.frame, d.index, scene::to_string(d.role)); });
         work(static_cast<std::uint64_t>(config_.draw_overhead_cycles));
         send(WorkKind::Draw, f, static_cast<std::uint32_t>(i));
       }
-      if (static_cast<std::int64_t>(i) == last_occluder) send(WorkKind::Snapshot, f, 0, trace::DepthWhich::AfterOccluders);
+      if (static_cast<std::int64_t>(i) == last_occluder) send(WorkKind::Snapshot, f, 0, scene::DepthWhich::AfterOccluders);
     }
-    send(WorkKind::Snapshot, f, 0, trace::DepthWhich::Final);
+    send(WorkKind::Snapshot, f, 0, scene::DepthWhich::Final);
     send(WorkKind::FrameEnd, f);
   }
   send(WorkKind::Stop, nullptr);

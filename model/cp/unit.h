@@ -27,12 +27,12 @@ class CommandProcessor;
 class FrameProgram {
  public:
   virtual ~FrameProgram() = default;
-  virtual std::shared_ptr<const cull::CullReport> run_frame(const std::shared_ptr<const trace::Frame>& frame,
+  virtual std::shared_ptr<const cull::CullReport> run_frame(const std::shared_ptr<const scene::Frame>& frame,
                                                             CommandProcessor& cp) = 0;
 };
 
 // Hands out the trace's frames one at a time (memory stays bounded by a frame); nullopt at the end.
-using FrameSource = std::function<std::optional<trace::Frame>()>;
+using FrameSource = std::function<std::optional<scene::Frame>()>;
 
 class CommandProcessor : public sim::Unit {
  public:
@@ -46,13 +46,13 @@ class CommandProcessor : public sim::Unit {
   // Issues one draw (command processing costs draw_overhead_cycles); from the CP's thread only.
   void issue_draw(std::shared_ptr<Work> w);
   // Issues a depth snapshot marker.
-  void issue_snapshot(const std::shared_ptr<const trace::Frame>& f, trace::DepthWhich which);
+  void issue_snapshot(const std::shared_ptr<const scene::Frame>& f, scene::DepthWhich which);
 
  private:
   void run();
   void issue();
-  void send(WorkKind kind, const std::shared_ptr<const trace::Frame>& f, std::uint32_t draw = 0,
-            trace::DepthWhich which = trace::DepthWhich::Final,
+  void send(WorkKind kind, const std::shared_ptr<const scene::Frame>& f, std::uint32_t draw = 0,
+            scene::DepthWhich which = scene::DepthWhich::Final,
             std::shared_ptr<const cull::CullReport> report = nullptr);
   FrameProgram* program_ = nullptr;
   CommandProcessorConfig config_;

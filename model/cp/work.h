@@ -10,9 +10,8 @@
 
 #include <fmt/format.h>
 
-#include "model/cull/bounds.h"
-#include "traces/format/codec.h"
-#include "traces/format/reader.h"
+#include "model/cull/report.h"
+#include "model/scene/frame.h"
 
 namespace nbsim::cp {
 
@@ -26,19 +25,19 @@ enum class WorkKind : std::uint8_t {
 
 struct Work {
   WorkKind kind = WorkKind::Draw;
-  std::shared_ptr<const trace::Frame> frame;  // the frame this work belongs to
+  std::shared_ptr<const scene::Frame> frame;  // the frame this work belongs to
   std::uint32_t draw = 0;                     // index into frame->draws (Draw)
-  trace::DepthWhich which = trace::DepthWhich::Final;  // (Snapshot)
+  scene::DepthWhich which = scene::DepthWhich::Final;  // (Snapshot)
   float clear_depth = 1.0f;                            // (FrameBegin)
   // Culling modes (model/cull): a draw the cull stage made itself (a bounding box), used instead
   // of frame->draws[draw]; whether its depth writes feed the cull structure (N-buffer, Hi-Z); a
   // ticket the cull stage waits on; and, on FrameEnd, what the cull stage did in the frame.
-  std::shared_ptr<const trace::DrawRecord> own;
+  std::shared_ptr<const scene::DrawRecord> own;
   bool feeds_cull = false;
   std::uint64_t ticket = 0;
   std::shared_ptr<const cull::CullReport> cull_report;
 
-  const trace::DrawRecord& record() const { return own ? *own : frame->draws[draw]; }
+  const scene::DrawRecord& record() const { return own ? *own : frame->draws[draw]; }
 };
 
 using WorkPtr = std::shared_ptr<const Work>;
@@ -49,7 +48,7 @@ inline std::string timeline_label(const Work& w) {
   switch (w.kind) {
     case WorkKind::FrameBegin: return fmt::format("frame {} clear", frame);
     case WorkKind::Draw:
-      return fmt::format("frame {} draw {} ({})", frame, w.record().index, trace::to_string(w.record().role));
+      return fmt::format("frame {} draw {} ({})", frame, w.record().index, scene::to_string(w.record().role));
     case WorkKind::Snapshot: return fmt::format("frame {} snapshot", frame);
     case WorkKind::FrameEnd: return fmt::format("frame {} end", frame);
     case WorkKind::Stop: return "stop";

@@ -19,7 +19,7 @@
 
 #include "model/common/depth.h"
 #include "model/common/rect.h"
-#include "model/cull/bounds.h"
+#include "model/cull/report.h"
 #include "model/geometry/primitive.h"
 #include "model/raster/setup.h"
 

@@ -144,25 +144,25 @@ void CullUnit::prepare(CullReport& r) {
   pending_update_texels_ = pending_clear_texels_ = 0;
 }
 
-void CullUnit::test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const trace::Frame>& f, const FrameView& v,
-                          const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests,
+void CullUnit::test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const scene::Frame>& f, const scene::FrameView& v,
+                          const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests,
                           std::vector<std::uint64_t>& cost, CullReport& r) {
-  const trace::SceneObjects& s = *setup_.scene;
+  const scene::SceneObjects& s = *setup_.scene;
   std::vector<std::uint64_t> tickets(items.size());
   for (std::size_t i = 0; i < items.size(); ++i) {
-    auto d = std::make_shared<trace::DrawRecord>();
-    d->role = items[i].node >= 0 ? trace::DrawRole::NodeQuery : trace::DrawRole::BoundsQuery;
+    auto d = std::make_shared<scene::DrawRecord>();
+    d->role = items[i].node >= 0 ? scene::DrawRole::NodeQuery : scene::DrawRole::BoundsQuery;
     d->object = items[i].object;
     d->node = items[i].node;
     d->state.func = setup_.depth_func;
     d->state.write = false;
     d->state.test = true;
-    d->state.cull = trace::CullFace::Back;
+    d->state.cull = scene::CullFace::Back;
     d->state.front_ccw = true;
-    d->state.clip = setup_.zero_to_one ? trace::ClipControl::ZeroToOne : trace::ClipControl::NegativeOneToOne;
-    const trace::Aabb& b = items[i].node >= 0 ? s.node_bounds[static_cast<std::size_t>(items[i].node)]
+    d->state.clip = setup_.zero_to_one ? scene::ClipControl::ZeroToOne : scene::ClipControl::NegativeOneToOne;
+    const scene::Aabb& b = items[i].node >= 0 ? s.node_bounds[static_cast<std::size_t>(items[i].node)]
                                               : s.objects[static_cast<std::size_t>(items[i].object)];
-    box_clip_positions(b, v, d->clip_positions);
+    scene::box_clip_positions(b, v, d->clip_positions);
     d->has_bounds = true;
     d->bounds = tests[i];
     auto w = std::make_shared<cp::Work>();
@@ -181,10 +181,10 @@ void CullUnit::test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const 
   }
 }
 
-void CullUnit::test_lookups(const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests,
+void CullUnit::test_lookups(const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests,
                             std::vector<std::uint64_t>& cost, CullReport& r) {
   for (std::size_t i = 0; i < items.size(); ++i) {
-    trace::BoundsTest& t = tests[i];
+    scene::BoundsTest& t = tests[i];
     if (t.crosses_near) {
       t.visible = true;
       continue;
@@ -222,10 +222,10 @@ void CullUnit::test_lookups(const std::vector<TestItem>& items, std::vector<trac
 
 bool CullUnit::tests_primitives(const cp::Work& w) const {
   if (granularity_ != Granularity::Primitive || w.kind != cp::WorkKind::Draw || w.own || w.feeds_cull) return false;
-  const trace::DrawRecord& d = w.record();
-  if (d.role != trace::DrawRole::Visible || !d.state.test) return false;
+  const scene::DrawRecord& d = w.record();
+  if (d.role != scene::DrawRole::Visible || !d.state.test) return false;
   // "Strictly farther than all the depth stored" proves that the fragments fail only these tests.
-  using F = trace::DepthFunc;
+  using F = scene::DepthFunc;
   return setup_.op == FarOp::Max ? d.state.func == F::Less || d.state.func == F::Lequal
                                  : d.state.func == F::Greater || d.state.func == F::Gequal;
 }
@@ -307,38 +307,38 @@ void CullUnit::test_primitives(const cp::Work& w, std::span<const raster::SetupP
   primitive_false_culls_ += false_culls;
 }
 
-std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<const trace::Frame>& f, cp::CommandProcessor& cp) {
+std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) {
   ++frames_begun_;  // the command processor has sent this frame's FrameBegin (a clear)
   auto report = std::make_shared<CullReport>();
   CullReport& r = *report;
   r.mode = mode_;
-  const trace::SceneObjects& s = *setup_.scene;
-  const FrameView v = FrameView::make(f->begin, setup_.width_px, setup_.height_px, setup_.near_m, setup_.nearest_margin,
+  const scene::SceneObjects& s = *setup_.scene;
+  const scene::FrameView v = scene::FrameView::make(f->begin, setup_.width_px, setup_.height_px, setup_.near_m, setup_.nearest_margin,
                                       setup_.zero_to_one, setup_.op == FarOp::Min);
-  const std::vector<std::uint32_t> in_frustum = frustum_objects(s, v);
+  const std::vector<std::uint32_t> in_frustum = scene::frustum_objects(s, v);
 
   // The recorded geometry of each object (an Occluder or Visible draw), and this frame's occluders.
   std::vector<std::int64_t> geometry(s.objects.size(), -1);
   std::vector<char> is_occluder(s.objects.size(), 0);
   for (std::size_t i = 0; i < f->draws.size(); ++i) {
-    const trace::DrawRecord& d = f->draws[i];
+    const scene::DrawRecord& d = f->draws[i];
     if (d.object < 0 || static_cast<std::size_t>(d.object) >= s.objects.size() || d.clip_positions.empty()) continue;
-    if (d.role != trace::DrawRole::Occluder && d.role != trace::DrawRole::Visible) continue;
+    if (d.role != scene::DrawRole::Occluder && d.role != scene::DrawRole::Visible) continue;
     geometry[static_cast<std::size_t>(d.object)] = static_cast<std::int64_t>(i);
-    if (d.role == trace::DrawRole::Occluder) is_occluder[static_cast<std::size_t>(d.object)] = 1;
+    if (d.role == scene::DrawRole::Occluder) is_occluder[static_cast<std::size_t>(d.object)] = 1;
   }
 
   // 1. The occluders, in the recorded order; their depth writes feed the cull structure.
   for (std::size_t i = 0; i < f->draws.size(); ++i) {
-    const trace::DrawRecord& d = f->draws[i];
-    if (d.role != trace::DrawRole::Occluder || d.clip_positions.empty()) continue;
+    const scene::DrawRecord& d = f->draws[i];
+    if (d.role != scene::DrawRole::Occluder || d.clip_positions.empty()) continue;
     auto w = std::make_shared<cp::Work>();
     w->frame = f;
     w->draw = static_cast<std::uint32_t>(i);
     w->feeds_cull = true;
     issue(cp, std::move(w), false);
   }
-  cp.issue_snapshot(f, trace::DepthWhich::AfterOccluders);
+  cp.issue_snapshot(f, scene::DepthWhich::AfterOccluders);
   wait_all();
   prepare(r);
   // Every earlier frame's draws have left the pipeline: from here on the raster unit tests only
@@ -350,10 +350,10 @@ std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<cons
   }
 
   // 2. Bounds tests of the candidates.
-  const BatchTester tester = [&](const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests) {
+  const scene::BatchTester tester = [&](const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests) {
     r.bounds_tests += items.size();
-    for (const TestItem& it : items) r.node_tests += it.node >= 0 ? 1 : 0;
-    for (const trace::BoundsTest& t : tests) r.crossing_near += t.crosses_near ? 1 : 0;
+    for (const scene::TestItem& it : items) r.node_tests += it.node >= 0 ? 1 : 0;
+    for (const scene::BoundsTest& t : tests) r.crossing_near += t.crosses_near ? 1 : 0;
     if (mode_ == CullMode::None) {
       for (std::size_t i = 0; i < items.size(); ++i) {
         tests[i].visible = true;
@@ -370,10 +370,10 @@ std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<cons
       test_lookups(items, tests, cost, r);
     for (std::size_t i = 0; i < items.size(); ++i) r.tests.push_back({items[i].object, items[i].node, tests[i], cost[i]});
   };
-  const std::vector<char> visible = find_visible(s, v, in_frustum, is_occluder, hierarchical(mode_), tester);
+  const std::vector<char> visible = scene::find_visible(s, v, in_frustum, is_occluder, hierarchical(mode_), tester);
 
   // 3. The objects found visible, with the geometry the trace recorded for them.
-  const trace::GroundTruth* truth = f->truth ? &*f->truth : nullptr;
+  const scene::GroundTruth* truth = f->truth ? &*f->truth : nullptr;
   r.has_truth = truth && truth->visible_pixels.size() >= s.objects.size();
   r.in_frustum = in_frustum.size();
   for (auto o : in_frustum) {

@@ -23,7 +23,7 @@
 
 #include "model/config/schema.h"
 #include "model/cp/unit.h"
-#include "model/cull/bounds.h"
+#include "model/cull/report.h"
 #include "model/cull/primitive.h"
 #include "model/depth/unit.h"
 #include "model/hiz/hiz_config.h"
@@ -57,8 +57,8 @@ struct CullSetup {
   FarOp op = FarOp::Max;
   double near_m = 0.0, nearest_margin = 0.0;
   bool zero_to_one = false;
-  trace::DepthFunc depth_func = trace::DepthFunc::Less;
-  const trace::SceneObjects* scene = nullptr;  // must outlive the unit; required
+  scene::DepthFunc depth_func = scene::DepthFunc::Less;
+  const scene::SceneObjects* scene = nullptr;  // must outlive the unit; required
   bool fused_interpolation = true;  // the depth unit's (depth.fused_interpolation): per-primitive depth bounds
 };
 
@@ -87,7 +87,7 @@ class CullUnit : public sim::Unit,
   }
 
   // cp::FrameProgram (from the command processor's thread).
-  std::shared_ptr<const CullReport> run_frame(const std::shared_ptr<const trace::Frame>& f, cp::CommandProcessor& cp) override;
+  std::shared_ptr<const CullReport> run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
 
   // depth::DepthListener (from the depth unit's thread).
   void depth_cleared(float depth) override;
@@ -116,10 +116,10 @@ class CullUnit : public sim::Unit,
   std::uint64_t issue(cp::CommandProcessor& cp, std::shared_ptr<cp::Work> w, bool wants_result);
   void wait_all();  // until every issued draw and frame clear has left the depth unit
   void prepare(CullReport& r);  // the structure the queries read is current
-  void test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const trace::Frame>& f, const FrameView& v,
-                  const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests,
+  void test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const scene::Frame>& f, const scene::FrameView& v,
+                  const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests,
                   std::vector<std::uint64_t>& cost, CullReport& r);
-  void test_lookups(const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests,
+  void test_lookups(const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests,
                   std::vector<std::uint64_t>& cost, CullReport& r);
 
   CullUnitConfig config_;
@@ -146,7 +146,7 @@ class CullUnit : public sim::Unit,
   // cull.granularity=primitive: the report each triangle's frame adds to (this frame's, and the
   // previous frame's while its last draws are still in the raster unit); the depth buffer after
   // this frame's occluders, for the false-cull check; scratch of test_primitives().
-  std::unordered_map<const trace::Frame*, std::shared_ptr<CullReport>> reports_;
+  std::unordered_map<const scene::Frame*, std::shared_ptr<CullReport>> reports_;
   DepthImage occluder_depth_;
   raster::Rasterizer check_raster_;
   std::vector<std::size_t> prim_index_;

@@ -42,7 +42,7 @@ DepthUnit::DepthUnit(const sc_core::sc_module_name& name, stats::Registry& regis
 }
 
 Rect DepthUnit::test(const raster::BlockBatch& b, DrawResult& r) {
-  const trace::DepthState& s = b.work->record().state;
+  const scene::DepthState& s = b.work->record().state;
   const raster::DepthState state{static_cast<raster::DepthFunc>(s.func), s.test, s.write && s.test};
   std::uint64_t miss_bytes = 0;
   int x0 = width_, y0 = height_, x1 = 0, y1 = 0;

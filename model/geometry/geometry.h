@@ -33,10 +33,10 @@
 
 namespace nbsim::geometry {
 
-// Depth convention of the clip volume. Fixed values, equal to trace::ClipControl.
+// Depth convention of the clip volume. Fixed values, equal to scene::ClipControl.
 enum class ClipControl : std::uint8_t { NegativeOneToOne = 0, ZeroToOne = 1 };
 
-// A clip-space position x, y, z, w (the layout of trace::DrawRecord::clip_positions).
+// A clip-space position x, y, z, w (the layout of scene::DrawRecord::clip_positions).
 using ClipPosition = std::array<float, 4>;
 
 struct GeometryConfig {

@@ -23,7 +23,7 @@ struct WindowTriangle {
   std::array<WindowVertex, 3> v{};
 };
 
-// Which faces are dropped. Fixed values, GL's order, equal to trace::CullFace of trace files.
+// Which faces are dropped. Fixed values, GL's order, equal to scene::CullFace of trace files.
 enum class CullFace : std::uint8_t { None = 0, Back = 1, Front = 2, FrontAndBack = 3 };
 
 // Facing as GL defines it (glFrontFace, glCullFace) for a y-up render target, i.e. an FBO:

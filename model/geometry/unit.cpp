@@ -14,9 +14,9 @@ GeometryConfig stage_config(const GeometryUnitConfig& c, int w, int h) {
   return g;
 }
 
-GeometryState state_of(const trace::DepthState& s) {
+GeometryState state_of(const scene::DepthState& s) {
   GeometryState g;
-  g.clip = s.clip == trace::ClipControl::ZeroToOne ? ClipControl::ZeroToOne : ClipControl::NegativeOneToOne;
+  g.clip = s.clip == scene::ClipControl::ZeroToOne ? ClipControl::ZeroToOne : ClipControl::NegativeOneToOne;
   g.face.cull = static_cast<CullFace>(s.cull);
   g.face.front_ccw = s.front_ccw;
   g.depth_clamp = s.depth_clamp;
@@ -56,7 +56,7 @@ void GeometryUnit::run() {
     auto batch = std::make_shared<TriangleBatch>();
     batch->work = w;
     if (w->kind == cp::WorkKind::Draw) {
-      const trace::DrawRecord& d = w->record();
+      const scene::DrawRecord& d = w->record();
       stage_.process(d.clip_positions, state_of(d.state), batch->triangles, batch->counters);
       const GeometryCounters& k = batch->counters;
       prims_in_ += k.prims_in;

@@ -15,7 +15,7 @@
 
 namespace nbsim::raster {
 
-// GL's depth functions in GL's order. Fixed values, equal to trace::DepthFunc.
+// GL's depth functions in GL's order. Fixed values, equal to scene::DepthFunc.
 enum class DepthFunc : std::uint8_t {
   Never = 0,
   Less = 1,

@@ -10,23 +10,11 @@
 #include "model/common/error.h"
 #include "model/sim/kernel.h"
 #include "model/sim/timeline.h"
+#include "traces/format/reader.h"
 
 namespace nbsim::pipeline {
 
 namespace {
-
-const char* role_name(trace::DrawRole r) {
-  switch (r) {
-    case trace::DrawRole::Occluder: return "occluder";
-    case trace::DrawRole::BoundsQuery: return "bounds_query";
-    case trace::DrawRole::NodeQuery: return "node_query";
-    case trace::DrawRole::NBufferBuild: return "nbuffer_build";
-    case trace::DrawRole::NBufferQuery: return "nbuffer_query";
-    case trace::DrawRole::Visible: return "visible";
-    case trace::DrawRole::IdBuffer: return "id_buffer";
-  }
-  return "?";
-}
 
 // What the cull stage did over the whole replay (culling modes).
 struct CullTotals {
@@ -149,7 +137,7 @@ class Collector : public depth::ResultSink {
     if (d.role == trace::DrawRole::Visible && r.depth.passed < d.gl.samples_passed) ++cull.visible_draws_passed_below_gl;
     if (draws_.is_open())
       draws_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, d.index, d.object,
-                            role_name(d.role), d.clip_positions.size() / 3, r.geometry.prims_out, d.gl.clip_prims_out,
+                            trace::to_string(d.role), d.clip_positions.size() / 3, r.geometry.prims_out, d.gl.clip_prims_out,
                             r.depth.fragments, d.gl.fragments, r.depth.passed, d.gl.samples_passed, r.depth.depth_tests,
                             "none", 0, r.done_cycle);
   }

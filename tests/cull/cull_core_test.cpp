@@ -1,15 +1,18 @@
-// CullCoreTest: the cull stage's plain core (model/cull/bounds.h) against what the GL renderer
-// recorded in the sample traces: box geometry, bounds tests and the candidate set. No SystemC.
+// CullCoreTest: the cull stage's modes (model/cull/report.h) and the scene's visibility code
+// (model/scene/visibility.h) against what the GL renderer recorded in the sample traces: box geometry, bounds tests and the candidate set. No SystemC.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <set>
 
-#include "model/cull/bounds.h"
+#include "model/cull/report.h"
 #include "traces/format/reader.h"
 
 namespace nbsim::cull {
 namespace {
+
+using scene::FrameView;
+using scene::TestItem;
 
 std::filesystem::path sample(const char* name) { return std::filesystem::path(NBSIM_SAMPLES) / name; }
 

@@ -13,21 +13,8 @@
 
 namespace nbsim::capture {
 
-std::string to_string(trace::TestMode m) {
-  switch (m) {
-    case trace::TestMode::OcclusionQuery: return "oq";
-    case trace::TestMode::OcclusionQueryHier: return "oq_hier";
-    case trace::TestMode::NBuffer: return "nb";
-    case trace::TestMode::NBufferHier: return "nb_hier";
-    case trace::TestMode::None: return "none";
-  }
-  return "?";
-}
-
 trace::TestMode parse_test_mode(const std::string& s) {
-  for (auto m : {trace::TestMode::OcclusionQuery, trace::TestMode::OcclusionQueryHier, trace::TestMode::NBuffer,
-                 trace::TestMode::NBufferHier, trace::TestMode::None})
-    if (to_string(m) == s) return m;
+  if (const auto m = scene::parse_test_mode(s)) return *m;
   throw InputError(fmt::format("unknown test mode '{}': expected oq, oq_hier, nb, nb_hier or none", s));
 }
 
@@ -63,7 +50,7 @@ CaptureSummary capture_city(const CaptureOptions& o, const std::string& out_path
       {"clip_control", o.reversed_z ? "ZERO_TO_ONE" : "NEGATIVE_ONE_TO_ONE"},
       {"depth_clear", o.reversed_z ? "0" : "1"},
       {"technique", "occlusion_culling"},
-      {"test_mode", to_string(o.mode)},
+      {"test_mode", std::string(scene::to_string(o.mode))},
       {"scene", "city"},
       {"seed", std::to_string(o.seed)},
       {"objects", std::to_string(city.objects.size())},

@@ -38,7 +38,6 @@ using Progress = std::function<void(int, int)>;
 
 CaptureSummary capture_city(const CaptureOptions& options, const std::string& out_path, const Progress& progress = {});
 
-std::string to_string(trace::TestMode m);
 // "oq", "oq_hier", "nb", "nb_hier", "none"; empty optional-like: throws InputError on others.
 trace::TestMode parse_test_mode(const std::string& s);
 

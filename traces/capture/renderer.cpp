@@ -19,6 +19,7 @@
 
 #include "model/common/error.h"
 #include "model/nbuffer/covering.h"
+#include "model/scene/visibility.h"
 #include "nbsim_shaders.h"
 
 namespace nbsim::capture {
@@ -70,30 +71,6 @@ std::string with_defines(const char* source, const std::string& defines) {
   return s.insert(eol + 1, defines);
 }
 
-// The box of an AABB as 8 corners (bit 0 = x, 1 = y, 2 = z) and 36 CCW outward indices.
-constexpr std::array<std::uint32_t, 36> kBoxIndices = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
-                                                       2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
-
-struct Plane {
-  glm::dvec4 n;
-};
-
-// Frustum planes of a view-projection matrix (Gribb and Hartmann), inward facing.
-std::array<Plane, 6> frustum_planes(const glm::dmat4& m, bool zero_to_one) {
-  const glm::dvec4 r0{m[0][0], m[1][0], m[2][0], m[3][0]}, r1{m[0][1], m[1][1], m[2][1], m[3][1]};
-  const glm::dvec4 r2{m[0][2], m[1][2], m[2][2], m[3][2]}, r3{m[0][3], m[1][3], m[2][3], m[3][3]};
-  return {Plane{r3 + r0}, Plane{r3 - r0}, Plane{r3 + r1}, Plane{r3 - r1},
-          Plane{zero_to_one ? r2 : r3 + r2}, Plane{r3 - r2}};
-}
-
-bool outside(const std::array<Plane, 6>& planes, const trace::Aabb& b) {
-  for (const Plane& p : planes) {
-    const glm::dvec3 v{p.n.x >= 0 ? b.hi[0] : b.lo[0], p.n.y >= 0 ? b.hi[1] : b.lo[1], p.n.z >= 0 ? b.hi[2] : b.lo[2]};
-    if (p.n.x * v.x + p.n.y * v.y + p.n.z * v.z + p.n.w < 0) return true;
-  }
-  return false;
-}
-
 }  // namespace
 
 struct Renderer::Impl {
@@ -124,7 +101,6 @@ struct Renderer::Impl {
   std::vector<Pending> pending;
   std::size_t tf_used = 0;
   glm::mat4 view_proj{1.0f};
-  glm::dmat4 view_proj_d{1.0};
   std::vector<std::uint32_t> previous_visible;
 
   Impl(const City& c, RendererOptions o) : city(c), opt(o) {
@@ -183,7 +159,13 @@ struct Renderer::Impl {
     glCreateBuffers(1, &box_vbo);
     glCreateBuffers(1, &box_ebo);
     glNamedBufferStorage(box_vbo, static_cast<GLsizeiptr>(corners.size() * sizeof(glm::vec3)), corners.data(), 0);
-    glNamedBufferStorage(box_ebo, sizeof kBoxIndices, kBoxIndices.data(), 0);
+    // The box pattern the model uses too (model/scene/visibility.h), widened to GL's index type.
+    const std::array<std::uint32_t, 36> box_indices = [] {
+      std::array<std::uint32_t, 36> out{};
+      std::copy(scene::kBoxIndices.begin(), scene::kBoxIndices.end(), out.begin());
+      return out;
+    }();
+    glNamedBufferStorage(box_ebo, sizeof box_indices, box_indices.data(), 0);
     glVertexArrayVertexBuffer(box_vao, 0, box_vbo, 0, sizeof(glm::vec3));
     glVertexArrayElementBuffer(box_vao, box_ebo);
     glEnableVertexArrayAttrib(box_vao, 0);
@@ -356,34 +338,7 @@ struct Renderer::Impl {
     glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
   }
 
-  // ---- bounds tests --------------------------------------------------------------------------
-
-  trace::BoundsTest bounds_test(const trace::Aabb& b) const {
-    trace::BoundsTest t;
-    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-    double nearest = reversed ? -INFINITY : INFINITY;
-    for (int i = 0; i < 8; ++i) {
-      const glm::dvec4 c = view_proj_d * glm::dvec4(i & 1 ? b.hi[0] : b.lo[0], i & 2 ? b.hi[1] : b.lo[1], i & 4 ? b.hi[2] : b.lo[2], 1.0);
-      if (c.w < opt.projection.near_m * 0.999) { t.crosses_near = true; continue; }
-      const double x = (c.x / c.w * 0.5 + 0.5) * opt.width, y = (c.y / c.w * 0.5 + 0.5) * opt.height;
-      const double z = reversed ? c.z / c.w : c.z / c.w * 0.5 + 0.5;
-      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-      nearest = reversed ? std::max(nearest, z) : std::min(nearest, z);
-    }
-    if (t.crosses_near) {  // never culled: the whole viewport, nearest possible depth
-      t.x = 0, t.y = 0, t.w = opt.width, t.h = opt.height;
-      t.nearest_depth = reversed ? 1.0f : 0.0f;
-      return t;
-    }
-    const int ix0 = std::clamp(static_cast<int>(std::floor(x0)), 0, opt.width);
-    const int iy0 = std::clamp(static_cast<int>(std::floor(y0)), 0, opt.height);
-    const int ix1 = std::clamp(static_cast<int>(std::ceil(x1)), 0, opt.width);
-    const int iy1 = std::clamp(static_cast<int>(std::ceil(y1)), 0, opt.height);
-    t.x = ix0, t.y = iy0, t.w = std::max(0, ix1 - ix0), t.h = std::max(0, iy1 - iy0);
-    const double m = reversed ? nearest + opt.nearest_margin : nearest - opt.nearest_margin;
-    t.nearest_depth = static_cast<float>(std::clamp(m, 0.0, 1.0));
-    return t;
-  }
+  // ---- bounds tests (the scene's, model/scene/visibility.h) --------------------------------
 
   // Tests a batch of bounds against the GLSL N-buffer in one compute dispatch; sets .visible.
   void nbuffer_query(std::vector<trace::BoundsTest>& tests) {
@@ -468,26 +423,6 @@ struct Renderer::Impl {
 
   // ---- one frame -----------------------------------------------------------------------------
 
-  std::vector<std::uint32_t> frustum_objects(const std::array<Plane, 6>& planes) const {
-    std::vector<std::uint32_t> out;
-    const auto& s = city.scene;
-    std::vector<std::int32_t> stack{0};
-    while (!stack.empty()) {
-      const auto n = static_cast<std::size_t>(stack.back());
-      stack.pop_back();
-      if (outside(planes, s.node_bounds[n])) continue;
-      if (s.node_left[n] < 0) {
-        for (std::uint32_t i = s.node_first[n]; i < s.node_first[n] + s.node_count[n]; ++i)
-          if (!outside(planes, s.objects[s.leaf_objects[i]])) out.push_back(s.leaf_objects[i]);
-      } else {
-        stack.push_back(s.node_left[n]);
-        stack.push_back(s.node_right[n]);
-      }
-    }
-    std::sort(out.begin(), out.end());
-    return out;
-  }
-
   trace::DepthSnapshot read_depth(trace::DepthWhich which) {
     trace::DepthSnapshot d;
     d.which = which;
@@ -508,15 +443,15 @@ struct Renderer::Impl {
     const glm::mat4 view = view_matrix(pose);
     const glm::mat4 proj = projection_matrix(opt.projection, static_cast<double>(opt.width) / opt.height);
     view_proj = proj * view;
-    view_proj_d = glm::dmat4(view_proj);
     f.begin.frame = index;
     f.begin.mode = opt.mode;
     std::memcpy(f.begin.view.data(), glm::value_ptr(view), 64);
     std::memcpy(f.begin.proj.data(), glm::value_ptr(proj), 64);
     f.begin.eye = {pose.eye.x, pose.eye.y, pose.eye.z};
 
-    const auto planes = frustum_planes(view_proj_d, reversed);
-    const std::vector<std::uint32_t> in_frustum = frustum_objects(planes);
+    const scene::FrameView v =
+        scene::FrameView::make(f.begin, opt.width, opt.height, opt.projection.near_m, opt.nearest_margin, reversed, reversed);
+    const std::vector<std::uint32_t> in_frustum = scene::frustum_objects(city.scene, v);
     std::vector<char> is_occluder(city.objects.size(), 0), in_view(city.objects.size(), 0);
     for (auto o : in_frustum) in_view[o] = 1;
     for (auto o : previous_visible)
@@ -545,10 +480,15 @@ struct Renderer::Impl {
     if (nbuffer_mode) build_nbuffer();
     if (opt.mode == TestMode::None) {
       for (auto o : in_frustum) visible[o] = !is_occluder[o];
-    } else if (opt.mode == TestMode::OcclusionQuery || opt.mode == TestMode::NBuffer) {
-      flat_tests(in_frustum, is_occluder, visible);
     } else {
-      hierarchical_tests(planes, is_occluder, visible);
+      const bool hier = opt.mode == TestMode::OcclusionQueryHier || opt.mode == TestMode::NBufferHier;
+      const scene::BatchTester tester = [&](const std::vector<scene::TestItem>& items, std::vector<trace::BoundsTest>& tests) {
+        if (nbuffer_mode)
+          test_with_nbuffer(items, tests);
+        else
+          test_with_queries(items, tests);
+      };
+      visible = scene::find_visible(city.scene, v, in_frustum, is_occluder, hier, tester);
     }
 
     // 3. The objects found visible.
@@ -579,34 +519,27 @@ struct Renderer::Impl {
     return f;
   }
 
-  void flat_tests(const std::vector<std::uint32_t>& in_frustum, const std::vector<char>& is_occluder, std::vector<char>& visible) {
-    std::vector<std::uint32_t> candidates;
-    for (auto o : in_frustum)
-      if (!is_occluder[o]) candidates.push_back(o);
-    if (opt.mode == TestMode::OcclusionQuery) {
-      begin_scene_pass();
-      std::vector<std::size_t> slots;
-      for (auto o : candidates) {
-        const auto t = bounds_test(city.scene.objects[o]);
-        const std::size_t slot = draw_box(static_cast<std::int32_t>(o), -1);
-        draws[slot].has_bounds = true;
-        draws[slot].bounds = t;
-        slots.push_back(slot);
-      }
-      for (std::size_t i = 0; i < candidates.size(); ++i) {
-        auto& b = draws[slots[i]].bounds;
-        b.visible = b.crosses_near || samples_passed(slots[i]) > 0;
-        visible[candidates[i]] = b.visible;
-      }
-    } else {
-      std::vector<trace::BoundsTest> tests;
-      for (auto o : candidates) tests.push_back(bounds_test(city.scene.objects[o]));
-      nbuffer_query(tests);
-      for (std::size_t i = 0; i < candidates.size(); ++i) {
-        record_lookup(static_cast<std::int32_t>(candidates[i]), -1, tests[i]);
-        visible[candidates[i]] = tests[i].visible;
-      }
+  // One batch of bounds tests as occlusion queries: each box drawn inside a query, then every
+  // query's passed samples read (the round trip the technique stalls on).
+  void test_with_queries(const std::vector<scene::TestItem>& items, std::vector<trace::BoundsTest>& tests) {
+    begin_scene_pass();
+    std::vector<std::size_t> slots;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      const std::size_t slot = draw_box(items[i].object, items[i].node);
+      draws[slot].has_bounds = true;
+      draws[slot].bounds = tests[i];
+      slots.push_back(slot);
     }
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      tests[i].visible = tests[i].crosses_near || samples_passed(slots[i]) > 0;
+      draws[slots[i]].bounds.visible = tests[i].visible;
+    }
+  }
+
+  // One batch of bounds tests against the GLSL N-buffer (one compute dispatch), each recorded.
+  void test_with_nbuffer(const std::vector<scene::TestItem>& items, std::vector<trace::BoundsTest>& tests) {
+    nbuffer_query(tests);
+    for (std::size_t i = 0; i < items.size(); ++i) record_lookup(items[i].object, items[i].node, tests[i]);
   }
 
   // A bounds test against the N-buffer, recorded as a draw without geometry.
@@ -621,58 +554,6 @@ struct Renderer::Impl {
     d.bounds = t;
     draws.push_back(d);
     pending.push_back({false, 0, 0});  // no GL draw: no counters to read
-  }
-
-  // BVH traversal, one batch per tree depth: nodes whose bounds pass are opened; a leaf's objects
-  // are tested in the next batch. Occluders are not tested (they are drawn already).
-  void hierarchical_tests(const std::array<Plane, 6>& planes, const std::vector<char>& is_occluder, std::vector<char>& visible) {
-    const auto& s = city.scene;
-    struct Item { std::int32_t object, node; };
-    std::vector<Item> batch{{-1, 0}}, next;
-    const bool oq = opt.mode == TestMode::OcclusionQueryHier;
-    while (!batch.empty()) {
-      next.clear();
-      std::vector<Item> tested;
-      std::vector<trace::BoundsTest> tests;
-      for (const Item& it : batch) {
-        const trace::Aabb& b = it.node >= 0 ? s.node_bounds[static_cast<std::size_t>(it.node)] : s.objects[static_cast<std::size_t>(it.object)];
-        if (outside(planes, b)) continue;
-        if (it.node < 0 && is_occluder[static_cast<std::size_t>(it.object)]) continue;
-        tested.push_back(it);
-        tests.push_back(bounds_test(b));
-      }
-      if (oq) {
-        begin_scene_pass();
-        std::vector<std::size_t> slots;
-        for (std::size_t i = 0; i < tested.size(); ++i) {
-          const std::size_t slot = draw_box(tested[i].object, tested[i].node);
-          draws[slot].has_bounds = true;
-          draws[slot].bounds = tests[i];
-          slots.push_back(slot);
-        }
-        for (std::size_t i = 0; i < tested.size(); ++i) {
-          tests[i].visible = tests[i].crosses_near || samples_passed(slots[i]) > 0;
-          draws[slots[i]].bounds.visible = tests[i].visible;
-        }
-      } else {
-        nbuffer_query(tests);
-        for (std::size_t i = 0; i < tested.size(); ++i) record_lookup(tested[i].object, tested[i].node, tests[i]);
-      }
-      for (std::size_t i = 0; i < tested.size(); ++i) {
-        if (!tests[i].visible) continue;
-        const Item it = tested[i];
-        if (it.node < 0) { visible[static_cast<std::size_t>(it.object)] = 1; continue; }
-        const auto n = static_cast<std::size_t>(it.node);
-        if (s.node_left[n] >= 0) {
-          next.push_back({-1, s.node_left[n]});
-          next.push_back({-1, s.node_right[n]});
-        } else {
-          for (std::uint32_t k = s.node_first[n]; k < s.node_first[n] + s.node_count[n]; ++k)
-            next.push_back({static_cast<std::int32_t>(s.leaf_objects[k]), -1});
-        }
-      }
-      std::swap(batch, next);
-    }
   }
 
   // Reads every draw's counters and captured clip-space vertices.

@@ -232,46 +232,6 @@ std::string chunk_type_name(std::uint32_t type) {
   return s;
 }
 
-std::string_view to_string(DrawRole role) noexcept {
-  switch (role) {
-    case DrawRole::Occluder: return "occluder";
-    case DrawRole::BoundsQuery: return "bounds_query";
-    case DrawRole::NodeQuery: return "node_query";
-    case DrawRole::NBufferBuild: return "nbuffer_build";
-    case DrawRole::NBufferQuery: return "nbuffer_query";
-    case DrawRole::Visible: return "visible";
-    case DrawRole::IdBuffer: return "id_buffer";
-  }
-  return "?";
-}
-
-std::string_view to_string(TestMode mode) noexcept {
-  switch (mode) {
-    case TestMode::OcclusionQuery: return "occlusion_query";
-    case TestMode::OcclusionQueryHier: return "occlusion_query_hier";
-    case TestMode::NBuffer: return "nbuffer";
-    case TestMode::NBufferHier: return "nbuffer_hier";
-    case TestMode::None: return "none";
-  }
-  return "?";
-}
-
-std::string_view to_string(DepthWhich which) noexcept {
-  return which == DepthWhich::AfterOccluders ? "after_occluders" : which == DepthWhich::Final ? "final" : "?";
-}
-
-std::string_view to_string(DepthFunc func) noexcept {
-  static constexpr std::string_view names[] = {"never", "less", "equal", "lequal", "greater", "notequal", "gequal", "always"};
-  const auto i = static_cast<std::size_t>(func);
-  return i < std::size(names) ? names[i] : "?";
-}
-
-std::string_view to_string(CullFace cull) noexcept {
-  static constexpr std::string_view names[] = {"none", "back", "front", "front_and_back"};
-  const auto i = static_cast<std::size_t>(cull);
-  return i < std::size(names) ? names[i] : "?";
-}
-
 std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc) noexcept {
   return static_cast<std::uint32_t>(::crc32_z(crc, bytes.data(), bytes.size()));
 }

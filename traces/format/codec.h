@@ -45,12 +45,6 @@ bool is_known_chunk_type(std::uint32_t type) noexcept;
 std::string chunk_type_name(std::uint32_t type);
 inline std::string chunk_type_name(ChunkType type) { return chunk_type_name(static_cast<std::uint32_t>(type)); }
 
-std::string_view to_string(DrawRole role) noexcept;
-std::string_view to_string(TestMode mode) noexcept;
-std::string_view to_string(DepthWhich which) noexcept;
-std::string_view to_string(DepthFunc func) noexcept;
-std::string_view to_string(CullFace cull) noexcept;
-
 // CRC-32 as zlib computes it (polynomial 0xEDB88320, initial value 0), continued from `crc`.
 std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc = 0) noexcept;
 

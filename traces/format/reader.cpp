@@ -320,18 +320,6 @@ template EndMarker TraceReader::decode<EndMarker>(const Chunk&) const;
 
 // ---- FrameReader ------------------------------------------------------------------------------
 
-const DepthSnapshot* Frame::depth(DepthWhich which) const noexcept {
-  for (const DepthSnapshot& d : depths)
-    if (d.which == which) return &d;
-  return nullptr;
-}
-
-const NBufferLevels* Frame::nbuffer(FarOp op) const noexcept {
-  for (const NBufferLevels& l : levels)
-    if (l.op == static_cast<std::uint8_t>(op)) return &l;
-  return nullptr;
-}
-
 FrameReader::FrameReader(const std::filesystem::path& file) : trace_(file) {}
 FrameReader::FrameReader(TraceReader trace) : trace_(std::move(trace)) {}
 

@@ -101,20 +101,8 @@ class TraceReader {
   std::uint32_t frame_draws_ = 0;  // DRAW chunks in the open frame
 };
 
-// One frame, FRAM .. FEND, decoded.
-struct Frame {
-  std::uint64_t ordinal = 0;  // 0 for the trace's first frame
-  std::uint64_t offset = 0;   // byte offset of its FRAM chunk
-  FrameBegin begin;
-  std::vector<DrawRecord> draws;  // draws[i].index == i
-  std::vector<DepthSnapshot> depths;  // at most one per DepthWhich, in file order
-  std::vector<NBufferLevels> levels;  // at most one per FarOp, in file order
-  std::optional<GroundTruth> truth;
-  FrameEnd end;
-
-  const DepthSnapshot* depth(DepthWhich which) const noexcept;
-  const NBufferLevels* nbuffer(FarOp op) const noexcept;
-};
+// One frame, FRAM .. FEND, decoded (model/scene/frame.h).
+using scene::Frame;
 
 // Groups a trace's chunks into frames, checking the per-record rules of FORMAT.md "Structure".
 class FrameReader {

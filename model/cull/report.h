@@ -1,17 +1,15 @@
-// The cull stage's plain C++ core (no SystemC): the culling modes, an object's screen bounds test
-// and bounding-box geometry computed from the frame's matrices as the GL renderer computes them,
-// the view-frustum test, and the flat or BVH-hierarchical traversal that decides which candidate
-// objects to draw. model/cull/unit.h wraps it with the query units, timing and counters.
+// The cull stage's modes and its per-frame report (plain C++, no SystemC). The bounds tests and the
+// traversal it runs are the scene's (model/scene/visibility.h); model/cull/unit.h wraps them with
+// the query units, timing and counters.
 #pragma once
 
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <optional>
 #include <string_view>
 #include <vector>
 
-#include "traces/format/records.h"
+#include "model/scene/visibility.h"
 
 namespace nbsim::cull {
 
@@ -30,53 +28,6 @@ enum class CullMode : std::uint8_t {
 std::string_view to_string(CullMode m) noexcept;
 std::optional<CullMode> parse_cull_mode(std::string_view s) noexcept;
 bool hierarchical(CullMode m) noexcept;
-
-// One frame's camera as the renderer used it. view_proj = proj * view in float (as glm computes
-// it on the host; the vertex shader receives it), and in double for the bounds tests.
-struct FrameView {
-  std::array<float, 16> view_proj{};     // column-major
-  std::array<double, 16> view_proj_d{};  // the same values, widened
-  int width_px = 0, height_px = 0;
-  double near_m = 0.0;          // header property "near"
-  double nearest_margin = 0.0;  // header property "nearest_margin": subtracted toward the eye
-  bool zero_to_one = false;     // clip control ZERO_TO_ONE (reversed Z) vs NEGATIVE_ONE_TO_ONE
-  bool reversed = false;        // depth func GREATER: nearer is larger
-
-  static FrameView make(const trace::FrameBegin& f, int width_px, int height_px, double near_m, double nearest_margin,
-                        bool zero_to_one, bool reversed);
-};
-
-// The screen rectangle and nearest depth of an AABB: the 8 corners projected in double; bounds
-// with a corner behind near * 0.999 cross the near plane (whole viewport, nearest possible depth,
-// never culled); the rectangle is floor/ceil of the projected extent clipped to the viewport; the
-// nearest depth moves `nearest_margin` toward the eye. `visible` is left true.
-trace::BoundsTest bounds_test(const trace::Aabb& b, const FrameView& v);
-
-// The AABB's box as GL's vertex shader computes it: 12 triangles (36 vertices, CCW outward, the
-// renderer's 8-corner / 36-index pattern), clip position = view_proj * (corner, 1) in float.
-void box_clip_positions(const trace::Aabb& b, const FrameView& v, std::vector<std::array<float, 4>>& out);
-
-// True when the AABB is entirely outside one of the six frustum planes (Gribb-Hartmann).
-bool outside_frustum(const trace::Aabb& b, const FrameView& v);
-
-// Objects whose bounds meet the frustum (BVH traversal from node 0), sorted by id.
-std::vector<std::uint32_t> frustum_objects(const trace::SceneObjects& s, const FrameView& v);
-
-// One bounds test a traversal asks for: an object (node < 0) or a BVH node.
-struct TestItem {
-  std::int32_t object = -1;
-  std::int32_t node = -1;
-};
-
-// Decides, for one batch of items with their bounds tests, which are visible (sets .visible).
-using BatchTester = std::function<void(const std::vector<TestItem>& items, std::vector<trace::BoundsTest>& tests)>;
-
-// Which candidate objects are visible. Flat: every object in `in_frustum` that is not an occluder,
-// in one batch. Hierarchical (the renderer's traversal): one batch per BVH depth, from node 0;
-// items outside the frustum are skipped, a visible node opens its children (or its leaf's objects)
-// for the next batch, occluders are never tested. Returns a flag per scene object.
-std::vector<char> find_visible(const trace::SceneObjects& s, const FrameView& v, const std::vector<std::uint32_t>& in_frustum,
-                               const std::vector<char>& is_occluder, bool hierarchical, const BatchTester& tester);
 
 // What the cull stage did in one frame (plain counters; the replay derives ratios).
 struct CullReport {
@@ -113,7 +64,7 @@ struct CullReport {
   struct Test {
     std::int32_t object = -1;  // object id, or -1 for a BVH node
     std::int32_t node = -1;    // BVH node id, or -1 for an object
-    trace::BoundsTest bounds;  // rect, nearest depth, crosses_near, and the decision in .visible
+    scene::BoundsTest bounds;  // rect, nearest depth, crosses_near, and the decision in .visible
     std::uint64_t depth_tests = 0;  // box fragments (occlusion queries) or texels compared (N-buffer, Hi-Z)
   };
   std::vector<Test> tests;

@@ -1,39 +1,21 @@
-// The cull stage's core: modes, bounds tests, box geometry, frustum and traversal; see bounds.h.
-#include "model/cull/bounds.h"
+// Visibility on the frame's scene; see visibility.h.
+#include "model/scene/visibility.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "model/common/error.h"
-#include "model/common/names.h"
-
-namespace nbsim::cull {
+namespace nbsim::scene {
 
 namespace {
 
-constexpr std::array<std::string_view, 8> kModeNames = {"trace", "none",    "oq",       "oq_hier",
-                                                        "nb",    "nb_hier", "hiz_tile", "hiz_pyramid"};
-
-// The box's 36 indices into its 8 corners (bit 0 = x, 1 = y, 2 = z), CCW seen from outside: the
-// same pattern as the renderer's index buffer, so that GL's and the model's triangles coincide.
-// Fixed by the trace: changing it changes which box fragments GL and the model count.
-constexpr std::array<std::uint8_t, 36> kBoxIndices = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
-                                                      2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
-
-std::array<double, 3> corner(const trace::Aabb& b, int i) {
+std::array<double, 3> corner(const Aabb& b, int i) {
   return {static_cast<double>(i & 1 ? b.hi[0] : b.lo[0]), static_cast<double>(i & 2 ? b.hi[1] : b.lo[1]),
           static_cast<double>(i & 4 ? b.hi[2] : b.lo[2])};
 }
 
 }  // namespace
 
-std::string_view to_string(CullMode m) noexcept { return enum_name(kModeNames, m); }
-
-std::optional<CullMode> parse_cull_mode(std::string_view s) noexcept { return parse_enum_name<CullMode>(kModeNames, s); }
-
-bool hierarchical(CullMode m) noexcept { return m == CullMode::OqHier || m == CullMode::NbHier; }
-
-FrameView FrameView::make(const trace::FrameBegin& f, int width_px, int height_px, double near_m, double nearest_margin,
+FrameView FrameView::make(const FrameBegin& f, int width_px, int height_px, double near_m, double nearest_margin,
                           bool zero_to_one, bool reversed) {
   FrameView v;
   // proj * view column by column, as glm's mat4 product does it in float (no fused operations:
@@ -58,8 +40,8 @@ FrameView FrameView::make(const trace::FrameBegin& f, int width_px, int height_p
   return v;
 }
 
-trace::BoundsTest bounds_test(const trace::Aabb& b, const FrameView& v) {
-  trace::BoundsTest t;
+BoundsTest bounds_test(const Aabb& b, const FrameView& v) {
+  BoundsTest t;
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   double nearest = v.reversed ? -INFINITY : INFINITY;
   const auto& m = v.view_proj_d;
@@ -91,7 +73,7 @@ trace::BoundsTest bounds_test(const trace::Aabb& b, const FrameView& v) {
   return t;
 }
 
-void box_clip_positions(const trace::Aabb& b, const FrameView& v, std::vector<std::array<float, 4>>& out) {
+void box_clip_positions(const Aabb& b, const FrameView& v, std::vector<std::array<float, 4>>& out) {
   std::array<std::array<float, 4>, 8> corners{};
   const auto& m = v.view_proj;
   for (int i = 0; i < 8; ++i) {
@@ -106,7 +88,7 @@ void box_clip_positions(const trace::Aabb& b, const FrameView& v, std::vector<st
   for (std::uint8_t i : kBoxIndices) out.push_back(corners[i]);
 }
 
-bool outside_frustum(const trace::Aabb& b, const FrameView& v) {
+bool outside_frustum(const Aabb& b, const FrameView& v) {
   const auto& m = v.view_proj_d;
   const auto row = [&](int r) { return std::array<double, 4>{m[static_cast<std::size_t>(r)], m[static_cast<std::size_t>(4 + r)],
                                                              m[static_cast<std::size_t>(8 + r)], m[static_cast<std::size_t>(12 + r)]}; };
@@ -127,7 +109,7 @@ bool outside_frustum(const trace::Aabb& b, const FrameView& v) {
   return false;
 }
 
-std::vector<std::uint32_t> frustum_objects(const trace::SceneObjects& s, const FrameView& v) {
+std::vector<std::uint32_t> frustum_objects(const SceneObjects& s, const FrameView& v) {
   std::vector<std::uint32_t> out;
   if (s.node_bounds.empty()) {  // no BVH: test every object
     for (std::size_t o = 0; o < s.objects.size(); ++o)
@@ -151,11 +133,11 @@ std::vector<std::uint32_t> frustum_objects(const trace::SceneObjects& s, const F
   return out;
 }
 
-std::vector<char> find_visible(const trace::SceneObjects& s, const FrameView& v, const std::vector<std::uint32_t>& in_frustum,
+std::vector<char> find_visible(const SceneObjects& s, const FrameView& v, const std::vector<std::uint32_t>& in_frustum,
                                const std::vector<char>& is_occluder, bool hier, const BatchTester& tester) {
   std::vector<char> visible(s.objects.size(), 0);
   std::vector<TestItem> items;
-  std::vector<trace::BoundsTest> tests;
+  std::vector<BoundsTest> tests;
   if (!hier || s.node_bounds.empty()) {
     for (auto o : in_frustum)
       if (!is_occluder[o]) items.push_back({static_cast<std::int32_t>(o), -1});
@@ -170,7 +152,7 @@ std::vector<char> find_visible(const trace::SceneObjects& s, const FrameView& v,
     items.clear();
     tests.clear();
     for (const TestItem& it : batch) {
-      const trace::Aabb& b = it.node >= 0 ? s.node_bounds[static_cast<std::size_t>(it.node)] : s.objects[static_cast<std::size_t>(it.object)];
+      const Aabb& b = it.node >= 0 ? s.node_bounds[static_cast<std::size_t>(it.node)] : s.objects[static_cast<std::size_t>(it.object)];
       if (outside_frustum(b, v)) continue;
       if (it.node < 0 && is_occluder[static_cast<std::size_t>(it.object)]) continue;
       items.push_back(it);
@@ -198,4 +180,4 @@ std::vector<char> find_visible(const trace::SceneObjects& s, const FrameView& v,
   return visible;
 }
 
-}  // namespace nbsim::cull
+}  // namespace nbsim::scene

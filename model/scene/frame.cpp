@@ -1,0 +1,41 @@
+// The frame's look-ups and the names of its enums; see frame.h.
+#include "model/scene/frame.h"
+
+#include "model/common/names.h"
+
+namespace nbsim::scene {
+
+namespace {
+
+// One name table per enum, indexed by the enum's fixed value.
+constexpr std::array<std::string_view, 7> kRoleNames = {"occluder",      "bounds_query", "node_query", "nbuffer_build",
+                                                        "nbuffer_query", "visible",      "id_buffer"};
+// The capture's --mode names, which are also the model's cull.mode names for the same techniques.
+constexpr std::array<std::string_view, 5> kTestModeNames = {"oq", "oq_hier", "nb", "nb_hier", "none"};
+constexpr std::array<std::string_view, 2> kDepthWhichNames = {"after_occluders", "final"};
+constexpr std::array<std::string_view, 8> kDepthFuncNames = {"never",   "less",     "equal",  "lequal",
+                                                             "greater", "notequal", "gequal", "always"};
+constexpr std::array<std::string_view, 4> kCullFaceNames = {"none", "back", "front", "front_and_back"};
+
+}  // namespace
+
+const DepthSnapshot* Frame::depth(DepthWhich which) const noexcept {
+  for (const DepthSnapshot& d : depths)
+    if (d.which == which) return &d;
+  return nullptr;
+}
+
+const NBufferLevels* Frame::nbuffer(FarOp op) const noexcept {
+  for (const NBufferLevels& l : levels)
+    if (l.op == static_cast<std::uint8_t>(op)) return &l;
+  return nullptr;
+}
+
+std::string_view to_string(DrawRole role) noexcept { return enum_name(kRoleNames, role); }
+std::string_view to_string(TestMode mode) noexcept { return enum_name(kTestModeNames, mode); }
+std::optional<TestMode> parse_test_mode(std::string_view s) noexcept { return parse_enum_name<TestMode>(kTestModeNames, s); }
+std::string_view to_string(DepthWhich which) noexcept { return enum_name(kDepthWhichNames, which); }
+std::string_view to_string(DepthFunc func) noexcept { return enum_name(kDepthFuncNames, func); }
+std::string_view to_string(CullFace cull) noexcept { return enum_name(kCullFaceNames, cull); }
+
+}  // namespace nbsim::scene
