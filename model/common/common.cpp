@@ -1,6 +1,7 @@
 // Small shared definitions of model/common.
 #include "model/common/depth.h"
 #include "model/common/error.h"
+#include "model/common/names.h"
 #include "model/common/storage.h"
 
 #include <cstdio>
@@ -8,17 +9,12 @@
 
 namespace nbsim {
 
-std::string_view to_string(FarOp op) noexcept { return op == FarOp::Max ? "max" : "min"; }
+std::string_view to_string(FarOp op) noexcept { return enum_name(kFarOpNames, op); }
 
-std::string_view to_string(StorageFormat f) noexcept {
-  return f == StorageFormat::F32 ? "f32" : f == StorageFormat::U24 ? "u24" : "u16";
-}
+std::string_view to_string(StorageFormat f) noexcept { return enum_name(kStorageFormatNames, f); }
 
 std::optional<StorageFormat> parse_storage_format(std::string_view s) noexcept {
-  if (s == "f32") return StorageFormat::F32;
-  if (s == "u24") return StorageFormat::U24;
-  if (s == "u16") return StorageFormat::U16;
-  return std::nullopt;
+  return parse_enum_name<StorageFormat>(kStorageFormatNames, s);
 }
 
 DepthImage::DepthImage(int w, int h, float fill)

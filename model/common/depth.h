@@ -7,6 +7,7 @@
 //   (FarOp::Min). Min-litmaps for shadow clamping use FarOp::Min too.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string_view>
 #include <vector>
@@ -32,6 +33,8 @@ constexpr float neutral_depth(FarOp op) noexcept { return op == FarOp::Max ? 0.0
 // The farthest possible depth: a conservative answer when nothing better is known.
 constexpr float far_limit(FarOp op) noexcept { return op == FarOp::Max ? 1.0f : 0.0f; }
 
+// Names of FarOp, indexed by its value (model/common/names.h).
+inline constexpr std::array<std::string_view, 2> kFarOpNames = {"max", "min"};
 std::string_view to_string(FarOp op) noexcept;
 
 // A single-channel float image, y up, row-major (index = y * width + x).

@@ -5,7 +5,9 @@
 #include <array>
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace nbsim {
 
@@ -22,6 +24,12 @@ constexpr std::optional<Enum> parse_enum_name(const std::array<std::string_view,
   for (std::size_t i = 0; i < N; ++i)
     if (names[i] == s) return static_cast<Enum>(i);
   return std::nullopt;
+}
+
+// Every name of the table, for a config key's allowed labels or a command-line option's choices.
+template <std::size_t N>
+std::vector<std::string> name_list(const std::array<std::string_view, N>& names) {
+  return {names.begin(), names.end()};
 }
 
 }  // namespace nbsim

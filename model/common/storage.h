@@ -4,6 +4,7 @@
 // representable codes (code / (2^bits - 1)); the timing model charges bytes by format.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -23,6 +24,8 @@ constexpr int storage_bits(StorageFormat f) noexcept {
 // Bytes one texel occupies in memory. U24 is stored as D24X8 (a 32-bit word), as GPUs store it.
 constexpr int storage_bytes(StorageFormat f) noexcept { return f == StorageFormat::U16 ? 2 : 4; }
 
+// Names of StorageFormat, indexed by its value (model/common/names.h).
+inline constexpr std::array<std::string_view, 3> kStorageFormatNames = {"f32", "u24", "u16"};
 std::string_view to_string(StorageFormat f) noexcept;
 std::optional<StorageFormat> parse_storage_format(std::string_view s) noexcept;
 

@@ -11,8 +11,6 @@ namespace nbsim::cull {
 
 namespace {
 
-constexpr std::array<std::string_view, 2> kGranularityNames = {"object", "primitive"};
-
 // Relative bound on the rounding of DepthPlane::raw_at against the exact plane: two roundings
 // (fused) or four (unfused), each at most 2^-24 of a term no larger than the sum of the absolute
 // terms. 2^-20 leaves a factor of four to spare; fixed by the analysis, not tunable.

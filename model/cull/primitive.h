@@ -13,6 +13,7 @@
 // (tests/cull/cull_primitive_test.cpp checks them against brute force).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -31,6 +32,8 @@ enum class Granularity : std::uint8_t {
   Primitive = 1,  // also every triangle of the objects drawn as visible candidates
 };
 
+// Names of Granularity, indexed by its value (model/common/names.h); cull.granularity takes them.
+inline constexpr std::array<std::string_view, 2> kGranularityNames = {"object", "primitive"};
 std::string_view to_string(Granularity g) noexcept;
 std::optional<Granularity> parse_granularity(std::string_view s) noexcept;
 // The modes with a depth-query structure a triangle can be tested against: nb, nb_hier, hiz_tile,

@@ -25,6 +25,9 @@ enum class CullMode : std::uint8_t {
   HizPyramid = 7,  // Hi-Z pyramid, at most 2x2 texels per query
 };
 
+// Names of CullMode, indexed by its value (model/common/names.h); cull.mode takes them.
+inline constexpr std::array<std::string_view, 8> kCullModeNames = {"trace", "none",    "oq",       "oq_hier",
+                                                                   "nb",    "nb_hier", "hiz_tile", "hiz_pyramid"};
 std::string_view to_string(CullMode m) noexcept;
 std::optional<CullMode> parse_cull_mode(std::string_view s) noexcept;
 bool hierarchical(CullMode m) noexcept;

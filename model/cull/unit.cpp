@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "model/common/error.h"
+#include "model/common/names.h"
 #include "model/raster/depth_test.h"
 
 namespace nbsim::cull {
@@ -14,11 +15,11 @@ void CullUnitConfig::describe(config::Schema& s, CullUnitConfig& c) {
   s.add("cull.mode", c.mode,
         "trace replays the recorded draws; the others cull every candidate object themselves: none (draw all), oq, "
         "oq_hier (occlusion queries, flat or over the BVH), nb, nb_hier (N-buffer unit), hiz_tile, hiz_pyramid",
-        {"trace", "none", "oq", "oq_hier", "nb", "nb_hier", "hiz_tile", "hiz_pyramid"});
+        name_list(kCullModeNames));
   s.add("cull.granularity", c.granularity,
         "object tests the bounds of candidate objects; primitive also tests every triangle of the objects drawn, "
         "between setup and the tile walk, and drops the hidden ones (modes nb, nb_hier, hiz_tile, hiz_pyramid only)",
-        {"object", "primitive"});
+        name_list(kGranularityNames));
   s.add("cull.bounds_tests_per_cycle", c.bounds_tests_per_cycle, "tests/cycle", "object or node bounds projected a cycle",
         0.01, 1024.0);
   s.add("cull.bounds_latency_cycles", c.bounds_latency_cycles, "cycles", "latency of a batch of bounds tests", 0, 100000);

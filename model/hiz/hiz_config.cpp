@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "model/common/error.h"
+#include "model/common/names.h"
 
 namespace nbsim {
 
@@ -16,7 +17,7 @@ void HiZUnitConfig::describe(config::Schema& s, HiZUnitConfig& c) {
         kMaxTilePx);
   s.add("hiz.format", c.format,
         "storage of the Hi-Z baselines' depths, rounded toward far (u24 stored as 32-bit D24X8)",
-        {"f32", "u24", "u16"});
+        name_list(kStorageFormatNames));
 }
 
 void HiZUnitConfig::validate() const {

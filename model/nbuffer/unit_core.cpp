@@ -9,6 +9,7 @@
 #include <string>
 
 #include "model/common/error.h"
+#include "model/common/names.h"
 
 namespace nbsim::nbuffer {
 
@@ -55,15 +56,10 @@ enum Trigger : std::size_t { kEager = 0, kForced = 1, kEndOfPass = 2, kLazy = 3,
 
 }  // namespace
 
-std::string_view to_string(UpdatePolicy p) noexcept {
-  return p == UpdatePolicy::Eager ? "eager" : p == UpdatePolicy::Batched ? "batched" : "lazy";
-}
+std::string_view to_string(UpdatePolicy p) noexcept { return enum_name(kUpdatePolicyNames, p); }
 
 std::optional<UpdatePolicy> parse_update_policy(std::string_view s) noexcept {
-  if (s == "eager") return UpdatePolicy::Eager;
-  if (s == "batched") return UpdatePolicy::Batched;
-  if (s == "lazy") return UpdatePolicy::Lazy;
-  return std::nullopt;
+  return parse_enum_name<UpdatePolicy>(kUpdatePolicyNames, s);
 }
 
 std::string_view to_string(QueryOutcome o) noexcept { return kOutcomeLabels[static_cast<std::size_t>(o)]; }
@@ -79,7 +75,7 @@ void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c) {
         "pixels (conservative); 1, 2, 4 or 8",
         1, 8);
   s.add("nbuffer.format", c.format, "level storage format, rounded toward far (u24 stored as 32-bit D24X8)",
-        {"f32", "u24", "u16"});
+        name_list(kStorageFormatNames));
   s.add("nbuffer.level_cap", c.level_cap, "level",
         "highest level built, -1 builds all; larger rectangles are tiled with top-level squares", -1, kMaxLevelCap);
   s.add("nbuffer.capped_max_lookups", c.capped_max_lookups, "lookups",
@@ -89,7 +85,7 @@ void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c) {
   s.add("nbuffer.update_policy", c.update_policy,
         "when depth changes reach the levels: eager (at once), batched (at the end of a pass), lazy (when a query "
         "reads them)",
-        {"eager", "batched", "lazy"});
+        name_list(kUpdatePolicyNames));
   s.add("nbuffer.lookup_latency_cycles", c.lookup_latency_cycles, "cycles",
         "latency of a query's lookups (address, tag check, data, compare) on cache hits", 0, kMaxLatencyCycles);
   s.add("nbuffer.lookups_per_cycle", c.lookups_per_cycle, "lookups/cycle",

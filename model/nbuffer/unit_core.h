@@ -35,6 +35,8 @@ namespace nbsim::nbuffer {
 // When depth-buffer changes reach the levels. Fixed values (they may end up in run outputs).
 enum class UpdatePolicy : std::uint8_t { Eager = 0, Batched = 1, Lazy = 2 };
 
+// Names of UpdatePolicy, indexed by its value (model/common/names.h).
+inline constexpr std::array<std::string_view, 3> kUpdatePolicyNames = {"eager", "batched", "lazy"};
 std::string_view to_string(UpdatePolicy p) noexcept;
 std::optional<UpdatePolicy> parse_update_policy(std::string_view s) noexcept;
 

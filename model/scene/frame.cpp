@@ -10,8 +10,6 @@ namespace {
 // One name table per enum, indexed by the enum's fixed value.
 constexpr std::array<std::string_view, 7> kRoleNames = {"occluder",      "bounds_query", "node_query", "nbuffer_build",
                                                         "nbuffer_query", "visible",      "id_buffer"};
-// The capture's --mode names, which are also the model's cull.mode names for the same techniques.
-constexpr std::array<std::string_view, 5> kTestModeNames = {"oq", "oq_hier", "nb", "nb_hier", "none"};
 constexpr std::array<std::string_view, 2> kDepthWhichNames = {"after_occluders", "final"};
 constexpr std::array<std::string_view, 8> kDepthFuncNames = {"never",   "less",     "equal",  "lequal",
                                                              "greater", "notequal", "gequal", "always"};

@@ -155,6 +155,8 @@ std::string_view to_string(TestMode mode) noexcept;
 std::string_view to_string(DepthWhich which) noexcept;
 std::string_view to_string(DepthFunc func) noexcept;
 std::string_view to_string(CullFace cull) noexcept;
+// The capture's --mode names of TestMode, indexed by its value (also the model's cull.mode names).
+inline constexpr std::array<std::string_view, 5> kTestModeNames = {"oq", "oq_hier", "nb", "nb_hier", "none"};
 std::optional<TestMode> parse_test_mode(std::string_view s) noexcept;
 
 }  // namespace nbsim::scene

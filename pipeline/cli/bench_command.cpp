@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "model/common/names.h"
+#include "model/scene/frame.h"
 #include "model/common/error.h"
 #include "pipeline/bench/nbuffer_bench.h"
 #include "pipeline/bench/replay_bench.h"
@@ -100,7 +102,7 @@ void add_bench_commands(CLI::App& app, Action& action) {
     auto ro = std::make_shared<bench::ReplayBenchOptions>();
     rep->add_option("--size", ro->size, "Viewport, WxH")->capture_default_str();
     rep->add_option("--frames", ro->frames, "Frames")->check(CLI::Range(1, 10000))->capture_default_str();
-    rep->add_option("--mode", ro->mode, "Capture test mode")->check(CLI::IsMember({"oq", "oq_hier", "nb", "nb_hier", "none"}))->capture_default_str();
+    rep->add_option("--mode", ro->mode, "Capture test mode")->check(CLI::IsMember(name_list(scene::kTestModeNames)))->capture_default_str();
     rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes), replay_ms (the SystemC model), ratio,\n"
                 "depth_tests_per_s and cycles_per_s of the model, measured in the same run.");
     rep->callback([&action, ro] {

@@ -11,6 +11,7 @@
 #include <numeric>
 
 #include "model/common/error.h"
+#include "model/common/names.h"
 #include "model/nbuffer/nbuffer.h"
 #include "pipeline/cli/command.h"
 #include "pipeline/io/image_io.h"
@@ -54,10 +55,10 @@ struct NBufferOptions {
 
   void add_options(CLI::App* cmd) {
     cmd->add_option("--op", op, "Farthest is max (depth func LESS) or min (reversed Z, min-litmaps)")
-        ->check(CLI::IsMember({"max", "min"}))
+        ->check(CLI::IsMember(name_list(kFarOpNames)))
         ->capture_default_str();
     cmd->add_option("--format", format, "Level storage: f32, u24 or u16 unorm (rounded toward far)")
-        ->check(CLI::IsMember({"f32", "u24", "u16"}))
+        ->check(CLI::IsMember(name_list(kStorageFormatNames)))
         ->capture_default_str();
     cmd->add_option("--max-level", max_level, "Build levels 0..K only (partial build); -1 builds all")
         ->check(CLI::Range(-1, 30))
