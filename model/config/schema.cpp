@@ -95,7 +95,15 @@ const Schema::Entry* Schema::find(const std::string& key) const {
 
 bool Schema::has(const std::string& key) const { return find(key) != nullptr; }
 
+void Schema::renamed(const std::string& old_key, const std::string& new_key) {
+  NBSIM_CHECK(find(new_key) != nullptr, "config key '" + old_key + "' renamed to an undeclared key '" + new_key + "'");
+  renamed_.emplace_back(old_key, new_key);
+}
+
 void Schema::unknown(const std::string& key, const std::string& origin) const {
+  for (const auto& [old_key, new_key] : renamed_)
+    if (key == old_key)
+      throw InputError(fmt::format("{}: config key '{}' is now '{}' (same meaning and limits)", origin, key, new_key));
   const Entry* best = nullptr;
   std::size_t best_d = 4;  // suggest only close matches
   for (const auto& e : entries_) {

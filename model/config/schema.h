@@ -36,6 +36,8 @@ class Schema {
   // Current values as {"unit": {"field": value}}, for run.json.
   nlohmann::ordered_json values() const;
   bool has(const std::string& key) const;
+  // A key that a later version moved: setting `old_key` is refused with a message naming `new_key`.
+  void renamed(const std::string& old_key, const std::string& new_key);
   std::size_t size() const noexcept { return entries_.size(); }
 
  private:
@@ -49,6 +51,7 @@ class Schema {
   const Entry* find(const std::string& key) const;
   [[noreturn]] void unknown(const std::string& key, const std::string& origin) const;
   std::vector<Entry> entries_;
+  std::vector<std::pair<std::string, std::string>> renamed_;  // (old key, new key)
 };
 
 }  // namespace nbsim::config

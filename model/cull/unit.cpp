@@ -23,18 +23,22 @@ void CullUnitConfig::describe(config::Schema& s, CullUnitConfig& c) {
   s.add("cull.bounds_tests_per_cycle", c.bounds_tests_per_cycle, "tests/cycle", "object or node bounds projected a cycle",
         0.01, 1024.0);
   s.add("cull.bounds_latency_cycles", c.bounds_latency_cycles, "cycles", "latency of a batch of bounds tests", 0, 100000);
-  s.add("cull.hiz_lookups_per_cycle", c.hiz_lookups_per_cycle, "texels/cycle", "Hi-Z texels compared a cycle", 0.01, 1024.0);
-  s.add("cull.hiz_lookup_latency_cycles", c.hiz_lookup_latency_cycles, "cycles", "latency of one Hi-Z query", 0, 100000);
-  s.add("cull.hiz_build_texels_per_cycle", c.hiz_build_texels_per_cycle, "texels/cycle",
-        "Hi-Z texels recomputed a cycle (tile updates, pyramid rebuild)", 0.01, 1024.0);
-  s.add("cull.hiz_build_latency_cycles", c.hiz_build_latency_cycles, "cycles", "latency of one Hi-Z update or rebuild", 0,
-        100000);
 }
 
 CullMode CullUnitConfig::parsed_mode() const {
   const auto m = parse_cull_mode(mode);
   if (!m) throw InputError(fmt::format("cull.mode: unknown mode '{}'", mode));
   return *m;
+}
+
+std::optional<query::Kind> CullUnitConfig::structure_kind() const {
+  switch (parsed_mode()) {
+    case CullMode::Nb:
+    case CullMode::NbHier: return query::Kind::NBuffer;
+    case CullMode::HizTile: return query::Kind::TileHiZ;
+    case CullMode::HizPyramid: return query::Kind::HiZPyramid;
+    default: return std::nullopt;
+  }
 }
 
 Granularity CullUnitConfig::parsed_granularity() const {
@@ -49,15 +53,14 @@ Granularity CullUnitConfig::parsed_granularity() const {
 }
 
 CullUnit::CullUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const CullUnitConfig& config,
-                   const nbuffer::NBufferUnitConfig& nbuffer, const HiZUnitConfig& hiz, const CullSetup& setup,
-                   memory::Channel& memory, const DepthImage& depth_buffer)
+                   const CullSetup& setup, const DepthImage& depth_buffer, query::Structure* structure)
     : sim::Unit(name, registry),
       config_(config),
       mode_(config.parsed_mode()),
       granularity_(config.parsed_granularity()),
       setup_(setup),
-      hiz_(hiz),
       depth_buffer_(depth_buffer),
+      structure_(structure),
       frames_(stats().counter("frames", "frames", "frames culled")),
       candidates_(stats().counter("candidates", "objects", "objects in the frustum that are not occluders")),
       bounds_tests_(stats().counter("bounds_tests", "tests", "object and BVH node bounds tested")),
@@ -68,7 +71,7 @@ CullUnit::CullUnit(const sc_core::sc_module_name& name, stats::Registry& registr
       culled_(stats().counter("culled", "objects", "candidates not found visible")),
       undrawable_(stats().counter("undrawable", "objects", "found visible but without recorded geometry in the trace")),
       false_culls_(stats().counter("false_culls", "objects", "culled candidates that ground truth shows visible")),
-      check_raster_(setup.width_px, setup.height_px),
+      check_(setup.width_px, setup.height_px),
       primitive_tests_(stats().counter("primitive_tests", "triangles",
                                        "triangles of drawn candidates tested before the tile walk (cull.granularity=primitive)")),
       primitives_culled_(stats().counter("primitives_culled", "triangles", "of those, found hidden and dropped")),
@@ -81,11 +84,9 @@ CullUnit::CullUnit(const sc_core::sc_module_name& name, stats::Registry& registr
   if (mode_ == CullMode::Trace) throw InputError("cull.mode=trace replays the recorded draws: no cull stage");
   if (!setup_.scene || setup_.scene->objects.empty())
     throw InputError(fmt::format("cull.mode={} needs the trace's scene objects (SCEN chunk)", to_string(mode_)));
-  if (mode_ == CullMode::Nb || mode_ == CullMode::NbHier)
-    nb_ = std::make_unique<nbuffer::NBufferUnit>("nbuffer", registry, nbuffer, setup.width_px, setup.height_px, setup.op,
-                                                 &memory);
-  if (mode_ == CullMode::HizTile || mode_ == CullMode::HizPyramid) hiz_.validate();
-  if (mode_ == CullMode::HizTile) tile_.emplace(setup.width_px, setup.height_px, hiz_.tile(setup.op));
+  const std::optional<query::Kind> kind = config.structure_kind();
+  NBSIM_CHECK(kind.has_value() == (structure_ != nullptr) && (!kind || *kind == structure_->structure_kind()),
+              fmt::format("cull.mode={} was given the wrong query structure", to_string(mode_)));
 }
 
 CullUnit::~CullUnit() = default;
@@ -116,29 +117,16 @@ void CullUnit::depth_cleared(float depth) {
   heard_cycle_ = std::max(heard_cycle_, sim::local_cycles());  // the depth unit's thread
   ++clears_;
   completed_event_.notify(sc_core::SC_ZERO_TIME);
-  if (nb_) pending_clear_texels_ += nb_->depth_cleared(depth).recomputed();
-  if (tile_) tile_->clear(depth);
+  if (structure_) pending_clear_texels_ += structure_->cleared(depth);
 }
 
 void CullUnit::depth_written(const cp::Work& w, const DepthImage& depth, const Rect& dirty) {
   if (!w.feeds_cull) return;
-  if (nb_) pending_update_texels_ += nb_->depth_changed(depth, dirty).recomputed();
-  if (tile_) pending_update_texels_ += tile_->update(depth, dirty).pixels_read;
+  if (structure_) pending_update_texels_ += structure_->changed(depth, dirty);
 }
 
 void CullUnit::prepare(CullReport& r) {
-  if (nb_) pending_update_texels_ += nb_->end_of_pass().recomputed();
-  if (tile_ && pending_update_texels_)
-    work(sim::batch_cycles(pending_update_texels_, config_.hiz_build_texels_per_cycle, config_.hiz_build_latency_cycles));
-  if (mode_ == CullMode::HizPyramid) {
-    pyramid_.emplace(depth_buffer_, hiz_.pyramid(setup_.op));
-    std::uint64_t texels = 0;
-    for (int k = 0; k < pyramid_->level_count(); ++k)
-      texels += static_cast<std::uint64_t>(pyramid_->level_width(k)) * static_cast<std::uint64_t>(pyramid_->level_height(k));
-    pending_update_texels_ += texels;
-    label("hiz pyramid build");
-    work(sim::batch_cycles(texels, config_.hiz_build_texels_per_cycle, config_.hiz_build_latency_cycles));
-  }
+  if (structure_) pending_update_texels_ += structure_->prepare(depth_buffer_);
   r.update_texels += pending_update_texels_;
   r.clear_texels += pending_clear_texels_;
   update_texels_ += pending_update_texels_;
@@ -194,30 +182,14 @@ void CullUnit::test_lookups(const std::vector<scene::TestItem>& items, std::vect
       t.visible = false;
       continue;
     }
-    const Rect rect{t.x, t.y, t.w, t.h};
-    const std::uint64_t before = r.lookups;
-    if (nb_) {
-      const nbuffer::QueryAnswer a = nb_->query(rect, t.nearest_depth);
-      r.lookups += static_cast<std::uint64_t>(a.lookups);
-      r.update_texels += a.update.recomputed();
-      update_texels_ += a.update.recomputed();
-      t.visible = !a.hidden;
-    } else if (tile_) {
-      const TileHiZAnswer a = tile_->query(rect, t.nearest_depth);
-      r.lookups += static_cast<std::uint64_t>(a.lookups);
-      t.visible = !a.hidden;
-      work(sim::batch_cycles(static_cast<std::uint64_t>(a.lookups), config_.hiz_lookups_per_cycle,
-                             config_.hiz_lookup_latency_cycles));
-    } else {
-      NBSIM_CHECK(pyramid_.has_value(), "Hi-Z pyramid queried before it was built");
-      const QueryResult q = pyramid_->query(rect);
-      r.lookups += static_cast<std::uint64_t>(q.texel_count);
-      t.visible = !(q.complete && nbuffer::hidden_behind(setup_.op, t.nearest_depth, q.value));
-      work(sim::batch_cycles(static_cast<std::uint64_t>(q.texel_count), config_.hiz_lookups_per_cycle,
-                             config_.hiz_lookup_latency_cycles));
-    }
-    cost[i] = r.lookups - before;
-    r.max_lookups = std::max(r.max_lookups, r.lookups - before);
+    NBSIM_CHECK(structure_ != nullptr, "a lookup mode without its query structure");
+    const query::Answer a = structure_->query(Rect{t.x, t.y, t.w, t.h}, t.nearest_depth);
+    r.lookups += a.lookups;
+    r.update_texels += a.update_texels;
+    update_texels_ += a.update_texels;
+    t.visible = !a.hidden;
+    cost[i] = a.lookups;
+    r.max_lookups = std::max(r.max_lookups, a.lookups);
   }
 }
 
@@ -243,58 +215,27 @@ void CullUnit::test_primitives(const cp::Work& w, std::span<const raster::SetupP
     prim_rects_.push_back(q.rect);
     prim_nearest_.push_back(q.nearest);
   }
-  std::uint64_t lookups = 0;
-  if (nb_) {
-    nb_->query_batch(prim_rects_, prim_nearest_, prim_answers_);
-    std::uint64_t update = 0;
-    for (std::size_t k = 0; k < prim_index_.size(); ++k) {
-      const nbuffer::QueryAnswer& a = prim_answers_[k];
-      lookups += static_cast<std::uint64_t>(a.lookups);
-      update += a.update.recomputed();
-      hidden[prim_index_[k]] = a.hidden ? 1 : 0;
-    }
-    r.update_texels += update;
-    update_texels_ += update;
-  } else {
-    for (std::size_t k = 0; k < prim_index_.size(); ++k) {
-      bool h = false;
-      if (tile_) {
-        const TileHiZAnswer a = tile_->query(prim_rects_[k], prim_nearest_[k]);
-        lookups += static_cast<std::uint64_t>(a.lookups);
-        h = a.hidden;
-      } else {
-        NBSIM_CHECK(pyramid_.has_value(), "Hi-Z pyramid queried before it was built");
-        const QueryResult q = pyramid_->query(prim_rects_[k]);
-        lookups += static_cast<std::uint64_t>(q.texel_count);
-        h = q.complete && nbuffer::hidden_behind(setup_.op, prim_nearest_[k], q.value);
-      }
-      hidden[prim_index_[k]] = h ? 1 : 0;
-    }
-    // No other work of this unit overlaps: the next frame's queries wait for this frame's draws.
-    label_with([&] { return fmt::format("{} primitive tests", prim_index_.size()); });
-    work(sim::batch_cycles(lookups, config_.hiz_lookups_per_cycle, config_.hiz_lookup_latency_cycles));
+  NBSIM_CHECK(structure_ != nullptr, "per-primitive culling without a query structure");
+  structure_->query_batch(prim_rects_, prim_nearest_, prim_answers_);
+  std::uint64_t lookups = 0, update = 0;
+  for (std::size_t k = 0; k < prim_index_.size(); ++k) {
+    const query::Answer& a = prim_answers_[k];
+    lookups += a.lookups;
+    update += a.update_texels;
+    hidden[prim_index_[k]] = a.hidden ? 1 : 0;
   }
+  r.update_texels += update;
+  update_texels_ += update;
 
-  // The check, off the clock: a dropped triangle's fragments against the occluders' depth. The
-  // depth buffer only moves nearer after them (the drawn candidates test and write with the same
-  // func), so a fragment that fails here fails when the triangle would have been drawn.
+  // The check, off the clock (false_cull_check.h).
   const auto func = static_cast<raster::DepthFunc>(w.record().state.func);
   std::uint64_t culled = 0, fragments = 0, false_culls = 0;
-  raster::TileCounters ignored;
   for (std::size_t i = 0; i < prims.size(); ++i) {
     if (!hidden[i]) continue;
     ++culled;
-    bool passes = false;
-    const raster::SetupTriangle& t = prims[i].setup;
-    check_raster_.rasterize(t, ignored, [&](int x, int y, std::uint16_t mask) {
-      for (int b = 0; b < 16; ++b) {
-        if (!(mask & (1u << b))) continue;
-        const int px = x + (b & 3), py = y + (b >> 2);
-        ++fragments;
-        passes = passes || raster::depth_passes(func, t.depth.at(px, py, setup_.fused_interpolation), occluder_depth_.at(px, py));
-      }
-    });
-    false_culls += passes ? 1 : 0;
+    const FalseCullCheck::Result c = check_.check(prims[i].setup, func, setup_.fused_interpolation);
+    fragments += c.fragments;
+    false_culls += c.passes ? 1 : 0;
   }
   r.primitive_tests += prim_index_.size();
   r.primitives_culled += culled;
@@ -347,7 +288,7 @@ std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<cons
   reports_.clear();
   if (granularity_ == Granularity::Primitive) {
     reports_[f.get()] = report;
-    occluder_depth_ = depth_buffer_;
+    check_.set_occluder_depth(depth_buffer_);
   }
 
   // 2. Bounds tests of the candidates.

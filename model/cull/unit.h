@@ -1,19 +1,22 @@
 // CullUnit: the cull stage of the replay model in a culling mode (cull.mode other than "trace").
 // It is the command processor's frame program: per frame it issues the recorded Occluder draws,
-// tests every candidate object's bounds (flat or over the BVH) with the mode's query unit, then
-// issues the recorded geometry of the objects found visible. Query units:
+// tests every candidate object's bounds (flat or over the BVH) with the mode's query, then issues
+// the recorded geometry of the objects found visible. Queries:
 //   oq, oq_hier      bounding boxes drawn through geometry -> raster -> depth, writes off; the
 //                    stage waits for each batch's passed samples (the occlusion query's stall);
-//   nb, nb_hier      the N-buffer unit (model/nbuffer/unit.h), fed by the depth unit's dirty
-//                    rectangles of the occluder draws; four lookups at most per test;
-//   hiz_tile         a single-level tile Hi-Z (model/hiz/tile_hiz.h), fed the same way;
-//   hiz_pyramid      a Hi-Z pyramid (model/hiz/pyramid.h) rebuilt from the depth after the occluders.
+//   nb, nb_hier      the N-buffer unit, fed the depth unit's dirty rectangles of the occluder
+//                    draws; four lookups at most per test;
+//   hiz_tile         a single-level tile Hi-Z, fed the same way;
+//   hiz_pyramid      a Hi-Z pyramid rebuilt from the depth after the occluders
+// (the last three are query structures, model/query/units.h, with their own timing).
 // With cull.granularity=primitive (nb, nb_hier and the hiz modes) it also tests, as the raster
 // unit's PrimitiveTester (model/raster/primitive_tester.h), every triangle of the objects it draws
-// as visible candidates, between setup and the tile walk, against the same query unit and its
-// timing (the N-buffer's query port; the Hi-Z lookups as this unit's work): see test_primitives().
-// It listens to the depth unit (clears, dirty rectangles, draw results) and reports per frame a
-// CullReport (model/cull/bounds.h) that rides on the frame's FrameEnd work item.
+// as visible candidates, between setup and the tile walk, against the same structure: see
+// test_primitives().
+// It listens to the depth unit (clears, dirty rectangles, draw results), passes the changes of the
+// occluder draws on to its query structure, and reports per frame a CullReport (report.h) that
+// rides on the frame's FrameEnd work item. The query structure (model/query/structure.h) is a
+// separate unit that the top level builds for the mode and hands over.
 #pragma once
 
 #include <memory>
@@ -26,8 +29,8 @@
 #include "model/cull/report.h"
 #include "model/cull/primitive.h"
 #include "model/depth/unit.h"
-#include "model/hiz/hiz_config.h"
-#include "model/nbuffer/unit.h"
+#include "model/cull/false_cull_check.h"
+#include "model/query/structure.h"
 #include "model/raster/primitive_tester.h"
 #include "model/raster/rasterizer.h"
 
@@ -38,10 +41,6 @@ struct CullUnitConfig {
   std::string granularity = "object";    // see Granularity; "primitive" needs a depth-query mode
   double bounds_tests_per_cycle = 1.0;   // bounds (8 corner transforms, rectangle) a cycle; tunable
   int bounds_latency_cycles = 20;        // per batch of bounds tests; tunable
-  double hiz_lookups_per_cycle = 4.0;    // Hi-Z texels compared a cycle (as the N-buffer's 4); tunable
-  int hiz_lookup_latency_cycles = 8;     // per Hi-Z query; tunable
-  double hiz_build_texels_per_cycle = 16.0;  // Hi-Z texels recomputed a cycle; tunable
-  int hiz_build_latency_cycles = 16;         // per Hi-Z update or rebuild; tunable
 
   // Declares "cull.<field>".
   static void describe(config::Schema& s, CullUnitConfig& c);
@@ -49,6 +48,8 @@ struct CullUnitConfig {
   // Throws InputError for an unknown granularity, and for "primitive" with a mode that has no
   // depth-query structure (trace, none, oq, oq_hier): refused rather than silently run as object.
   Granularity parsed_granularity() const;
+  // The kind of query structure the mode tests bounds against, or nothing (trace, none, oq, oq_hier).
+  std::optional<query::Kind> structure_kind() const;
 };
 
 // What the cull stage needs to know about the trace and the render target.
@@ -67,24 +68,17 @@ class CullUnit : public sim::Unit,
                  public depth::DepthListener,
                  public raster::PrimitiveTester {
  public:
-  // `depth_buffer` is the depth unit's buffer (read to rebuild the Hi-Z pyramid once the occluders
-  // are done). Throws InputError for a trace the mode cannot cull (no scene).
+  // `depth_buffer` is the depth unit's buffer (the structure is brought up to date from it once
+  // the occluders are done). `structure` is the query structure of config.structure_kind() (null
+  // when that is nothing); it must outlive the unit. Throws InputError for a trace the mode cannot
+  // cull (no scene).
   CullUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const CullUnitConfig& config,
-           const nbuffer::NBufferUnitConfig& nbuffer, const HiZUnitConfig& hiz, const CullSetup& setup,
-           memory::Channel& memory, const DepthImage& depth_buffer);
+           const CullSetup& setup, const DepthImage& depth_buffer, query::Structure* structure);
   ~CullUnit() override;
 
   CullMode mode() const noexcept { return mode_; }
   Granularity granularity() const noexcept { return granularity_; }
-  const nbuffer::NBufferUnit* nbuffer_unit() const noexcept { return nb_.get(); }
-  // Bytes the mode's query structure occupies in memory: the N-buffer levels, the tile Hi-Z or the
-  // Hi-Z pyramid; 0 for the occlusion-query modes, which query the depth buffer itself.
-  long long structure_bytes() const noexcept {
-    if (nb_) return nb_->core().levels().storage_bytes();
-    if (tile_) return tile_->storage_bytes();
-    if (pyramid_) return pyramid_->storage_bytes();
-    return 0;
-  }
+  const query::Structure* structure() const noexcept { return structure_; }
 
   // cp::FrameProgram (from the command processor's thread).
   std::shared_ptr<const CullReport> run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
@@ -101,12 +95,11 @@ class CullUnit : public sim::Unit,
   // earlier occluders' depth, for lookups and little gain, and the answer would depend on how far
   // the depth unit lags behind), and the occlusion-query boxes.
   bool tests_primitives(const cp::Work& w) const override;
-  // One query per triangle (model/cull/primitive.h), as one batch per draw: the N-buffer's query
-  // port streams the batch's lookups (NBufferUnit::query_batch); the Hi-Z modes spend
-  // batch_cycles(lookups, hiz_lookups_per_cycle, hiz_lookup_latency_cycles) of this unit's time.
-  // The structure then holds exactly the occluders' depth: every earlier frame has left the
-  // pipeline, and the visible draws do not feed it. Each culled triangle is also checked, off the
-  // clock, by rasterizing it against the occluders' depth (primitive_false_culls).
+  // One query per triangle (model/cull/primitive.h), as one batch per draw through the
+  // structure's query_batch (one latency per batch). The structure then holds exactly the
+  // occluders' depth: every earlier frame has left the pipeline, and the visible draws do not feed
+  // it. Each culled triangle is also checked, off the clock, against the occluders' depth
+  // (FalseCullCheck, primitive_false_culls).
   void test_primitives(const cp::Work& w, std::span<const raster::SetupPrimitive> prims, std::vector<char>& hidden) override;
 
  private:
@@ -126,11 +119,8 @@ class CullUnit : public sim::Unit,
   CullMode mode_;
   Granularity granularity_;
   CullSetup setup_;
-  HiZUnitConfig hiz_;
   const DepthImage& depth_buffer_;
-  std::unique_ptr<nbuffer::NBufferUnit> nb_;
-  std::optional<TileHiZ> tile_;
-  std::optional<HiZPyramid> pyramid_;
+  query::Structure* structure_;
 
   std::uint64_t issued_ = 0, completed_ = 0;
   std::uint64_t frames_begun_ = 0, clears_ = 0;
@@ -144,15 +134,14 @@ class CullUnit : public sim::Unit,
       &culled_, &undrawable_, &false_culls_;
 
   // cull.granularity=primitive: the report each triangle's frame adds to (this frame's, and the
-  // previous frame's while its last draws are still in the raster unit); the depth buffer after
-  // this frame's occluders, for the false-cull check; scratch of test_primitives().
+  // previous frame's while its last draws are still in the raster unit); the check of dropped
+  // triangles against this frame's occluders' depth; scratch of test_primitives().
   std::unordered_map<const scene::Frame*, std::shared_ptr<CullReport>> reports_;
-  DepthImage occluder_depth_;
-  raster::Rasterizer check_raster_;
+  FalseCullCheck check_;
   std::vector<std::size_t> prim_index_;
   std::vector<Rect> prim_rects_;
   std::vector<float> prim_nearest_;
-  std::vector<nbuffer::QueryAnswer> prim_answers_;
+  std::vector<query::Answer> prim_answers_;
   stats::Counter &primitive_tests_, &primitives_culled_, &primitive_lookups_, &primitive_fragments_culled_,
       &primitive_false_culls_;
 };

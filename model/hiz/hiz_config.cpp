@@ -18,6 +18,13 @@ void HiZUnitConfig::describe(config::Schema& s, HiZUnitConfig& c) {
   s.add("hiz.format", c.format,
         "storage of the Hi-Z baselines' depths, rounded toward far (u24 stored as 32-bit D24X8)",
         name_list(kStorageFormatNames));
+  s.add("hiz.lookups_per_cycle", c.lookups_per_cycle, "texels/cycle", "Hi-Z texels compared a cycle", 0.01, 1024.0);
+  s.add("hiz.lookup_latency_cycles", c.lookup_latency_cycles, "cycles", "latency of one Hi-Z query", 0, 100000);
+  s.add("hiz.build_texels_per_cycle", c.build_texels_per_cycle, "texels/cycle",
+        "Hi-Z texels recomputed a cycle (tile updates, pyramid rebuild)", 0.01, 1024.0);
+  s.add("hiz.build_latency_cycles", c.build_latency_cycles, "cycles", "latency of one Hi-Z update or rebuild", 0, 100000);
+  for (const char* field : {"lookups_per_cycle", "lookup_latency_cycles", "build_texels_per_cycle", "build_latency_cycles"})
+    s.renamed(std::string("cull.hiz_") + field, std::string("hiz.") + field);
 }
 
 void HiZUnitConfig::validate() const {

@@ -15,8 +15,13 @@ namespace nbsim {
 struct HiZUnitConfig {
   int tile_px = 8;             // tile Hi-Z: tile side in pixels, 1 .. 256 (8x8 as on shipped GPUs)
   std::string format = "f32";  // storage of both baselines: f32, u24 (as D24X8) or u16, rounded toward far
+  // Timing of the Hi-Z units (model/query/units.h); design guesses, tunable.
+  double lookups_per_cycle = 4.0;       // texels compared a cycle (as the N-buffer's four)
+  int lookup_latency_cycles = 8;        // per query, or per batch of per-triangle queries
+  double build_texels_per_cycle = 16.0; // texels recomputed a cycle (tile updates, pyramid rebuild)
+  int build_latency_cycles = 16;        // per tile update batch or pyramid rebuild
 
-  // Declares "hiz.tile_px" and "hiz.format", bound to `c`.
+  // Declares "hiz.<field>", bound to `c` (the timing keys were "cull.hiz_<field>" before).
   static void describe(config::Schema& schema, HiZUnitConfig& c);
   // Throws InputError naming the key when a value is outside its limits.
   void validate() const;

@@ -48,7 +48,21 @@ Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const G
   const cull::Granularity granularity = c.cull.parsed_granularity();
   if (c.cull.parsed_mode() != cull::CullMode::Trace) {
     NBSIM_CHECK(cull != nullptr, "a culling mode needs the cull setup");
-    cull_ = std::make_unique<cull::CullUnit>("cull", registry, c.cull, c.nbuffer, c.hiz, *cull, memory_, depth_.buffer());
+    if (const std::optional<query::Kind> kind = c.cull.structure_kind()) {
+      switch (*kind) {
+        case query::Kind::NBuffer:
+          structure_ = std::make_unique<query::NBufferStructure>("nbuffer", registry, c.nbuffer, width_px, height_px,
+                                                                 cull->op, &memory_);
+          break;
+        case query::Kind::TileHiZ:
+          structure_ = std::make_unique<query::TileHiZUnit>("hiz", registry, c.hiz, width_px, height_px, cull->op);
+          break;
+        case query::Kind::HiZPyramid:
+          structure_ = std::make_unique<query::HiZPyramidUnit>("hiz", registry, c.hiz, cull->op);
+          break;
+      }
+    }
+    cull_ = std::make_unique<cull::CullUnit>("cull", registry, c.cull, *cull, depth_.buffer(), structure_.get());
     cp_.set_program(cull_.get());
     depth_.set_listener(cull_.get());
     // Per-primitive culling: the cull stage tests the raster unit's triangles between setup and the tile walk.

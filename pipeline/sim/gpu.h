@@ -18,6 +18,7 @@
 #include "model/depth/unit.h"
 #include "model/geometry/unit.h"
 #include "model/memory/memory.h"
+#include "model/query/units.h"
 #include "model/raster/unit.h"
 
 namespace nbsim::pipeline {
@@ -59,7 +60,8 @@ class Gpu : public sc_core::sc_module {
   geometry::GeometryUnit geometry_;
   raster::RasterUnit raster_;
   depth::DepthUnit depth_;
-  std::unique_ptr<cull::CullUnit> cull_;  // culling modes only
+  std::unique_ptr<query::Structure> structure_;  // the culling mode's query structure, if it has one
+  std::unique_ptr<cull::CullUnit> cull_;          // culling modes only
 };
 
 }  // namespace nbsim::pipeline

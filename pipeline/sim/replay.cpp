@@ -331,9 +331,11 @@ ReplaySummary replay(const ReplayOptions& o) {
   s.stats = registry.values();
   if (o.config.cull.parsed_mode() != cull::CullMode::Trace) {
     s.cull = sink.cull.to_json();
-    const long long bytes = gpu.cull() ? gpu.cull()->structure_bytes() : 0;
+    const query::Structure* structure = gpu.cull() ? gpu.cull()->structure() : nullptr;
+    const long long bytes = structure ? structure->storage_bytes() : 0;
     s.cull["structure_memory_bytes"] = bytes;  // N-buffer levels, tile Hi-Z or pyramid
-    s.cull["nbuffer_memory_bytes"] = gpu.cull() && gpu.cull()->nbuffer_unit() ? nlohmann::ordered_json(bytes) : nullptr;
+    s.cull["nbuffer_memory_bytes"] =
+        structure && structure->structure_kind() == query::Kind::NBuffer ? nlohmann::ordered_json(bytes) : nullptr;
   }
 
   if (o.out) {

@@ -132,8 +132,9 @@ TEST(NBufferUnitConfigTest, HiZKeys) {
   HiZUnitConfig c;
   config::Schema s;
   HiZUnitConfig::describe(s, c);
-  EXPECT_EQ(s.size(), 2u);
+  EXPECT_EQ(s.size(), 6u) << "tile_px, format and four timing keys";
   EXPECT_EQ(s.values()["hiz"]["tile_px"], 8);
+  EXPECT_EQ(s.values()["hiz"]["lookup_latency_cycles"], 8);
   EXPECT_EQ(s.values()["hiz"]["format"], "f32");
   s.set("hiz.tile_px=16");
   s.set("hiz.format=u24");
@@ -143,6 +144,15 @@ TEST(NBufferUnitConfigTest, HiZKeys) {
   EXPECT_EQ(c.pyramid(FarOp::Max).format, StorageFormat::U24);
   EXPECT_THROW(s.set("hiz.tile_px=0"), InputError);
   EXPECT_THROW(s.set("hiz.tiles_px=4"), InputError);
+  // The timing keys moved from the cull stage to the Hi-Z unit: the old names say where.
+  try {
+    s.set("cull.hiz_lookups_per_cycle=2");
+    ADD_FAILURE() << "the old key cull.hiz_lookups_per_cycle was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is now 'hiz.lookups_per_cycle'"), std::string::npos) << e.what();
+  }
+  s.set("hiz.lookups_per_cycle=2");
+  EXPECT_EQ(c.lookups_per_cycle, 2.0);
   c.format = "f16";
   try {
     c.validate();

@@ -100,7 +100,7 @@ TEST(TimelineCliTest, CullingModeTracksEveryUnit) {
   EXPECT_EQ(units, 6) << "cp, geometry, raster, depth, cull and nbuffer";
   int nbuffer_tid = -1;
   for (const auto& e : j["traceEvents"])
-    if (e["ph"] == "M" && e["name"] == "thread_name" && e["args"]["name"] == "gpu.cull.nbuffer") nbuffer_tid = e["tid"];
+    if (e["ph"] == "M" && e["name"] == "thread_name" && e["args"]["name"] == "gpu.nbuffer") nbuffer_tid = e["tid"];
   std::map<std::string, int> nbuffer_kinds;
   for (const auto& e : j["traceEvents"])
     if (e["ph"] == "X" && e["tid"] == nbuffer_tid) ++nbuffer_kinds[e["name"].get<std::string>().substr(0, 5)];
