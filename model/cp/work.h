@@ -10,10 +10,15 @@
 
 #include <fmt/format.h>
 
-#include "model/cull/report.h"
 #include "model/scene/frame.h"
 
 namespace nbsim::cp {
+
+// What a frame program (unit.h) did in one frame; each program derives its own, and whoever reads
+// the frame's end downcasts to the program's type.
+struct FrameResult {
+  virtual ~FrameResult() = default;
+};
 
 enum class WorkKind : std::uint8_t {
   FrameBegin = 0,  // clear the depth buffer to `clear_depth`
@@ -29,13 +34,13 @@ struct Work {
   std::uint32_t draw = 0;                     // index into frame->draws (Draw)
   scene::DepthWhich which = scene::DepthWhich::Final;  // (Snapshot)
   float clear_depth = 1.0f;                            // (FrameBegin)
-  // Culling modes (model/cull): a draw the cull stage made itself (a bounding box), used instead
-  // of frame->draws[draw]; whether its depth writes feed the cull structure (N-buffer, Hi-Z); a
-  // ticket the cull stage waits on; and, on FrameEnd, what the cull stage did in the frame.
+  // Frame programs (unit.h): a draw the program made itself (a bounding box), used instead of
+  // frame->draws[draw]; whether its depth writes feed the program's query structures; a ticket the
+  // program waits on; and, on FrameEnd, what the program did in the frame.
   std::shared_ptr<const scene::DrawRecord> own;
   bool feeds_cull = false;
   std::uint64_t ticket = 0;
-  std::shared_ptr<const cull::CullReport> cull_report;
+  std::shared_ptr<const FrameResult> result;
 
   const scene::DrawRecord& record() const { return own ? *own : frame->draws[draw]; }
 };

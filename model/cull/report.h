@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "model/cp/work.h"
 #include "model/scene/visibility.h"
 
 namespace nbsim::cull {
@@ -33,7 +34,7 @@ std::optional<CullMode> parse_cull_mode(std::string_view s) noexcept;
 bool hierarchical(CullMode m) noexcept;
 
 // What the cull stage did in one frame (plain counters; the replay derives ratios).
-struct CullReport {
+struct CullReport : cp::FrameResult {
   CullMode mode = CullMode::Trace;
   std::uint64_t in_frustum = 0;       // objects in the view frustum
   std::uint64_t occluders = 0;        // of those, drawn first (recorded Occluder draws)

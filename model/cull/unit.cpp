@@ -249,7 +249,7 @@ void CullUnit::test_primitives(const cp::Work& w, std::span<const raster::SetupP
   primitive_false_culls_ += false_culls;
 }
 
-std::shared_ptr<const CullReport> CullUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) {
+std::shared_ptr<const cp::FrameResult> CullUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) {
   ++frames_begun_;  // the command processor has sent this frame's FrameBegin (a clear)
   auto report = std::make_shared<CullReport>();
   CullReport& r = *report;

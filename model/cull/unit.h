@@ -81,7 +81,7 @@ class CullUnit : public sim::Unit,
   const query::Structure* structure() const noexcept { return structure_; }
 
   // cp::FrameProgram (from the command processor's thread).
-  std::shared_ptr<const CullReport> run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
+  std::shared_ptr<const cp::FrameResult> run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
 
   // depth::DepthListener (from the depth unit's thread).
   void depth_cleared(float depth) override;

@@ -166,7 +166,7 @@ class Collector : public depth::ResultSink {
                              frame_.depth_matching, frame_.depth_pixels, cycle, cycle - last_cycle_);
     nlohmann::ordered_json pf = {{"frame", w.frame->begin.frame}, {"draws", frame_.draws}, {"depth_tests", frame_.depth_tests},
                                  {"cycles", cycle - last_cycle_}};
-    if (const cull::CullReport* r = w.cull_report.get()) {
+    if (const auto* r = dynamic_cast<const cull::CullReport*>(w.result.get())) {
       cull.add(*r, frame_.depth_tests, cycle - last_cycle_);
       if (culls_.is_open()) write_tests(w, *r);
       pf["query_depth_tests"] = r->query_depth_tests();
