@@ -9,12 +9,14 @@
 #include <filesystem>
 #include <set>
 
+#include "model/common/error.h"
 #include "model/nbuffer/nbuffer.h"
 #include "traces/capture/capture.h"
 #include "traces/capture/city.h"
 #include "traces/capture/paths.h"
 #include "traces/capture/renderer.h"
 #include "traces/capture/scenes.h"
+#include "traces/capture/technique.h"
 #include "traces/format/reader.h"
 
 namespace nbsim::capture {
@@ -208,6 +210,51 @@ TEST(CaptureTest, TraceFileChecksItself) {
     EXPECT_EQ(count, 4);
     std::filesystem::remove(file);
   }
+}
+
+
+// Every technique of the table runs on every scene along every camera path the scene's site allows
+// (tiny captures with the rows' default options, scenes at most 300 objects): the header names the
+// row, every frame is written, and a technique that reports what it drew drew every visible object.
+TEST(CaptureTest, EveryTechniqueRunsOnEverySceneAndPath) {
+  int runs = 0;
+  for (const auto& t : technique_table())
+    for (const auto& sc : scene_table())
+      for (const auto& p : path_table()) {
+        CaptureOptions o;
+        o.technique = t.info.name;
+        o.scene = sc.info.name;
+        o.path = p.info.name;
+        o.width = 48;
+        o.height = 32;
+        o.frames = 2;
+        for (const auto& spec : sc.info.options)
+          if (spec.name == "objects") o.options.set("objects", "300");
+        const auto file = std::filesystem::path(::testing::TempDir()) /
+                          ("every_" + std::to_string(::getpid()) + "_" + t.info.name + "_" + sc.info.name + "_" + p.info.name + ".nbt");
+        CaptureSummary sum;
+        try {
+          sum = capture(o, file.string());
+        } catch (const InputError& e) {
+          // Only a path that the scene's site does not allow may be refused.
+          EXPECT_TRUE(std::string(e.what()).find("needs a scene with") != std::string::npos)
+              << t.info.name << " on " << sc.info.name << " along " << p.info.name << ": " << e.what();
+          continue;
+        }
+        ++runs;
+        EXPECT_EQ(sum.frames, 2);
+        EXPECT_EQ(sum.visible_not_rendered, 0u) << t.info.name << " on " << sc.info.name << " along " << p.info.name;
+        trace::FrameReader frames(file);
+        ASSERT_NE(frames.trace().property("technique"), nullptr);
+        EXPECT_EQ(*frames.trace().property("technique"), t.info.name);
+        EXPECT_EQ(*frames.trace().property("scene"), sc.info.name);
+        EXPECT_EQ(*frames.trace().property("path"), p.info.name);
+        int count = 0;
+        while (frames.next()) ++count;
+        EXPECT_EQ(count, 2);
+        std::filesystem::remove(file);
+      }
+  EXPECT_GE(runs, 2) << "occlusion culling on the city along walk and fly at least";
 }
 
 }  // namespace
