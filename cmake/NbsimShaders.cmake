@@ -1,14 +1,16 @@
 # nbsim_embed_shaders(<target> <files...>): compiles the GLSL files of shaders/ into the target as
-# strings (nbsim::shaders::<name>, e.g. scene_vert), so the binary runs from anywhere. Editing a
-# shader re-runs the configure step.
+# strings named after their path below shaders/ (nbsim::shaders::<folder>_<name>, e.g.
+# shaders/common/scene.vert -> common_scene_vert, shaders/occlusion/nbuffer_query.comp ->
+# occlusion_nbuffer_query_comp), so the binary runs from anywhere and two techniques' folders may
+# hold files of the same name. Editing a shader re-runs the configure step.
 function(nbsim_embed_shaders target)
   set(out ${CMAKE_CURRENT_BINARY_DIR}/nbsim_shaders.cpp)
   set(hdr ${CMAKE_CURRENT_BINARY_DIR}/nbsim_shaders.h)
   set(body "// Generated from shaders/ by cmake/NbsimShaders.cmake. Do not edit.\n#include \"nbsim_shaders.h\"\nnamespace nbsim::shaders {\n")
   set(decl "// Generated from shaders/ by cmake/NbsimShaders.cmake. Do not edit.\n#pragma once\nnamespace nbsim::shaders {\n")
   foreach(f ${ARGN})
-    get_filename_component(name ${f} NAME)
-    string(REPLACE "." "_" sym ${name})
+    file(RELATIVE_PATH name ${PROJECT_SOURCE_DIR}/shaders ${f})
+    string(REGEX REPLACE "[./]" "_" sym ${name})
     file(READ ${f} text)
     string(APPEND body "extern const char* const ${sym} = R\"nbsim_glsl(${text})nbsim_glsl\";\n")
     string(APPEND decl "extern const char* const ${sym};\n")

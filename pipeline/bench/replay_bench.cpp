@@ -14,10 +14,11 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
   capture::CaptureOptions c;
   if (std::sscanf(o.size.c_str(), "%dx%d", &c.width, &c.height) != 2) c.width = c.height = 512;
   c.frames = o.frames;
-  c.mode = capture::parse_test_mode(o.mode);
-  c.levels_every = 0;
+  c.technique = "occlusion_culling";
+  c.scene = "city";
+  c.options = {{"mode", o.mode}, {"levels-every", "0"}};
   const auto file = std::filesystem::temp_directory_path() / ("nbsim_bench_" + std::to_string(::getpid()) + ".nbt");
-  const capture::CaptureSummary cap = capture::capture_city(c, file.string());
+  const capture::CaptureSummary cap = capture::capture(c, file.string());
 
   pipeline::ReplayOptions r;
   r.trace = file;

@@ -1,67 +1,126 @@
-// `nbsim capture city`: record a depth trace of the city walkthrough with the real GL renderer.
+// `nbsim capture TECHNIQUE --scene NAME --path NAME ...`: record a depth trace with the real GL
+// renderer. One subcommand per row of the technique table; the scene, camera path and technique
+// options come from their tables (traces/capture/technique.h, scenes.h, paths.h). `nbsim capture
+// city ...` is the old spelling of `occlusion_culling --scene city`, kept because recorded command
+// lines (the samples', scripts/golden) use it.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <map>
 #include <memory>
+#include <vector>
 
 #include "model/common/error.h"
 #include "pipeline/cli/command.h"
 #include "pipeline/cli/progress.h"
 #include "traces/capture/capture.h"
+#include "traces/capture/paths.h"
+#include "traces/capture/scenes.h"
+#include "traces/capture/technique.h"
 
 namespace nbsim::cli {
 
-void add_capture_command(CLI::App& app, Action& action) {
-  auto* cap = app.add_subcommand("capture", "Record depth traces with the headless GL renderer on Mesa");
-  cap->require_subcommand(1);
-  auto* cmd = cap->add_subcommand("city", "Occlusion culling in a procedural city walkthrough (N-buffer paper, 4.2)");
-  struct Opts {
-    std::string size = "512x512", path = "walk", mode = "nb_hier", out;
-    int frames = 60, objects = 6000, levels_every = 10;
-    unsigned seed = 1;
-    bool reversed_z = false;
-  };
-  auto o = std::make_shared<Opts>();
-  cmd->add_option("--size", o->size, "Viewport, WxH")->capture_default_str();
-  cmd->add_option("--frames", o->frames, "Frames along the camera path")->check(CLI::Range(1, 100000))->capture_default_str();
-  cmd->add_option("--path", o->path, "walk (street level) or fly (flyover)")->check(CLI::IsMember({"walk", "fly"}))->capture_default_str();
-  cmd->add_option("--seed", o->seed, "Seed of the city and the path")->capture_default_str();
-  cmd->add_option("--objects", o->objects, "Objects in the city, ground included")->check(CLI::Range(2, 1000000))->capture_default_str();
-  cmd->add_option("--mode", o->mode, "Visibility test: oq, oq_hier (occlusion queries, flat or over the BVH), nb, nb_hier (GLSL N-buffer), none")
-      ->check(CLI::IsMember({"oq", "oq_hier", "nb", "nb_hier", "none"}))
-      ->capture_default_str();
-  cmd->add_option("--levels-every", o->levels_every, "Record the GLSL N-buffer levels every K-th frame (0: never)")
-      ->check(CLI::Range(0, 1000000))
-      ->capture_default_str();
-  cmd->add_flag("--reversed-z", o->reversed_z, "Reversed Z: ZERO_TO_ONE clip control, depth func GREATER, clear 0");
-  cmd->add_option("-o,--out", o->out, "Trace file to write")->required();
-  cmd->footer("Per frame: occluders (last frame's visible objects), bounds tests of every other object in the\n"
-              "view frustum, visible objects, depth after occluders and at the end, ground truth from an ID buffer.");
-  cmd->callback([&action, o] {
-    action = [o] {
+namespace {
+
+// "Scenes (--scene): ...\nCamera paths (--path): ..." from the tables (without the scenes for the
+// old spelling, whose scene is fixed).
+std::string tables_footer(bool scenes = true) {
+  std::string out;
+  if (scenes) {
+    out += "Scenes (--scene):\n";
+    for (const auto& s : capture::scene_table()) out += fmt::format("  {:<18} {}\n", s.info.name, s.info.description);
+  }
+  out += "Camera paths (--path):\n";
+  for (const auto& p : capture::path_table()) out += fmt::format("  {:<18} {}\n", p.info.name, p.info.description);
+  return out;
+}
+
+struct Args {
+  std::string scene = "city", path = "walk", size = "512x512", out;
+  int frames = 60;
+  bool reversed_z = false;
+  // Registry options by name, with the CLI11 option that fills each.
+  std::map<std::string, std::string> values;
+  std::map<std::string, CLI::Option*> given;
+};
+
+// Adds --NAME once for every option the plug-ins in `owners` (row, kind) declare, grouped by the
+// kind of the first that declares it, naming every plug-in that reads it.
+void add_plugin_options(CLI::App* cmd, Args& a, const std::vector<std::pair<const capture::PluginInfo*, std::string>>& owners) {
+  for (const auto& [info, kind] : owners)
+    for (const capture::OptionSpec& spec : info->options) {
+      if (a.given.count(spec.name)) continue;
+      std::string readers;
+      for (const auto& [other, other_kind] : owners)
+        for (const capture::OptionSpec& o : other->options)
+          if (o.name == spec.name) readers += (readers.empty() ? "" : ", ") + other_kind + " " + other->name;
+      std::string& value = a.values[spec.name];
+      value = spec.default_value;
+      CLI::Option* opt = cmd->add_option("--" + spec.name, value, fmt::format("{} [{}]", spec.help, readers));
+      opt->type_name(spec.kind == capture::OptionSpec::Kind::Integer ? fmt::format("INT in [{} - {}]", spec.min, spec.max)
+                                                                      : "{" + fmt::format("{}", fmt::join(spec.choices, ",")) + "}");
+      opt->capture_default_str()->group(kind == "scene" ? "Scene options" : kind == "path" ? "Camera path options" : "Technique options");
+      a.given[spec.name] = opt;
+    }
+}
+
+// One capture subcommand. technique: the row it runs; legacy: the old `city` spelling (scene fixed
+// to city, no --scene).
+void add_capture_subcommand(CLI::App* cap, Action& action, const capture::TechniqueRow& technique, bool legacy) {
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = legacy ? cap->add_subcommand("city", "Old spelling of `occlusion_culling --scene city`, kept for recorded command lines")
+                         : cap->add_subcommand(technique.info.name, technique.info.description);
+  if (!legacy) cmd->add_option("--scene", a->scene, "Scene, by name (below)")->capture_default_str();
+  cmd->add_option("--path", a->path, "Camera path, by name (below)")->capture_default_str();
+  cmd->add_option("--size", a->size, "Viewport, WxH")->capture_default_str();
+  cmd->add_option("--frames", a->frames, "Frames along the camera path")->check(CLI::Range(1, 100000))->capture_default_str();
+  cmd->add_flag("--reversed-z", a->reversed_z, "Reversed Z: ZERO_TO_ONE clip control, depth func GREATER, clear 0");
+  cmd->add_option("-o,--out", a->out, "Trace file to write")->required();
+  std::vector<std::pair<const capture::PluginInfo*, std::string>> owners;
+  for (const auto& s : capture::scene_table())
+    if (!legacy || s.info.name == "city") owners.emplace_back(&s.info, "scene");
+  for (const auto& p : capture::path_table()) owners.emplace_back(&p.info, "path");
+  owners.emplace_back(&technique.info, "technique");
+  add_plugin_options(cmd, *a, owners);
+  cmd->footer(legacy ? "Same as: nbsim capture occlusion_culling --scene city [options]; traces are identical.\n" + tables_footer(false)
+                     : tables_footer());
+  const std::string technique_name = technique.info.name;
+  cmd->callback([&action, a, technique_name] {
+    action = [a, technique_name] {
       capture::CaptureOptions c;
-      std::tie(c.width, c.height) = parse_size(o->size, "--size");
-      c.frames = o->frames;
-      c.path = o->path == "walk" ? capture::PathKind::Walk : capture::PathKind::Fly;
-      c.seed = o->seed;
-      c.objects = o->objects;
-      c.mode = capture::parse_test_mode(o->mode);
-      c.levels_every = o->levels_every;
-      c.reversed_z = o->reversed_z;
-      c.command_line = "nbsim capture city --size " + o->size + " --frames " + std::to_string(o->frames) + " --path " +
-                       o->path + " --seed " + std::to_string(o->seed) + " --objects " + std::to_string(o->objects) +
-                       " --mode " + o->mode + " --levels-every " + std::to_string(o->levels_every) +
-                       (o->reversed_z ? " --reversed-z" : "") + " -o " + o->out;
+      c.technique = technique_name;
+      c.scene = a->scene;
+      c.path = a->path;
+      std::tie(c.width, c.height) = parse_size(a->size, "--size");
+      c.frames = a->frames;
+      c.reversed_z = a->reversed_z;
+      for (const auto& [name, opt] : a->given)
+        if (opt->count() > 0) c.options.set(name, a->values.at(name));
+      // Both spellings record the current one, every option spelled out.
+      c.command_line = capture::canonical_command_line(c, a->out);
       ProgressBar bar("capture", c.frames);
-      const auto s = capture::capture_city(c, o->out, [&](int done, int) { bar.update(done); });
+      const auto s = capture::capture(c, a->out, [&](int done, int) { bar.update(done); });
       bar.finish();
       fmt::print("captured {} frames at {} in {:.1f} s ({:.2f} frames/s, GL technique {:.1f} ms/frame): {} ({:.2f} MB, {:.0f} KB/frame)\n",
-                 s.frames, o->size, s.seconds, s.frames / s.seconds, s.gl_ms / s.frames, o->out,
+                 s.frames, a->size, s.seconds, s.frames / s.seconds, s.gl_ms / s.frames, a->out,
                  static_cast<double>(s.bytes) / 1e6, static_cast<double>(s.bytes) / 1e3 / s.frames);
       fmt::print("  {} draws; objects rendered {}, visible by ground truth {}, visible but not rendered {}\n", s.draws,
                  s.objects_rendered, s.objects_visible, s.visible_not_rendered);
       return s.visible_not_rendered == 0 ? 0 : 1;
     };
   });
+}
+
+}  // namespace
+
+void add_capture_command(CLI::App& app, Action& action) {
+  auto* cap = app.add_subcommand("capture", "Record depth traces with the headless GL renderer on Mesa");
+  cap->require_subcommand(1);
+  for (const auto& t : capture::technique_table()) add_capture_subcommand(cap, action, t, false);
+  add_capture_subcommand(cap, action, capture::find_technique("occlusion_culling"), true);
+  cap->footer("Usage: nbsim capture TECHNIQUE [--scene NAME] [--path NAME] [options] -o OUT  (TECHNIQUE --help lists its options)\n"
+              "`nbsim capture city ...` is the old spelling of `nbsim capture occlusion_culling --scene city ...`.\n" +
+              tables_footer());
 }
 
 }  // namespace nbsim::cli

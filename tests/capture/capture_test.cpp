@@ -1,6 +1,6 @@
-// CaptureTest: the GL renderer run headless on a small city, checked against itself and against
-// the C++ core: GLSL N-buffer levels equal the core's bit for bit, GL's counters are consistent,
-// the ID-buffer ground truth adds up, and no culling mode hides a visible object.
+// CaptureTest: the occlusion-culling technique run headless on a small city, checked against itself
+// and against the C++ core: GLSL N-buffer levels equal the core's bit for bit, GL's counters are
+// consistent, the ID-buffer ground truth adds up, and no culling mode hides a visible object.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,31 +9,37 @@
 #include <filesystem>
 #include <set>
 
+#include "model/common/error.h"
 #include "model/nbuffer/nbuffer.h"
 #include "traces/capture/capture.h"
+#include "traces/capture/city.h"
+#include "traces/capture/paths.h"
 #include "traces/capture/renderer.h"
+#include "traces/capture/scenes.h"
+#include "traces/capture/technique.h"
 #include "traces/format/reader.h"
 
 namespace nbsim::capture {
 namespace {
 
+// A small city and `frames` poses of a camera path, from the scene and path tables.
 struct Small {
-  City city;
+  CaptureScene scene;
   std::vector<CameraPose> poses;
-  Small(PathKind path, int frames) {
-    CityParams p;
-    p.objects = 600;
-    p.seed = 7;
-    city = make_city(p);
-    poses = make_path(city, path, frames, 7);
+  Small(const char* path, int frames) {
+    const OptionValues o = {{"objects", "600"}, {"seed", "7"}};
+    scene = find_scene("city").make(o);
+    poses = find_path(path).make(scene, frames, o);
   }
 };
 
-RendererOptions options(trace::TestMode mode, bool reversed = false) {
+// occlusion_culling at 160x120 in `mode`; levels_every 1 records every frame's levels.
+RendererOptions options(trace::TestMode mode, bool reversed = false, int levels_every = 0) {
   RendererOptions o;
+  o.technique = "occlusion_culling";
   o.width = 160;
   o.height = 120;
-  o.mode = mode;
+  o.options = {{"mode", std::string(scene::to_string(mode))}, {"levels-every", std::to_string(levels_every)}};
   o.projection.reversed_z = reversed;
   return o;
 }
@@ -63,20 +69,20 @@ TEST(CaptureTest, CityAndBvhAreConsistent) {
 // The GLSL N-buffer levels equal the C++ core's levels built from the captured depth, bit for bit.
 TEST(CaptureTest, GlslLevelsEqualCoreLevels) {
   for (bool reversed : {false, true}) {
-    Small s(PathKind::Walk, 3);
-    Renderer r(s.city, options(trace::TestMode::NBuffer, reversed));
+    Small s("walk", 3);
+    Renderer r(s.scene, options(trace::TestMode::NBuffer, reversed, 1));
     for (std::uint32_t f = 0; f < 3; ++f) {
-      const CapturedFrame fr = r.render(f, s.poses[f], true);
-      ASSERT_TRUE(fr.levels.has_value());
-      const auto& d = fr.depth.at(0);
+      const scene::Frame fr = r.render(f, s.poses[f]).frame;
+      ASSERT_EQ(fr.levels.size(), 1u) << "levels every frame";
+      const auto& d = fr.depths.at(0);
       ASSERT_EQ(d.which, trace::DepthWhich::AfterOccluders);
       DepthImage img(d.width, d.height, 0.0f);
       img.texels = d.texels;
       const NBuffer core(img, {reversed ? FarOp::Min : FarOp::Max, StorageFormat::F32, -1});
-      ASSERT_EQ(fr.levels->levels, core.level_count());
+      ASSERT_EQ(fr.levels[0].levels, core.level_count());
       for (int i = 0; i < core.level_count(); ++i) {
         const auto level = core.level(i);
-        const float* gl = fr.levels->texels.data() + static_cast<std::size_t>(i) * level.size();
+        const float* gl = fr.levels[0].texels.data() + static_cast<std::size_t>(i) * level.size();
         EXPECT_EQ(std::memcmp(gl, level.data(), level.size() * 4), 0) << "frame " << f << " level " << i << " reversed " << reversed;
       }
     }
@@ -88,11 +94,15 @@ TEST(CaptureTest, GlslLevelsEqualCoreLevels) {
 TEST(CaptureTest, CountersAndGroundTruthAreConsistent) {
   for (auto mode : {trace::TestMode::OcclusionQuery, trace::TestMode::OcclusionQueryHier, trace::TestMode::NBuffer,
                     trace::TestMode::NBufferHier, trace::TestMode::None}) {
-    for (PathKind path : {PathKind::Walk, PathKind::Fly}) {
+    for (const char* path : {"walk", "fly"}) {
       Small s(path, 4);
-      Renderer r(s.city, options(mode));
+      Renderer r(s.scene, options(mode));
       for (std::uint32_t f = 0; f < 4; ++f) {
-        const CapturedFrame fr = r.render(f, s.poses[f], false);
+        const CapturedFrame cf = r.render(f, s.poses[f]);
+        const scene::Frame& fr = cf.frame;
+        ASSERT_TRUE(fr.truth.has_value());
+        ASSERT_TRUE(cf.rendered_objects.has_value()) << "occlusion culling reports what it drew";
+        EXPECT_TRUE(fr.levels.empty()) << "levels-every 0 records no levels";
         for (const auto& d : fr.draws) {
           EXPECT_LE(d.gl.samples_passed, d.gl.fragments) << "draw " << d.index << " frame " << f;
           if (!d.clip_positions.empty()) {
@@ -100,13 +110,14 @@ TEST(CaptureTest, CountersAndGroundTruthAreConsistent) {
           }
         }
         std::uint64_t sum = 0;
-        for (auto v : fr.truth.visible_pixels) sum += v;
-        EXPECT_EQ(sum, fr.truth.covered_pixels) << "ID-buffer pixels add up";
-        EXPECT_LE(fr.truth.covered_pixels, 160u * 120u);
-        for (std::size_t o = 0; o < fr.truth.visible_pixels.size(); ++o) {
-          if (!fr.truth.visible_pixels[o]) continue;
-          EXPECT_TRUE(std::binary_search(fr.rendered_objects.begin(), fr.rendered_objects.end(), o))
-              << "object " << o << " is visible (" << fr.truth.visible_pixels[o] << " px) but mode "
+        for (auto v : fr.truth->visible_pixels) sum += v;
+        EXPECT_EQ(sum, fr.truth->covered_pixels) << "ID-buffer pixels add up";
+        EXPECT_LE(fr.truth->covered_pixels, 160u * 120u);
+        const auto& rendered = *cf.rendered_objects;
+        for (std::size_t o = 0; o < fr.truth->visible_pixels.size(); ++o) {
+          if (!fr.truth->visible_pixels[o]) continue;
+          EXPECT_TRUE(std::binary_search(rendered.begin(), rendered.end(), o))
+              << "object " << o << " is visible (" << fr.truth->visible_pixels[o] << " px) but mode "
               << static_cast<int>(mode) << " culled it in frame " << f;
         }
       }
@@ -117,10 +128,10 @@ TEST(CaptureTest, CountersAndGroundTruthAreConsistent) {
 // Occlusion-query decisions agree with GL's samples passed, and bounds crossing the near plane
 // are never culled.
 TEST(CaptureTest, QueryDecisionsFollowGlCounters) {
-  Small s(PathKind::Walk, 3);
-  Renderer r(s.city, options(trace::TestMode::OcclusionQuery));
+  Small s("walk", 3);
+  Renderer r(s.scene, options(trace::TestMode::OcclusionQuery));
   for (std::uint32_t f = 0; f < 3; ++f) {
-    const CapturedFrame fr = r.render(f, s.poses[f], false);
+    const scene::Frame fr = r.render(f, s.poses[f]).frame;
     int queries = 0;
     for (const auto& d : fr.draws) {
       if (d.role != trace::DrawRole::BoundsQuery) continue;
@@ -145,13 +156,10 @@ TEST(CaptureTest, TraceFileChecksItself) {
     o.width = 128;
     o.height = 96;
     o.frames = 4;
-    o.objects = 800;
-    o.seed = 5;
-    o.mode = trace::TestMode::NBuffer;
-    o.levels_every = 1;
+    o.options = {{"objects", "800"}, {"seed", "5"}, {"mode", "nb"}, {"levels-every", "1"}};
     o.reversed_z = reversed;
     const auto file = std::filesystem::path(::testing::TempDir()) / ("capture_" + std::to_string(::getpid()) + ".nbt");
-    const CaptureSummary sum = capture_city(o, file.string());
+    const CaptureSummary sum = capture(o, file.string());
     EXPECT_EQ(sum.frames, 4);
     EXPECT_EQ(sum.visible_not_rendered, 0u);
 
@@ -160,6 +168,11 @@ TEST(CaptureTest, TraceFileChecksItself) {
     ASSERT_NE(tr.property("gl_renderer"), nullptr);
     EXPECT_NE(tr.property("gl_renderer")->find("llvmpipe"), std::string::npos) << *tr.property("gl_renderer");
     EXPECT_EQ(*tr.property("depth_func"), reversed ? "GREATER" : "LESS");
+    ASSERT_NE(tr.property("technique"), nullptr);
+    EXPECT_EQ(*tr.property("technique"), "occlusion_culling") << "the technique's name comes from its row";
+    EXPECT_EQ(*tr.property("test_mode"), "nb");
+    EXPECT_EQ(*tr.property("scene"), "city");
+    EXPECT_EQ(*tr.property("path"), "walk");
     ASSERT_NE(tr.scene(), nullptr);
     EXPECT_EQ(tr.scene()->objects.size(), 800u);
     const FarOp op = reversed ? FarOp::Min : FarOp::Max;
@@ -197,6 +210,51 @@ TEST(CaptureTest, TraceFileChecksItself) {
     EXPECT_EQ(count, 4);
     std::filesystem::remove(file);
   }
+}
+
+
+// Every technique of the table runs on every scene along every camera path the scene's site allows
+// (tiny captures with the rows' default options, scenes at most 300 objects): the header names the
+// row, every frame is written, and a technique that reports what it drew drew every visible object.
+TEST(CaptureTest, EveryTechniqueRunsOnEverySceneAndPath) {
+  int runs = 0;
+  for (const auto& t : technique_table())
+    for (const auto& sc : scene_table())
+      for (const auto& p : path_table()) {
+        CaptureOptions o;
+        o.technique = t.info.name;
+        o.scene = sc.info.name;
+        o.path = p.info.name;
+        o.width = 48;
+        o.height = 32;
+        o.frames = 2;
+        for (const auto& spec : sc.info.options)
+          if (spec.name == "objects") o.options.set("objects", "300");
+        const auto file = std::filesystem::path(::testing::TempDir()) /
+                          ("every_" + std::to_string(::getpid()) + "_" + t.info.name + "_" + sc.info.name + "_" + p.info.name + ".nbt");
+        CaptureSummary sum;
+        try {
+          sum = capture(o, file.string());
+        } catch (const InputError& e) {
+          // Only a path that the scene's site does not allow may be refused.
+          EXPECT_TRUE(std::string(e.what()).find("needs a scene with") != std::string::npos)
+              << t.info.name << " on " << sc.info.name << " along " << p.info.name << ": " << e.what();
+          continue;
+        }
+        ++runs;
+        EXPECT_EQ(sum.frames, 2);
+        EXPECT_EQ(sum.visible_not_rendered, 0u) << t.info.name << " on " << sc.info.name << " along " << p.info.name;
+        trace::FrameReader frames(file);
+        ASSERT_NE(frames.trace().property("technique"), nullptr);
+        EXPECT_EQ(*frames.trace().property("technique"), t.info.name);
+        EXPECT_EQ(*frames.trace().property("scene"), sc.info.name);
+        EXPECT_EQ(*frames.trace().property("path"), p.info.name);
+        int count = 0;
+        while (frames.next()) ++count;
+        EXPECT_EQ(count, 2);
+        std::filesystem::remove(file);
+      }
+  EXPECT_GE(runs, 2) << "occlusion culling on the city along walk and fly at least";
 }
 
 }  // namespace

@@ -46,7 +46,7 @@ TEST(ReplayCliTest, CompareSamplesWithinThresholds) {
 // A fresh capture on this machine's Mesa compares within the thresholds too (flyover, flat queries).
 TEST(ReplayCliTest, CompareFreshCapture) {
   const fs::path t = scratch("fresh.nbt");
-  const CliResult c = run_nbsim("capture city --size 96x80 --frames 3 --objects 700 --path fly --mode oq_hier -o " + t.string());
+  const CliResult c = run_nbsim("capture occlusion_culling --scene city --size 96x80 --frames 3 --objects 700 --path fly --mode oq_hier -o " + t.string());
   ASSERT_EQ(c.status, 0) << c.out << c.err;
   const CliResult r = run_nbsim("compare " + t.string());
   EXPECT_EQ(r.status, 0) << r.out << r.err;

@@ -20,8 +20,8 @@ namespace fs = std::filesystem;
 
 struct Capture {
   const char* name;
-  trace::TestMode mode;
-  capture::PathKind path;
+  const char* mode;  // occlusion_culling's --mode
+  const char* path;  // camera path by name
   bool reversed_z;
 };
 
@@ -33,12 +33,12 @@ CompareSummary capture_and_compare(const Capture& c) {
   o.width = 160;
   o.height = 120;
   o.frames = 3;
-  o.objects = 700;
-  o.seed = 5;
+  o.technique = "occlusion_culling";
+  o.scene = "city";
   o.path = c.path;
-  o.mode = c.mode;
+  o.options = {{"objects", "700"}, {"seed", "5"}, {"mode", c.mode}};
   o.reversed_z = c.reversed_z;
-  capture::capture_city(o, file.string());
+  capture::capture(o, file.string());
   CompareSummary s = compare_trace(file);
   fs::remove_all(dir);
   return s;
@@ -72,19 +72,19 @@ void expect_matches_gl(const CompareSummary& s, const char* what) {
 
 // Occlusion queries on a walk: occluders, bounding boxes with depth writes off, visible objects.
 TEST(RasterGlCompareTest, WalkWithOcclusionQueriesMatchesGl) {
-  expect_matches_gl(capture_and_compare({"oq_walk", trace::TestMode::OcclusionQuery, capture::PathKind::Walk, false}),
+  expect_matches_gl(capture_and_compare({"oq_walk", "oq", "walk", false}),
                     "oq walk");
 }
 
 // The hierarchical N-buffer mode on a fly-over: more clipping (the camera is high, looking down).
 TEST(RasterGlCompareTest, FlyWithNBufferHierarchyMatchesGl) {
-  expect_matches_gl(capture_and_compare({"nbh_fly", trace::TestMode::NBufferHier, capture::PathKind::Fly, false}),
+  expect_matches_gl(capture_and_compare({"nbh_fly", "nb_hier", "fly", false}),
                     "nb_hier fly");
 }
 
 // Reversed Z: clip control ZERO_TO_ONE, GREATER, clear 0.
 TEST(RasterGlCompareTest, ReversedZMatchesGl) {
-  expect_matches_gl(capture_and_compare({"oq_rz", trace::TestMode::OcclusionQuery, capture::PathKind::Walk, true}),
+  expect_matches_gl(capture_and_compare({"oq_rz", "oq", "walk", true}),
                     "oq reversed z");
 }
 

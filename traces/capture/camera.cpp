@@ -5,25 +5,32 @@
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/gtc/constants.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
+#include "model/common/error.h"
+
 namespace nbsim::capture {
 
-std::vector<CameraPose> make_path(const City& city, PathKind kind, int frames, std::uint32_t seed) {
+std::vector<CameraPose> fly_path(const PathSite& site, int frames) {
   std::vector<CameraPose> poses;
   poses.reserve(static_cast<std::size_t>(frames));
-  const float pitch = static_cast<float>(city.pitch_m());
-  const int n = city.blocks_per_side;
-  if (kind == PathKind::Fly) {
-    const float c = 0.5f * static_cast<float>(city.extent_m()), r = 0.55f * static_cast<float>(city.extent_m());
-    for (int f = 0; f < frames; ++f) {
-      const float a = glm::two_pi<float>() * static_cast<float>(f) / static_cast<float>(std::max(frames, 1));
-      const glm::vec3 eye{c + r * std::cos(a), 120.0f + 0.05f * r, c + r * std::sin(a)};
-      poses.push_back({eye, {c, 0.0f, c}});
-    }
-    return poses;
+  const float c = 0.5f * static_cast<float>(site.extent_m), r = 0.55f * static_cast<float>(site.extent_m);
+  for (int f = 0; f < frames; ++f) {
+    const float a = glm::two_pi<float>() * static_cast<float>(f) / static_cast<float>(std::max(frames, 1));
+    const glm::vec3 eye{c + r * std::cos(a), 120.0f + 0.05f * r, c + r * std::sin(a)};
+    poses.push_back({eye, {c, 0.0f, c}});
   }
+  return poses;
+}
+
+std::vector<CameraPose> walk_path(const PathSite& site, int frames, std::uint32_t seed) {
+  NBSIM_CHECK(site.has_streets(), "walk_path() on a site without streets");
+  std::vector<CameraPose> poses;
+  poses.reserve(static_cast<std::size_t>(frames));
+  const float pitch = static_cast<float>(site.street_pitch_m);
+  const int n = site.blocks_per_side;
   // Walk: a random walk on the street-crossing grid at eye height, 1.2 m a frame, turning at
   // crossings; the view direction eases into each turn so frames stay coherent.
   std::mt19937 rng(seed ^ 0x5eedu);

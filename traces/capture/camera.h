@@ -1,5 +1,7 @@
-// Camera paths through the city: a street-level walkthrough that follows the street grid and turns
-// at crossings, and a flyover that circles the city looking down. One pose per frame.
+// Cameras of the capture: a pose per frame, the projection of the depth convention, and the two
+// camera paths over a scene's site: a street-level walkthrough that follows the street grid and
+// turns at crossings, and a flyover that circles the site looking down. The paths are chosen by
+// name from the table in paths.cpp; this file computes them.
 #pragma once
 
 #include <glm/mat4x4.hpp>
@@ -9,11 +11,17 @@
 #include <string_view>
 #include <vector>
 
-#include "traces/capture/city.h"
-
 namespace nbsim::capture {
 
-enum class PathKind : std::uint8_t { Walk = 0, Fly = 1 };
+// Where a camera path may go: the scene's ground square [0, extent_m] x [0, extent_m] on y = 0 and,
+// when the scene has streets, the grid of street crossings at multiples of street_pitch_m
+// (crossings 0..blocks_per_side on x and on z).
+struct PathSite {
+  double extent_m = 0.0;
+  double street_pitch_m = 0.0;  // distance between street centre lines; 0 when there are no streets
+  int blocks_per_side = 0;
+  bool has_streets() const noexcept { return street_pitch_m > 0.0 && blocks_per_side > 0; }
+};
 
 struct CameraPose {
   glm::vec3 eye{0.0f};
@@ -28,8 +36,10 @@ struct Projection {
 };
 
 // `frames` poses. The walk moves 1.2 m a frame at eye height (a slow drive at 30 frames a second,
-// so that 60 frames pass a few crossings); the flyover circles the city once over the path.
-std::vector<CameraPose> make_path(const City& city, PathKind kind, int frames, std::uint32_t seed);
+// so that 60 frames pass a few crossings), a random walk on the crossings from the site's centre
+// (the site must have streets); the flyover circles the site once, looking at its centre.
+std::vector<CameraPose> walk_path(const PathSite& site, int frames, std::uint32_t seed);
+std::vector<CameraPose> fly_path(const PathSite& site, int frames);
 
 glm::mat4 view_matrix(const CameraPose& pose);
 // GL projection for the depth convention: [-1, 1] clip z (LESS) or reversed Z in [0, 1] (GREATER).

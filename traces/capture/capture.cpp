@@ -1,40 +1,69 @@
-// Capture driver: city, path, renderer, trace writer; see capture.h.
+// Capture driver: scene, camera path, renderer with its technique, trace writer; see capture.h.
 #include "traces/capture/capture.h"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <regex>
 
 #include "model/common/error.h"
+#include "traces/capture/paths.h"
 #include "traces/capture/renderer.h"
+#include "traces/capture/scenes.h"
+#include "traces/capture/technique.h"
 #include "traces/format/writer.h"
 
 namespace nbsim::capture {
 
-trace::TestMode parse_test_mode(const std::string& s) {
-  if (const auto m = scene::parse_test_mode(s)) return *m;
-  throw InputError(fmt::format("unknown test mode '{}': expected oq, oq_hier, nb, nb_hier or none", s));
+namespace {
+
+void append(trace::Properties& to, const trace::Properties& from) { to.insert(to.end(), from.begin(), from.end()); }
+
+// The chosen rows' options, each name once, in the order scene, path, technique.
+std::vector<const OptionSpec*> chosen_options(const SceneRow& s, const PathRow& p, const TechniqueRow& t) {
+  std::vector<const OptionSpec*> out;
+  for (const PluginInfo* info : {&s.info, &p.info, &t.info})
+    for (const OptionSpec& o : info->options)
+      if (std::none_of(out.begin(), out.end(), [&](const OptionSpec* x) { return x->name == o.name; })) out.push_back(&o);
+  return out;
 }
 
-CaptureSummary capture_city(const CaptureOptions& o, const std::string& out_path, const Progress& progress) {
+}  // namespace
+
+std::string canonical_command_line(const CaptureOptions& o, const std::string& out_path) {
+  const SceneRow& s = find_scene(o.scene);
+  const PathRow& p = find_path(o.path);
+  const TechniqueRow& t = find_technique(o.technique);
+  std::string line = fmt::format("nbsim capture {} --scene {} --path {} --size {}x{} --frames {}", t.info.name, s.info.name,
+                                 p.info.name, o.width, o.height, o.frames);
+  for (const OptionSpec* spec : chosen_options(s, p, t)) line += fmt::format(" --{} {}", spec->name, o.options.text(*spec));
+  if (o.reversed_z) line += " --reversed-z";
+  return line + " -o " + out_path;
+}
+
+CaptureSummary capture(const CaptureOptions& o, const std::string& out_path, const Progress& progress) {
   if (o.width < 1 || o.height < 1 || o.width > 4096 || o.height > 4096)
     throw InputError(fmt::format("capture size {}x{} is out of range (1x1 to 4096x4096)", o.width, o.height));
   if (o.frames < 1) throw InputError("--frames must be at least 1");
-  if (o.objects < 2) throw InputError("--objects must be at least 2");
+  const SceneRow& scene_row = find_scene(o.scene);
+  const PathRow& path_row = find_path(o.path);
+  const TechniqueRow& technique_row = find_technique(o.technique);
+  check_options_declared(o.options, {&scene_row.info, &path_row.info, &technique_row.info});
+  // Every value checked before the (slow) scene is built.
+  for (const OptionSpec* spec : chosen_options(scene_row, path_row, technique_row)) o.options.text(*spec);
+
   const auto t0 = std::chrono::steady_clock::now();
-  CityParams cp;
-  cp.seed = o.seed;
-  cp.objects = o.objects;
-  const City city = make_city(cp);
-  const auto poses = make_path(city, o.path, o.frames, o.seed);
+  const CaptureScene scene = scene_row.make(o.options);
+  const auto poses = path_row.make(scene, o.frames, o.options);
   RendererOptions ro;
+  ro.technique = o.technique;
   ro.width = o.width;
   ro.height = o.height;
-  ro.mode = o.mode;
   ro.projection.reversed_z = o.reversed_z;
-  Renderer renderer(city, ro);
+  ro.options = o.options;
+  Renderer renderer(scene, ro);
 
   const auto& gl = renderer.gl_info();
   std::smatch m;
@@ -49,42 +78,43 @@ CaptureSummary capture_city(const CaptureOptions& o, const std::string& out_path
       {"depth_func", o.reversed_z ? "GREATER" : "LESS"},
       {"clip_control", o.reversed_z ? "ZERO_TO_ONE" : "NEGATIVE_ONE_TO_ONE"},
       {"depth_clear", o.reversed_z ? "0" : "1"},
-      {"technique", "occlusion_culling"},
-      {"test_mode", std::string(scene::to_string(o.mode))},
-      {"scene", "city"},
-      {"seed", std::to_string(o.seed)},
-      {"objects", std::to_string(city.objects.size())},
-      {"path", o.path == PathKind::Walk ? "walk" : "fly"},
-      {"frames", std::to_string(o.frames)},
-      {"fov_y_deg", fmt::format("{}", ro.projection.fov_y_deg)},
-      {"near", fmt::format("{}", ro.projection.near_m)},
-      {"far", fmt::format("{}", ro.projection.far_m)},
-      {"nearest_margin", fmt::format("{}", ro.nearest_margin)},
-      {"levels_every", std::to_string(o.levels_every)},
-      {"nbsim_version", NBSIM_VERSION},
-      {"command_line", o.command_line},
+      {"technique", technique_row.info.name},
   };
+  append(props, renderer.technique().variant_properties());
+  props.emplace_back("scene", scene_row.info.name);
+  append(props, scene.properties);
+  props.emplace_back("path", path_row.info.name);
+  props.emplace_back("frames", std::to_string(o.frames));
+  props.emplace_back("fov_y_deg", fmt::format("{}", ro.projection.fov_y_deg));
+  props.emplace_back("near", fmt::format("{}", ro.projection.near_m));
+  props.emplace_back("far", fmt::format("{}", ro.projection.far_m));
+  append(props, renderer.technique().setting_properties());
+  props.emplace_back("nbsim_version", NBSIM_VERSION);
+  props.emplace_back("command_line", o.command_line.empty() ? canonical_command_line(o, out_path) : o.command_line);
+
   trace::TraceWriter writer(out_path, props);
-  writer.write(city.scene);
+  writer.write(scene.scene);
   CaptureSummary sum;
   for (int f = 0; f < o.frames; ++f) {
-    const bool keep_levels = o.levels_every > 0 && f % o.levels_every == 0;
-    const CapturedFrame fr = renderer.render(static_cast<std::uint32_t>(f), poses[static_cast<std::size_t>(f)], keep_levels);
+    const CapturedFrame cf = renderer.render(static_cast<std::uint32_t>(f), poses[static_cast<std::size_t>(f)]);
+    const scene::Frame& fr = cf.frame;
     writer.begin_frame(fr.begin);
     for (const auto& d : fr.draws) writer.write(d);
-    for (const auto& d : fr.depth) writer.write(d);
-    if (fr.levels) writer.write(*fr.levels);
-    writer.write(fr.truth);
+    for (const auto& d : fr.depths) writer.write(d);
+    for (const auto& l : fr.levels) writer.write(l);
+    if (fr.truth) writer.write(*fr.truth);
     writer.end_frame(fr.end);
     sum.frames++;
     sum.gl_ms += fr.end.gl_ms;
     sum.draws += fr.draws.size();
-    sum.objects_rendered += fr.rendered_objects.size();
-    for (std::size_t obj = 0; obj < fr.truth.visible_pixels.size(); ++obj) {
-      if (!fr.truth.visible_pixels[obj]) continue;
-      ++sum.objects_visible;
-      if (!std::binary_search(fr.rendered_objects.begin(), fr.rendered_objects.end(), static_cast<std::uint32_t>(obj)))
-        ++sum.visible_not_rendered;
+    if (cf.rendered_objects && fr.truth) {
+      const auto& rendered = *cf.rendered_objects;
+      sum.objects_rendered += rendered.size();
+      for (std::size_t obj = 0; obj < fr.truth->visible_pixels.size(); ++obj) {
+        if (!fr.truth->visible_pixels[obj]) continue;
+        ++sum.objects_visible;
+        if (!std::binary_search(rendered.begin(), rendered.end(), static_cast<std::uint32_t>(obj))) ++sum.visible_not_rendered;
+      }
     }
     if (progress) progress(f + 1, o.frames);
   }

@@ -1,27 +1,29 @@
-// `nbsim capture city`: renders a camera path through the procedural city on Mesa and writes the
-// trace (traces/FORMAT.md). The renderer does the work; this file sets it up and streams frames.
+// `nbsim capture TECHNIQUE --scene NAME --path NAME`: renders a camera path through a scene with
+// one technique on Mesa and writes the trace (traces/FORMAT.md). The technique, the scene and the
+// camera path are chosen by name from their tables (technique.h, scenes.h, paths.h); the renderer
+// does the work; this file sets it up, writes the header and streams the frames.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <string>
 
-#include "traces/capture/camera.h"
-#include "traces/format/records.h"
+#include "traces/capture/plugin.h"
 
 namespace nbsim::capture {
 
 struct CaptureOptions {
+  std::string technique = "occlusion_culling";
+  std::string scene = "city";
+  std::string path = "walk";
   int width = 512;
   int height = 512;
   int frames = 60;
-  PathKind path = PathKind::Walk;
-  std::uint32_t seed = 1;
-  int objects = 6000;
-  trace::TestMode mode = trace::TestMode::NBufferHier;
-  bool reversed_z = false;
-  int levels_every = 10;  // record the GLSL N-buffer levels every k-th frame (0: never)
-  std::string command_line;
+  bool reversed_z = false;  // ZERO_TO_ONE clip control, depth func GREATER, clear 0
+  // The options of the technique, the scene and the path by name ("mode" = "nb_hier", "seed" =
+  // "1", ...); unset ones take their defaults, one that none of the three declares is an error.
+  OptionValues options;
+  std::string command_line;  // header property; canonical_command_line() when empty
 };
 
 struct CaptureSummary {
@@ -30,15 +32,20 @@ struct CaptureSummary {
   double gl_ms = 0.0;          // summed technique time (GL, per frame)
   std::uint64_t bytes = 0;     // trace file size
   std::uint64_t draws = 0;
+  // For techniques that cull objects (zero otherwise).
   std::uint64_t objects_rendered = 0, objects_visible = 0, visible_not_rendered = 0;
 };
 
 // Progress callback: frames done, frames total.
 using Progress = std::function<void(int, int)>;
 
-CaptureSummary capture_city(const CaptureOptions& options, const std::string& out_path, const Progress& progress = {});
+// Throws InputError on an unknown technique, scene or path, a bad or undeclared option, a bad size
+// or frame count, or a file that cannot be written.
+CaptureSummary capture(const CaptureOptions& options, const std::string& out_path, const Progress& progress = {});
 
-// "oq", "oq_hier", "nb", "nb_hier", "none"; empty optional-like: throws InputError on others.
-trace::TestMode parse_test_mode(const std::string& s);
+// The command line that repeats a capture in the current spelling, every option spelled out:
+// "nbsim capture TECHNIQUE --scene S --path P --size WxH --frames N [scene, path and technique
+// options] [--reversed-z] -o OUT".
+std::string canonical_command_line(const CaptureOptions& options, const std::string& out_path);
 
 }  // namespace nbsim::capture

@@ -1,58 +1,46 @@
-// The capture renderer: runs the occlusion-culling technique of the N-buffer paper (sections 3.1
-// and 4.2) on real OpenGL (Mesa llvmpipe, headless) for one frame at a time and records what the
-// trace needs: every draw with its GL state, clip-space geometry and GL counters, the depth buffer
-// after the occluders and at the end, the GLSL N-buffer levels, and the ID-buffer ground truth.
+// The capture renderer: a headless GL context on Mesa (llvmpipe) and one technique from the
+// technique table (technique.h) made on it for a scene. It renders one frame at a time into the
+// records the trace stores; capture.h streams them into a file.
 #pragma once
 
 #include <cstdint>
 #include <memory>
-#include <optional>
-#include <vector>
+#include <string>
 
 #include "traces/capture/camera.h"
-#include "traces/capture/city.h"
-#include "traces/format/records.h"
+#include "traces/capture/plugin.h"
+#include "traces/capture/scenes.h"
+#include "traces/capture/technique.h"
 #include "traces/gl/context.h"
 
 namespace nbsim::capture {
 
 struct RendererOptions {
+  std::string technique = "occlusion_culling";
   int width = 512;
   int height = 512;
-  trace::TestMode mode = trace::TestMode::NBufferHier;
   Projection projection;
-  // Margin subtracted from (LESS) or added to (reversed Z) a bounds' nearest depth, so that GL's
-  // interpolated fragment depths can never be nearer than it. Tunable; 1e-6 is ~16 float ulps at 1.
-  float nearest_margin = 1e-6f;
-};
-
-// One frame as the trace stores it.
-struct CapturedFrame {
-  trace::FrameBegin begin;
-  std::vector<trace::DrawRecord> draws;
-  std::vector<trace::DepthSnapshot> depth;      // after occluders, final
-  std::optional<trace::NBufferLevels> levels;   // when requested and the mode builds an N-buffer
-  trace::GroundTruth truth;
-  trace::FrameEnd end;
-  std::vector<std::uint32_t> rendered_objects;  // objects the technique drew (occluders + visible)
+  OptionValues options;  // the technique's options by name (others are ignored here)
 };
 
 class Renderer {
  public:
-  Renderer(const City& city, RendererOptions options);
-  ~Renderer();
+  // Throws InputError for an unknown technique or a bad option value.
+  Renderer(const CaptureScene& scene, const RendererOptions& options);
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Renders frame `index` from `pose`. Occluders are the objects visible (ground truth) in the
-  // previous call. keep_levels: read the GLSL N-buffer levels back into the frame.
-  CapturedFrame render(std::uint32_t index, const CameraPose& pose, bool keep_levels);
+  // Renders frame `index` (0, 1, ... in order) from `pose`.
+  CapturedFrame render(std::uint32_t index, const CameraPose& pose) { return technique_->render(index, pose); }
 
-  const gl::ContextInfo& gl_info() const;
+  const TechniqueRow& row() const noexcept { return *row_; }
+  const Technique& technique() const noexcept { return *technique_; }
+  const gl::ContextInfo& gl_info() const noexcept { return context_.info(); }
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  const TechniqueRow* row_;
+  gl::Context context_;  // made before the technique, current while it lives
+  std::unique_ptr<Technique> technique_;
 };
 
 }  // namespace nbsim::capture

@@ -1,0 +1,52 @@
+// GL program helpers; see gl_program.h.
+#include "traces/capture/gl_program.h"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace nbsim::capture {
+
+GLuint compile_shader(GLenum type, const std::string& source, const char* name) {
+  const GLuint s = glCreateShader(type);
+  const char* src = source.c_str();
+  glShaderSource(s, 1, &src, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096] = {};
+    glGetShaderInfoLog(s, sizeof log, nullptr, log);
+    glDeleteShader(s);
+    throw std::runtime_error(fmt::format("GLSL compile error in {}: {}", name, log));
+  }
+  return s;
+}
+
+GLuint link_program(std::initializer_list<GLuint> shaders, const char* name, bool capture_position) {
+  const GLuint p = glCreateProgram();
+  for (GLuint s : shaders) glAttachShader(p, s);
+  if (capture_position) {
+    const char* varyings[] = {"gl_Position"};
+    glTransformFeedbackVaryings(p, 1, varyings, GL_INTERLEAVED_ATTRIBS);
+  }
+  glLinkProgram(p);
+  for (GLuint s : shaders) glDeleteShader(s);
+  GLint ok = 0;
+  glGetProgramiv(p, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096] = {};
+    glGetProgramInfoLog(p, sizeof log, nullptr, log);
+    glDeleteProgram(p);
+    throw std::runtime_error(fmt::format("GLSL link error in {}: {}", name, log));
+  }
+  return p;
+}
+
+std::string with_defines(const char* source, const std::string& defines) {
+  std::string s(source);
+  const auto eol = s.find('\n', s.find("#version"));
+  return s.insert(eol + 1, defines);
+}
+
+}  // namespace nbsim::capture

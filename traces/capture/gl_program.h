@@ -1,0 +1,26 @@
+// GL program helpers of the capture renderer: compile a shader, link a program (optionally capturing
+// gl_Position with transform feedback), insert #defines into embedded GLSL. Also the one place that
+// includes GL's core prototypes, so every capture file sees the same declarations.
+#pragma once
+
+#ifndef GL_GLEXT_PROTOTYPES
+#define GL_GLEXT_PROTOTYPES 1
+#endif
+#include <GL/glcorearb.h>
+
+#include <initializer_list>
+#include <string>
+
+namespace nbsim::capture {
+
+// Compiles one shader stage; throws std::runtime_error with GL's log, naming `name`, on failure.
+GLuint compile_shader(GLenum type, const std::string& source, const char* name);
+
+// Links the shaders into a program and deletes them. capture_position: record gl_Position with
+// transform feedback (interleaved, one vec4 a vertex). Throws std::runtime_error with GL's log.
+GLuint link_program(std::initializer_list<GLuint> shaders, const char* name, bool capture_position = false);
+
+// `source` with `defines` inserted after its #version line.
+std::string with_defines(const char* source, const std::string& defines);
+
+}  // namespace nbsim::capture

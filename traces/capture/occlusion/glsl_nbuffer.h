@@ -1,0 +1,47 @@
+// The GLSL N-buffer of the occlusion-culling technique (N-buffer paper, Fig. 2 and section 3.2):
+// built from a depth texture by one full-screen pass per level (shaders/occlusion/nbuffer_build.frag,
+// each pass a recorded draw), queried in batches by a compute shader (nbuffer_query.comp), read
+// back as the trace's level record. Levels are R32F; max under LESS, min under reversed Z.
+#pragma once
+
+#include <vector>
+
+#include "model/common/depth.h"
+#include "model/scene/frame.h"
+#include "traces/capture/draw_recorder.h"
+#include "traces/capture/gl_program.h"
+
+namespace nbsim::capture {
+
+class GlslNBuffer {
+ public:
+  // Levels: nbuffer_level_count(width, height) (model/nbuffer/covering.h).
+  GlslNBuffer(int width, int height, FarOp op);
+  ~GlslNBuffer();
+  GlslNBuffer(const GlslNBuffer&) = delete;
+  GlslNBuffer& operator=(const GlslNBuffer&) = delete;
+
+  int levels() const noexcept { return levels_; }
+
+  // Builds every level from `depth_texture`, recording each pass (role NBufferBuild, its level,
+  // `state`) with `recorder`. Leaves back-face culling on and depth testing off.
+  void build(GLuint depth_texture, DrawRecorder& recorder, const scene::DepthState& state);
+
+  // One compute dispatch over the batch: sets each test's .visible (off-screen rectangles are
+  // never visible; bounds crossing the near plane always are).
+  void query(std::vector<scene::BoundsTest>& tests);
+
+  scene::NBufferLevels read() const;
+
+ private:
+  int width_ = 0, height_ = 0, levels_ = 1;
+  FarOp op_ = FarOp::Max;
+  GLuint build_prog_ = 0, query_prog_ = 0, empty_vao_ = 0;
+  GLuint query_ssbo_ = 0, result_ssbo_ = 0;
+  // One R32F texture per level to render into (no feedback loop), copied into the array texture
+  // that the passes and the queries read.
+  std::vector<GLuint> level_tex_, level_fbo_;
+  GLuint level_array_ = 0;
+};
+
+}  // namespace nbsim::capture

@@ -1,0 +1,29 @@
+// The camera-path table; see paths.h. A new path is a function in camera.cpp and one row here.
+#include "traces/capture/paths.h"
+
+#include "model/common/error.h"
+
+namespace nbsim::capture {
+
+namespace {
+
+std::vector<CameraPose> walk(const CaptureScene& s, int frames, const OptionValues& options) {
+  if (!s.site.has_streets()) throw InputError("camera path 'walk' needs a scene with streets (e.g. city); use --path fly");
+  return walk_path(s.site, frames, static_cast<std::uint32_t>(options.integer(seed_option())));
+}
+
+std::vector<CameraPose> fly(const CaptureScene& s, int frames, const OptionValues&) { return fly_path(s.site, frames); }
+
+}  // namespace
+
+const std::vector<PathRow>& path_table() {
+  static const std::vector<PathRow> table = {
+      {{"walk", "Street-level walkthrough, 1.2 m a frame, turning at random crossings (needs streets)", {seed_option()}}, walk},
+      {{"fly", "Flyover circling the scene once, looking at its centre", {}}, fly},
+  };
+  return table;
+}
+
+const PathRow& find_path(std::string_view name) { return find_row(path_table(), name, "camera path"); }
+
+}  // namespace nbsim::capture

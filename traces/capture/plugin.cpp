@@ -1,0 +1,86 @@
+// Plug-in options and rows; see plugin.h.
+#include "traces/capture/plugin.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+
+#include "model/common/error.h"
+
+namespace nbsim::capture {
+
+namespace {
+
+bool parse_integer(const std::string& s, std::int64_t& out) {
+  const char* end = s.data() + s.size();
+  const auto [p, ec] = std::from_chars(s.data(), end, out);
+  return !s.empty() && ec == std::errc() && p == end;
+}
+
+std::string joined(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+}  // namespace
+
+std::string option_problem(const OptionSpec& spec, const std::string& value) {
+  switch (spec.kind) {
+    case OptionSpec::Kind::Integer: {
+      std::int64_t v = 0;
+      if (!parse_integer(value, v)) return fmt::format("--{} '{}' is not an integer", spec.name, value);
+      if (v < spec.min || v > spec.max)
+        return fmt::format("--{} {} is out of range ({} to {})", spec.name, value, spec.min, spec.max);
+      return {};
+    }
+    case OptionSpec::Kind::Choice:
+      if (std::find(spec.choices.begin(), spec.choices.end(), value) == spec.choices.end())
+        return fmt::format("--{} '{}' is not one of {}", spec.name, value, joined(spec.choices));
+      return {};
+  }
+  return fmt::format("--{} has an unknown kind", spec.name);
+}
+
+std::string OptionValues::text(const OptionSpec& spec) const {
+  const auto it = values_.find(spec.name);
+  const std::string& v = it == values_.end() ? spec.default_value : it->second;
+  if (const std::string problem = option_problem(spec, v); !problem.empty()) throw InputError(problem);
+  return v;
+}
+
+std::int64_t OptionValues::integer(const OptionSpec& spec) const {
+  NBSIM_CHECK(spec.kind == OptionSpec::Kind::Integer, "integer() of a non-integer option " + spec.name);
+  std::int64_t v = 0;
+  parse_integer(text(spec), v);
+  return v;
+}
+
+const OptionSpec& seed_option() {
+  static const OptionSpec seed{"seed", "Seed of the scene and the camera path", "1", OptionSpec::Kind::Integer, 0, 4294967295LL, {}};
+  return seed;
+}
+
+void check_options_declared(const OptionValues& values, const std::vector<const PluginInfo*>& chosen) {
+  for (const auto& [name, value] : values.values()) {
+    bool declared = false;
+    std::vector<std::string> accepted, owners;
+    for (const PluginInfo* p : chosen) {
+      owners.push_back(p->name);
+      for (const OptionSpec& s : p->options) {
+        declared = declared || s.name == name;
+        if (std::find(accepted.begin(), accepted.end(), "--" + s.name) == accepted.end()) accepted.push_back("--" + s.name);
+      }
+    }
+    if (!declared)
+      throw InputError(fmt::format("option --{} is not an option of {}; they accept: {}", name, joined(owners),
+                                   accepted.empty() ? std::string("no options") : joined(accepted)));
+  }
+}
+
+void unknown_row(std::string_view kind, std::string_view name, const std::string& known) {
+  throw InputError(fmt::format("unknown {} '{}': known {}s are {}", kind, name, kind, known));
+}
+
+}  // namespace nbsim::capture

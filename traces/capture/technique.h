@@ -1,0 +1,65 @@
+// The capture side of the technique seam (ARCHITECTURE.md): a technique is a class that owns its
+// GL resources and passes and renders one frame at a time into a frame record, built from the
+// shared pieces (gl_program.h, draw_recorder.h, scene_pass.h, render_target.h, readback.h,
+// ground_truth.h). Techniques are chosen by name from one table (techniques.cpp): the name, a
+// one-line description, the options the technique reads and its factory. The header's "technique"
+// property is the row's name.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "model/scene/frame.h"
+#include "traces/capture/camera.h"
+#include "traces/capture/plugin.h"
+#include "traces/capture/scenes.h"
+#include "traces/format/records.h"
+
+namespace nbsim::capture {
+
+// What a technique is made with. The GL context is current while it is made and used.
+struct TechniqueSetup {
+  const CaptureScene& scene;  // outlives the technique
+  int width = 0, height = 0;  // viewport, pixels
+  Projection projection;      // reversed_z picks the depth convention
+  const OptionValues& options;  // its options (declared in its row); read them while constructing
+};
+
+// One rendered frame: the records the trace stores, in scene::Frame (begin, draws with index ==
+// position, depth images, N-buffer levels, ground truth, end), and the objects the technique drew.
+struct CapturedFrame {
+  scene::Frame frame;
+  // For techniques that cull objects: every object they drew, sorted. The capture checks that
+  // each object the ground truth sees is among them (a conservative technique culls none).
+  std::optional<std::vector<std::uint32_t>> rendered_objects;
+};
+
+class Technique {
+ public:
+  virtual ~Technique() = default;
+
+  // Header properties the technique adds. The header is: GL and depth convention, "technique" =
+  // the row's name, variant_properties(), the scene's, the camera path's and the projection's,
+  // setting_properties(), the tool's. (This is the order of every trace captured so far.)
+  virtual trace::Properties variant_properties() const = 0;   // what the technique is (e.g. test_mode)
+  virtual trace::Properties setting_properties() const = 0;   // how it is tuned (e.g. nearest_margin)
+
+  // Renders frame `index` (0, 1, ... in order) from `pose`.
+  virtual CapturedFrame render(std::uint32_t index, const CameraPose& pose) = 0;
+};
+
+struct TechniqueRow {
+  PluginInfo info;
+  // Throws InputError on bad option values.
+  std::function<std::unique_ptr<Technique>(const TechniqueSetup&)> make;
+};
+
+const std::vector<TechniqueRow>& technique_table();
+// Throws InputError listing the known techniques.
+const TechniqueRow& find_technique(std::string_view name);
+
+}  // namespace nbsim::capture
