@@ -27,7 +27,8 @@ void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
 }
 
 Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& c, int width_px, int height_px,
-         cp::FrameSource source, float clear_depth, depth::ResultSink& sink, const cull::CullSetup* cull)
+         cp::FrameSource source, float clear_depth, depth::ResultSink& sink, std::string_view technique,
+         const cull::CullSetup& setup)
     : sc_core::sc_module(name),
       memory_(c.memory),
       cp_to_geometry_("cp_to_geometry", c.fifo_depth),
@@ -44,30 +45,11 @@ Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const G
   raster_.in(geometry_to_raster_);
   raster_.out(raster_to_depth_);
   depth_.in(raster_to_depth_);
-  // Refuses cull.granularity=primitive in a mode without a depth-query structure (trace included).
-  const cull::Granularity granularity = c.cull.parsed_granularity();
-  if (c.cull.parsed_mode() != cull::CullMode::Trace) {
-    NBSIM_CHECK(cull != nullptr, "a culling mode needs the cull setup");
-    if (const std::optional<query::Kind> kind = c.cull.structure_kind()) {
-      switch (*kind) {
-        case query::Kind::NBuffer:
-          structure_ = std::make_unique<query::NBufferStructure>("nbuffer", registry, c.nbuffer, width_px, height_px,
-                                                                 cull->op, &memory_);
-          break;
-        case query::Kind::TileHiZ:
-          structure_ = std::make_unique<query::TileHiZUnit>("hiz", registry, c.hiz, width_px, height_px, cull->op);
-          break;
-        case query::Kind::HiZPyramid:
-          structure_ = std::make_unique<query::HiZPyramidUnit>("hiz", registry, c.hiz, cull->op);
-          break;
-      }
-    }
-    cull_ = std::make_unique<cull::CullUnit>("cull", registry, c.cull, *cull, depth_.buffer(), structure_.get());
-    cp_.set_program(cull_.get());
-    depth_.set_listener(cull_.get());
-    // Per-primitive culling: the cull stage tests the raster unit's triangles between setup and the tile walk.
-    if (granularity == cull::Granularity::Primitive) raster_.set_primitive_tester(cull_.get());
-  }
+  program_ = build_program(technique, ProgramContext{registry, c, setup, depth_.buffer(), memory_});
+  if (program_.frames) cp_.set_program(program_.frames);
+  if (program_.depth_listener) depth_.set_listener(program_.depth_listener);
+  // Per-primitive culling: the program tests the raster unit's triangles between setup and the tile walk.
+  if (program_.primitive_tester) raster_.set_primitive_tester(program_.primitive_tester);
   // The shared memory channel: bytes per client (every client has registered by now) and busy cycles.
   stats::Group& mem = registry.group(std::string(this->name()) + ".memory");
   for (std::size_t i = 0; i < memory_.clients().size(); ++i) {

@@ -5,9 +5,11 @@
 //   trace frames --> [cp] --fifo--> [geometry] --fifo--> [raster] --fifo--> [depth] --> ResultSink
 //                     ^                                                        |
 //                     |  frame program                 clears, dirty rects,    +- [memory channel]
-//                   [cull] <-------------------------- draw results -----------+        |
-//                     +-- [nbuffer] (nb modes) / tile Hi-Z / Hi-Z pyramid ---------------+
-// The cull stage exists only when cull.mode is not "trace" (model/cull/unit.h).
+//               [program] <------------------------ draw results -----------+        |
+//                     +-- [query structures: nbuffer / hiz] -----------------------------+
+// The frame program comes from the trace's technique and the config (programs.h: occlusion
+// culling's is the cull stage, model/cull/unit.h); with cull.mode=trace the command processor
+// replays the recorded draws and there is none.
 #pragma once
 
 #include <memory>
@@ -20,6 +22,7 @@
 #include "model/memory/memory.h"
 #include "model/query/units.h"
 #include "model/raster/unit.h"
+#include "pipeline/sim/programs.h"
 
 namespace nbsim::pipeline {
 
@@ -45,11 +48,13 @@ struct GpuConfig {
 
 class Gpu : public sc_core::sc_module {
  public:
+  // `technique` (the trace header's) and `setup` choose and feed the frame program (programs.h).
   Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& config, int width_px, int height_px,
-      cp::FrameSource source, float clear_depth, depth::ResultSink& sink, const cull::CullSetup* cull = nullptr);
+      cp::FrameSource source, float clear_depth, depth::ResultSink& sink, std::string_view technique,
+      const cull::CullSetup& setup);
 
   const memory::Channel& memory() const noexcept { return memory_; }
-  const cull::CullUnit* cull() const noexcept { return cull_.get(); }
+  const Program& program() const noexcept { return program_; }
 
  private:
   memory::Channel memory_;
@@ -60,8 +65,7 @@ class Gpu : public sc_core::sc_module {
   geometry::GeometryUnit geometry_;
   raster::RasterUnit raster_;
   depth::DepthUnit depth_;
-  std::unique_ptr<query::Structure> structure_;  // the culling mode's query structure, if it has one
-  std::unique_ptr<cull::CullUnit> cull_;          // culling modes only
+  Program program_;
 };
 
 }  // namespace nbsim::pipeline

@@ -315,7 +315,9 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.fused_interpolation = o.config.depth.fused_interpolation;
   sink.cull.mode = o.config.cull.mode;
   sink.cull.granularity = o.config.cull.granularity;
-  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, &setup);
+  const std::string* technique = tr.property("technique");
+  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink,
+          technique ? *technique : std::string(), setup);
   std::optional<sim::Timeline> timeline;  // only when asked: units then report their busy spans
   if (o.timeline || o.vcd) {
     sim::TimelineOptions to;
@@ -331,7 +333,8 @@ ReplaySummary replay(const ReplayOptions& o) {
   s.stats = registry.values();
   if (o.config.cull.parsed_mode() != cull::CullMode::Trace) {
     s.cull = sink.cull.to_json();
-    const query::Structure* structure = gpu.cull() ? gpu.cull()->structure() : nullptr;
+    const auto& structures = gpu.program().structures;
+    const query::Structure* structure = structures.empty() ? nullptr : structures.front().get();
     const long long bytes = structure ? structure->storage_bytes() : 0;
     s.cull["structure_memory_bytes"] = bytes;  // N-buffer levels, tile Hi-Z or pyramid
     s.cull["nbuffer_memory_bytes"] =

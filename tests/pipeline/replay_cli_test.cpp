@@ -160,6 +160,27 @@ TEST(ReplayCliTest, EmptyFramesReplay) {
   EXPECT_TRUE(j["within_thresholds"].get<bool>());
 }
 
+// The frame program comes from the trace's technique (pipeline/sim/programs.h): a technique
+// without a program replays its recorded draws, and a config that asks to cull it is refused.
+TEST(ReplayCliTest, ProgramChosenByTechnique) {
+  const fs::path t = scratch("other_technique.nbt");
+  {
+    nbsim::trace::TraceWriter w(t, {{"viewport", "8x8"}, {"depth_func", "LESS"}, {"depth_clear", "1"},
+                                    {"technique", "no_such_technique"}, {"frames", "1"}});
+    nbsim::trace::FrameBegin b;
+    w.begin_frame(b);
+    nbsim::trace::FrameEnd e;
+    w.end_frame(e);
+    w.close();
+  }
+  const CliResult replayed = run_nbsim("compare " + t.string() + " --json");
+  EXPECT_EQ(replayed.status, 0) << replayed.out << replayed.err;
+  const CliResult culled = run_nbsim("compare " + t.string() + " --set cull.mode=nb");
+  EXPECT_EQ(culled.status, 2) << culled.out << culled.err;
+  EXPECT_TRUE(has(culled.err, "the trace's technique is 'no_such_technique'")) << culled.err;
+  EXPECT_TRUE(has(culled.err, "programs exist for: occlusion_culling")) << culled.err;
+}
+
 // A damaged trace is refused by replay with exit 2 and the chunk named.
 TEST(ReplayCliTest, RefusesDamagedTrace) {
   const fs::path t = scratch("damaged.nbt");

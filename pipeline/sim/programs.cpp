@@ -1,0 +1,80 @@
+// The frame-program and structure-instance tables; see programs.h.
+#include "pipeline/sim/programs.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <string>
+
+#include "model/common/error.h"
+#include "pipeline/sim/gpu.h"
+
+namespace nbsim::pipeline {
+
+namespace {
+
+// Occlusion culling (the N-buffer paper, 3.1/4.2): cull.mode picks the query; "trace" replays.
+Program occlusion_culling(const ProgramContext& c) {
+  Program p;
+  c.config.cull.parsed_granularity();  // refuses cull.granularity=primitive with nothing to test against
+  if (c.config.cull.parsed_mode() == cull::CullMode::Trace) return p;
+  // The mode's query structure: the N-buffer unit, or the Hi-Z baselines.
+  if (const std::optional<query::Kind> kind = c.config.cull.structure_kind())
+    p.structures.push_back(c.structure(*kind == query::Kind::NBuffer ? "nbuffer" : "hiz", *kind, c.setup.op));
+  auto unit = std::make_unique<cull::CullUnit>("cull", c.registry, c.config.cull, c.setup, c.depth_buffer,
+                                               p.structures.empty() ? nullptr : p.structures.front().get());
+  p.frames = unit.get();
+  p.depth_listener = unit.get();
+  if (unit->granularity() == cull::Granularity::Primitive) p.primitive_tester = unit.get();
+  p.unit = std::move(unit);
+  return p;
+}
+
+constexpr std::array<ProgramRow, 1> kPrograms = {{
+    {"occlusion_culling",
+     "occlusion culling of a scene's objects (cull.mode: trace replays the recorded draws; none, oq, oq_hier, nb, "
+     "nb_hier, hiz_tile, hiz_pyramid cull every candidate again)",
+     occlusion_culling},
+}};
+
+constexpr std::array<StructureInstance, 2> kInstances = {{
+    {"nbuffer", "the N-buffer unit (keys nbuffer.*)"},
+    {"hiz", "the Hi-Z baselines, tile or pyramid (keys hiz.*)"},
+}};
+
+std::string technique_list() {
+  std::string s;
+  for (const ProgramRow& r : kPrograms) s += (s.empty() ? "" : ", ") + std::string(r.technique);
+  return s;
+}
+
+}  // namespace
+
+std::span<const ProgramRow> program_table() { return kPrograms; }
+std::span<const StructureInstance> structure_instances() { return kInstances; }
+
+std::unique_ptr<query::Structure> ProgramContext::structure(std::string_view instance, query::Kind kind, FarOp op) const {
+  const std::string name(instance);
+  const int w = setup.width_px, h = setup.height_px;
+  if (instance == "nbuffer" && kind == query::Kind::NBuffer)
+    return std::make_unique<query::NBufferStructure>(name.c_str(), registry, config.nbuffer, w, h, op, &memory);
+  if (instance == "hiz" && kind == query::Kind::TileHiZ)
+    return std::make_unique<query::TileHiZUnit>(name.c_str(), registry, config.hiz, w, h, op);
+  if (instance == "hiz" && kind == query::Kind::HiZPyramid)
+    return std::make_unique<query::HiZPyramidUnit>(name.c_str(), registry, config.hiz, op);
+  throw InputError(fmt::format("no query structure instance '{}' of kind {}", instance, query::to_string(kind)));
+}
+
+Program build_program(std::string_view technique, const ProgramContext& context) {
+  for (const ProgramRow& r : kPrograms)
+    if (r.technique == technique) return r.build(context);
+  if (context.config.cull.parsed_mode() != cull::CullMode::Trace)
+    throw InputError(fmt::format(
+        "cull.mode={} culls with occlusion culling's program, but the trace's technique is '{}' (programs exist for: "
+        "{}); cull.mode=trace replays the recorded draws of any technique",
+        context.config.cull.mode, technique.empty() ? "(none)" : std::string(technique), technique_list()));
+  context.config.cull.parsed_granularity();
+  return {};
+}
+
+}  // namespace nbsim::pipeline

@@ -1,0 +1,68 @@
+// The frame programs that replay a technique's traces, one row per technique, chosen by the name
+// the trace header carries ("technique"), and the query-structure instances a program may own.
+// Adding a technique's program is one row here (and its files under model/); the top level
+// (gpu.h) only wires what a row builds.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "model/cp/unit.h"
+#include "model/cull/unit.h"
+#include "model/depth/unit.h"
+#include "model/memory/memory.h"
+#include "model/query/units.h"
+#include "model/raster/primitive_tester.h"
+
+namespace nbsim::pipeline {
+
+struct GpuConfig;
+
+// What a program's factory gets from the top level. Units it builds become children of the top
+// level's module (they are built during its elaboration).
+struct ProgramContext {
+  stats::Registry& registry;
+  const GpuConfig& config;
+  const cull::CullSetup& setup;    // the trace as the programs see it: viewport, depth convention, scene
+  const DepthImage& depth_buffer;  // the depth unit's
+  memory::Channel& memory;
+
+  // Builds the query structure `instance` (a name of structure_instances(), whose config keys it
+  // reads) of `kind` over the viewport, farthest by `op`. Throws InputError for an unknown instance.
+  std::unique_ptr<query::Structure> structure(std::string_view instance, query::Kind kind, FarOp op) const;
+};
+
+// A program as the top level wires it: the frame program for the command processor, and its
+// listener on the depth unit and primitive tester in the raster unit when it has them.
+struct Program {
+  std::vector<std::unique_ptr<query::Structure>> structures;  // built before the program's unit
+  std::unique_ptr<sc_core::sc_module> unit;                   // owns the program
+  cp::FrameProgram* frames = nullptr;                         // null: replay the recorded draws
+  depth::DepthListener* depth_listener = nullptr;
+  raster::PrimitiveTester* primitive_tester = nullptr;
+};
+
+struct ProgramRow {
+  std::string_view technique;    // the trace header's "technique"
+  std::string_view description;  // for --help and messages
+  // The program this configuration asks for, or an empty Program to replay the recorded draws.
+  // Throws InputError for a configuration the technique cannot run.
+  Program (*build)(const ProgramContext& context);
+};
+
+std::span<const ProgramRow> program_table();
+
+// A query-structure instance: its name (also its config keys' prefix) and what it is.
+struct StructureInstance {
+  std::string_view name;
+  std::string_view description;
+};
+std::span<const StructureInstance> structure_instances();
+
+// The program for a trace of `technique` under `config`. A technique without a row replays its
+// recorded draws, and refuses a config that asks a program to cull (cull.mode other than trace).
+Program build_program(std::string_view technique, const ProgramContext& context);
+
+}  // namespace nbsim::pipeline
