@@ -1,5 +1,6 @@
-// Configuration of the Hi-Z baselines (config keys "hiz.<field>"): the single-level tile Hi-Z
-// (tile_hiz.h) and the Hi-Z pyramid (pyramid.h). A run uses one of them, so they share one group.
+// Configuration of the Hi-Z baselines (config keys "<instance>.<field>", "hiz.<field>" for
+// occlusion culling's): the single-level tile Hi-Z (tile_hiz.h) and the Hi-Z pyramid (pyramid.h).
+// A run uses one of them, so they share one group.
 // The depth convention (FarOp) comes from the trace, not from the config.
 #pragma once
 
@@ -21,8 +22,12 @@ struct HiZUnitConfig {
   double build_texels_per_cycle = 16.0; // texels recomputed a cycle (tile updates, pyramid rebuild)
   int build_latency_cycles = 16;        // per tile update batch or pyramid rebuild
 
-  // Declares "hiz.<field>", bound to `c` (the timing keys were "cull.hiz_<field>" before).
-  static void describe(config::Schema& schema, HiZUnitConfig& c);
+  // The keys' prefix: the instance's name (pipeline/sim/programs.h), "hiz" for occlusion
+  // culling's. Set by describe(); messages name the keys with it.
+  std::string key_prefix = "hiz";
+
+  // Declares "<prefix>.<field>", bound to `c` (hiz's timing keys were "cull.hiz_<field>" before).
+  static void describe(config::Schema& schema, HiZUnitConfig& c, const std::string& prefix = "hiz");
   // Throws InputError naming the key when a value is outside its limits.
   void validate() const;
   // The cores' configs (call after validate()).

@@ -69,69 +69,71 @@ int texel_bytes(StorageFormat f) noexcept { return nbsim::storage_bytes(f); }
 // ---------------------------------------------------------------------------------------------
 // Configuration
 
-void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c) {
-  s.add("nbuffer.resolution_divisor", c.resolution_divisor, "",
+void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c, const std::string& prefix) {
+  c.key_prefix = prefix;
+  const auto key = [&prefix](const char* field) { return prefix + "." + field; };
+  s.add(key("resolution_divisor"), c.resolution_divisor, "",
         "levels are built over a reduced image whose texel is the farthest of a divisor x divisor block of depth "
         "pixels (conservative); 1, 2, 4 or 8",
         1, 8);
-  s.add("nbuffer.format", c.format, "level storage format, rounded toward far (u24 stored as 32-bit D24X8)",
+  s.add(key("format"), c.format, "level storage format, rounded toward far (u24 stored as 32-bit D24X8)",
         name_list(kStorageFormatNames));
-  s.add("nbuffer.level_cap", c.level_cap, "level",
+  s.add(key("level_cap"), c.level_cap, "level",
         "highest level built, -1 builds all; larger rectangles are tiled with top-level squares", -1, kMaxLevelCap);
-  s.add("nbuffer.capped_max_lookups", c.capped_max_lookups, "lookups",
+  s.add(key("capped_max_lookups"), c.capped_max_lookups, "lookups",
         "most lookups spent tiling a rectangle whose level is above level_cap; beyond, or 0, the query answers "
         "incomplete (never hidden)",
         0, kMaxCappedLookups);
-  s.add("nbuffer.update_policy", c.update_policy,
+  s.add(key("update_policy"), c.update_policy,
         "when depth changes reach the levels: eager (at once), batched (at the end of a pass), lazy (when a query "
         "reads them)",
         name_list(kUpdatePolicyNames));
-  s.add("nbuffer.lookup_latency_cycles", c.lookup_latency_cycles, "cycles",
+  s.add(key("lookup_latency_cycles"), c.lookup_latency_cycles, "cycles",
         "latency of a query's lookups (address, tag check, data, compare) on cache hits", 0, kMaxLatencyCycles);
-  s.add("nbuffer.lookups_per_cycle", c.lookups_per_cycle, "lookups/cycle",
+  s.add(key("lookups_per_cycle"), c.lookups_per_cycle, "lookups/cycle",
         "texel lookups the query port issues per cycle", kMinRate, kMaxLookupRate);
-  s.add("nbuffer.update_texels_per_cycle", c.update_texels_per_cycle, "texels/cycle",
+  s.add(key("update_texels_per_cycle"), c.update_texels_per_cycle, "texels/cycle",
         "texels the update engine recomputes per cycle", kMinRate, kMaxUpdateRate);
-  s.add("nbuffer.update_latency_cycles", c.update_latency_cycles, "cycles",
+  s.add(key("update_latency_cycles"), c.update_latency_cycles, "cycles",
         "fill and drain latency of one batch of the update engine", 0, kMaxLatencyCycles);
-  s.add("nbuffer.cache_size_bytes", c.cache.size_bytes, "bytes",
+  s.add(key("cache_size_bytes"), c.cache.size_bytes, "bytes",
         "texel cache of the query port, a multiple of cache_line_bytes x cache_ways; 0 disables it", 0, kMaxCacheBytes);
-  s.add("nbuffer.cache_line_bytes", c.cache.line_bytes, "bytes",
+  s.add(key("cache_line_bytes"), c.cache.line_bytes, "bytes",
         "cache line, also the memory burst of a miss and one tile of texels; a power of two", kMinLineBytes,
         kMaxLineBytes);
-  s.add("nbuffer.cache_ways", c.cache.ways, "ways", "associativity of the texel cache", 1, kMaxWays);
+  s.add(key("cache_ways"), c.cache.ways, "ways", "associativity of the texel cache", 1, kMaxWays);
 }
 
 void NBufferUnitConfig::validate() const {
   auto bad = [](const std::string& msg) { throw InputError(msg); };
   if (resolution_divisor != 1 && resolution_divisor != 2 && resolution_divisor != 4 && resolution_divisor != 8)
-    bad(fmt::format("nbuffer.resolution_divisor must be 1, 2, 4 or 8, got {}", resolution_divisor));
-  if (!parse_storage_format(format)) bad(fmt::format("nbuffer.format must be one of f32, u24, u16, got '{}'", format));
+    bad(fmt::format("{}.resolution_divisor must be 1, 2, 4 or 8, got {}", key_prefix, resolution_divisor));
+  if (!parse_storage_format(format)) bad(fmt::format("{}.format must be one of f32, u24, u16, got '{}'", key_prefix, format));
   if (!parse_update_policy(update_policy))
-    bad(fmt::format("nbuffer.update_policy must be one of eager, batched, lazy, got '{}'", update_policy));
+    bad(fmt::format("{}.update_policy must be one of eager, batched, lazy, got '{}'", key_prefix, update_policy));
   if (level_cap < -1 || level_cap > kMaxLevelCap)
-    bad(fmt::format("nbuffer.level_cap must be -1 (all levels) or 0 to {}, got {}", kMaxLevelCap, level_cap));
+    bad(fmt::format("{}.level_cap must be -1 (all levels) or 0 to {}, got {}", key_prefix, kMaxLevelCap, level_cap));
   if (capped_max_lookups < 0 || capped_max_lookups > kMaxCappedLookups)
-    bad(fmt::format("nbuffer.capped_max_lookups must be 0 to {}, got {}", kMaxCappedLookups, capped_max_lookups));
+    bad(fmt::format("{}.capped_max_lookups must be 0 to {}, got {}", key_prefix, kMaxCappedLookups, capped_max_lookups));
   if (lookup_latency_cycles < 0 || lookup_latency_cycles > kMaxLatencyCycles)
-    bad(fmt::format("nbuffer.lookup_latency_cycles must be 0 to {}, got {}", kMaxLatencyCycles, lookup_latency_cycles));
+    bad(fmt::format("{}.lookup_latency_cycles must be 0 to {}, got {}", key_prefix, kMaxLatencyCycles, lookup_latency_cycles));
   if (update_latency_cycles < 0 || update_latency_cycles > kMaxLatencyCycles)
-    bad(fmt::format("nbuffer.update_latency_cycles must be 0 to {}, got {}", kMaxLatencyCycles, update_latency_cycles));
+    bad(fmt::format("{}.update_latency_cycles must be 0 to {}, got {}", key_prefix, kMaxLatencyCycles, update_latency_cycles));
   if (!std::isfinite(lookups_per_cycle) || lookups_per_cycle < kMinRate || lookups_per_cycle > kMaxLookupRate)
-    bad(fmt::format("nbuffer.lookups_per_cycle must be {} to {}, got {}", kMinRate, kMaxLookupRate, lookups_per_cycle));
+    bad(fmt::format("{}.lookups_per_cycle must be {} to {}, got {}", key_prefix, kMinRate, kMaxLookupRate, lookups_per_cycle));
   if (!std::isfinite(update_texels_per_cycle) || update_texels_per_cycle < kMinRate ||
       update_texels_per_cycle > kMaxUpdateRate)
-    bad(fmt::format("nbuffer.update_texels_per_cycle must be {} to {}, got {}", kMinRate, kMaxUpdateRate,
+    bad(fmt::format("{}.update_texels_per_cycle must be {} to {}, got {}", key_prefix, kMinRate, kMaxUpdateRate,
                     update_texels_per_cycle));
   const int line = cache.line_bytes;
   if (line < kMinLineBytes || line > kMaxLineBytes || (line & (line - 1)) != 0)
-    bad(fmt::format("nbuffer.cache_line_bytes must be a power of two from {} to {}, got {}", kMinLineBytes,
+    bad(fmt::format("{}.cache_line_bytes must be a power of two from {} to {}, got {}", key_prefix, kMinLineBytes,
                     kMaxLineBytes, line));
   if (cache.ways < 1 || cache.ways > kMaxWays)
-    bad(fmt::format("nbuffer.cache_ways must be 1 to {}, got {}", kMaxWays, cache.ways));
+    bad(fmt::format("{}.cache_ways must be 1 to {}, got {}", key_prefix, kMaxWays, cache.ways));
   if (cache.size_bytes < 0 || cache.size_bytes > kMaxCacheBytes || cache.size_bytes % (line * cache.ways) != 0)
     bad(fmt::format(
-        "nbuffer.cache_size_bytes must be 0 or a multiple of cache_line_bytes x cache_ways = {} up to {}, got {}",
+        "{}.cache_size_bytes must be 0 or a multiple of cache_line_bytes x cache_ways = {} up to {}, got {}", key_prefix,
         line * cache.ways, kMaxCacheBytes, cache.size_bytes));
 }
 

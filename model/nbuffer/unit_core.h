@@ -40,7 +40,7 @@ inline constexpr std::array<std::string_view, 3> kUpdatePolicyNames = {"eager", 
 std::string_view to_string(UpdatePolicy p) noexcept;
 std::optional<UpdatePolicy> parse_update_policy(std::string_view s) noexcept;
 
-// Configuration of the N-buffer unit (config keys "nbuffer.<field>"). Every default is tunable;
+// Configuration of an N-buffer unit (config keys "<instance>.<field>", "nbuffer.<field>" for occlusion culling's). Every default is tunable;
 // the timing defaults are design guesses, not measurements (see describe() for limits).
 struct NBufferUnitConfig {
   int resolution_divisor = 1;   // 1, 2, 4 or 8: levels over a (W/d) x (H/d) image
@@ -55,9 +55,13 @@ struct NBufferUnitConfig {
   // Texel cache of the query port: 16 KiB, 256-byte lines (an 8x8 tile of f32 texels), 4 ways.
   memory::CacheConfig cache{16 * 1024, 256, 4};
 
-  // Declares every field as "nbuffer.<field>" (the cache as nbuffer.cache_size_bytes,
-  // nbuffer.cache_line_bytes, nbuffer.cache_ways), bound to `c`.
-  static void describe(config::Schema& schema, NBufferUnitConfig& c);
+  // The keys' prefix: the instance's name (pipeline/sim/programs.h), "nbuffer" for the one
+  // occlusion culling owns. Set by describe(); messages name the keys with it.
+  std::string key_prefix = "nbuffer";
+
+  // Declares every field as "<prefix>.<field>" (the cache as <prefix>.cache_size_bytes,
+  // <prefix>.cache_line_bytes, <prefix>.cache_ways), bound to `c`.
+  static void describe(config::Schema& schema, NBufferUnitConfig& c, const std::string& prefix = "nbuffer");
   // Throws InputError naming the key when a value is outside its limits or inconsistent.
   void validate() const;
   StorageFormat storage_format() const;  // the parsed `format` (call after validate())

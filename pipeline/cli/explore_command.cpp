@@ -33,8 +33,7 @@ nlohmann::json check_config(const nlohmann::json& settings, const std::string& o
   pipeline::GpuConfig::describe(schema, c);
   schema.apply(settings, origin);
   try {
-    c.nbuffer.validate();
-    c.hiz.validate();
+    c.validate();
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", origin, e.what()));
   }

@@ -17,13 +17,25 @@ void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
         "sustained bandwidth shared by every client", 0.01, 1e6);
   s.add("memory.latency_cycles", c.memory.latency_cycles, "cycles", "from request to data", 0, 100000);
   cull::CullUnitConfig::describe(s, c.cull);
-  nbuffer::NBufferUnitConfig::describe(s, c.nbuffer);
-  HiZUnitConfig::describe(s, c.hiz);
+  for (auto& [name, config] : c.nbuffers) nbuffer::NBufferUnitConfig::describe(s, config, name);
+  for (auto& [name, config] : c.hiz) HiZUnitConfig::describe(s, config, name);
   s.add("gpu.fifo_depth", c.fifo_depth, "work items", "depth of the fifos between units", 1, 4096);
   s.add("gpu.quantum_cycles", c.quantum_cycles, "cycles",
         "temporal decoupling quantum: a unit runs ahead of simulated time by up to this many cycles before it "
         "synchronises (0: every work item synchronises, the most detailed timing)",
         0, 10'000'000);
+}
+
+GpuConfig::GpuConfig() {
+  for (const StructureInstance& i : structure_instances()) {
+    if (i.kind == InstanceKind::NBuffer) nbuffers[std::string(i.name)].key_prefix = i.name;
+    if (i.kind == InstanceKind::HiZ) hiz[std::string(i.name)].key_prefix = i.name;
+  }
+}
+
+void GpuConfig::validate() const {
+  for (const auto& [name, config] : nbuffers) config.validate();
+  for (const auto& [name, config] : hiz) config.validate();
 }
 
 Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& c, int width_px, int height_px,

@@ -12,7 +12,9 @@
 // replays the recorded draws and there is none.
 #pragma once
 
+#include <map>
 #include <memory>
+#include <string>
 
 #include "model/config/schema.h"
 #include "model/cp/unit.h"
@@ -33,8 +35,10 @@ struct GpuConfig {
   depth::DepthUnitConfig depth;
   memory::ChannelConfig memory;
   cull::CullUnitConfig cull;
-  nbuffer::NBufferUnitConfig nbuffer;  // used by the nb culling modes
-  HiZUnitConfig hiz;                   // used by the hiz culling modes
+  // The query-structure instances (programs.h structure_instances()) by name, one config each
+  // (keys "<name>.<field>"): "nbuffer" and "hiz" for occlusion culling's modes.
+  std::map<std::string, nbuffer::NBufferUnitConfig, std::less<>> nbuffers;
+  std::map<std::string, HiZUnitConfig, std::less<>> hiz;
   int fifo_depth = 4;  // work items between two units; tunable
   // Timing granularity, a fidelity knob: how many cycles a unit's thread may run ahead of SystemC
   // time before it synchronises (TLM-2.0 temporal decoupling, model/sim/unit.h). 0: every work
@@ -44,6 +48,11 @@ struct GpuConfig {
   // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.",
   // "nbuffer.", "hiz.", "gpu.").
   static void describe(config::Schema& s, GpuConfig& c);
+  // Throws InputError naming the key when a unit's value is out of its limits or inconsistent
+  // (the checks the units make when they are built, for a config checked before any run).
+  void validate() const;
+
+  GpuConfig();  // every structure instance at its defaults
 };
 
 class Gpu : public sc_core::sc_module {

@@ -38,8 +38,8 @@ constexpr std::array<ProgramRow, 1> kPrograms = {{
 }};
 
 constexpr std::array<StructureInstance, 2> kInstances = {{
-    {"nbuffer", "the N-buffer unit (keys nbuffer.*)"},
-    {"hiz", "the Hi-Z baselines, tile or pyramid (keys hiz.*)"},
+    {"nbuffer", InstanceKind::NBuffer, "occlusion culling's N-buffer unit (cull.mode nb, nb_hier)"},
+    {"hiz", InstanceKind::HiZ, "occlusion culling's Hi-Z baselines (cull.mode hiz_tile, hiz_pyramid)"},
 }};
 
 std::string technique_list() {
@@ -56,12 +56,14 @@ std::span<const StructureInstance> structure_instances() { return kInstances; }
 std::unique_ptr<query::Structure> ProgramContext::structure(std::string_view instance, query::Kind kind, FarOp op) const {
   const std::string name(instance);
   const int w = setup.width_px, h = setup.height_px;
-  if (instance == "nbuffer" && kind == query::Kind::NBuffer)
-    return std::make_unique<query::NBufferStructure>(name.c_str(), registry, config.nbuffer, w, h, op, &memory);
-  if (instance == "hiz" && kind == query::Kind::TileHiZ)
-    return std::make_unique<query::TileHiZUnit>(name.c_str(), registry, config.hiz, w, h, op);
-  if (instance == "hiz" && kind == query::Kind::HiZPyramid)
-    return std::make_unique<query::HiZPyramidUnit>(name.c_str(), registry, config.hiz, op);
+  const auto nb = config.nbuffers.find(instance);
+  if (nb != config.nbuffers.end() && kind == query::Kind::NBuffer)
+    return std::make_unique<query::NBufferStructure>(name.c_str(), registry, nb->second, w, h, op, &memory);
+  const auto hiz = config.hiz.find(instance);
+  if (hiz != config.hiz.end() && kind == query::Kind::TileHiZ)
+    return std::make_unique<query::TileHiZUnit>(name.c_str(), registry, hiz->second, w, h, op);
+  if (hiz != config.hiz.end() && kind == query::Kind::HiZPyramid)
+    return std::make_unique<query::HiZPyramidUnit>(name.c_str(), registry, hiz->second, op);
   throw InputError(fmt::format("no query structure instance '{}' of kind {}", instance, query::to_string(kind)));
 }
 

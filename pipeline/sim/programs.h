@@ -54,9 +54,13 @@ struct ProgramRow {
 
 std::span<const ProgramRow> program_table();
 
-// A query-structure instance: its name (also its config keys' prefix) and what it is.
+// A query-structure instance: its name (also its config keys' prefix: "<name>.<field>", declared
+// by GpuConfig::describe), the kind of unit it configures, and what it is for. A program that
+// owns several structures of one kind (a min and a max N-buffer) has one row for each.
+enum class InstanceKind : std::uint8_t { NBuffer = 0, HiZ = 1 };
 struct StructureInstance {
   std::string_view name;
+  InstanceKind kind;
   std::string_view description;
 };
 std::span<const StructureInstance> structure_instances();

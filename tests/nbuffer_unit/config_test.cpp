@@ -127,6 +127,29 @@ TEST(NBufferUnitConfigTest, ZeroCacheMissesEveryLookup) {
   EXPECT_EQ(a.cache_misses, static_cast<std::uint64_t>(a.lookups));
 }
 
+// Two instances of one unit (a min and a max N-buffer) have their own keys, and each names its own
+// keys in messages (pipeline/sim/programs.h: the instance's name is its prefix).
+TEST(NBufferUnitConfigTest, InstancesHaveTheirOwnKeys) {
+  NBufferUnitConfig min_levels, max_levels;
+  config::Schema s;
+  NBufferUnitConfig::describe(s, min_levels, "litmap_min");
+  NBufferUnitConfig::describe(s, max_levels, "litmap_max");
+  s.set("litmap_min.format=u16");
+  s.set("litmap_max.resolution_divisor=4");
+  EXPECT_EQ(min_levels.format, "u16");
+  EXPECT_EQ(max_levels.format, "f32") << "one instance's key reached the other";
+  EXPECT_EQ(max_levels.resolution_divisor, 4);
+  EXPECT_EQ(min_levels.resolution_divisor, 1);
+  EXPECT_THROW(s.set("nbuffer.format=u16"), InputError) << "no instance is named nbuffer here";
+  max_levels.update_policy = "sometimes";
+  try {
+    max_levels.validate();
+    ADD_FAILURE() << "update_policy 'sometimes' accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("litmap_max.update_policy must be"), std::string::npos) << e.what();
+  }
+}
+
 // The Hi-Z keys: defaults, --set, and refusals.
 TEST(NBufferUnitConfigTest, HiZKeys) {
   HiZUnitConfig c;
