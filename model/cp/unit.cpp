@@ -22,14 +22,13 @@ CommandProcessor::CommandProcessor(const sc_core::sc_module_name& name, stats::R
 }
 
 void CommandProcessor::send(WorkKind kind, const std::shared_ptr<const scene::Frame>& f, std::uint32_t draw,
-                            scene::DepthWhich which, std::shared_ptr<const FrameResult> result) {
+                            scene::DepthWhich which) {
   auto w = std::make_shared<Work>();
   w->kind = kind;
   w->frame = f;
   w->draw = draw;
   w->which = which;
   w->clear_depth = clear_depth_;
-  w->result = std::move(result);
   sim::blocking([&] { out.write(w); });
 }
 
@@ -60,8 +59,8 @@ void CommandProcessor::issue() {
     ++frames_;
     send(WorkKind::FrameBegin, f);
     if (program_) {
-      std::shared_ptr<const FrameResult> result = program_->run_frame(f, *this);
-      send(WorkKind::FrameEnd, f, 0, scene::DepthWhich::Final, std::move(result));
+      program_->run_frame(f, *this);
+      send(WorkKind::FrameEnd, f);
       continue;
     }
     // GL read the "after occluders" depth right after the last occluder draw.

@@ -24,12 +24,11 @@ class CommandProcessor;
 // A frame program: what the command processor issues for one frame between FrameBegin and
 // FrameEnd when a technique's program replays the trace (pipeline/sim/programs.h picks it by the
 // trace's technique; model/cull/unit.h is occlusion culling's). Without one the command processor
-// issues the recorded draws as they are. Returns what it did, attached to the frame's FrameEnd.
+// issues the recorded draws as they are. What a program did is in its statistics.
 class FrameProgram {
  public:
   virtual ~FrameProgram() = default;
-  virtual std::shared_ptr<const FrameResult> run_frame(const std::shared_ptr<const scene::Frame>& frame,
-                                                       CommandProcessor& cp) = 0;
+  virtual void run_frame(const std::shared_ptr<const scene::Frame>& frame, CommandProcessor& cp) = 0;
 };
 
 // Hands out the trace's frames one at a time (memory stays bounded by a frame); nullopt at the end.
@@ -53,8 +52,7 @@ class CommandProcessor : public sim::Unit {
   void run();
   void issue();
   void send(WorkKind kind, const std::shared_ptr<const scene::Frame>& f, std::uint32_t draw = 0,
-            scene::DepthWhich which = scene::DepthWhich::Final,
-            std::shared_ptr<const FrameResult> result = nullptr);
+            scene::DepthWhich which = scene::DepthWhich::Final);
   FrameProgram* program_ = nullptr;
   CommandProcessorConfig config_;
   FrameSource source_;

@@ -14,12 +14,6 @@
 
 namespace nbsim::cp {
 
-// What a frame program (unit.h) did in one frame; each program derives its own, and whoever reads
-// the frame's end downcasts to the program's type.
-struct FrameResult {
-  virtual ~FrameResult() = default;
-};
-
 enum class WorkKind : std::uint8_t {
   FrameBegin = 0,  // clear the depth buffer to `clear_depth`
   Draw = 1,        // one draw with geometry
@@ -35,12 +29,11 @@ struct Work {
   scene::DepthWhich which = scene::DepthWhich::Final;  // (Snapshot)
   float clear_depth = 1.0f;                            // (FrameBegin)
   // Frame programs (unit.h): a draw the program made itself (a bounding box), used instead of
-  // frame->draws[draw]; whether its depth writes feed the program's query structures; a ticket the
-  // program waits on; and, on FrameEnd, what the program did in the frame.
+  // frame->draws[draw]; whether its depth writes feed the program's query structures; and a ticket
+  // the program waits on. What a program did is in its statistics.
   std::shared_ptr<const scene::DrawRecord> own;
   bool feeds_cull = false;
   std::uint64_t ticket = 0;
-  std::shared_ptr<const FrameResult> result;
 
   const scene::DrawRecord& record() const { return own ? *own : frame->draws[draw]; }
 };

@@ -1,15 +1,15 @@
-// The cull stage's modes and its per-frame report (plain C++, no SystemC). The bounds tests and the
-// traversal it runs are the scene's (model/scene/visibility.h); model/cull/unit.h wraps them with
-// the query units, timing and counters.
+// The cull stage's modes and the log of its bounds tests (plain C++, no SystemC). The bounds tests
+// and the traversal it runs are the scene's (model/scene/visibility.h); model/cull/unit.h wraps
+// them with the query structures, timing and statistics.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <ostream>
 #include <string_view>
 #include <vector>
 
-#include "model/cp/work.h"
 #include "model/scene/visibility.h"
 
 namespace nbsim::cull {
@@ -33,49 +33,12 @@ std::string_view to_string(CullMode m) noexcept;
 std::optional<CullMode> parse_cull_mode(std::string_view s) noexcept;
 bool hierarchical(CullMode m) noexcept;
 
-// What the cull stage did in one frame (plain counters; the replay derives ratios).
-struct CullReport : cp::FrameResult {
-  CullMode mode = CullMode::Trace;
-  std::uint64_t in_frustum = 0;       // objects in the view frustum
-  std::uint64_t occluders = 0;        // of those, drawn first (recorded Occluder draws)
-  std::uint64_t candidates = 0;       // in_frustum - occluders: the objects the stage decides on
-  std::uint64_t bounds_tests = 0;     // object and node bounds tested
-  std::uint64_t node_tests = 0;       // of those, BVH nodes
-  std::uint64_t found_visible = 0;    // candidates found visible
-  std::uint64_t culled = 0;           // candidates not found visible
-  std::uint64_t undrawable = 0;       // found visible but the trace holds no geometry for them
-  std::uint64_t box_depth_tests = 0;  // occlusion queries: depth tests of the rasterized boxes
-  std::uint64_t lookups = 0;          // N-buffer / Hi-Z texels compared against
-  std::uint64_t max_lookups = 0;      // most texels one bounds test compared against
-  std::uint64_t update_texels = 0;    // N-buffer / Hi-Z texels recomputed from depth changes or rebuilt
-  std::uint64_t clear_texels = 0;     // N-buffer texels filled by the frame's fast clear (not counted as work)
-  bool has_truth = false;             // the frame has ground truth; the three below are meaningful
-  std::uint64_t candidates_not_visible = 0;  // candidates with no visible pixel
-  std::uint64_t false_culls = 0;             // culled candidates with visible pixels
-  std::uint64_t crossing_near = 0;           // bounds tests that crossed the near plane (never culled)
-  // cull.granularity=primitive (model/cull/primitive.h): the triangles of the drawn candidates,
-  // tested between setup and the tile walk. The raster unit fills these in after run_frame returned
-  // and before the frame's FrameEnd passes it (the pipeline is in order), so they are final when
-  // the FrameEnd reaches the end of the pipeline.
-  std::uint64_t primitive_tests = 0;             // triangles tested (accepted by setup, on screen)
-  std::uint64_t primitives_culled = 0;           // of those, found hidden and dropped
-  std::uint64_t primitive_lookups = 0;           // N-buffer / Hi-Z texels compared against for them
-  std::uint64_t primitive_fragments_culled = 0;  // fragments the dropped triangles would have rasterized
-  std::uint64_t primitive_false_culls = 0;       // dropped triangles with a fragment that passes against
-                                                 // the occluders' depth (an upper bound on real ones)
-
-  // Every bounds test of the frame, in order: what was tested, the decision and what it cost.
-  struct Test {
-    std::int32_t object = -1;  // object id, or -1 for a BVH node
-    std::int32_t node = -1;    // BVH node id, or -1 for an object
-    scene::BoundsTest bounds;  // rect, nearest depth, crosses_near, and the decision in .visible
-    std::uint64_t depth_tests = 0;  // box fragments (occlusion queries) or texels compared (N-buffer, Hi-Z)
-  };
-  std::vector<Test> tests;
-
-  // The depth tests spent on visibility queries (ARCHITECTURE.md: the paper-comparable count),
-  // bounds and per-primitive queries alike.
-  std::uint64_t query_depth_tests() const noexcept { return box_depth_tests + lookups + primitive_lookups; }
-};
+// The log of every bounds test (culls.csv, when a replay writes its outputs): what was tested
+// (an object, or a BVH node), its screen rectangle and nearest depth, the decision, what it cost
+// (box fragments or texels compared) and, for objects, the ground truth's visible pixels.
+inline constexpr std::string_view kBoundsTestLogHeader =
+    "frame,mode,object,node,x,y,w,h,nearest_depth,crosses_near,decision,depth_tests,truth_visible_pixels,false_cull";
+void write_bounds_test(std::ostream& log, std::uint32_t frame, CullMode mode, const scene::TestItem& item,
+                       const scene::BoundsTest& test, std::uint64_t depth_tests, const scene::GroundTruth* truth);
 
 }  // namespace nbsim::cull

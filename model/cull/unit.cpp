@@ -62,16 +62,24 @@ CullUnit::CullUnit(const sc_core::sc_module_name& name, stats::Registry& registr
       depth_buffer_(depth_buffer),
       structure_(structure),
       frames_(stats().counter("frames", "frames", "frames culled")),
+      in_frustum_(stats().counter("in_frustum", "objects", "objects in the view frustum")),
+      occluders_(stats().counter("occluders", "objects", "of those, drawn first (the recorded occluder draws)")),
       candidates_(stats().counter("candidates", "objects", "objects in the frustum that are not occluders")),
       bounds_tests_(stats().counter("bounds_tests", "tests", "object and BVH node bounds tested")),
       node_tests_(stats().counter("node_tests", "tests", "of those, BVH node bounds")),
-      lookups_(stats().counter("lookups", "texels", "N-buffer or Hi-Z texels compared against (query depth tests)")),
-      box_depth_tests_(stats().counter("box_depth_tests", "tests", "depth tests of occlusion-query boxes")),
-      update_texels_(stats().counter("update_texels", "texels", "N-buffer or Hi-Z texels recomputed or rebuilt")),
+      crossing_near_(stats().counter("crossing_near", "tests", "bounds tests crossing the near plane (never culled)")),
+      found_visible_(stats().counter("found_visible", "objects", "candidates found visible")),
       culled_(stats().counter("culled", "objects", "candidates not found visible")),
       undrawable_(stats().counter("undrawable", "objects", "found visible but without recorded geometry in the trace")),
+      frames_with_truth_(stats().counter("frames_with_truth", "frames", "frames whose ground truth covers the scene")),
+      candidates_not_visible_(
+          stats().counter("candidates_not_visible", "objects", "candidates with no visible pixel (ground truth)")),
       false_culls_(stats().counter("false_culls", "objects", "culled candidates that ground truth shows visible")),
-      check_(setup.width_px, setup.height_px),
+      box_depth_tests_(stats().counter("box_depth_tests", "tests", "depth tests of occlusion-query boxes")),
+      lookups_(stats().counter("lookups", "texels", "N-buffer or Hi-Z texels compared against for bounds (query depth tests)")),
+      max_lookups_(stats().maximum("max_lookups", "texels", "most texels one bounds test compared against")),
+      update_texels_(stats().counter("update_texels", "texels", "N-buffer or Hi-Z texels recomputed or rebuilt")),
+      clear_texels_(stats().counter("clear_texels", "texels", "N-buffer texels filled by fast clears (not counted as work)")),
       primitive_tests_(stats().counter("primitive_tests", "triangles",
                                        "triangles of drawn candidates tested before the tile walk (cull.granularity=primitive)")),
       primitives_culled_(stats().counter("primitives_culled", "triangles", "of those, found hidden and dropped")),
@@ -80,7 +88,16 @@ CullUnit::CullUnit(const sc_core::sc_module_name& name, stats::Registry& registr
       primitive_fragments_culled_(stats().counter("primitive_fragments_culled", "fragments",
                                                   "fragments (and depth tests) the dropped triangles would have cost")),
       primitive_false_culls_(stats().counter("primitive_false_culls", "triangles",
-                                             "dropped triangles with a fragment passing against the occluders' depth")) {
+                                             "dropped triangles with a fragment passing against the occluders' depth")),
+      check_(setup.width_px, setup.height_px) {
+  // Derived when the statistics are dumped (ARCHITECTURE.md: the paper-comparable count).
+  stats().formula("query_depth_tests", "tests",
+                  "depth tests spent on visibility queries: box fragments, and texels compared for bounds and triangles",
+                  [this] { return static_cast<double>(query_depth_tests()); });
+  stats().formula("culling_efficiency", "", "culled / candidates_not_visible (1 when every candidate was visible)", [this] {
+    return candidates_not_visible_.value() ? static_cast<double>(culled_.value()) / static_cast<double>(candidates_not_visible_.value())
+                                           : 1.0;
+  });
   if (mode_ == CullMode::Trace) throw InputError("cull.mode=trace replays the recorded draws: no cull stage");
   if (!setup_.scene || setup_.scene->objects.empty())
     throw InputError(fmt::format("cull.mode={} needs the trace's scene objects (SCEN chunk)", to_string(mode_)));
@@ -125,17 +142,16 @@ void CullUnit::depth_written(const cp::Work& w, const DepthImage& depth, const R
   if (structure_) pending_update_texels_ += structure_->changed(depth, dirty);
 }
 
-void CullUnit::prepare(CullReport& r) {
+void CullUnit::prepare() {
   if (structure_) pending_update_texels_ += structure_->prepare(depth_buffer_);
-  r.update_texels += pending_update_texels_;
-  r.clear_texels += pending_clear_texels_;
   update_texels_ += pending_update_texels_;
+  clear_texels_ += pending_clear_texels_;
   pending_update_texels_ = pending_clear_texels_ = 0;
 }
 
 void CullUnit::test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const scene::Frame>& f, const scene::FrameView& v,
                           const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests,
-                          std::vector<std::uint64_t>& cost, CullReport& r) {
+                          std::vector<std::uint64_t>& cost) {
   const scene::SceneObjects& s = *setup_.scene;
   std::vector<std::uint64_t> tickets(items.size());
   for (std::size_t i = 0; i < items.size(); ++i) {
@@ -163,7 +179,7 @@ void CullUnit::test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const 
   for (std::size_t i = 0; i < items.size(); ++i) {
     const auto it = results_.find(tickets[i]);
     NBSIM_CHECK(it != results_.end(), "an occlusion query's result went missing");
-    r.box_depth_tests += it->second.depth_tests;
+    box_depth_tests_ += it->second.depth_tests;
     cost[i] = it->second.depth_tests;
     tests[i].visible = tests[i].crosses_near || it->second.passed > 0;
     results_.erase(it);
@@ -171,7 +187,7 @@ void CullUnit::test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const 
 }
 
 void CullUnit::test_lookups(const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests,
-                            std::vector<std::uint64_t>& cost, CullReport& r) {
+                            std::vector<std::uint64_t>& cost) {
   for (std::size_t i = 0; i < items.size(); ++i) {
     scene::BoundsTest& t = tests[i];
     if (t.crosses_near) {
@@ -184,12 +200,11 @@ void CullUnit::test_lookups(const std::vector<scene::TestItem>& items, std::vect
     }
     NBSIM_CHECK(structure_ != nullptr, "a lookup mode without its query structure");
     const query::Answer a = structure_->query(Rect{t.x, t.y, t.w, t.h}, t.nearest_depth);
-    r.lookups += a.lookups;
-    r.update_texels += a.update_texels;
+    lookups_ += a.lookups;
     update_texels_ += a.update_texels;
     t.visible = !a.hidden;
     cost[i] = a.lookups;
-    r.max_lookups = std::max(r.max_lookups, a.lookups);
+    max_lookups_.raise_to(a.lookups);
   }
 }
 
@@ -204,9 +219,6 @@ bool CullUnit::tests_primitives(const cp::Work& w) const {
 }
 
 void CullUnit::test_primitives(const cp::Work& w, std::span<const raster::SetupPrimitive> prims, std::vector<char>& hidden) {
-  const auto it = reports_.find(w.frame.get());
-  NBSIM_CHECK(it != reports_.end(), "a triangle was tested after its frame's report was dropped");
-  CullReport& r = *it->second;
   prim_index_.clear(), prim_rects_.clear(), prim_nearest_.clear();
   for (std::size_t i = 0; i < prims.size(); ++i) {
     const PrimitiveQuery q = primitive_query(*prims[i].window, prims[i].setup, setup_.op, setup_.fused_interpolation);
@@ -224,7 +236,6 @@ void CullUnit::test_primitives(const cp::Work& w, std::span<const raster::SetupP
     update += a.update_texels;
     hidden[prim_index_[k]] = a.hidden ? 1 : 0;
   }
-  r.update_texels += update;
   update_texels_ += update;
 
   // The check, off the clock (false_cull_check.h).
@@ -237,11 +248,6 @@ void CullUnit::test_primitives(const cp::Work& w, std::span<const raster::SetupP
     fragments += c.fragments;
     false_culls += c.passes ? 1 : 0;
   }
-  r.primitive_tests += prim_index_.size();
-  r.primitives_culled += culled;
-  r.primitive_lookups += lookups;
-  r.primitive_fragments_culled += fragments;
-  r.primitive_false_culls += false_culls;
   primitive_tests_ += prim_index_.size();
   primitives_culled_ += culled;
   primitive_lookups_ += lookups;
@@ -249,15 +255,23 @@ void CullUnit::test_primitives(const cp::Work& w, std::span<const raster::SetupP
   primitive_false_culls_ += false_culls;
 }
 
-std::shared_ptr<const cp::FrameResult> CullUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) {
+void CullUnit::set_test_log(std::ostream* log) {
+  test_log_ = log;
+  if (test_log_) *test_log_ << kBoundsTestLogHeader << "\n";
+}
+
+std::uint64_t CullUnit::query_depth_tests() const noexcept {
+  return box_depth_tests_.value() + lookups_.value() + primitive_lookups_.value();
+}
+
+void CullUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) {
   ++frames_begun_;  // the command processor has sent this frame's FrameBegin (a clear)
-  auto report = std::make_shared<CullReport>();
-  CullReport& r = *report;
-  r.mode = mode_;
   const scene::SceneObjects& s = *setup_.scene;
-  const scene::FrameView v = scene::FrameView::make(f->begin, setup_.width_px, setup_.height_px, setup_.near_m, setup_.nearest_margin,
-                                      setup_.zero_to_one, setup_.op == FarOp::Min);
+  const scene::FrameView v = scene::FrameView::make(f->begin, setup_.width_px, setup_.height_px, setup_.near_m,
+                                                    setup_.nearest_margin, setup_.zero_to_one, setup_.op == FarOp::Min);
   const std::vector<std::uint32_t> in_frustum = scene::frustum_objects(s, v);
+  const scene::GroundTruth* truth = f->truth ? &*f->truth : nullptr;
+  const bool has_truth = truth && truth->visible_pixels.size() >= s.objects.size();
 
   // The recorded geometry of each object (an Occluder or Visible draw), and this frame's occluders.
   std::vector<std::int64_t> geometry(s.objects.size(), -1);
@@ -270,7 +284,7 @@ std::shared_ptr<const cp::FrameResult> CullUnit::run_frame(const std::shared_ptr
     if (d.role == scene::DrawRole::Occluder) is_occluder[static_cast<std::size_t>(d.object)] = 1;
   }
 
-  // 1. The occluders, in the recorded order; their depth writes feed the cull structure.
+  // 1. The occluders, in the recorded order; their depth writes feed the query structure.
   for (std::size_t i = 0; i < f->draws.size(); ++i) {
     const scene::DrawRecord& d = f->draws[i];
     if (d.role != scene::DrawRole::Occluder || d.clip_positions.empty()) continue;
@@ -281,59 +295,55 @@ std::shared_ptr<const cp::FrameResult> CullUnit::run_frame(const std::shared_ptr
     issue(cp, std::move(w), false);
   }
   cp.issue_snapshot(f, scene::DepthWhich::AfterOccluders);
+  // Every earlier frame has left the pipeline once this returns, its statistics final: from here
+  // on everything this unit counts is this frame's until its FrameEnd, and the raster unit tests
+  // only this frame's triangles, against the occluders' depth.
   wait_all();
-  prepare(r);
-  // Every earlier frame's draws have left the pipeline: from here on the raster unit tests only
-  // this frame's triangles, against the occluders' depth.
-  reports_.clear();
-  if (granularity_ == Granularity::Primitive) {
-    reports_[f.get()] = report;
-    check_.set_occluder_depth(depth_buffer_);
-  }
+  prepare();
+  if (granularity_ == Granularity::Primitive) check_.set_occluder_depth(depth_buffer_);
 
-  // 2. Bounds tests of the candidates.
+  // 2. Bounds tests of the candidates, each logged with its decision and cost.
   const scene::BatchTester tester = [&](const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests) {
-    r.bounds_tests += items.size();
-    for (const scene::TestItem& it : items) r.node_tests += it.node >= 0 ? 1 : 0;
-    for (const scene::BoundsTest& t : tests) r.crossing_near += t.crosses_near ? 1 : 0;
-    if (mode_ == CullMode::None) {
-      for (std::size_t i = 0; i < items.size(); ++i) {
-        tests[i].visible = true;
-        r.tests.push_back({items[i].object, items[i].node, tests[i], 0});
-      }
-      return;
-    }
-    label_with([&] { return fmt::format("{} bounds tests", items.size()); });
-    work(sim::batch_cycles(items.size(), config_.bounds_tests_per_cycle, config_.bounds_latency_cycles));
+    bounds_tests_ += items.size();
+    for (const scene::TestItem& it : items) node_tests_ += it.node >= 0 ? 1 : 0;
+    for (const scene::BoundsTest& t : tests) crossing_near_ += t.crosses_near ? 1 : 0;
     std::vector<std::uint64_t> cost(items.size(), 0);
-    if (mode_ == CullMode::Oq || mode_ == CullMode::OqHier)
-      test_boxes(cp, f, v, items, tests, cost, r);
-    else
-      test_lookups(items, tests, cost, r);
-    for (std::size_t i = 0; i < items.size(); ++i) r.tests.push_back({items[i].object, items[i].node, tests[i], cost[i]});
+    if (mode_ == CullMode::None) {
+      for (scene::BoundsTest& t : tests) t.visible = true;
+    } else {
+      label_with([&] { return fmt::format("{} bounds tests", items.size()); });
+      work(sim::batch_cycles(items.size(), config_.bounds_tests_per_cycle, config_.bounds_latency_cycles));
+      if (mode_ == CullMode::Oq || mode_ == CullMode::OqHier)
+        test_boxes(cp, f, v, items, tests, cost);
+      else
+        test_lookups(items, tests, cost);
+    }
+    if (test_log_)
+      for (std::size_t i = 0; i < items.size(); ++i)
+        write_bounds_test(*test_log_, f->begin.frame, mode_, items[i], tests[i], cost[i], truth);
   };
   const std::vector<char> visible = scene::find_visible(s, v, in_frustum, is_occluder, hierarchical(mode_), tester);
 
   // 3. The objects found visible, with the geometry the trace recorded for them.
-  const scene::GroundTruth* truth = f->truth ? &*f->truth : nullptr;
-  r.has_truth = truth && truth->visible_pixels.size() >= s.objects.size();
-  r.in_frustum = in_frustum.size();
+  ++frames_;
+  frames_with_truth_ += has_truth ? 1 : 0;
+  in_frustum_ += in_frustum.size();
   for (auto o : in_frustum) {
     if (is_occluder[o]) {
-      ++r.occluders;
+      ++occluders_;
       continue;
     }
-    ++r.candidates;
-    const bool truly_visible = r.has_truth && truth->visible_pixels[o] > 0;
-    if (r.has_truth && !truly_visible) ++r.candidates_not_visible;
+    ++candidates_;
+    const bool truly_visible = has_truth && truth->visible_pixels[o] > 0;
+    if (has_truth && !truly_visible) ++candidates_not_visible_;
     if (!visible[o]) {
-      ++r.culled;
-      if (truly_visible) ++r.false_culls;
+      ++culled_;
+      if (truly_visible) ++false_culls_;
       continue;
     }
-    ++r.found_visible;
+    ++found_visible_;
     if (geometry[o] < 0) {
-      ++r.undrawable;
+      ++undrawable_;
       continue;
     }
     auto w = std::make_shared<cp::Work>();
@@ -341,16 +351,6 @@ std::shared_ptr<const cp::FrameResult> CullUnit::run_frame(const std::shared_ptr
     w->draw = static_cast<std::uint32_t>(geometry[o]);
     issue(cp, std::move(w), false);
   }
-  ++frames_;
-  candidates_ += r.candidates;
-  bounds_tests_ += r.bounds_tests;
-  node_tests_ += r.node_tests;
-  lookups_ += r.lookups;
-  box_depth_tests_ += r.box_depth_tests;
-  culled_ += r.culled;
-  undrawable_ += r.undrawable;
-  false_culls_ += r.false_culls;
-  return report;
 }
 
 }  // namespace nbsim::cull

@@ -13,13 +13,15 @@
 // unit's PrimitiveTester (model/raster/primitive_tester.h), every triangle of the objects it draws
 // as visible candidates, between setup and the tile walk, against the same structure: see
 // test_primitives().
-// It listens to the depth unit (clears, dirty rectangles, draw results), passes the changes of the
-// occluder draws on to its query structure, and reports per frame a CullReport (report.h) that
-// rides on the frame's FrameEnd work item. The query structure (model/query/structure.h) is a
+// It listens to the depth unit (clears, dirty rectangles, draw results) and passes the changes of
+// the occluder draws on to its query structure. What it did is in its statistics (the only result
+// channel: per frame, they are final when the frame's FrameEnd leaves the depth unit, because the
+// next frame's tests wait for that) and, when asked, in a log of every bounds test (culls.csv). The query structure (model/query/structure.h) is a
 // separate unit that the top level builds for the mode and hands over.
 #pragma once
 
 #include <memory>
+#include <ostream>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -81,7 +83,12 @@ class CullUnit : public sim::Unit,
   const query::Structure* structure() const noexcept { return structure_; }
 
   // cp::FrameProgram (from the command processor's thread).
-  std::shared_ptr<const cp::FrameResult> run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
+  void run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
+
+  // Writes kBoundsTestLogHeader, then one row per bounds test (report.h) to `log` (null: none).
+  void set_test_log(std::ostream* log);
+  // Depth tests spent on visibility queries so far (the statistic query_depth_tests).
+  std::uint64_t query_depth_tests() const noexcept;
 
   // depth::DepthListener (from the depth unit's thread).
   void depth_cleared(float depth) override;
@@ -108,12 +115,12 @@ class CullUnit : public sim::Unit,
   };
   std::uint64_t issue(cp::CommandProcessor& cp, std::shared_ptr<cp::Work> w, bool wants_result);
   void wait_all();  // until every issued draw and frame clear has left the depth unit
-  void prepare(CullReport& r);  // the structure the queries read is current
+  void prepare();  // the structure the queries read is current
   void test_boxes(cp::CommandProcessor& cp, const std::shared_ptr<const scene::Frame>& f, const scene::FrameView& v,
                   const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests,
-                  std::vector<std::uint64_t>& cost, CullReport& r);
+                  std::vector<std::uint64_t>& cost);
   void test_lookups(const std::vector<scene::TestItem>& items, std::vector<scene::BoundsTest>& tests,
-                  std::vector<std::uint64_t>& cost, CullReport& r);
+                    std::vector<std::uint64_t>& cost);
 
   CullUnitConfig config_;
   CullMode mode_;
@@ -130,20 +137,21 @@ class CullUnit : public sim::Unit,
   // Work heard from the depth unit since the last frame's queries started.
   std::uint64_t pending_update_texels_ = 0, pending_clear_texels_ = 0;
 
-  stats::Counter &frames_, &candidates_, &bounds_tests_, &node_tests_, &lookups_, &box_depth_tests_, &update_texels_,
-      &culled_, &undrawable_, &false_culls_;
+  std::ostream* test_log_ = nullptr;
 
-  // cull.granularity=primitive: the report each triangle's frame adds to (this frame's, and the
-  // previous frame's while its last draws are still in the raster unit); the check of dropped
-  // triangles against this frame's occluders' depth; scratch of test_primitives().
-  std::unordered_map<const scene::Frame*, std::shared_ptr<CullReport>> reports_;
+  stats::Counter &frames_, &in_frustum_, &occluders_, &candidates_, &bounds_tests_, &node_tests_, &crossing_near_,
+      &found_visible_, &culled_, &undrawable_, &frames_with_truth_, &candidates_not_visible_, &false_culls_,
+      &box_depth_tests_, &lookups_, &max_lookups_, &update_texels_, &clear_texels_;
+  stats::Counter &primitive_tests_, &primitives_culled_, &primitive_lookups_, &primitive_fragments_culled_,
+      &primitive_false_culls_;
+
+  // cull.granularity=primitive: the check of dropped triangles against this frame's occluders'
+  // depth; scratch of test_primitives().
   FalseCullCheck check_;
   std::vector<std::size_t> prim_index_;
   std::vector<Rect> prim_rects_;
   std::vector<float> prim_nearest_;
   std::vector<query::Answer> prim_answers_;
-  stats::Counter &primitive_tests_, &primitives_culled_, &primitive_lookups_, &primitive_fragments_culled_,
-      &primitive_false_culls_;
 };
 
 }  // namespace nbsim::cull

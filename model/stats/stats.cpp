@@ -32,6 +32,12 @@ Counter& Group::counter(const std::string& name, const std::string& unit, const 
   return counters_.emplace_back(name, unit, description);
 }
 
+Counter& Group::maximum(const std::string& name, const std::string& unit, const std::string& description) {
+  claim(name);
+  kinds_[name] = 'm';
+  return counters_.emplace_back(name, unit, description);
+}
+
 VectorCounter& Group::vector(const std::string& name, const std::string& unit, const std::string& description,
                              std::vector<std::string> labels) {
   claim(name);
@@ -67,7 +73,8 @@ nlohmann::ordered_json Group::values() const {
   std::size_t ci = 0, vi = 0;
   for (const auto& name : order_) {
     switch (kinds_.at(name)) {
-      case 'c': j[name] = counters_[ci++].value(); break;
+      case 'c':
+      case 'm': j[name] = counters_[ci++].value(); break;
       case 'v': {
         const VectorCounter& v = vectors_[vi++];
         nlohmann::ordered_json b = nlohmann::ordered_json::object();
@@ -87,7 +94,12 @@ nlohmann::ordered_json Group::describe() const {
   for (const auto& name : order_) {
     std::string unit, desc, kind;
     switch (kinds_.at(name)) {
-      case 'c': unit = counters_[ci].unit(), desc = counters_[ci].description(), kind = "counter", ++ci; break;
+      case 'c':
+      case 'm':
+        unit = counters_[ci].unit(), desc = counters_[ci].description();
+        kind = kinds_.at(name) == 'c' ? "counter" : "maximum";
+        ++ci;
+        break;
       case 'v': unit = vectors_[vi].unit(), desc = vectors_[vi].description(), kind = "vector", ++vi; break;
       default: {
         const Formula& f = by_name(formulas_, name);
@@ -104,7 +116,8 @@ void Group::flatten(std::vector<std::pair<std::string, double>>& out) const {
   for (const auto& name : order_) {
     const std::string full = name_ + "." + name;
     switch (kinds_.at(name)) {
-      case 'c': out.emplace_back(full, static_cast<double>(counters_[ci++].value())); break;
+      case 'c':
+      case 'm': out.emplace_back(full, static_cast<double>(counters_[ci++].value())); break;
       case 'v': {
         const VectorCounter& v = vectors_[vi++];
         for (std::size_t k = 0; k < v.size(); ++k) out.emplace_back(full + "." + v.labels()[k], static_cast<double>(v.value(k)));

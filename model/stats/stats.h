@@ -15,13 +15,15 @@
 
 namespace nbsim::stats {
 
-// A monotonically counted quantity (events, bytes, cycles).
+// A monotonically counted quantity (events, bytes, cycles), or, declared with Group::maximum, the
+// largest value seen (raise_to).
 class Counter {
  public:
   Counter(std::string name, std::string unit, std::string description)
       : name_(std::move(name)), unit_(std::move(unit)), description_(std::move(description)) {}
   Counter& operator+=(std::uint64_t n) noexcept { value_ += n; return *this; }
   Counter& operator++() noexcept { ++value_; return *this; }
+  void raise_to(std::uint64_t n) noexcept { value_ = n > value_ ? n : value_; }
   std::uint64_t value() const noexcept { return value_; }
   void reset() noexcept { value_ = 0; }
   const std::string& name() const noexcept { return name_; }
@@ -67,6 +69,8 @@ class Group {
   Group& operator=(const Group&) = delete;
 
   Counter& counter(const std::string& name, const std::string& unit, const std::string& description);
+  // The largest of the values given to raise_to() (e.g. the most lookups one query took).
+  Counter& maximum(const std::string& name, const std::string& unit, const std::string& description);
   VectorCounter& vector(const std::string& name, const std::string& unit, const std::string& description,
                         std::vector<std::string> labels);
   void formula(const std::string& name, const std::string& unit, const std::string& description, std::function<double()> f);

@@ -12,6 +12,7 @@
 // replays the recorded draws and there is none.
 #pragma once
 
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
@@ -60,7 +61,7 @@ class Gpu : public sc_core::sc_module {
   // `technique` (the trace header's) and `setup` choose and feed the frame program (programs.h).
   Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& config, int width_px, int height_px,
       cp::FrameSource source, float clear_depth, depth::ResultSink& sink, std::string_view technique,
-      const cull::CullSetup& setup);
+      const cull::CullSetup& setup, const std::filesystem::path* out = nullptr);
 
   const memory::Channel& memory() const noexcept { return memory_; }
   const Program& program() const noexcept { return program_; }

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <fstream>
 #include <string>
 
 #include "model/common/error.h"
@@ -23,6 +24,12 @@ Program occlusion_culling(const ProgramContext& c) {
     p.structures.push_back(c.structure(*kind == query::Kind::NBuffer ? "nbuffer" : "hiz", *kind, c.setup.op));
   auto unit = std::make_unique<cull::CullUnit>("cull", c.registry, c.config.cull, c.setup, c.depth_buffer,
                                                p.structures.empty() ? nullptr : p.structures.front().get());
+  if (c.out) {  // every bounds test with its decision, cost and ground truth
+    auto log = std::make_unique<std::ofstream>(*c.out / "culls.csv");
+    if (!*log) throw InputError(fmt::format("cannot write into '{}'", c.out->string()));
+    unit->set_test_log(log.get());
+    p.logs.push_back(std::move(log));
+  }
   p.frames = unit.get();
   p.depth_listener = unit.get();
   if (unit->granularity() == cull::Granularity::Primitive) p.primitive_tester = unit.get();

@@ -4,7 +4,9 @@
 // (gpu.h) only wires what a row builds.
 #pragma once
 
+#include <filesystem>
 #include <memory>
+#include <ostream>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -28,6 +30,7 @@ struct ProgramContext {
   const cull::CullSetup& setup;    // the trace as the programs see it: viewport, depth convention, scene
   const DepthImage& depth_buffer;  // the depth unit's
   memory::Channel& memory;
+  const std::filesystem::path* out = nullptr;  // the run's output folder, for a program's own logs (null: none)
 
   // Builds the query structure `instance` (a name of structure_instances(), whose config keys it
   // reads) of `kind` over the viewport, farthest by `op`. Throws InputError for an unknown instance.
@@ -42,6 +45,7 @@ struct Program {
   cp::FrameProgram* frames = nullptr;                         // null: replay the recorded draws
   depth::DepthListener* depth_listener = nullptr;
   raster::PrimitiveTester* primitive_tester = nullptr;
+  std::vector<std::unique_ptr<std::ostream>> logs;  // files the program writes into the output folder
 };
 
 struct ProgramRow {

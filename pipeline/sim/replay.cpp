@@ -16,96 +16,24 @@ namespace nbsim::pipeline {
 
 namespace {
 
-// What the cull stage did over the whole replay (culling modes).
-struct CullTotals {
-  std::string mode, granularity;
-  std::uint64_t frames = 0, frames_with_truth = 0;
-  std::uint64_t query_depth_tests = 0, box_depth_tests = 0, lookups = 0, max_lookups = 0;
-  std::uint64_t update_texels = 0, clear_texels = 0, drawn_depth_tests = 0, cycles = 0;
-  std::uint64_t in_frustum = 0, occluders = 0, candidates = 0, bounds_tests = 0, node_tests = 0, crossing_near = 0;
-  std::uint64_t found_visible = 0, culled = 0, undrawable = 0, candidates_not_visible = 0, false_culls = 0;
-  // cull.granularity=primitive: per-triangle tests of the drawn candidates (model/cull/primitive.h);
-  // their lookups are in query_depth_tests and lookups are not.
-  std::uint64_t primitive_tests = 0, primitives_culled = 0, primitive_lookups = 0, primitive_fragments_culled = 0;
-  std::uint64_t primitive_false_culls = 0;
-  // Drawn candidates (Visible draws) whose passed samples are fewer than GL recorded for the same
-  // draw: a triangle culled with a visible fragment shows up here, GL's counters being the ground
-  // truth (the model's other draws are bit-exact with GL's; see Collector::draw_done).
-  std::uint64_t visible_draws_passed_below_gl = 0;
+// The cull stage's per-frame values (run.json "frames"): differences of its statistics between two
+// frame ends, which are exact because the next frame's tests wait for the frame to leave the
+// pipeline (model/cull/unit.h).
+constexpr std::array<const char*, 11> kCullFrameCounts = {
+    "bounds_tests",    "candidates",        "culled",            "candidates_not_visible",     "false_culls",
+    "undrawable",      "primitive_tests",   "primitives_culled", "primitive_lookups",          "primitive_fragments_culled",
+    "primitive_false_culls"};
 
-  void add(const cull::CullReport& r, std::uint64_t frame_depth_tests, std::uint64_t frame_cycles) {
-    ++frames;
-    frames_with_truth += r.has_truth ? 1 : 0;
-    query_depth_tests += r.query_depth_tests();
-    box_depth_tests += r.box_depth_tests;
-    lookups += r.lookups;
-    max_lookups = std::max(max_lookups, r.max_lookups);
-    update_texels += r.update_texels;
-    clear_texels += r.clear_texels;
-    drawn_depth_tests += frame_depth_tests - r.box_depth_tests;  // occluders and visible objects
-    cycles += frame_cycles;
-    in_frustum += r.in_frustum, occluders += r.occluders, candidates += r.candidates;
-    bounds_tests += r.bounds_tests, node_tests += r.node_tests, crossing_near += r.crossing_near;
-    found_visible += r.found_visible, culled += r.culled, undrawable += r.undrawable;
-    candidates_not_visible += r.candidates_not_visible, false_culls += r.false_culls;
-    primitive_tests += r.primitive_tests, primitives_culled += r.primitives_culled;
-    primitive_lookups += r.primitive_lookups, primitive_fragments_culled += r.primitive_fragments_culled;
-    primitive_false_culls += r.primitive_false_culls;
-  }
-
-  std::uint64_t total_depth_tests() const { return query_depth_tests + update_texels + drawn_depth_tests; }
-
-  nlohmann::ordered_json to_json() const {
-    const auto per_frame = [this](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
-    nlohmann::ordered_json j;
-    j["mode"] = mode;
-    j["frames"] = frames;
-    j["query_depth_tests"] = query_depth_tests;
-    j["query_depth_tests_per_frame"] = per_frame(query_depth_tests);
-    j["box_depth_tests"] = box_depth_tests;
-    j["lookups"] = lookups;
-    j["max_lookups_per_test"] = max_lookups;
-    j["update_texels"] = update_texels;
-    j["update_texels_per_frame"] = per_frame(update_texels);
-    j["clear_texels_per_frame"] = per_frame(clear_texels);
-    j["drawn_depth_tests"] = drawn_depth_tests;
-    j["drawn_depth_tests_per_frame"] = per_frame(drawn_depth_tests);
-    j["total_depth_tests"] = total_depth_tests();
-    j["total_depth_tests_per_frame"] = per_frame(total_depth_tests());
-    j["cycles"] = cycles;
-    j["cycles_per_frame"] = per_frame(cycles);
-    j["in_frustum"] = in_frustum;
-    j["occluders"] = occluders;
-    j["candidates"] = candidates;
-    j["bounds_tests"] = bounds_tests;
-    j["node_tests"] = node_tests;
-    j["crossing_near"] = crossing_near;
-    j["found_visible"] = found_visible;
-    j["culled"] = culled;
-    j["undrawable"] = undrawable;
-    j["frames_with_truth"] = frames_with_truth;
-    j["candidates_not_visible"] = candidates_not_visible;
-    j["false_culls"] = false_culls;
-    j["culling_efficiency"] = candidates_not_visible ? static_cast<double>(culled) / static_cast<double>(candidates_not_visible) : 1.0;
-    j["granularity"] = granularity;
-    j["primitive_tests"] = primitive_tests;
-    j["primitive_tests_per_frame"] = per_frame(primitive_tests);
-    j["primitives_culled"] = primitives_culled;
-    j["primitives_culled_per_frame"] = per_frame(primitives_culled);
-    j["primitive_lookups"] = primitive_lookups;
-    j["primitive_lookups_per_frame"] = per_frame(primitive_lookups);
-    j["primitive_fragments_culled"] = primitive_fragments_culled;
-    j["primitive_fragments_culled_per_frame"] = per_frame(primitive_fragments_culled);
-    j["primitive_false_culls"] = primitive_false_culls;
-    j["visible_draws_passed_below_gl"] = visible_draws_passed_below_gl;
-    return j;
-  }
-};
+// A statistic of a group's values (0 when the group has none of that name).
+std::uint64_t stat(const nlohmann::ordered_json& group, const char* name) {
+  const auto it = group.find(name);
+  return it == group.end() ? 0 : static_cast<std::uint64_t>(it->get<double>());
+}
 
 // Collects the depth unit's results, compares them with GL's, and writes the CSV files.
 class Collector : public depth::ResultSink {
  public:
-  Collector(ReplaySummary& s, const ReplayOptions& o) : s_(s), o_(o) {
+  Collector(ReplaySummary& s, const ReplayOptions& o, const stats::Registry& registry) : s_(s), o_(o), registry_(registry) {
     if (o.out) {
       draws_.open(*o.out / "draws.csv");
       frames_.open(*o.out / "frames.csv");
@@ -114,10 +42,6 @@ class Collector : public depth::ResultSink {
                 "model_passed,gl_passed,depth_tests,culled,lookups,done_cycle\n";
       frames_ << "frame,draws,model_fragments,gl_fragments,model_passed,gl_passed,depth_tests,depth_pixels_matching,"
                  "depth_pixels,end_cycle,cycles\n";
-      // Every bounds test a culling mode made (empty with cull.mode=trace, which only replays).
-      culls_.open(*o.out / "culls.csv");
-      if (!culls_) throw InputError(fmt::format("cannot write into '{}'", o.out->string()));
-      culls_ << "frame,mode,object,node,x,y,w,h,nearest_depth,crosses_near,decision,depth_tests,truth_visible_pixels,false_cull\n";
     }
   }
 
@@ -134,7 +58,7 @@ class Collector : public depth::ResultSink {
     frame_.passed_model += r.depth.passed, frame_.passed_gl += d.gl.samples_passed;
     frame_.depth_tests += r.depth.depth_tests;
     if (r.depth.fragments == d.gl.fragments && r.depth.passed == d.gl.samples_passed) ++s_.draws_exact;
-    if (d.role == trace::DrawRole::Visible && r.depth.passed < d.gl.samples_passed) ++cull.visible_draws_passed_below_gl;
+    if (d.role == trace::DrawRole::Visible && r.depth.passed < d.gl.samples_passed) ++visible_draws_passed_below_gl;
     if (draws_.is_open())
       draws_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, d.index, d.object,
                             trace::to_string(d.role), d.clip_positions.size() / 3, r.geometry.prims_out, d.gl.clip_prims_out,
@@ -166,23 +90,14 @@ class Collector : public depth::ResultSink {
                              frame_.depth_matching, frame_.depth_pixels, cycle, cycle - last_cycle_);
     nlohmann::ordered_json pf = {{"frame", w.frame->begin.frame}, {"draws", frame_.draws}, {"depth_tests", frame_.depth_tests},
                                  {"cycles", cycle - last_cycle_}};
-    if (const auto* r = dynamic_cast<const cull::CullReport*>(w.result.get())) {
-      cull.add(*r, frame_.depth_tests, cycle - last_cycle_);
-      if (culls_.is_open()) write_tests(w, *r);
-      pf["query_depth_tests"] = r->query_depth_tests();
-      pf["update_texels"] = r->update_texels;
-      pf["total_depth_tests"] = r->query_depth_tests() + r->update_texels + (frame_.depth_tests - r->box_depth_tests);
-      pf["bounds_tests"] = r->bounds_tests;
-      pf["candidates"] = r->candidates;
-      pf["culled"] = r->culled;
-      pf["candidates_not_visible"] = r->candidates_not_visible;
-      pf["false_culls"] = r->false_culls;
-      pf["undrawable"] = r->undrawable;
-      pf["primitive_tests"] = r->primitive_tests;
-      pf["primitives_culled"] = r->primitives_culled;
-      pf["primitive_lookups"] = r->primitive_lookups;
-      pf["primitive_fragments_culled"] = r->primitive_fragments_culled;
-      pf["primitive_false_culls"] = r->primitive_false_culls;
+    if (const stats::Group* g = registry_.find("gpu.cull")) {
+      const nlohmann::ordered_json now = g->values();
+      const auto delta = [&](const char* name) { return stat(now, name) - stat(last_cull_, name); };
+      pf["query_depth_tests"] = delta("query_depth_tests");
+      pf["update_texels"] = delta("update_texels");
+      pf["total_depth_tests"] = delta("query_depth_tests") + delta("update_texels") + (frame_.depth_tests - delta("box_depth_tests"));
+      for (const char* name : kCullFrameCounts) pf[name] = delta(name);
+      last_cull_ = now;
     }
     per_frame_.push_back(std::move(pf));
     last_cycle_ = cycle;
@@ -194,26 +109,9 @@ class Collector : public depth::ResultSink {
 
   void stopped(std::uint64_t cycle) override { s_.cycles = cycle; }
 
-  // One culls.csv row per bounds test: what was tested, the decision, its cost, the ground truth.
-  void write_tests(const cp::Work& w, const cull::CullReport& r) {
-    const trace::GroundTruth* truth = w.frame->truth ? &*w.frame->truth : nullptr;
-    for (const cull::CullReport::Test& t : r.tests) {
-      std::string pixels = "";
-      bool false_cull = false;
-      if (t.object >= 0 && truth && static_cast<std::size_t>(t.object) < truth->visible_pixels.size()) {
-        const std::uint32_t px = truth->visible_pixels[static_cast<std::size_t>(t.object)];
-        pixels = std::to_string(px);
-        false_cull = px > 0 && !t.bounds.visible;
-      }
-      culls_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, cull::to_string(r.mode),
-                            t.object, t.node, t.bounds.x, t.bounds.y, t.bounds.w, t.bounds.h, t.bounds.nearest_depth,
-                            t.bounds.crosses_near ? 1 : 0, t.bounds.visible ? "visible" : "culled", t.depth_tests, pixels,
-                            false_cull ? 1 : 0);
-    }
-  }
-
   std::uint64_t total_frames = 0;
-  CullTotals cull;
+  std::uint64_t visible_draws_passed_below_gl = 0;  // drawn candidates with fewer passed samples than GL's
+  std::uint64_t last_frame_cycle() const noexcept { return last_cycle_; }
   nlohmann::ordered_json per_frame_ = nlohmann::ordered_json::array();
 
  private:
@@ -223,10 +121,53 @@ class Collector : public depth::ResultSink {
   };
   ReplaySummary& s_;
   const ReplayOptions& o_;
-  std::ofstream draws_, frames_, culls_;
+  const stats::Registry& registry_;
+  nlohmann::ordered_json last_cull_ = nlohmann::ordered_json::object();  // gpu.cull at the last frame end
+  std::ofstream draws_, frames_;
   FrameTotals frame_;
   std::uint64_t last_cycle_ = 0;
 };
+
+// The cull stage's run totals (summary "cull", the columns of Table 2 and of explore's results),
+// derived from its statistics and the depth unit's when the run is done.
+nlohmann::ordered_json cull_summary(const nlohmann::ordered_json& cull, const nlohmann::ordered_json& depth,
+                                    const cull::CullUnitConfig& config, std::uint64_t cycles,
+                                    std::uint64_t visible_draws_passed_below_gl) {
+  const std::uint64_t frames = stat(cull, "frames");
+  const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
+  const std::uint64_t query = stat(cull, "query_depth_tests"), update = stat(cull, "update_texels");
+  const std::uint64_t drawn = stat(depth, "depth_tests") - stat(cull, "box_depth_tests");  // occluders and visible objects
+  const std::uint64_t total = query + update + drawn;
+  nlohmann::ordered_json j;
+  j["mode"] = config.mode;
+  j["frames"] = frames;
+  j["query_depth_tests"] = query;
+  j["query_depth_tests_per_frame"] = per_frame(query);
+  j["box_depth_tests"] = stat(cull, "box_depth_tests");
+  j["lookups"] = stat(cull, "lookups");
+  j["max_lookups_per_test"] = stat(cull, "max_lookups");
+  j["update_texels"] = update;
+  j["update_texels_per_frame"] = per_frame(update);
+  j["clear_texels_per_frame"] = per_frame(stat(cull, "clear_texels"));
+  j["drawn_depth_tests"] = drawn;
+  j["drawn_depth_tests_per_frame"] = per_frame(drawn);
+  j["total_depth_tests"] = total;
+  j["total_depth_tests_per_frame"] = per_frame(total);
+  j["cycles"] = cycles;
+  j["cycles_per_frame"] = per_frame(cycles);
+  for (const char* name : {"in_frustum", "occluders", "candidates", "bounds_tests", "node_tests", "crossing_near", "found_visible",
+                           "culled", "undrawable", "frames_with_truth", "candidates_not_visible", "false_culls"})
+    j[name] = stat(cull, name);
+  j["culling_efficiency"] = cull["culling_efficiency"];
+  j["granularity"] = config.granularity;
+  for (const char* name : {"primitive_tests", "primitives_culled", "primitive_lookups", "primitive_fragments_culled"}) {
+    j[name] = stat(cull, name);
+    j[std::string(name) + "_per_frame"] = per_frame(stat(cull, name));
+  }
+  j["primitive_false_culls"] = stat(cull, "primitive_false_culls");
+  j["visible_draws_passed_below_gl"] = visible_draws_passed_below_gl;
+  return j;
+}
 
 double rel(std::uint64_t a, std::uint64_t b) {
   if (b == 0) return a == 0 ? 0.0 : 1.0;
@@ -292,9 +233,9 @@ ReplaySummary replay(const ReplayOptions& o) {
   const std::string* nframes = tr.property("frames");
 
   ReplaySummary s;
-  Collector sink(s, o);
-  if (nframes) sink.total_frames = std::strtoull(nframes->c_str(), nullptr, 10);
   stats::Registry registry;
+  Collector sink(s, o, registry);
+  if (nframes) sink.total_frames = std::strtoull(nframes->c_str(), nullptr, 10);
   sim::install_report_handler();
   // The cull stage's view of the trace (culling modes only read it).
   const auto number = [&tr](const char* key, double fallback) {
@@ -313,11 +254,9 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.zero_to_one = clip_control && *clip_control == "ZERO_TO_ONE";
   setup.scene = tr.scene();
   setup.fused_interpolation = o.config.depth.fused_interpolation;
-  sink.cull.mode = o.config.cull.mode;
-  sink.cull.granularity = o.config.cull.granularity;
   const std::string* technique = tr.property("technique");
   Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink,
-          technique ? *technique : std::string(), setup);
+          technique ? *technique : std::string(), setup, o.out ? &*o.out : nullptr);
   std::optional<sim::Timeline> timeline;  // only when asked: units then report their busy spans
   if (o.timeline || o.vcd) {
     sim::TimelineOptions to;
@@ -331,8 +270,9 @@ ReplaySummary replay(const ReplayOptions& o) {
   sim::rethrow_thread_failure();  // a damaged trace read mid-run, as an InputError
   s.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.stats = registry.values();
-  if (o.config.cull.parsed_mode() != cull::CullMode::Trace) {
-    s.cull = sink.cull.to_json();
+  if (s.stats.contains("gpu.cull")) {
+    s.cull = cull_summary(s.stats["gpu.cull"], s.stats["gpu.depth"], o.config.cull, sink.last_frame_cycle(),
+                          sink.visible_draws_passed_below_gl);
     const auto& structures = gpu.program().structures;
     const query::Structure* structure = structures.empty() ? nullptr : structures.front().get();
     const long long bytes = structure ? structure->storage_bytes() : 0;

@@ -26,6 +26,25 @@ TEST(StatsTest, DumpsValuesInDeclarationOrder) {
   EXPECT_EQ(flat[2].first, "gpu.nbuffer.updates.l1");
 }
 
+// A maximum keeps the largest value raised to, sits in declaration order among the counters, and
+// is described as a maximum.
+TEST(StatsTest, MaximumKeepsTheLargest) {
+  Registry r;
+  Group& g = r.group("gpu.cull");
+  Counter& tests = g.counter("bounds_tests", "tests", "bounds tested");
+  Counter& most = g.maximum("max_lookups", "texels", "most texels one test read");
+  Counter& after = g.counter("culled", "objects", "culled");
+  most.raise_to(3);
+  most.raise_to(1);
+  tests += 2;
+  after += 5;
+  const auto v = r.values()["gpu.cull"];
+  EXPECT_EQ(v["max_lookups"], 3) << "a smaller value lowered the maximum";
+  EXPECT_EQ(v["bounds_tests"], 2);
+  EXPECT_EQ(v["culled"], 5) << "a maximum between two counters shifted their values";
+  EXPECT_EQ(r.describe()[1]["kind"], "maximum");
+}
+
 // Every statistic is described with its full name, unit and description.
 TEST(StatsTest, DescribesEveryStatistic) {
   Registry r;
