@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/model/reference.h"
+#include "tests/common/reference.h"
 
 extern "C" int sc_main(int, char*[]) { return 1; }  // libsystemc's main() needs one; gtest's main runs
 

@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "tests/raster/coverage.h"
+#include "tests/model/raster/coverage.h"
 
 namespace nbsim::raster {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "model/common/depth.h"
 #include "model/raster/setup.h"
-#include "tests/raster/coverage.h"
+#include "tests/model/raster/coverage.h"
 
 namespace nbsim::raster {
 namespace {

@@ -22,7 +22,7 @@
 
 #include "model/raster/rasterizer.h"
 #include "tests/common/run_nbsim.h"
-#include "tests/raster/coverage.h"
+#include "tests/model/raster/coverage.h"
 
 namespace nbsim {
 namespace {

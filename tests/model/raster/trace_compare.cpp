@@ -1,5 +1,5 @@
 // Counter comparison of the raster path against GL on a captured trace; see trace_compare.h.
-#include "tests/raster/trace_compare.h"
+#include "tests/model/raster/trace_compare.h"
 
 #include <algorithm>
 #include <chrono>

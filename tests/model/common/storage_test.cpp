@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "model/nbuffer/nbuffer.h"
-#include "tests/model/reference.h"
+#include "tests/common/reference.h"
 
 namespace nbsim {
 namespace {

@@ -10,7 +10,7 @@
 #include <iostream>
 #include <string>
 
-#include "tests/raster/trace_compare.h"
+#include "tests/model/raster/trace_compare.h"
 #include "traces/capture/capture.h"
 
 namespace nbsim::raster_compare {

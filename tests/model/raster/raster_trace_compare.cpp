@@ -10,7 +10,7 @@
 #include <string>
 
 #include "model/common/error.h"
-#include "tests/raster/trace_compare.h"
+#include "tests/model/raster/trace_compare.h"
 
 int main(int argc, char** argv) {
   using namespace nbsim::raster_compare;

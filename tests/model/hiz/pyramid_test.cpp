@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "model/common/error.h"
-#include "tests/model/reference.h"
+#include "tests/common/reference.h"
 
 namespace nbsim {
 namespace {
