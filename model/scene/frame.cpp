@@ -16,6 +16,7 @@ constexpr std::array<std::string_view, 2> kDepthWhichNames = {"after_occluders",
 constexpr std::array<std::string_view, 8> kDepthFuncNames = {"never",   "less",     "equal",  "lequal",
                                                              "greater", "notequal", "gequal", "always"};
 constexpr std::array<std::string_view, 4> kCullFaceNames = {"none", "back", "front", "front_and_back"};
+constexpr std::array<std::string_view, 2> kClipControlNames = {"negative_one_to_one", "zero_to_one"};
 
 }  // namespace
 
@@ -37,5 +38,6 @@ std::optional<TestMode> parse_test_mode(std::string_view s) noexcept { return pa
 std::string_view to_string(DepthWhich which) noexcept { return enum_name(kDepthWhichNames, which); }
 std::string_view to_string(DepthFunc func) noexcept { return enum_name(kDepthFuncNames, func); }
 std::string_view to_string(CullFace cull) noexcept { return enum_name(kCullFaceNames, cull); }
+std::string_view to_string(ClipControl clip) noexcept { return enum_name(kClipControlNames, clip); }
 
 }  // namespace nbsim::scene

@@ -155,6 +155,7 @@ std::string_view to_string(TestMode mode) noexcept;
 std::string_view to_string(DepthWhich which) noexcept;
 std::string_view to_string(DepthFunc func) noexcept;
 std::string_view to_string(CullFace cull) noexcept;
+std::string_view to_string(ClipControl clip) noexcept;
 std::optional<TestMode> parse_test_mode(std::string_view s) noexcept;
 
 }  // namespace nbsim::scene

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
 
@@ -14,6 +15,7 @@
 #include "pipeline/cli/command.h"
 #include "pipeline/io/image_io.h"
 #include "traces/format/codec.h"
+#include "traces/format/describe.h"
 #include "traces/format/reader.h"
 
 namespace nbsim::cli {
@@ -172,11 +174,12 @@ struct DumpOptions {
   std::string which = "final";
   std::string levels;
   std::string truth;
+  bool records = false;
 };
 
 int run_dump(const DumpOptions& o) {
-  if (o.depth.empty() && o.levels.empty() && o.truth.empty())
-    throw InputError("nothing to dump: pass --depth OUT.exr, --levels DIR or --truth OUT.csv|OUT.png");
+  if (o.depth.empty() && o.levels.empty() && o.truth.empty() && !o.records)
+    throw InputError("nothing to dump: pass --records, --depth OUT.exr, --levels DIR or --truth OUT.csv|OUT.png");
   const std::string truth_ext = lower_extension(o.truth);
   if (!o.truth.empty() && truth_ext != ".csv" && truth_ext != ".png")
     throw InputError(fmt::format("--truth '{}': expected a .csv (visible pixels per object) or .png (ID buffer) file", o.truth));
@@ -198,6 +201,7 @@ int run_dump(const DumpOptions& o) {
                                  count, first, last));
   }
   const tr::Frame& f = *frame;
+  if (o.records) fmt::print("{}", tr::dump_frame(f));
 
   // Check that everything asked for is there before writing anything.
   const tr::DepthWhich which = o.which == "final" ? tr::DepthWhich::Final : tr::DepthWhich::AfterOccluders;
@@ -269,6 +273,27 @@ int run_dump(const DumpOptions& o) {
   return 0;
 }
 
+int run_format(std::uint32_t version, const std::string& update) {
+  if (version < 1 || version > tr::kFormatVersion)
+    throw InputError(fmt::format("--format-version {}: this nbsim knows format versions 1 to {}", version, tr::kFormatVersion));
+  if (update.empty()) {
+    fmt::print("{}", tr::record_tables(version));
+    return 0;
+  }
+  std::ifstream in(update, std::ios::binary);
+  if (!in) throw InputError(fmt::format("cannot read '{}'", update));
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string fresh = tr::refresh_format_doc(doc);
+  if (fresh == doc) {
+    fmt::print("{}: its {} record tables are current\n", update, tr::format_doc_regions(doc).size());
+    return 0;
+  }
+  std::ofstream out(update, std::ios::binary | std::ios::trunc);
+  if (!(out << fresh) || !out.flush()) throw InputError(fmt::format("cannot write '{}'", update));
+  fmt::print("{}: refreshed its {} record tables\n", update, tr::format_doc_regions(doc).size());
+  return 0;
+}
+
 }  // namespace
 
 void add_trace_commands(CLI::App& app, Action& action) {
@@ -296,6 +321,16 @@ void add_trace_commands(CLI::App& app, Action& action) {
     cmd->callback([&action, file] { action = [=] { return run_verify(*file); }; });
   }
   {
+    auto* cmd = tc->add_subcommand("format", "Print the record tables of the trace format (Markdown), from the records' one description");
+    auto version = std::make_shared<std::uint32_t>(tr::kFormatVersion);
+    auto update = std::make_shared<std::string>();
+    cmd->add_option("--format-version", *version, "Layout of this format version")->capture_default_str();
+    cmd->add_option("--update", *update, "Refresh the generated tables of this document (traces/FORMAT.md) in place");
+    cmd->footer("The tables are what the codec reads and writes: traces/format/schema.h describes each record once.\n"
+                "FORMAT.md holds them between '<!-- generated: nbsim trace format TYPE VERSION -->' markers.");
+    cmd->callback([&action, version, update] { action = [=] { return run_format(*version, *update); }; });
+  }
+  {
     auto* cmd = tc->add_subcommand("dump", "Write one frame's depth snapshot, N-buffer levels (EXR) and ground truth (CSV or PNG)");
     auto o = std::make_shared<DumpOptions>();
     cmd->add_option("FILE", o->file, "Trace file")->required();
@@ -306,7 +341,8 @@ void add_trace_commands(CLI::App& app, Action& action) {
         ->capture_default_str();
     cmd->add_option("--levels", o->levels, "Write the N-buffer levels the GLSL shader built as DIR/level_NN.exr");
     cmd->add_option("--truth", o->truth, "Write the ground truth: OUT.csv (visible pixels per object) or OUT.png (ID buffer)");
-    cmd->footer("At least one of --depth, --levels, --truth. Nothing is written when the frame lacks any of them.\n"
+    cmd->add_flag("--records", o->records, "Print every record of the frame, field by field (long vectors abbreviated)");
+    cmd->footer("At least one of --records, --depth, --levels, --truth. Nothing is written when the frame lacks any of them.\n"
                 "With both max and min N-buffers in the frame, the level files are named max_level_NN.exr and min_level_NN.exr.");
     cmd->callback([&action, o] { action = [=] { return run_dump(*o); }; });
   }

@@ -309,14 +309,14 @@ TEST(TraceCorruptionTest, FieldValuesOutOfRange) {
       {ChunkType::Draw, [](Bytes& p) { p[4] = 7; }, "field 'role' is 7"},                       // DrawRole 0..6
       {ChunkType::Draw, [](Bytes& p) { p[15] = 2; }, "field 'state.write' is 2, not 0 or 1"},   // bools are 0/1
       {ChunkType::Draw, [](Bytes& p) { p[14] = 8; }, "state.func"},                             // DepthFunc 0..7
-      {ChunkType::Draw, [](Bytes& p) { p[13] = 32; }, "level 32"},                              // levels below 32
+      {ChunkType::Draw, [](Bytes& p) { p[13] = 32; }, "field 'level' is 32"},                  // levels below 32
       {ChunkType::FrameBegin, [](Bytes& p) { p[4] = 5; }, "field 'mode' is 5"},                 // TestMode 0..4
       {ChunkType::Depth, [](Bytes& p) { p[0] = 2; }, "field 'which' is 2"},                     // DepthWhich 0..1
-      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 0); }, "depth snapshot size 0x16"},       // sides >= 1
-      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 100000); }, "depth snapshot size 100000x16"},
-      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 0x80000000u); }, "outside 1x1"},         // negative side
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 0); }, "field 'width' is 0, outside 1 .. 16384"},  // sides >= 1
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 100000); }, "field 'width' is 100000"},
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 0x80000000u); }, "field 'width' is -2147483648"},  // negative side
       {ChunkType::Levels, [](Bytes& p) { p[0] = 2; }, "field 'op' is 2"},                       // FarOp 0..1
-      {ChunkType::Levels, [](Bytes& p) { put_le32(p, 9, 33); }, "level count 33"},              // at most 32 levels
+      {ChunkType::Levels, [](Bytes& p) { put_le32(p, 9, 33); }, "field 'levels' is 33"},               // at most 32 levels
       {ChunkType::Truth, [](Bytes& p) { put_le32(p, 0, 0xFFFFFFFFu); }, "counts 4294967295 elements"},  // hostile count
       {ChunkType::Scene, [](Bytes& p) { put_le32(p, 0, 0x7FFFFFFFu); }, "counts 2147483647 elements"},
       {ChunkType::Header, [](Bytes& p) { put_le32(p, 0, 5000); }, "counts 5000 elements"},

@@ -409,7 +409,7 @@ TEST(TraceWriterDeathTest, AbortsOnMisuse) {
         d.texels.pop_back();
         w.write(d);
       },
-      "holds 15 texels");
+      "holds 15 elements");
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "traces/format/records.h"
+#include "traces/format/schema.h"
 
 namespace nbsim::trace {
 
@@ -25,15 +26,6 @@ inline constexpr std::size_t kChunkHeaderBytes = 24;  // type, flags, stored len
 inline constexpr std::size_t kChunkCrcBytes = 4;
 inline constexpr std::uint32_t kFlagZstd = 1;         // bit 0: the payload is one zstd frame
 inline constexpr std::uint32_t kKnownFlags = kFlagZstd;
-
-// Limits, fixed by the format, so that a damaged or hostile file never causes a huge allocation.
-// 256 MiB holds the N-buffer levels of a 2048x2048 frame (11 planes of 16 MiB).
-inline constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{256} << 20;  // stored and raw
-inline constexpr std::size_t kMaxKeyBytes = 64;
-inline constexpr std::size_t kMaxValueBytes = 64 * 1024;
-inline constexpr std::size_t kMaxProperties = 1024;
-inline constexpr std::int32_t kMaxImageSide = 16384;
-inline constexpr std::int32_t kMaxLevels = 32;
 
 // Tunable writer choices (not part of the format: any reader reads any choice). Payloads below
 // 1 KiB rarely shrink; zstd level 3 (its default) compresses depth images ~3-10x at >100 MB/s.
@@ -71,6 +63,7 @@ std::vector<std::uint8_t> encode(const EndMarker& end);
 // vector sizes, an image size out of range, a bad property key, ... Decoders refuse the same.
 std::string record_problem(const Properties& properties);
 std::string record_problem(const SceneObjects& scene);
+std::string record_problem(const FrameBegin& frame);
 std::string record_problem(const DrawRecord& draw);
 std::string record_problem(const DepthSnapshot& depth);
 std::string record_problem(const NBufferLevels& levels);

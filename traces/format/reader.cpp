@@ -102,12 +102,6 @@ TraceReader::~TraceReader() = default;
 TraceReader::TraceReader(TraceReader&&) noexcept = default;
 TraceReader& TraceReader::operator=(TraceReader&&) noexcept = default;
 
-const std::string* TraceReader::property(std::string_view key) const noexcept {
-  for (const auto& [k, v] : properties_)
-    if (k == key) return &v;
-  return nullptr;
-}
-
 std::size_t TraceReader::read_bytes(std::uint8_t* dst, std::size_t n) {
   const std::size_t got = src_->read(dst, n);
   pos_ += got;
@@ -146,7 +140,12 @@ void TraceReader::open() {
 
   Chunk head = read_chunk();
   if (head.type != ChunkType::Header) fail(head, "the first chunk must be HEAD");
-  properties_ = decode<Properties>(head);
+  Properties properties = decode<Properties>(head);
+  try {
+    header_ = parse_header(properties);
+  } catch (const InputError& e) {
+    fail(head, e.what());
+  }
   if (auto c = next(); c && c->type == ChunkType::Scene)
     scene_ = decode<SceneObjects>(*c);
   else
