@@ -36,6 +36,9 @@ struct FrameSummary {
   std::optional<std::uint64_t> objects_visible, covered_pixels;
   double gl_ms = 0.0;
   std::vector<std::string> depths;  // "after_occluders", "final"
+  std::vector<std::string> stencils;  // names (version 2)
+  bool light = false;
+  std::vector<std::string> technique_records;  // chunk types
   std::vector<std::string> level_text;  // "max x9", ...
   std::vector<ojson> level_json;
 };
@@ -56,7 +59,10 @@ FrameSummary summarize(const tr::Frame& f) {
     s.covered_pixels = f.truth->covered_pixels;
   }
   s.gl_ms = f.end.gl_ms;
-  for (const tr::DepthSnapshot& d : f.depths) s.depths.emplace_back(tr::to_string(d.which));
+  for (const tr::DepthSnapshot& d : f.depths) s.depths.emplace_back(d.name);
+  for (const tr::StencilSnapshot& st : f.stencils) s.stencils.emplace_back(st.name);
+  s.light = f.light.has_value();
+  for (const tr::TechniqueRecord& t : f.technique_records) s.technique_records.push_back(tr::chunk_type_name(t.type));
   for (const tr::NBufferLevels& l : f.levels) {
     const std::string_view op = to_string(static_cast<FarOp>(l.op));
     s.level_text.push_back(fmt::format("{} x{}", op, l.levels));
@@ -109,6 +115,10 @@ int run_info(const std::string& file, bool json) {
       o["gl_ms"] = s.gl_ms;
       o["depth"] = s.depths;
       o["levels"] = s.level_json;
+      // Version 2's records only when the frame has them (occlusion-culling summaries stay as they were).
+      if (!s.stencils.empty()) o["stencil"] = s.stencils;
+      if (s.light) o["light"] = true;
+      if (!s.technique_records.empty()) o["technique_records"] = s.technique_records;
       o["offset"] = s.offset;
       fr.push_back(std::move(o));
     }
@@ -133,6 +143,9 @@ int run_info(const std::string& file, bool json) {
                tr::to_string(s.mode), s.draws, s.fragments, s.samples_passed, visible);
     if (!s.depths.empty()) fmt::print("; depth: {}", fmt::join(s.depths, ", "));
     if (!s.level_text.empty()) fmt::print("; N-buffer: {}", fmt::join(s.level_text, ", "));
+    if (!s.stencils.empty()) fmt::print("; stencil: {}", fmt::join(s.stencils, ", "));
+    if (s.light) fmt::print("; light camera");
+    if (!s.technique_records.empty()) fmt::print("; technique records: {}", fmt::join(s.technique_records, ", "));
     fmt::print("\n");
   }
   fmt::print("total: {} draws, {} GL fragments, {} samples passed\n", draws, fragments, samples);
@@ -204,13 +217,13 @@ int run_dump(const DumpOptions& o) {
   if (o.records) fmt::print("{}", tr::dump_frame(f));
 
   // Check that everything asked for is there before writing anything.
-  const tr::DepthWhich which = o.which == "final" ? tr::DepthWhich::Final : tr::DepthWhich::AfterOccluders;
+  const std::string which = o.which == "occluders" ? std::string(tr::to_string(tr::DepthWhich::AfterOccluders)) : o.which;
   const tr::DepthSnapshot* depth = o.depth.empty() ? nullptr : f.depth(which);
   if (!o.depth.empty() && !depth) {
     std::vector<std::string> have;
-    for (const tr::DepthSnapshot& d : f.depths) have.emplace_back(tr::to_string(d.which));
+    for (const tr::DepthSnapshot& d : f.depths) have.emplace_back(d.name);
     throw InputError(fmt::format("frame {} of '{}' has no '{}' depth snapshot (it has: {})", o.frame, o.file,
-                                 tr::to_string(which), have.empty() ? std::string("none") : fmt::format("{}", fmt::join(have, ", "))));
+                                 which, have.empty() ? std::string("none") : fmt::format("{}", fmt::join(have, ", "))));
   }
   if (!o.levels.empty() && f.levels.empty())
     throw InputError(fmt::format("frame {} of '{}' records no N-buffer levels (the capture may store them every k-th frame only)",
@@ -227,7 +240,7 @@ int run_dump(const DumpOptions& o) {
     img.height = depth->height;
     img.texels = depth->texels;
     io::write_depth(img, o.depth);
-    fmt::print("wrote {} ({}x{}, '{}' depth of frame {})\n", o.depth, img.width, img.height, tr::to_string(which), o.frame);
+    fmt::print("wrote {} ({}x{}, '{}' depth of frame {})\n", o.depth, img.width, img.height, which, o.frame);
   }
   if (!o.levels.empty()) {
     const fs::path dir(o.levels);
@@ -336,8 +349,9 @@ void add_trace_commands(CLI::App& app, Action& action) {
     cmd->add_option("FILE", o->file, "Trace file")->required();
     cmd->add_option("--frame", o->frame, "Frame number (as recorded in the trace)")->required();
     cmd->add_option("--depth", o->depth, "Write the depth snapshot as a single-channel float image (EXR), y up");
-    cmd->add_option("--which", o->which, "Which snapshot: final (end of frame) or occluders (after the occluder pass)")
-        ->check(CLI::IsMember({"final", "occluders"}))
+    cmd->add_option("--which", o->which,
+                    "Which depth image, by name: final (end of frame), occluders or after_occluders (after the occluder "
+                    "pass), or any image a technique recorded")
         ->capture_default_str();
     cmd->add_option("--levels", o->levels, "Write the N-buffer levels the GLSL shader built as DIR/level_NN.exr");
     cmd->add_option("--truth", o->truth, "Write the ground truth: OUT.csv (visible pixels per object) or OUT.png (ID buffer)");

@@ -69,7 +69,7 @@ TEST(CaptureTest, GlslLevelsEqualCoreLevels) {
       const CapturedFrame fr = r.render(f, s.poses[f], true);
       ASSERT_TRUE(fr.levels.has_value());
       const auto& d = fr.depth.at(0);
-      ASSERT_EQ(d.which, trace::DepthWhich::AfterOccluders);
+      ASSERT_EQ(d.name, "after_occluders");
       DepthImage img(d.width, d.height, 0.0f);
       img.texels = d.texels;
       const NBuffer core(img, {reversed ? FarOp::Min : FarOp::Max, StorageFormat::F32, -1});

@@ -425,7 +425,7 @@ struct Renderer::Impl {
 
   trace::DepthSnapshot read_depth(trace::DepthWhich which) {
     trace::DepthSnapshot d;
-    d.which = which;
+    d.name = std::string(trace::to_string(which));
     d.width = opt.width;
     d.height = opt.height;
     d.texels.resize(static_cast<std::size_t>(opt.width) * opt.height);

@@ -16,172 +16,16 @@
 
 #include "model/common/depth.h"
 #include "model/common/error.h"
+#include "traces/format/bytes.h"
 #include "traces/format/schema.h"
 
 namespace nbsim::trace {
 
 namespace {
 
-static_assert(sizeof(float) == 4 && std::numeric_limits<float>::is_iec559, "floats are IEEE-754 binary32");
-static_assert(sizeof(double) == 8 && std::numeric_limits<double>::is_iec559, "doubles are IEEE-754 binary64");
-
-constexpr bool kLittleHost = std::endian::native == std::endian::little;
-
-// Appends little-endian fields to a payload.
-class Out {
- public:
-  void u8(std::uint8_t v) { bytes_.push_back(v); }
-  void boolean(bool v) { u8(v ? 1 : 0); }
-  void u32(std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) bytes_.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  }
-  void u64(std::uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes_.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  }
-  void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
-  void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
-  void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
-  void count(std::size_t n) {
-    NBSIM_CHECK(n <= std::numeric_limits<std::uint32_t>::max(), "a vector of more than 2^32-1 elements");
-    u32(static_cast<std::uint32_t>(n));
-  }
-  void str(const std::string& s) {
-    count(s.size());
-    bytes_.insert(bytes_.end(), s.begin(), s.end());
-  }
-  // 4-byte elements (float, int32, uint32) without a count.
-  template <class T>
-  void words(const std::vector<T>& v) {
-    static_assert(sizeof(T) == 4);
-    if constexpr (kLittleHost) {
-      const std::size_t at = bytes_.size();
-      bytes_.resize(at + 4 * v.size());
-      if (!v.empty()) std::memcpy(bytes_.data() + at, v.data(), 4 * v.size());
-    } else {
-      for (const T& x : v) u32(std::bit_cast<std::uint32_t>(x));
-    }
-  }
-  template <class T>
-  void counted_words(const std::vector<T>& v) {
-    count(v.size());
-    words(v);
-  }
-  void aabbs(const std::vector<Aabb>& v) {
-    count(v.size());
-    for (const Aabb& b : v) {
-      for (float x : b.lo) f32(x);
-      for (float x : b.hi) f32(x);
-    }
-  }
-  void reserve(std::size_t n) { bytes_.reserve(n); }
-  std::vector<std::uint8_t> take() { return std::move(bytes_); }
-
- private:
-  std::vector<std::uint8_t> bytes_;
-};
-
-// Reads little-endian fields from a payload; every read is bounds-checked, and counts are checked
-// against the bytes left before anything is allocated.
-class In {
- public:
-  explicit In(std::span<const std::uint8_t> p) : p_(p) {}
-
-  std::size_t left() const { return p_.size() - pos_; }
-
-  std::uint8_t u8(const char* field) {
-    need(1, field);
-    return p_[pos_++];
-  }
-  bool boolean(const char* field) {
-    const std::uint8_t v = u8(field);
-    if (v > 1) throw InputError(fmt::format("field '{}' is {}, not 0 or 1", field, v));
-    return v == 1;
-  }
-  std::uint32_t u32(const char* field) {
-    need(4, field);
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(p_[pos_++]) << (8 * i);
-    return v;
-  }
-  std::uint64_t u64(const char* field) {
-    need(8, field);
-    std::uint64_t v = 0;
-    for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(p_[pos_++]) << (8 * i);
-    return v;
-  }
-  std::int32_t i32(const char* field) { return static_cast<std::int32_t>(u32(field)); }
-  float f32(const char* field) { return std::bit_cast<float>(u32(field)); }
-  double f64(const char* field) { return std::bit_cast<double>(u64(field)); }
-
-  // An enum stored as one byte with values 0..max.
-  template <class E>
-  E enumeration(const char* field, E max) {
-    const std::uint8_t v = u8(field);
-    if (v > static_cast<std::uint8_t>(max))
-      throw InputError(fmt::format("field '{}' is {}, outside the valid values 0..{}", field, v,
-                                   static_cast<unsigned>(max)));
-    return static_cast<E>(v);
-  }
-
-  // A u32 element count whose elements (elem_bytes each) must fit in the bytes left.
-  std::size_t count(std::size_t elem_bytes, const char* field) {
-    const std::uint32_t n = u32(field);
-    if (n > left() / elem_bytes)
-      throw InputError(fmt::format("field '{}' counts {} elements of {} bytes, but only {} payload bytes are left "
-                                   "(it decodes short)", field, n, elem_bytes, left()));
-    return n;
-  }
-  std::string str(std::size_t max_bytes, const char* field) {
-    const std::size_t n = count(1, field);
-    if (n > max_bytes)
-      throw InputError(fmt::format("field '{}' is a string of {} bytes, above the limit of {}", field, n, max_bytes));
-    std::string s(reinterpret_cast<const char*>(p_.data() + pos_), n);
-    pos_ += n;
-    return s;
-  }
-  // n 4-byte elements without a count (n already checked against left() by the caller or here).
-  template <class T>
-  void words(std::vector<T>& v, std::size_t n, const char* field) {
-    static_assert(sizeof(T) == 4);
-    if (n > left() / 4)
-      throw InputError(fmt::format("field '{}' needs {} elements of 4 bytes, but only {} payload bytes are left "
-                                   "(it decodes short)", field, n, left()));
-    v.resize(n);
-    if constexpr (kLittleHost) {
-      if (n) std::memcpy(v.data(), p_.data() + pos_, 4 * n);
-      pos_ += 4 * n;
-    } else {
-      for (T& x : v) x = std::bit_cast<T>(u32(field));
-    }
-  }
-  template <class T>
-  void counted_words(std::vector<T>& v, const char* field) {
-    words(v, count(4, field), field);
-  }
-  void aabbs(std::vector<Aabb>& v, const char* field) {
-    v.resize(count(24, field));
-    for (Aabb& b : v) {
-      for (float& x : b.lo) x = f32(field);
-      for (float& x : b.hi) x = f32(field);
-    }
-  }
-  // The whole payload must be used: bytes left over mean a damaged or mismatched record.
-  void finish() const {
-    if (pos_ != p_.size())
-      throw InputError(fmt::format("{} bytes are left over after the last field (the payload of {} bytes decodes long)",
-                                   p_.size() - pos_, p_.size()));
-  }
-
- private:
-  void need(std::size_t n, const char* field) const {
-    if (left() < n)
-      throw InputError(fmt::format("the payload of {} bytes ends at byte {} while reading field '{}' (it decodes short)",
-                                   p_.size(), pos_, field));
-  }
-
-  std::span<const std::uint8_t> p_;
-  std::size_t pos_ = 0;
-};
+using bytes::In;
+using bytes::kLittleHost;
+using bytes::Out;
 
 void check_version(std::uint32_t version) {
   NBSIM_CHECK(version >= 1 && version <= kFormatVersion, fmt::format("decoding format version {}", version));
@@ -198,7 +42,7 @@ bool good_key_char(char c) {
 
 }  // namespace
 
-bool is_known_chunk_type(std::uint32_t type) noexcept {
+std::uint32_t chunk_type_since(std::uint32_t type) noexcept {
   switch (static_cast<ChunkType>(type)) {
     case ChunkType::Header:
     case ChunkType::Scene:
@@ -209,10 +53,16 @@ bool is_known_chunk_type(std::uint32_t type) noexcept {
     case ChunkType::Truth:
     case ChunkType::FrameEnd:
     case ChunkType::End:
-      return true;
+      return 1;
+    case ChunkType::DrawBatch:
+    case ChunkType::Stencil:
+    case ChunkType::Light:
+      return 2;
   }
-  return false;
+  return 0;
 }
+
+bool is_known_chunk_type(std::uint32_t type) noexcept { return chunk_type_since(type) != 0; }
 
 std::string chunk_type_name(std::uint32_t type) {
   std::string s;
@@ -237,7 +87,9 @@ std::array<std::uint8_t, kPreambleBytes> encode_preamble(std::uint32_t version) 
   return p;
 }
 
-std::vector<std::uint8_t> encode_chunk(ChunkType type, std::span<const std::uint8_t> payload, bool compress) {
+std::vector<std::uint8_t> encode_chunk(ChunkType type, std::span<const std::uint8_t> payload, bool compress,
+                                       std::uint32_t extra_flags) {
+  NBSIM_CHECK((extra_flags & ~kFlagTechnique) == 0, "encode_chunk: only the technique flag may be added");
   if (payload.size() > kMaxChunkBytes)
     throw InputError(fmt::format("a {} record of {} bytes exceeds the trace format's chunk limit of {} MiB",
                                  chunk_type_name(type), payload.size(), kMaxChunkBytes >> 20));
@@ -262,7 +114,7 @@ std::vector<std::uint8_t> encode_chunk(ChunkType type, std::span<const std::uint
   if (!(flags & kFlagZstd) && !payload.empty()) std::memcpy(body, payload.data(), payload.size());
   Out header;
   header.u32(static_cast<std::uint32_t>(type));
-  header.u32(flags);
+  header.u32(flags | extra_flags);
   header.u64(stored);
   header.u64(payload.size());
   const std::vector<std::uint8_t> head = header.take();
@@ -318,7 +170,8 @@ class EncodeIo {
   template <class T> void words(const char*, std::vector<T>& v, const char*, const char*) { o_.counted_words(v); }
   template <class T> void image(const char* name, std::vector<T>& v, std::uint64_t count, const char*, const char*) {
     NBSIM_CHECK(v.size() == count, fmt::format("encoding field '{}' of {} elements, the record says {}", name, v.size(), count));
-    o_.words(v);
+    if constexpr (sizeof(T) == 1) o_.raw(v);
+    else o_.words(v);
   }
   template <class E, class F> void items(const char*, std::vector<E>& v, const char*, Element, F&& f, const char*) {
     o_.count(v.size());
@@ -366,7 +219,8 @@ class DecodeIo {
   void string(const char* n, std::string& v, std::size_t max, const char*) { v = in_.str(max, n); }
   template <class T> void words(const char* n, std::vector<T>& v, const char*, const char*) { in_.counted_words(v, n); }
   template <class T> void image(const char* n, std::vector<T>& v, std::uint64_t count, const char*, const char*) {
-    in_.words(v, count, n);
+    if constexpr (sizeof(T) == 1) in_.raw(v, count, n);
+    else in_.words(v, count, n);
   }
   template <class E, class F> void items(const char* n, std::vector<E>& v, const char*, Element el, F&& f, const char*) {
     v.resize(in_.count(el.bytes, n));
@@ -488,6 +342,31 @@ std::string extra_problem(const GroundTruth& t) {
   return {};
 }
 
+std::string name_problem(const char* what, const std::string& name) {
+  if (name.empty() || !std::all_of(name.begin(), name.end(), good_key_char))
+    return fmt::format("{} '{}' is not 1 to {} characters of A-Z a-z 0-9 _ . -", what, name, kMaxNameBytes);
+  return {};
+}
+
+std::string extra_problem(const DrawRecord& d) {
+  if (d.topology == Topology::Points && d.point_sizes.size() != d.clip_positions.size())
+    return fmt::format("a point draw with {} vertices and {} point sizes (one per vertex)", d.clip_positions.size(),
+                       d.point_sizes.size());
+  if (d.topology != Topology::Points && !d.point_sizes.empty())
+    return fmt::format("a {} draw with {} point sizes (only point draws have them)", to_string(d.topology), d.point_sizes.size());
+  return {};
+}
+
+std::string extra_problem(const DrawBatch& b) {
+  for (std::size_t i = 0; i < b.draws.size(); ++i)
+    if (std::string p = extra_problem(b.draws[i]); !p.empty()) return fmt::format("draw {} of the batch: {}", i, p);
+  return {};
+}
+
+std::string extra_problem(const DepthSnapshot& d) { return name_problem("depth image name", d.name); }
+std::string extra_problem(const StencilSnapshot& s) { return name_problem("stencil image name", s.name); }
+std::string extra_problem(const NBufferLevels& l) { return name_problem("N-buffer source name", l.source); }
+
 template <class R>
 std::string extra_problem(const R&) {
   return {};
@@ -531,6 +410,9 @@ std::string record_problem(const DrawRecord& r) { return problem_of(r); }
 std::string record_problem(const DepthSnapshot& r) { return problem_of(r); }
 std::string record_problem(const NBufferLevels& r) { return problem_of(r); }
 std::string record_problem(const GroundTruth& r) { return problem_of(r); }
+std::string record_problem(const DrawBatch& r) { return problem_of(r); }
+std::string record_problem(const StencilSnapshot& r) { return problem_of(r); }
+std::string record_problem(const Camera& r) { return problem_of(r); }
 
 std::vector<std::uint8_t> encode(const Properties& r) { return encode_record(r, 256); }
 std::vector<std::uint8_t> encode(const SceneObjects& s) {
@@ -544,6 +426,13 @@ std::vector<std::uint8_t> encode(const GroundTruth& t) {
   return encode_record(t, 24 + 4 * t.visible_pixels.size() + 4 * t.ids.size());
 }
 std::vector<std::uint8_t> encode(const FrameEnd& r) { return encode_record(r, 16); }
+std::vector<std::uint8_t> encode(const DrawBatch& b) {
+  std::size_t n = 4;
+  for (const DrawRecord& d : b.draws) n += 160 + 20 * d.clip_positions.size();
+  return encode_record(b, n);
+}
+std::vector<std::uint8_t> encode(const StencilSnapshot& s) { return encode_record(s, 16 + s.name.size() + s.texels.size()); }
+std::vector<std::uint8_t> encode(const Camera& c) { return encode_record(c, 140); }
 std::vector<std::uint8_t> encode(const EndMarker& r) { return encode_record(r, 12); }
 
 // Each decoder reads the layout of the file's version: the visitor reads a field added in version
@@ -557,5 +446,8 @@ NBufferLevels decode_levels(std::span<const std::uint8_t> p, std::uint32_t v) { 
 GroundTruth decode_truth(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<GroundTruth>(p, v); }
 FrameEnd decode_frame_end(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<FrameEnd>(p, v); }
 EndMarker decode_end(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<EndMarker>(p, v); }
+DrawBatch decode_draw_batch(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<DrawBatch>(p, v); }
+StencilSnapshot decode_stencil(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<StencilSnapshot>(p, v); }
+Camera decode_light(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<Camera>(p, v); }
 
 }  // namespace nbsim::trace

@@ -12,6 +12,7 @@
 #include "model/common/error.h"
 #include "traces/format/codec.h"
 #include "traces/format/schema.h"
+#include "traces/format/technique_chunks.h"
 
 namespace nbsim::trace {
 
@@ -40,7 +41,8 @@ std::string join_meaning(std::string a, const char* b) {
 }
 
 // Builds a record's table: one row per field, with offsets that stay exact after variable-size
-// fields (as a constant plus multiples of the counts' symbols, "25+16·V").
+// fields (as a constant plus multiples of the counts' symbols, "25+16·V", and string lengths,
+// "4+len(name)").
 class DocIo {
  public:
   explicit DocIo(std::uint32_t version) : version_(version) {}
@@ -65,7 +67,7 @@ class DocIo {
   }
   void string(const char* n, std::string&, std::size_t, const char* m) {
     row(n, "string", m, 4);
-    variable_ = true;
+    add_term(fmt::format("len({})", n), 1);
   }
   template <class T> void words(const char* n, std::vector<T>&, const char* symbol, const char* m) {
     row(n, fmt::format("vec<{}>", word_type<T>()), join_meaning(fmt::format("{} elements", symbol), m), 4);
@@ -73,7 +75,7 @@ class DocIo {
   }
   template <class T> void image(const char* n, std::vector<T>&, std::uint64_t, const char* count_text, const char* m) {
     row(n, fmt::format("{}[{}]", word_type<T>(), count_text), m, 0);
-    add_term(count_text, 4);
+    add_term(count_text, sizeof(T));
   }
   template <class E, class F> void items(const char* n, std::vector<E>&, const char* symbol, Element el, F&&, const char* m) {
     row(n, fmt::format("vec<{}>", el.type), join_meaning(fmt::format("{} elements", symbol), m), 4);
@@ -95,12 +97,13 @@ class DocIo {
   template <class T> static const char* word_type() {
     if constexpr (std::is_same_v<T, float>) return "f32";
     else if constexpr (std::is_same_v<T, std::int32_t>) return "i32";
+    else if constexpr (std::is_same_v<T, std::uint8_t>) return "u8";
     else return "u32";
   }
   std::string offset(const char* plus = "+") const {
     if (variable_) return "…";
     std::string s = fmt::format("{}", constant_);
-    for (const auto& [sym, k] : terms_) s += fmt::format("{}{}·{}", plus, k, sym);
+    for (const auto& [sym, k] : terms_) s += k == 1 ? fmt::format("{}{}", plus, sym) : fmt::format("{}{}·{}", plus, k, sym);
     return s;
   }
   void row(const char* n, std::string type, std::string meaning, std::size_t bytes) {
@@ -177,7 +180,9 @@ std::string table_of(ChunkType type, std::uint32_t version) {
   std::string name;
   for (const RecordKind& k : record_kinds())
     if (k.type == type) name = k.record;
-  return fmt::format("### {}: {} ({})\n\n{}", chunk_type_name(type), name, io.size(), io.table());
+  std::string fourcc = chunk_type_name(type);
+  while (!fourcc.empty() && fourcc.back() == ' ') fourcc.pop_back();  // "END "
+  return fmt::format("### {}: {} ({})\n\n{}", fourcc, name, io.size(), io.table());
 }
 
 template <class R>
@@ -198,7 +203,8 @@ const std::vector<RecordKind>& record_kinds() {
       {ChunkType::FrameBegin, "FrameBegin", 1}, {ChunkType::Draw, "DrawRecord", 1},
       {ChunkType::Depth, "DepthSnapshot", 1}, {ChunkType::Levels, "NBufferLevels", 1},
       {ChunkType::Truth, "GroundTruth", 1},   {ChunkType::FrameEnd, "FrameEnd", 1},
-      {ChunkType::End, "EndMarker", 1},
+      {ChunkType::End, "EndMarker", 1},       {ChunkType::DrawBatch, "DrawBatch", 2},
+      {ChunkType::Stencil, "StencilSnapshot", 2}, {ChunkType::Light, "Camera", 2},
   };
   return kinds;
 }
@@ -222,6 +228,9 @@ std::string record_table(ChunkType type, std::uint32_t version) {
     case ChunkType::Truth: return table_of<GroundTruth>(type, version);
     case ChunkType::FrameEnd: return table_of<FrameEnd>(type, version);
     case ChunkType::End: return table_of<EndMarker>(type, version);
+    case ChunkType::DrawBatch: return table_of<DrawBatch>(type, version);
+    case ChunkType::Stencil: return table_of<StencilSnapshot>(type, version);
+    case ChunkType::Light: return table_of<Camera>(type, version);
   }
   return {};
 }
@@ -234,6 +243,7 @@ std::string record_tables(std::uint32_t version) {
     if (!s.empty()) s += "\n";
     s += t;
   }
+  for (const ChunkSpec& spec : technique_chunks()) s += "\n" + technique_table(spec);
   return s;
 }
 
@@ -309,12 +319,17 @@ std::string dump_record(const DepthSnapshot& r) { return dump_of(r); }
 std::string dump_record(const NBufferLevels& r) { return dump_of(r); }
 std::string dump_record(const GroundTruth& r) { return dump_of(r); }
 std::string dump_record(const FrameEnd& r) { return dump_of(r); }
+std::string dump_record(const StencilSnapshot& r) { return dump_of(r); }
+std::string dump_record(const Camera& r) { return dump_of(r); }
 
 std::string dump_frame(const scene::Frame& f) {
   std::string s = dump_record(f.begin);
   for (const DrawRecord& d : f.draws) s += dump_record(d);
   for (const DepthSnapshot& d : f.depths) s += dump_record(d);
   for (const NBufferLevels& l : f.levels) s += dump_record(l);
+  for (const StencilSnapshot& st : f.stencils) s += dump_record(st);
+  if (f.light) s += dump_record(*f.light);
+  for (const TechniqueRecord& t : f.technique_records) s += dump_technique(t);
   if (f.truth) s += dump_record(*f.truth);
   s += dump_record(f.end);
   return s;

@@ -28,7 +28,8 @@ std::string record_name(ChunkType type);
 // in that version.
 std::string record_table(ChunkType type, std::uint32_t version);
 
-// Every record's table of `version`, one after the other (what `nbsim trace format` prints).
+// Every record's table of `version`, one after the other, then the registered technique chunks'
+// tables (what `nbsim trace format` prints).
 std::string record_tables(std::uint32_t version);
 
 // FORMAT.md's text with every generated region refreshed. A region is
@@ -48,6 +49,8 @@ std::string dump_record(const DepthSnapshot& r);
 std::string dump_record(const NBufferLevels& r);
 std::string dump_record(const GroundTruth& r);
 std::string dump_record(const FrameEnd& r);
+std::string dump_record(const StencilSnapshot& r);
+std::string dump_record(const Camera& r);
 // A whole frame: FRAM, its records in the order the reader keeps them, FEND.
 std::string dump_frame(const scene::Frame& f);
 

@@ -25,6 +25,7 @@ struct Chunk {
   std::uint64_t offset = 0;        // byte offset of the chunk header in the file
   std::uint64_t stored_bytes = 0;  // payload bytes in the file (compressed or not)
   bool compressed = false;
+  bool technique = false;          // a technique's chunk type (kFlagTechnique): `type` is its fourcc
   std::vector<std::uint8_t> payload;  // the decoded payload
 };
 
@@ -102,7 +103,7 @@ class TraceReader {
   bool in_frame_ = false;
   bool any_frame_ = false;
   std::uint32_t frame_ = 0;        // the open (or last) frame's number
-  std::uint32_t frame_draws_ = 0;  // DRAW chunks in the open frame
+  std::uint32_t frame_draws_ = 0;  // draws in the open frame (DRAW chunks and DRWS batches)
 };
 
 // One frame, FRAM .. FEND, decoded (model/scene/frame.h).

@@ -55,6 +55,11 @@ template <> struct EnumInfo<CullFace> { static constexpr const char* name = "Cul
 template <> struct EnumInfo<ClipControl> { static constexpr const char* name = "ClipControl"; static constexpr unsigned max = 1; };
 template <> struct EnumInfo<DepthWhich> { static constexpr const char* name = "DepthWhich"; static constexpr unsigned max = 1; };
 template <> struct EnumInfo<FarOp> { static constexpr const char* name = "FarOp"; static constexpr unsigned max = 1; };
+template <> struct EnumInfo<Topology> { static constexpr const char* name = "Topology"; static constexpr unsigned max = 1; };
+template <> struct EnumInfo<StencilOp> { static constexpr const char* name = "StencilOp"; static constexpr unsigned max = 7; };
+
+// Names of depth and stencil images and of N-buffer sources: 1 to 64 characters, like property keys.
+inline constexpr std::size_t kMaxNameBytes = 64;
 
 template <class E>
 std::string_view enum_value_name(E e) {
@@ -108,6 +113,18 @@ void position_fields(Io& io, std::array<float, 4>& p) {
 }
 
 template <class Io>
+void stencil_face_fields(Io& io, StencilFace& f, const char* func, const char* ref, const char* value_mask,
+                         const char* write_mask, const char* fail, const char* depth_fail, const char* pass) {
+  io.enumeration(func, f.func, "the stencil test's comparison");
+  io.i32(ref, f.ref, "reference value");
+  io.u32(value_mask, f.value_mask, "ANDed with the reference and the stored value");
+  io.u32(write_mask, f.write_mask, "stencil bits written");
+  io.enumeration(fail, f.fail, "when the stencil test fails");
+  io.enumeration(depth_fail, f.depth_fail, "when the stencil test passes and the depth test fails");
+  io.enumeration(pass, f.pass, "when both pass");
+}
+
+template <class Io>
 void fields(Io& io, DrawRecord& d) {
   io.u32("index", d.index, "draw index within the frame: 0, 1, 2, ...");
   io.enumeration("role", d.role, "");
@@ -136,6 +153,24 @@ void fields(Io& io, DrawRecord& d) {
   io.u64("gl.samples_passed", d.gl.samples_passed, "GL_SAMPLES_PASSED");
   io.u64("gl.clip_prims_in", d.gl.clip_prims_in, "GL_CLIPPING_INPUT_PRIMITIVES");
   io.u64("gl.clip_prims_out", d.gl.clip_prims_out, "GL_CLIPPING_OUTPUT_PRIMITIVES");
+  io.since(2, [&] {
+    io.enumeration("topology", d.topology, "three vertices a triangle, or one a point sprite");
+    io.words("point_sizes", d.point_sizes, "S",
+             "gl_PointSize per vertex, pixels: S = V for points, 0 for triangles");
+    io.boolean("stencil.test", d.stencil.test, "GL_STENCIL_TEST");
+    stencil_face_fields(io, d.stencil.front, "stencil.front.func", "stencil.front.ref", "stencil.front.value_mask",
+                        "stencil.front.write_mask", "stencil.front.fail", "stencil.front.depth_fail", "stencil.front.pass");
+    stencil_face_fields(io, d.stencil.back, "stencil.back.func", "stencil.back.ref", "stencil.back.value_mask",
+                        "stencil.back.write_mask", "stencil.back.fail", "stencil.back.depth_fail", "stencil.back.pass");
+    io.boolean("discards", d.discards, "the fragment shader may discard");
+    io.boolean("writes_depth", d.writes_depth, "the fragment shader writes gl_FragDepth");
+  });
+}
+
+template <class Io>
+void fields(Io& io, DrawBatch& b) {
+  io.items("draws", b.draws, "D", Element{"DRAW record", 80, false}, [](Io& e, DrawRecord& d) { fields(e, d); },
+           "consecutive draws of the frame, each laid out as a DRAW payload");
 }
 
 inline std::uint64_t texel_count(std::int32_t w, std::int32_t h, std::int32_t planes = 1) {
@@ -145,7 +180,12 @@ inline std::uint64_t texel_count(std::int32_t w, std::int32_t h, std::int32_t pl
 
 template <class Io>
 void fields(Io& io, DepthSnapshot& d) {
-  io.enumeration("which", d.which, "");
+  io.until(1, [&] {  // version 1 knew two images by number; they are names since
+    DepthWhich which = d.name == "after_occluders" ? DepthWhich::AfterOccluders : DepthWhich::Final;
+    io.enumeration("which", which, "");
+    d.name = std::string(enum_value_name(which));
+  });
+  io.since(2, [&] { io.string("name", d.name, kMaxNameBytes, "the image's name, unique in the frame: after_occluders, final, ..."); });
   io.ranged("width", d.width, std::int32_t{1}, kMaxImageSide, "W", "");
   io.ranged("height", d.height, std::int32_t{1}, kMaxImageSide, "H", "");
   io.image("texels", d.texels, texel_count(d.width, d.height), "W·H", "window depth, y up, row-major (index y·W + x)");
@@ -153,6 +193,9 @@ void fields(Io& io, DepthSnapshot& d) {
 
 template <class Io>
 void fields(Io& io, NBufferLevels& l) {
+  io.since(2, [&] {
+    io.string("source", l.source, kMaxNameBytes, "name of the depth image the levels were built from (version 1: after_occluders)");
+  });
   FarOp op = static_cast<FarOp>(l.op);
   io.enumeration("op", op, "max under LESS/LEQUAL, min under reversed Z");
   l.op = static_cast<std::uint8_t>(op);
@@ -161,6 +204,21 @@ void fields(Io& io, NBufferLevels& l) {
   io.ranged("levels", l.levels, std::int32_t{1}, kMaxLevels, "L", "");
   io.image("texels", l.texels, texel_count(l.width, l.height, l.levels), "L·W·H",
            "L planes of W·H, level 0 first; each y up, row-major");
+}
+
+template <class Io>
+void fields(Io& io, StencilSnapshot& s) {
+  io.string("name", s.name, kMaxNameBytes, "the image's name, unique in the frame");
+  io.ranged("width", s.width, std::int32_t{1}, kMaxImageSide, "W", "");
+  io.ranged("height", s.height, std::int32_t{1}, kMaxImageSide, "H", "");
+  io.image("texels", s.texels, texel_count(s.width, s.height), "W·H", "stencil value, y up, row-major");
+}
+
+template <class Io>
+void fields(Io& io, Camera& c) {
+  io.floats("view", c.view, "the light's view matrix, column-major");
+  io.floats("proj", c.proj, "the light's projection matrix, column-major");
+  io.floats("eye", c.eye, "the light's position, world space");
 }
 
 template <class Io>
