@@ -11,6 +11,7 @@
 
 #include "model/common/error.h"
 #include "traces/format/codec.h"
+#include "traces/format/header.h"
 #include "traces/format/schema.h"
 #include "traces/format/technique_chunks.h"
 
@@ -194,6 +195,7 @@ std::string dump_of(const R& r) {
 
 constexpr std::string_view kRegionOpen = "<!-- generated: nbsim trace format ";
 constexpr std::string_view kRegionClose = "<!-- end generated -->";
+constexpr std::string_view kHeaderKeys = "HEAD-KEYS";  // the region of the header's known keys
 
 }  // namespace
 
@@ -243,7 +245,12 @@ std::string record_tables(std::uint32_t version) {
     if (!s.empty()) s += "\n";
     s += t;
   }
-  for (const ChunkSpec& spec : technique_chunks()) s += "\n" + technique_table(spec);
+  s += "\n### HEAD keys\n\n";
+  s += header_keys_table();
+  for (const ChunkSpec& spec : technique_chunks()) {
+    s += "\n";
+    s += technique_table(spec);
+  }
   return s;
 }
 
@@ -276,6 +283,7 @@ Region parse_region(std::string_view doc, std::size_t at) {
 }
 
 std::string table_for(const Region& r) {
+  if (r.type == kHeaderKeys) return header_keys_table();
   for (const RecordKind& k : record_kinds())
     if (chunk_type_name(k.type) == r.type || (r.type == "END" && k.type == ChunkType::End)) {
       std::string t = record_table(k.type, r.version);

@@ -28,13 +28,14 @@ std::string record_name(ChunkType type);
 // in that version.
 std::string record_table(ChunkType type, std::uint32_t version);
 
-// Every record's table of `version`, one after the other, then the registered technique chunks'
-// tables (what `nbsim trace format` prints).
+// Every record's table of `version`, one after the other, then the header's known keys and the
+// registered technique chunks' tables (what `nbsim trace format` prints).
 std::string record_tables(std::uint32_t version);
 
 // FORMAT.md's text with every generated region refreshed. A region is
 //   <!-- generated: nbsim trace format DRAW 2 -->  ...  <!-- end generated -->
-// and holds record_table(DRAW, 2). Throws InputError for a malformed or unknown region.
+// and holds record_table(DRAW, 2); the region "HEAD-KEYS 2" holds header_keys_table(). Throws
+// InputError for a malformed or unknown region.
 std::string refresh_format_doc(std::string_view doc);
 
 // The records of `version` that FORMAT.md must show: "TYPE version" for each region found.

@@ -6,7 +6,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <functional>
+#include <vector>
 
 #include "model/common/error.h"
 #include "model/common/names.h"
@@ -39,20 +39,19 @@ std::optional<T> number(std::string_view s) {
   return v;
 }
 
-std::uint64_t count(std::string_view key, std::string_view v) {
-  if (v.starts_with('-')) refuse(key, v, "a whole number, at least 0");
+std::uint64_t count(std::string_view key, std::string_view v, std::string_view expected) {
+  if (v.starts_with('-')) refuse(key, v, expected);
   if (const auto n = number<std::uint64_t>(v)) return *n;
-  refuse(key, v, "a whole number, at least 0");
+  refuse(key, v, expected);
 }
 
-double real(std::string_view key, std::string_view v, double lo, double hi, bool open_lo, std::string_view expected) {
+double real(std::string_view key, std::string_view v, std::string_view expected, double lo, double hi, bool open_lo) {
   const auto x = number<double>(v);
   if (!x || *x < lo || *x > hi || (open_lo && *x == lo)) refuse(key, v, expected);
   return *x;
 }
 
-Viewport viewport(std::string_view key, std::string_view v) {
-  const std::string expected = fmt::format("WIDTHxHEIGHT, each 1 .. {}", kMaxImageSide);
+Viewport viewport(std::string_view key, std::string_view v, std::string_view expected) {
   const std::size_t x = v.find('x');
   if (x == std::string_view::npos) refuse(key, v, expected);
   const auto w = number<std::int32_t>(v.substr(0, x)), h = number<std::int32_t>(v.substr(x + 1));
@@ -61,56 +60,82 @@ Viewport viewport(std::string_view key, std::string_view v) {
 }
 
 template <class E, std::size_t N>
-E named(std::string_view key, std::string_view v, const std::array<std::string_view, N>& names) {
+E named(std::string_view key, std::string_view v, std::string_view expected, const std::array<std::string_view, N>& names) {
   if (const auto e = parse_enum_name<E>(names, v)) return *e;
-  refuse(key, v, fmt::format("one of {}", fmt::join(names, ", ")));
+  refuse(key, v, expected);
 }
 
-// One row per typed key: its name and how it sets the header.
+// One row per known key: its name, the values it takes (also what a refusal says is expected),
+// an example, what it means and how it sets the typed header (nothing for free text).
 struct Key {
   std::string_view name;
-  std::function<void(Header&, std::string_view)> parse;
+  std::string_view values;
+  std::string_view example;
+  std::string_view meaning;
+  void (*parse)(Header&, std::string_view key, std::string_view value, std::string_view values);
 };
 
-const std::array<Key, 17>& keys() {
-  static const std::array<Key, 17> table = {{
-      {"viewport", [](Header& h, std::string_view v) { h.viewport = viewport("viewport", v); }},
-      {"depth_format",
-       [](Header& h, std::string_view v) {
-         named<std::uint8_t>("depth_format", v, kGlDepthFormats);
+const std::vector<Key>& keys() {
+  static const std::vector<Key> table = {
+      {"gl_renderer", "text", "llvmpipe (LLVM 15.0.6, 256 bits)", "GL_RENDERER", nullptr},
+      {"gl_version", "text", "4.5 (Core Profile) Mesa 22.3.6", "GL_VERSION", nullptr},
+      {"gl_vendor", "text", "Mesa", "GL_VENDOR", nullptr},
+      {"mesa_version", "text", "22.3.6", "Mesa's version, from GL_VERSION", nullptr},
+      {"viewport", "WIDTHxHEIGHT, each 1 .. 16384", "512x512", "the frame's size in pixels; replay needs it",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.viewport = viewport(k, v, e); }},
+      {"depth_format", "one of DEPTH_COMPONENT16, DEPTH_COMPONENT24, DEPTH_COMPONENT32, DEPTH_COMPONENT32F, DEPTH24_STENCIL8, DEPTH32F_STENCIL8",
+       "DEPTH_COMPONENT32F", "the depth buffer's GL format",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         if (!parse_enum_name<std::uint8_t>(kGlDepthFormats, v)) refuse(k, v, e);
          h.depth_format = std::string(v);
        }},
-      {"depth_func", [](Header& h, std::string_view v) { h.depth_func = named<DepthFunc>("depth_func", v, kGlDepthFuncs); }},
-      {"clip_control",
-       [](Header& h, std::string_view v) { h.clip_control = named<ClipControl>("clip_control", v, kGlClipControls); }},
-      {"depth_clear",
-       [](Header& h, std::string_view v) {
-         h.depth_clear = static_cast<float>(real("depth_clear", v, 0.0, 1.0, false, "a depth in 0 .. 1"));
+      {"depth_func", "one of NEVER, LESS, EQUAL, LEQUAL, GREATER, NOTEQUAL, GEQUAL, ALWAYS", "LESS",
+       "the frame's depth func: LESS, or GREATER with reversed Z (default LESS)",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.depth_func = named<DepthFunc>(k, v, e, kGlDepthFuncs); }},
+      {"clip_control", "one of NEGATIVE_ONE_TO_ONE, ZERO_TO_ONE", "NEGATIVE_ONE_TO_ONE",
+       "glClipControl's depth mode (default NEGATIVE_ONE_TO_ONE)",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.clip_control = named<ClipControl>(k, v, e, kGlClipControls);
        }},
-      {"technique", [](Header& h, std::string_view v) { h.technique = std::string(v); }},
-      {"test_mode",
-       [](Header& h, std::string_view v) {
+      {"depth_clear", "a depth in 0 .. 1", "1", "the depth buffer's clear value (default 1)",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.depth_clear = static_cast<float>(real(k, v, e, 0.0, 1.0, false));
+       }},
+      {"technique", "text", "occlusion_culling", "the technique the capture ran",
+       [](Header& h, std::string_view, std::string_view v, std::string_view) { h.technique = std::string(v); }},
+      {"test_mode", "one of oq, oq_hier, nb, nb_hier, none", "nb_hier", "occlusion culling's test mode",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
          h.test_mode = scene::parse_test_mode(v);
-         if (!h.test_mode) refuse("test_mode", v, "one of oq, oq_hier, nb, nb_hier, none");
+         if (!h.test_mode) refuse(k, v, e);
        }},
-      {"scene", [](Header& h, std::string_view v) { h.scene = std::string(v); }},
-      {"path", [](Header& h, std::string_view v) { h.path = std::string(v); }},
-      {"seed", [](Header& h, std::string_view v) { h.seed = count("seed", v); }},
-      {"objects", [](Header& h, std::string_view v) { h.objects = count("objects", v); }},
-      {"frames", [](Header& h, std::string_view v) { h.frames = count("frames", v); }},
-      {"levels_every", [](Header& h, std::string_view v) { h.levels_every = count("levels_every", v); }},
-      {"fov_y_deg",
-       [](Header& h, std::string_view v) {
-         h.fov_y_deg = real("fov_y_deg", v, 0.0, 180.0, true, "an angle in degrees, above 0 and below 180");
-         if (h.fov_y_deg == 180.0) refuse("fov_y_deg", v, "an angle in degrees, above 0 and below 180");
+      {"scene", "text", "city", "the scene",
+       [](Header& h, std::string_view, std::string_view v, std::string_view) { h.scene = std::string(v); }},
+      {"seed", "a whole number, at least 0", "1", "the scene's and path's random seed",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.seed = count(k, v, e); }},
+      {"objects", "a whole number, at least 0", "5000", "the scene's object count",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.objects = count(k, v, e); }},
+      {"path", "text", "walk", "the camera path",
+       [](Header& h, std::string_view, std::string_view v, std::string_view) { h.path = std::string(v); }},
+      {"frames", "a whole number, at least 0", "60", "the frames the capture was asked for",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.frames = count(k, v, e); }},
+      {"fov_y_deg", "an angle in degrees, above 0 and below 180", "60", "the camera's vertical field of view",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.fov_y_deg = real(k, v, e, 0.0, 180.0, true);
+         if (h.fov_y_deg == 180.0) refuse(k, v, e);
        }},
-      {"near", [](Header& h, std::string_view v) { h.near_m = real("near", v, 0.0, 1e300, true, "a distance above 0"); }},
-      {"far", [](Header& h, std::string_view v) { h.far_m = real("far", v, 0.0, 1e300, true, "a distance above 0"); }},
-      {"nearest_margin",
-       [](Header& h, std::string_view v) {
-         h.nearest_margin = real("nearest_margin", v, 0.0, 1.0, false, "a depth margin in 0 .. 1");
+      {"near", "a distance above 0", "0.5", "the near plane, m",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.near_m = real(k, v, e, 0.0, 1e300, true); }},
+      {"far", "a distance above near", "4000", "the far plane, m",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.far_m = real(k, v, e, 0.0, 1e300, true); }},
+      {"nearest_margin", "a depth margin in 0 .. 1", "1e-06", "margin subtracted from a bounds test's nearest depth",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.nearest_margin = real(k, v, e, 0.0, 1.0, false);
        }},
-  }};
+      {"levels_every", "a whole number, at least 0", "1", "the N-buffer levels are recorded every k-th frame (0: never)",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.levels_every = count(k, v, e); }},
+      {"nbsim_version", "text", "0.1.0", "the capturing nbsim's version", nullptr},
+      {"command_line", "text", "nbsim capture city --frames 60 -o walk.nbtrace", "the capture's command line", nullptr},
+  };
   return table;
 }
 
@@ -131,10 +156,16 @@ Header parse_header(const Properties& properties) {
   h.properties = properties;
   for (const auto& [k, v] : properties)
     for (const Key& key : keys())
-      if (key.name == k) key.parse(h, v);
+      if (key.name == k && key.parse) key.parse(h, k, v, key.values);
   if (h.far_m != 0.0 && h.near_m != 0.0 && h.far_m <= h.near_m)
     refuse("far", *h.property("far"), fmt::format("a distance above near ({})", *h.property("near")));
   return h;
+}
+
+std::string header_keys_table() {
+  std::string t = "| Key | Values | Example | Meaning |\n|-----|--------|---------|---------|\n";
+  for (const Key& k : keys()) t += fmt::format("| `{}` | {} | `{}` | {} |\n", k.name, k.values, k.example, k.meaning);
+  return t;
 }
 
 std::string_view gl_name(DepthFunc func) noexcept { return enum_name(kGlDepthFuncs, func); }

@@ -1,7 +1,7 @@
 // The typed trace header: the HEAD chunk's key/value properties parsed and checked once, when a
 // trace is opened (TraceReader), so that replay, `nbsim trace` and tests read numbers and enums
 // instead of parsing strings. Keys the table in header.cpp does not know stay as they are in
-// `properties`. FORMAT.md "HEAD" lists the keys.
+// `properties`. That table also writes FORMAT.md's list of keys (header_keys_table).
 #pragma once
 
 #include <cstdint>
@@ -49,6 +49,9 @@ struct Header {
 // must be ("header property 'viewport' is '128x96x': expected WIDTHxHEIGHT, each 1 .. 16384");
 // TraceReader adds the file and chunk.
 Header parse_header(const Properties& properties);
+
+// The Markdown table of the keys the header knows (FORMAT.md "HEAD"): key, values, example, meaning.
+std::string header_keys_table();
 
 // The GL names of the header's depth funcs and clip controls ("LESS", "ZERO_TO_ONE").
 std::string_view gl_name(DepthFunc func) noexcept;
