@@ -315,13 +315,13 @@ inline std::vector<SampleFrame> sample_frames(std::uint32_t objects = 6) {
 // The sample frames with every record and field of version 2: frame 2 adds point and stencil
 // draws, two more depth images ("litmap_min", "litmap_max"), their min and max N-buffers, two
 // stencil images, a light camera and technique records (one registered, one raw); frame 5 a raw
-// technique record only. More draws than fit one DRWS batch in frame 0.
+// technique record only. Frame 0 has 1029 draws (more than one DRWS batch of the writer's holds).
 inline std::vector<SampleFrame> sample_frames_v2(std::uint32_t objects = 6) {
   std::vector<SampleFrame> fs = sample_frames(objects);
   for (std::size_t k = 0; k < fs.size(); ++k)
     for (std::size_t i = 0; i < fs[k].draws.size(); ++i)
       fs[k].draws[i] = sample_draw_v2(static_cast<std::uint32_t>(i), fs[k].draws[i].clip_positions.size(), static_cast<std::uint32_t>(k));
-  for (std::uint32_t i = static_cast<std::uint32_t>(fs[0].draws.size()); i < kDrawsPerBatch + 5; ++i)
+  for (std::uint32_t i = static_cast<std::uint32_t>(fs[0].draws.size()); i < 1029; ++i)
     fs[0].draws.push_back(sample_draw_v2(i, i % 4, 9));
   fs[0].end.draws = static_cast<std::uint32_t>(fs[0].draws.size());
   SampleFrame& f = fs[1];

@@ -33,7 +33,9 @@ inline constexpr std::uint32_t kKnownFlags = kFlagZstd | kFlagTechnique;
 // 1 KiB rarely shrink; zstd level 3 (its default) compresses depth images ~3-10x at >100 MB/s.
 // A frame's draws go in DRWS batches of at most kDrawsPerBatch draws or kBatchBytes payload bytes
 // (whichever comes first): large enough for zstd to find the draws' shared structure, small
-// enough to keep the writer's memory bounded.
+// enough to keep the writer's memory bounded. Measured on a 10-frame 512x512 city fly capture
+// (3685 draws a frame), the draws' stored bytes per frame by batch size: 1 draw 1122 KB, 16 292 KB,
+// 64 267 KB, 256 259 KB, 1024 259 KB, the whole frame 259 KB.
 inline constexpr std::size_t kCompressMinBytes = 1024;
 inline constexpr int kZstdLevel = 3;
 inline constexpr std::size_t kDrawsPerBatch = 1024;
