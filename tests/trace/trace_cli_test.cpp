@@ -277,4 +277,28 @@ TEST(TraceCliTest, DumpRecords) {
   EXPECT_TRUE(has(r.out, "FEND FrameEnd\n  frame: 2\n  draws: 3\n")) << r.out;
 }
 
+// info --json lists a frame's stencil images, light camera and technique records when it has them
+// (nbsim itself registers no technique chunk, so it reads them raw) and omits the keys otherwise.
+TEST(TraceCliTest, InfoShowsVersion2Records) {
+  const fs::path f = scratch("v2_info.nbtrace");
+  write_sample_trace_v2(f);
+  const CliResult r = nbsim("trace info --json " + f.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& frames = j["frames"];
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[0]["draws"], 1029);
+  EXPECT_FALSE(frames[0].contains("stencil") || frames[0].contains("light") || frames[0].contains("technique_records"));
+  EXPECT_EQ(frames[1]["depth"], nlohmann::json({"after_occluders", "final", "litmap_min", "litmap_max"}));
+  EXPECT_EQ(frames[1]["stencil"], nlohmann::json({"shadow_mask", "volumes"}));
+  EXPECT_EQ(frames[1]["light"], true);
+  EXPECT_EQ(frames[1]["technique_records"], nlohmann::json({"TSTX", "RAWX", "TSTX"}));
+  EXPECT_EQ(frames[2]["technique_records"], nlohmann::json({"RAWX"}));
+  const CliResult d = nbsim("trace dump " + f.string() + " --frame 2 --records");
+  ASSERT_EQ(d.status, 0) << d.err;
+  EXPECT_TRUE(has(d.out, "STNC StencilSnapshot\n  name: \"shadow_mask\"\n")) << d.out;
+  EXPECT_TRUE(has(d.out, "LGHT Camera\n  view: [")) << d.out;
+  EXPECT_TRUE(has(d.out, "TSTX (unregistered technique chunk)\n  payload: ")) << d.out;
+}
+
 }  // namespace
