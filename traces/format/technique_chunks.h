@@ -37,7 +37,8 @@ struct ChunkSpec {
 void register_technique_chunk(ChunkSpec spec);
 // The spec of a registered type, or nullptr.
 const ChunkSpec* find_technique_chunk(std::uint32_t type);
-// Every registered spec, in registration order.
+// Every registered spec, in registration order. Techniques register at start-up, before traces are
+// read or written on other threads (registration locks; this listing does not).
 const std::vector<ChunkSpec>& technique_chunks();
 
 // The payload of a record of a registered type, from its fields (which must match the spec's
