@@ -10,7 +10,9 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include "model/common/depth.h"
@@ -53,6 +55,29 @@ enum class DrawRole : std::uint8_t {
 // The culling technique a frame ran (ARCHITECTURE.md Table 2 modes).
 enum class TestMode : std::uint8_t { OcclusionQuery = 0, OcclusionQueryHier = 1, NBuffer = 2, NBufferHier = 3, None = 4 };
 
+// What a draw rasterizes: triangles (three clip-space vertices each) or point sprites (one vertex
+// each, every fragment at the vertex's depth, a square of the vertex's point size in pixels).
+enum class Topology : std::uint8_t { Triangles = 0, Points = 1 };
+
+// GL's stencil operations in GL's order (glStencilOp).
+enum class StencilOp : std::uint8_t { Keep = 0, Zero = 1, Replace = 2, Incr = 3, IncrWrap = 4, Decr = 5, DecrWrap = 6, Invert = 7 };
+
+// One face's stencil state; GL's stencil funcs are the depth funcs. Defaults are GL's.
+struct StencilFace {
+  DepthFunc func = DepthFunc::Always;
+  std::int32_t ref = 0;
+  std::uint32_t value_mask = 0xFFFFFFFFu;  // ANDed with ref and the stored value before the test
+  std::uint32_t write_mask = 0xFFFFFFFFu;
+  StencilOp fail = StencilOp::Keep;        // stencil test fails
+  StencilOp depth_fail = StencilOp::Keep;  // stencil test passes, depth test fails
+  StencilOp pass = StencilOp::Keep;        // both pass
+};
+
+struct StencilState {
+  bool test = false;  // GL_STENCIL_TEST
+  StencilFace front, back;
+};
+
 struct DepthState {
   DepthFunc func = DepthFunc::Less;
   bool write = true;
@@ -88,11 +113,24 @@ struct DrawRecord {
   std::uint8_t level = 0;    // N-buffer level written (NBufferBuild)
   DepthState state;
   // Post-transform geometry as GL computed it (transform feedback): clip-space x, y, z, w per
-  // vertex, three vertices a triangle. Empty for full-screen passes.
+  // vertex, three vertices a triangle (one a point). Empty for full-screen passes.
   std::vector<std::array<float, 4>> clip_positions;
   bool has_bounds = false;
   BoundsTest bounds;
   GlCounters gl;
+  Topology topology = Topology::Triangles;
+  std::vector<float> point_sizes;  // Points: gl_PointSize per vertex, pixels; Triangles: empty
+  StencilState stencil;
+  bool discards = false;      // the fragment shader may discard fragments
+  bool writes_depth = false;  // the fragment shader writes gl_FragDepth (no early depth test)
+};
+
+// A camera: view and projection (column-major, as GL takes them) and its position, world space.
+// A frame's second camera is a light's (shadow volumes with litmaps).
+struct Camera {
+  std::array<float, 16> view{};
+  std::array<float, 16> proj{};
+  std::array<float, 3> eye{};
 };
 
 struct FrameBegin {
@@ -103,18 +141,47 @@ struct FrameBegin {
   std::array<float, 3> eye{};
 };
 
+// The two depth images of occlusion culling; their names ("after_occluders", "final") are depth
+// image names like any technique's.
 enum class DepthWhich : std::uint8_t { AfterOccluders = 0, Final = 1 };
 
+// A named depth image of the frame (occlusion culling: "after_occluders" and "final"; other
+// techniques add theirs, e.g. litmaps "litmap_min" and "litmap_max").
 struct DepthSnapshot {
-  DepthWhich which = DepthWhich::Final;
+  std::string name = "final";
   std::int32_t width = 0, height = 0;
   std::vector<float> texels;  // y up, row-major
 };
 
+// A named stencil image of the frame (shadow volumes' mask, for instance).
+struct StencilSnapshot {
+  std::string name;
+  std::int32_t width = 0, height = 0;
+  std::vector<std::uint8_t> texels;  // y up, row-major
+};
+
+// N-buffer levels GL built from one of the frame's depth images.
 struct NBufferLevels {
+  std::string source = "after_occluders";  // the depth image's name (occlusion culling builds from the occluder pass)
   std::uint8_t op = 0;  // FarOp
   std::int32_t width = 0, height = 0, levels = 0;
   std::vector<float> texels;  // levels planes of width * height, y up, row-major
+};
+
+// A technique's own record (a chunk type the technique registered in traces/format): its type
+// (fourcc) and payload as stored and, when the reader knew the type's field description, the
+// decoded fields in order.
+struct TechniqueField {
+  std::string name;
+  std::variant<std::uint64_t, std::int64_t, double, std::string, std::vector<float>, std::vector<std::uint32_t>,
+               std::vector<std::int32_t>>
+      value;
+};
+struct TechniqueRecord {
+  std::uint32_t type = 0;
+  std::vector<std::uint8_t> payload;
+  bool decoded = false;  // `fields` holds the payload's fields (the type was registered)
+  std::vector<TechniqueField> fields;
 };
 
 struct GroundTruth {
@@ -139,13 +206,20 @@ struct Frame {
   std::uint64_t offset = 0;   // byte offset of its FRAM chunk (0 when it did not come from a file)
   FrameBegin begin;
   std::vector<DrawRecord> draws;  // draws[i].index == i
-  std::vector<DepthSnapshot> depths;  // at most one per DepthWhich, in file order
-  std::vector<NBufferLevels> levels;  // at most one per FarOp, in file order
+  std::vector<DepthSnapshot> depths;  // names unique, in file order
+  std::vector<NBufferLevels> levels;  // at most one per (source, op), in file order
+  std::vector<StencilSnapshot> stencils;  // names unique, in file order
+  std::optional<Camera> light;            // a second camera, when the technique has a light
+  std::vector<TechniqueRecord> technique_records;  // in file order
   std::optional<GroundTruth> truth;
   FrameEnd end;
 
   const DepthSnapshot* depth(DepthWhich which) const noexcept;
+  const DepthSnapshot* depth(std::string_view name) const noexcept;
+  const StencilSnapshot* stencil(std::string_view name) const noexcept;
+  // The first level set with this op (occlusion culling has at most one per op).
   const NBufferLevels* nbuffer(FarOp op) const noexcept;
+  const NBufferLevels* nbuffer(std::string_view source, FarOp op) const noexcept;
 };
 
 // Names (run outputs, `nbsim trace info`, timelines), one table per enum in frame.cpp; "?" for a
@@ -155,6 +229,9 @@ std::string_view to_string(TestMode mode) noexcept;
 std::string_view to_string(DepthWhich which) noexcept;
 std::string_view to_string(DepthFunc func) noexcept;
 std::string_view to_string(CullFace cull) noexcept;
+std::string_view to_string(ClipControl clip) noexcept;
+std::string_view to_string(Topology topology) noexcept;
+std::string_view to_string(StencilOp op) noexcept;
 // The capture's --mode names of TestMode, indexed by its value (also the model's cull.mode names).
 inline constexpr std::array<std::string_view, 5> kTestModeNames = {"oq", "oq_hier", "nb", "nb_hier", "none"};
 std::optional<TestMode> parse_test_mode(std::string_view s) noexcept;

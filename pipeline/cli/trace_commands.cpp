@@ -7,6 +7,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
 
@@ -14,6 +15,7 @@
 #include "pipeline/cli/command.h"
 #include "pipeline/io/image_io.h"
 #include "traces/format/codec.h"
+#include "traces/format/describe.h"
 #include "traces/format/reader.h"
 
 namespace nbsim::cli {
@@ -34,6 +36,9 @@ struct FrameSummary {
   std::optional<std::uint64_t> objects_visible, covered_pixels;
   double gl_ms = 0.0;
   std::vector<std::string> depths;  // "after_occluders", "final"
+  std::vector<std::string> stencils;  // names (version 2)
+  bool light = false;
+  std::vector<std::string> technique_records;  // chunk types
   std::vector<std::string> level_text;  // "max x9", ...
   std::vector<ojson> level_json;
 };
@@ -54,7 +59,10 @@ FrameSummary summarize(const tr::Frame& f) {
     s.covered_pixels = f.truth->covered_pixels;
   }
   s.gl_ms = f.end.gl_ms;
-  for (const tr::DepthSnapshot& d : f.depths) s.depths.emplace_back(tr::to_string(d.which));
+  for (const tr::DepthSnapshot& d : f.depths) s.depths.emplace_back(d.name);
+  for (const tr::StencilSnapshot& st : f.stencils) s.stencils.emplace_back(st.name);
+  s.light = f.light.has_value();
+  for (const tr::TechniqueRecord& t : f.technique_records) s.technique_records.push_back(tr::chunk_type_name(t.type));
   for (const tr::NBufferLevels& l : f.levels) {
     const std::string_view op = to_string(static_cast<FarOp>(l.op));
     s.level_text.push_back(fmt::format("{} x{}", op, l.levels));
@@ -107,6 +115,10 @@ int run_info(const std::string& file, bool json) {
       o["gl_ms"] = s.gl_ms;
       o["depth"] = s.depths;
       o["levels"] = s.level_json;
+      // Version 2's records only when the frame has them (occlusion-culling summaries stay as they were).
+      if (!s.stencils.empty()) o["stencil"] = s.stencils;
+      if (s.light) o["light"] = true;
+      if (!s.technique_records.empty()) o["technique_records"] = s.technique_records;
       o["offset"] = s.offset;
       fr.push_back(std::move(o));
     }
@@ -131,6 +143,9 @@ int run_info(const std::string& file, bool json) {
                tr::to_string(s.mode), s.draws, s.fragments, s.samples_passed, visible);
     if (!s.depths.empty()) fmt::print("; depth: {}", fmt::join(s.depths, ", "));
     if (!s.level_text.empty()) fmt::print("; N-buffer: {}", fmt::join(s.level_text, ", "));
+    if (!s.stencils.empty()) fmt::print("; stencil: {}", fmt::join(s.stencils, ", "));
+    if (s.light) fmt::print("; light camera");
+    if (!s.technique_records.empty()) fmt::print("; technique records: {}", fmt::join(s.technique_records, ", "));
     fmt::print("\n");
   }
   fmt::print("total: {} draws, {} GL fragments, {} samples passed\n", draws, fragments, samples);
@@ -172,11 +187,12 @@ struct DumpOptions {
   std::string which = "final";
   std::string levels;
   std::string truth;
+  bool records = false;
 };
 
 int run_dump(const DumpOptions& o) {
-  if (o.depth.empty() && o.levels.empty() && o.truth.empty())
-    throw InputError("nothing to dump: pass --depth OUT.exr, --levels DIR or --truth OUT.csv|OUT.png");
+  if (o.depth.empty() && o.levels.empty() && o.truth.empty() && !o.records)
+    throw InputError("nothing to dump: pass --records, --depth OUT.exr, --levels DIR or --truth OUT.csv|OUT.png");
   const std::string truth_ext = lower_extension(o.truth);
   if (!o.truth.empty() && truth_ext != ".csv" && truth_ext != ".png")
     throw InputError(fmt::format("--truth '{}': expected a .csv (visible pixels per object) or .png (ID buffer) file", o.truth));
@@ -198,15 +214,16 @@ int run_dump(const DumpOptions& o) {
                                  count, first, last));
   }
   const tr::Frame& f = *frame;
+  if (o.records) fmt::print("{}", tr::dump_frame(f));
 
   // Check that everything asked for is there before writing anything.
-  const tr::DepthWhich which = o.which == "final" ? tr::DepthWhich::Final : tr::DepthWhich::AfterOccluders;
+  const std::string which = o.which == "occluders" ? std::string(tr::to_string(tr::DepthWhich::AfterOccluders)) : o.which;
   const tr::DepthSnapshot* depth = o.depth.empty() ? nullptr : f.depth(which);
   if (!o.depth.empty() && !depth) {
     std::vector<std::string> have;
-    for (const tr::DepthSnapshot& d : f.depths) have.emplace_back(tr::to_string(d.which));
+    for (const tr::DepthSnapshot& d : f.depths) have.emplace_back(d.name);
     throw InputError(fmt::format("frame {} of '{}' has no '{}' depth snapshot (it has: {})", o.frame, o.file,
-                                 tr::to_string(which), have.empty() ? std::string("none") : fmt::format("{}", fmt::join(have, ", "))));
+                                 which, have.empty() ? std::string("none") : fmt::format("{}", fmt::join(have, ", "))));
   }
   if (!o.levels.empty() && f.levels.empty())
     throw InputError(fmt::format("frame {} of '{}' records no N-buffer levels (the capture may store them every k-th frame only)",
@@ -223,7 +240,7 @@ int run_dump(const DumpOptions& o) {
     img.height = depth->height;
     img.texels = depth->texels;
     io::write_depth(img, o.depth);
-    fmt::print("wrote {} ({}x{}, '{}' depth of frame {})\n", o.depth, img.width, img.height, tr::to_string(which), o.frame);
+    fmt::print("wrote {} ({}x{}, '{}' depth of frame {})\n", o.depth, img.width, img.height, which, o.frame);
   }
   if (!o.levels.empty()) {
     const fs::path dir(o.levels);
@@ -269,6 +286,27 @@ int run_dump(const DumpOptions& o) {
   return 0;
 }
 
+int run_format(std::uint32_t version, const std::string& update) {
+  if (version < 1 || version > tr::kFormatVersion)
+    throw InputError(fmt::format("--format-version {}: this nbsim knows format versions 1 to {}", version, tr::kFormatVersion));
+  if (update.empty()) {
+    fmt::print("{}", tr::record_tables(version));
+    return 0;
+  }
+  std::ifstream in(update, std::ios::binary);
+  if (!in) throw InputError(fmt::format("cannot read '{}'", update));
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string fresh = tr::refresh_format_doc(doc);
+  if (fresh == doc) {
+    fmt::print("{}: its {} record tables are current\n", update, tr::format_doc_regions(doc).size());
+    return 0;
+  }
+  std::ofstream out(update, std::ios::binary | std::ios::trunc);
+  if (!(out << fresh) || !out.flush()) throw InputError(fmt::format("cannot write '{}'", update));
+  fmt::print("{}: refreshed its {} record tables\n", update, tr::format_doc_regions(doc).size());
+  return 0;
+}
+
 }  // namespace
 
 void add_trace_commands(CLI::App& app, Action& action) {
@@ -296,17 +334,29 @@ void add_trace_commands(CLI::App& app, Action& action) {
     cmd->callback([&action, file] { action = [=] { return run_verify(*file); }; });
   }
   {
+    auto* cmd = tc->add_subcommand("format", "Print the record tables of the trace format (Markdown), from the records' one description");
+    auto version = std::make_shared<std::uint32_t>(tr::kFormatVersion);
+    auto update = std::make_shared<std::string>();
+    cmd->add_option("--format-version", *version, "Layout of this format version")->capture_default_str();
+    cmd->add_option("--update", *update, "Refresh the generated tables of this document (traces/FORMAT.md) in place");
+    cmd->footer("The tables are what the codec reads and writes: traces/format/schema.h describes each record once.\n"
+                "FORMAT.md holds them between '<!-- generated: nbsim trace format TYPE VERSION -->' markers.");
+    cmd->callback([&action, version, update] { action = [=] { return run_format(*version, *update); }; });
+  }
+  {
     auto* cmd = tc->add_subcommand("dump", "Write one frame's depth snapshot, N-buffer levels (EXR) and ground truth (CSV or PNG)");
     auto o = std::make_shared<DumpOptions>();
     cmd->add_option("FILE", o->file, "Trace file")->required();
     cmd->add_option("--frame", o->frame, "Frame number (as recorded in the trace)")->required();
     cmd->add_option("--depth", o->depth, "Write the depth snapshot as a single-channel float image (EXR), y up");
-    cmd->add_option("--which", o->which, "Which snapshot: final (end of frame) or occluders (after the occluder pass)")
-        ->check(CLI::IsMember({"final", "occluders"}))
+    cmd->add_option("--which", o->which,
+                    "Which depth image, by name: final (end of frame), occluders or after_occluders (after the occluder "
+                    "pass), or any image a technique recorded")
         ->capture_default_str();
     cmd->add_option("--levels", o->levels, "Write the N-buffer levels the GLSL shader built as DIR/level_NN.exr");
     cmd->add_option("--truth", o->truth, "Write the ground truth: OUT.csv (visible pixels per object) or OUT.png (ID buffer)");
-    cmd->footer("At least one of --depth, --levels, --truth. Nothing is written when the frame lacks any of them.\n"
+    cmd->add_flag("--records", o->records, "Print every record of the frame, field by field (long vectors abbreviated)");
+    cmd->footer("At least one of --records, --depth, --levels, --truth. Nothing is written when the frame lacks any of them.\n"
                 "With both max and min N-buffers in the frame, the level files are named max_level_NN.exr and min_level_NN.exr.");
     cmd->callback([&action, o] { action = [=] { return run_dump(*o); }; });
   }

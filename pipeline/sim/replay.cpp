@@ -224,39 +224,29 @@ ReplaySummary replay(const ReplayOptions& o) {
   }
   auto frames = std::make_shared<trace::FrameReader>(o.trace);
   const trace::TraceReader& tr = frames->trace();
-  const std::string* viewport = tr.property("viewport");
-  int w = 0, h = 0;
-  if (!viewport || std::sscanf(viewport->c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1)
-    throw InputError(fmt::format("{}: the header has no valid 'viewport' property", o.trace.string()));
-  const std::string* clear = tr.property("depth_clear");
-  const float clear_depth = clear && *clear == "0" ? 0.0f : 1.0f;
-  const std::string* nframes = tr.property("frames");
+  const trace::Header& head = tr.header();  // parsed and checked when the trace was opened
+  if (!head.viewport) throw InputError(fmt::format("{}: the header has no 'viewport' property", o.trace.string()));
+  const int w = head.viewport->width, h = head.viewport->height;
+  const float clear_depth = head.depth_clear;
 
   ReplaySummary s;
   stats::Registry registry;
   Collector sink(s, o, registry);
-  if (nframes) sink.total_frames = std::strtoull(nframes->c_str(), nullptr, 10);
+  if (head.frames) sink.total_frames = *head.frames;
   sim::install_report_handler();
   // The cull stage's view of the trace (culling modes only read it).
-  const auto number = [&tr](const char* key, double fallback) {
-    const std::string* v = tr.property(key);
-    return v ? std::strtod(v->c_str(), nullptr) : fallback;
-  };
-  const std::string* func = tr.property("depth_func");
-  const std::string* clip_control = tr.property("clip_control");
   cull::CullSetup setup;
   setup.width_px = w;
   setup.height_px = h;
-  setup.op = func && (*func == "GREATER" || *func == "GEQUAL") ? FarOp::Min : FarOp::Max;
+  setup.op = head.far_op();
   setup.depth_func = setup.op == FarOp::Min ? trace::DepthFunc::Greater : trace::DepthFunc::Less;
-  setup.near_m = number("near", 0.0);
-  setup.nearest_margin = number("nearest_margin", 0.0);
-  setup.zero_to_one = clip_control && *clip_control == "ZERO_TO_ONE";
+  setup.near_m = head.near_m;
+  setup.nearest_margin = head.nearest_margin;
+  setup.zero_to_one = head.clip_control == trace::ClipControl::ZeroToOne;
   setup.scene = tr.scene();
   setup.fused_interpolation = o.config.depth.fused_interpolation;
-  const std::string* technique = tr.property("technique");
-  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink,
-          technique ? *technique : std::string(), setup, o.out ? &*o.out : nullptr);
+  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head.technique, setup,
+          o.out ? &*o.out : nullptr);
   std::optional<sim::Timeline> timeline;  // only when asked: units then report their busy spans
   if (o.timeline || o.vcd) {
     sim::TimelineOptions to;

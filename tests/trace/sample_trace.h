@@ -21,6 +21,7 @@
 
 #include "traces/format/codec.h"
 #include "traces/format/reader.h"
+#include "traces/format/technique_chunks.h"
 #include "traces/format/writer.h"
 
 namespace nbsim::trace::testing {
@@ -138,11 +139,92 @@ inline DrawRecord sample_draw(std::uint32_t index, std::size_t vertices, std::ui
   return d;
 }
 
+// A draw with every field of version 2 set away from its default: point sprites with sizes, both
+// stencil faces, discard and gl_FragDepth.
+inline DrawRecord sample_draw_v2(std::uint32_t index, std::size_t vertices, std::uint32_t seed = 1) {
+  DrawRecord d = sample_draw(index, vertices, seed);
+  d.topology = vertices % 3 == 0 && index % 2 == 0 ? Topology::Triangles : Topology::Points;
+  if (d.topology == Topology::Points)
+    for (std::size_t v = 0; v < vertices; ++v) d.point_sizes.push_back(v == 0 ? -0.0f : 1.0f + static_cast<float>(v % 32));
+  d.stencil.test = index % 2 == 0;
+  d.stencil.front = {DepthFunc::Gequal, -7, 0x0Fu, 0xF0u, StencilOp::IncrWrap, StencilOp::Invert, StencilOp::Replace};
+  d.stencil.back = {DepthFunc::NotEqual, 255, 0xFFFFFF00u, 0x1u, StencilOp::DecrWrap, StencilOp::Zero, StencilOp::Decr};
+  d.discards = index % 3 != 2;
+  d.writes_depth = index % 2 == 1;
+  return d;
+}
+
+inline StencilSnapshot sample_stencil(const std::string& name, std::int32_t w, std::int32_t h) {
+  StencilSnapshot s;
+  s.name = name;
+  s.width = w;
+  s.height = h;
+  for (std::int32_t i = 0; i < w * h; ++i) s.texels.push_back(static_cast<std::uint8_t>((i / 7) % 3 == 0 ? 0 : i * 37));
+  return s;
+}
+
+inline Camera sample_light(std::uint32_t frame) {
+  Camera c;
+  for (std::size_t i = 0; i < 16; ++i) {
+    c.view[i] = awkward_floats()[(i + 3) % awkward_floats().size()];
+    c.proj[i] = static_cast<float>(i) * -0.5f + static_cast<float>(frame);
+  }
+  c.eye = {-0.0f, 100.0f + static_cast<float>(frame), std::bit_cast<float>(0x7FC00001u)};
+  return c;
+}
+
+// A technique chunk type for the tests, with a field of every kind (registered once per process).
+inline constexpr std::uint32_t kTestChunk = fourcc("TSTX");
+inline void register_test_chunk() {
+  static const bool once = [] {
+    register_technique_chunk({kTestChunk,
+                              "test_technique",
+                              "TestRecord",
+                              {{"count", FieldKind::U32, "a u32"},
+                               {"offset", FieldKind::I32, "an i32"},
+                               {"total", FieldKind::U64, "a u64"},
+                               {"scale", FieldKind::F32, "an f32"},
+                               {"ms", FieldKind::F64, "an f64"},
+                               {"label", FieldKind::String, "a string"},
+                               {"depths", FieldKind::VecF32, "floats"},
+                               {"ids", FieldKind::VecU32, "u32s"},
+                               {"deltas", FieldKind::VecI32, "i32s"}}});
+    return true;
+  }();
+  (void)once;
+}
+
+inline TechniqueRecord sample_technique_record(std::uint32_t seed) {
+  register_test_chunk();
+  TechniqueRecord r;
+  r.type = kTestChunk;
+  r.decoded = true;
+  r.fields = {{"count", std::uint64_t{4000000000u + seed}},
+              {"offset", std::int64_t{-5 - static_cast<std::int64_t>(seed)}},
+              {"total", std::uint64_t{(1ull << 60) + seed}},
+              {"scale", 0.375},
+              {"ms", 1.0 / 3.0},
+              {"label", std::string("litmap \"max\"")},
+              {"depths", std::vector<float>{-0.0f, 1e-40f, 0.5f}},
+              {"ids", std::vector<std::uint32_t>{seed, 0xFFFFFFFFu}},
+              {"deltas", std::vector<std::int32_t>{}}};
+  r.payload = encode(r);  // what the reader keeps next to the fields
+  return r;
+}
+
+// A technique record of a type this build does not know: kept raw.
+inline TechniqueRecord sample_raw_record() {
+  TechniqueRecord r;
+  r.type = fourcc("RAWX");
+  r.payload = {1, 2, 3, 4, 5, 0, 255};
+  return r;
+}
+
 // A depth image with flat regions and a gradient (compresses like a real depth buffer), plus
 // the awkward floats in the first texels.
 inline DepthSnapshot sample_depth(DepthWhich which, std::int32_t w, std::int32_t h, std::uint32_t seed = 1) {
   DepthSnapshot d;
-  d.which = which;
+  d.name = std::string(to_string(which));
   d.width = w;
   d.height = h;
   d.texels.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 1.0f);
@@ -198,6 +280,9 @@ struct SampleFrame {
   std::vector<DrawRecord> draws;
   std::vector<DepthSnapshot> depths;
   std::vector<NBufferLevels> levels;
+  std::vector<StencilSnapshot> stencils;
+  std::optional<Camera> light;
+  std::vector<TechniqueRecord> technique_records;
   std::optional<GroundTruth> truth;
   FrameEnd end;
 };
@@ -227,11 +312,44 @@ inline std::vector<SampleFrame> sample_frames(std::uint32_t objects = 6) {
   return fs;
 }
 
+// The sample frames with every record and field of version 2: frame 2 adds point and stencil
+// draws, two more depth images ("litmap_min", "litmap_max"), their min and max N-buffers, two
+// stencil images, a light camera and technique records (one registered, one raw); frame 5 a raw
+// technique record only. Frame 0 has 1029 draws (more than one DRWS batch of the writer's holds).
+inline std::vector<SampleFrame> sample_frames_v2(std::uint32_t objects = 6) {
+  std::vector<SampleFrame> fs = sample_frames(objects);
+  for (std::size_t k = 0; k < fs.size(); ++k)
+    for (std::size_t i = 0; i < fs[k].draws.size(); ++i)
+      fs[k].draws[i] = sample_draw_v2(static_cast<std::uint32_t>(i), fs[k].draws[i].clip_positions.size(), static_cast<std::uint32_t>(k));
+  for (std::uint32_t i = static_cast<std::uint32_t>(fs[0].draws.size()); i < 1029; ++i)
+    fs[0].draws.push_back(sample_draw_v2(i, i % 4, 9));
+  fs[0].end.draws = static_cast<std::uint32_t>(fs[0].draws.size());
+  SampleFrame& f = fs[1];
+  for (const char* name : {"litmap_min", "litmap_max"}) {
+    DepthSnapshot d = sample_depth(DepthWhich::Final, 16, 8, 11);
+    d.name = name;
+    f.depths.push_back(d);
+  }
+  NBufferLevels min = sample_levels(nbsim::FarOp::Min, 16, 8, 4), max = sample_levels(nbsim::FarOp::Max, 16, 8, 4);
+  min.source = "litmap_min";
+  max.source = "litmap_max";
+  f.levels.push_back(min);
+  f.levels.push_back(max);
+  f.stencils = {sample_stencil("shadow_mask", 32, 24), sample_stencil("volumes", 3, 1)};
+  f.light = sample_light(2);
+  f.technique_records = {sample_technique_record(1), sample_raw_record(), sample_technique_record(2)};
+  fs[2].technique_records = {sample_raw_record()};
+  return fs;
+}
+
 inline void write_frame(TraceWriter& w, const SampleFrame& f) {
   w.begin_frame(f.begin);
   for (const DrawRecord& d : f.draws) w.write(d);
   for (const DepthSnapshot& d : f.depths) w.write(d);
   for (const NBufferLevels& l : f.levels) w.write(l);
+  for (const StencilSnapshot& st : f.stencils) w.write(st);
+  if (f.light) w.write_light(*f.light);
+  for (const TechniqueRecord& t : f.technique_records) w.write(t);
   if (f.truth) w.write(*f.truth);
   w.end_frame(f.end);
 }
@@ -241,6 +359,14 @@ inline void write_sample_trace(const fs::path& file) {
   TraceWriter w(file, sample_properties());
   w.write(sample_scene());
   for (const SampleFrame& f : sample_frames()) write_frame(w, f);
+  w.close();
+}
+
+// The same with every record and field of version 2 (sample_frames_v2).
+inline void write_sample_trace_v2(const fs::path& file) {
+  TraceWriter w(file, sample_properties());
+  w.write(sample_scene());
+  for (const SampleFrame& f : sample_frames_v2()) write_frame(w, f);
   w.close();
 }
 
@@ -320,16 +446,61 @@ inline void expect_same(const DrawRecord& a, const DrawRecord& b) {
   EXPECT_EQ(a.gl.samples_passed, b.gl.samples_passed);
   EXPECT_EQ(a.gl.clip_prims_in, b.gl.clip_prims_in);
   EXPECT_EQ(a.gl.clip_prims_out, b.gl.clip_prims_out);
+  EXPECT_EQ(a.topology, b.topology) << "draw " << a.index;
+  EXPECT_TRUE(same_words(a.point_sizes, b.point_sizes)) << "draw " << a.index;
+  EXPECT_EQ(a.stencil.test, b.stencil.test);
+  for (const auto& [x, y] : {std::pair{&a.stencil.front, &b.stencil.front}, std::pair{&a.stencil.back, &b.stencil.back}}) {
+    EXPECT_EQ(x->func, y->func);
+    EXPECT_EQ(x->ref, y->ref);
+    EXPECT_EQ(x->value_mask, y->value_mask);
+    EXPECT_EQ(x->write_mask, y->write_mask);
+    EXPECT_EQ(x->fail, y->fail);
+    EXPECT_EQ(x->depth_fail, y->depth_fail);
+    EXPECT_EQ(x->pass, y->pass);
+  }
+  EXPECT_EQ(a.discards, b.discards);
+  EXPECT_EQ(a.writes_depth, b.writes_depth);
+}
+
+inline void expect_same(const StencilSnapshot& a, const StencilSnapshot& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  EXPECT_EQ(a.texels, b.texels);
+}
+
+inline void expect_same(const Camera& a, const Camera& b) {
+  EXPECT_TRUE(same_floats(a.view, b.view)) << "light view";
+  EXPECT_TRUE(same_floats(a.proj, b.proj)) << "light proj";
+  EXPECT_TRUE(same_floats(a.eye, b.eye)) << "light eye";
+}
+
+inline void expect_same(const TechniqueRecord& a, const TechniqueRecord& b) {
+  EXPECT_EQ(a.type, b.type);
+  EXPECT_EQ(a.payload, b.payload);
+  EXPECT_EQ(a.decoded, b.decoded);
+  ASSERT_EQ(a.fields.size(), b.fields.size());
+  for (std::size_t i = 0; i < a.fields.size(); ++i) {
+    EXPECT_EQ(a.fields[i].name, b.fields[i].name);
+    if (const auto* v = std::get_if<std::vector<float>>(&a.fields[i].value)) {
+      const auto* w = std::get_if<std::vector<float>>(&b.fields[i].value);
+      ASSERT_NE(w, nullptr) << a.fields[i].name;
+      EXPECT_TRUE(same_words(*v, *w)) << a.fields[i].name;
+    } else {
+      EXPECT_TRUE(a.fields[i].value == b.fields[i].value) << a.fields[i].name;
+    }
+  }
 }
 
 inline void expect_same(const DepthSnapshot& a, const DepthSnapshot& b) {
-  EXPECT_EQ(a.which, b.which);
+  EXPECT_EQ(a.name, b.name);
   EXPECT_EQ(a.width, b.width);
   EXPECT_EQ(a.height, b.height);
   EXPECT_TRUE(same_words(a.texels, b.texels));
 }
 
 inline void expect_same(const NBufferLevels& a, const NBufferLevels& b) {
+  EXPECT_EQ(a.source, b.source);
   EXPECT_EQ(a.op, b.op);
   EXPECT_EQ(a.width, b.width);
   EXPECT_EQ(a.height, b.height);
@@ -353,6 +524,12 @@ inline void expect_same(const SampleFrame& want, const Frame& got) {
   for (std::size_t i = 0; i < want.depths.size(); ++i) expect_same(want.depths[i], got.depths[i]);
   ASSERT_EQ(want.levels.size(), got.levels.size());
   for (std::size_t i = 0; i < want.levels.size(); ++i) expect_same(want.levels[i], got.levels[i]);
+  ASSERT_EQ(want.stencils.size(), got.stencils.size());
+  for (std::size_t i = 0; i < want.stencils.size(); ++i) expect_same(want.stencils[i], got.stencils[i]);
+  ASSERT_EQ(want.light.has_value(), got.light.has_value());
+  if (want.light) expect_same(*want.light, *got.light);
+  ASSERT_EQ(want.technique_records.size(), got.technique_records.size());
+  for (std::size_t i = 0; i < want.technique_records.size(); ++i) expect_same(want.technique_records[i], got.technique_records[i]);
   ASSERT_EQ(want.truth.has_value(), got.truth.has_value());
   if (want.truth) expect_same(*want.truth, *got.truth);
   EXPECT_EQ(want.end.frame, got.end.frame);

@@ -12,6 +12,7 @@
 #include "pipeline/io/image_io.h"
 #include "tests/common/run_nbsim.h"
 #include "tests/trace/sample_trace.h"
+#include "traces/format/describe.h"
 
 namespace {
 
@@ -35,7 +36,7 @@ const fs::path& sample() {
 
 // --help works on every trace subcommand and exits 0.
 TEST(TraceCliTest, HelpExitsZero) {
-  for (const char* sub : {"trace", "trace info", "trace verify", "trace dump"}) {
+  for (const char* sub : {"trace", "trace info", "trace verify", "trace dump", "trace format"}) {
     const CliResult r = nbsim(std::string(sub) + " --help");
     EXPECT_EQ(r.status, 0) << sub << ": " << r.err;
     EXPECT_TRUE(has(r.out, "Usage")) << sub << ": " << r.out;
@@ -48,7 +49,7 @@ TEST(TraceCliTest, VerifySoundTrace) {
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << "one line: " << r.out;
-  EXPECT_TRUE(has(r.out, "sound") && has(r.out, "format version 1") && has(r.out, "3 frames") && has(r.out, "9 draws"))
+  EXPECT_TRUE(has(r.out, "sound") && has(r.out, "format version " + std::to_string(kFormatVersion)) && has(r.out, "3 frames") && has(r.out, "9 draws"))
       << r.out;
 }
 
@@ -63,12 +64,12 @@ TEST(TraceCliTest, VerifyRefusesDamage) {
     std::vector<std::string> messages;
   };
   Bytes flipped = good;
-  flipped[offsets[3] + kChunkHeaderBytes + 2] ^= 0x10;  // inside the first DRAW's payload
+  flipped[offsets[3] + kChunkHeaderBytes + 2] ^= 0x10;  // inside the first draw batch's payload
   Bytes newer = good;
   const auto pre = encode_preamble(kFormatVersion + 1);
   std::copy(pre.begin(), pre.end(), newer.begin());
   const Row rows[] = {
-      {"flipped.nbtrace", flipped, {"chunk 3 (DRAW) at byte " + std::to_string(offsets[3]), "CRC-32 mismatch"}},
+      {"flipped.nbtrace", flipped, {"chunk 3 (DRWS) at byte " + std::to_string(offsets[3]), "CRC-32 mismatch"}},
       {"no_end.nbtrace", Bytes(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(offsets.back())),
        {"chunk " + std::to_string(offsets.size() - 1) + " at byte " + std::to_string(offsets.back()), "without an END chunk"}},
       {"empty.nbtrace", {}, {"empty"}},
@@ -115,7 +116,7 @@ TEST(TraceCliTest, InfoJson) {
   const CliResult r = nbsim("trace info --json " + sample().string());
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::ordered_json::parse(r.out);
-  EXPECT_EQ(j["format_version"], 1);
+  EXPECT_EQ(j["format_version"], kFormatVersion);
   EXPECT_EQ(j["bytes"], fs::file_size(sample()));
   const Properties props = sample_properties();
   ASSERT_EQ(j["properties"].size(), props.size());
@@ -222,7 +223,7 @@ TEST(TraceCliTest, DumpRefusals) {
       {t + " --frame 0 --truth " + scratch("refused.png").string() + d, "records no ID-buffer image"},
       {t + " --frame 0 --truth " + scratch("refused.txt").string(), "expected a .csv"},
       {t + " --frame 0", "nothing to dump"},
-      {t + " --frame 0 --which middle" + d, "--which"},
+      {t + " --frame 0 --which middle" + d, "no 'middle' depth snapshot (it has: final)"},
       {t + d, "--frame"},
   };
   for (const Row& row : rows) {
@@ -233,6 +234,71 @@ TEST(TraceCliTest, DumpRefusals) {
     EXPECT_FALSE(fs::exists(out)) << row.args << ": wrote output although refused";
   }
   EXPECT_FALSE(fs::exists(scratch("refused_levels"))) << "no level directory for a refused dump";
+}
+
+// `trace format` prints the record tables from the schema (the same text FORMAT.md holds), for
+// this version or an older one, and refuses a version this build does not know.
+TEST(TraceCliTest, FormatPrintsTheRecordTables) {
+  CliResult r = nbsim("trace format");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, record_tables(kFormatVersion));
+  EXPECT_TRUE(has(r.out, "### DRWS: DrawBatch") && has(r.out, "| `stencil.back.pass` |")) << r.out;
+  r = nbsim("trace format --format-version 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "| `which` |") && !has(r.out, "DRWS")) << r.out;
+  r = nbsim("trace format --format-version " + std::to_string(kFormatVersion + 1));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "knows format versions 1 to")) << r.err;
+  // --update leaves a current document as it is.
+  const fs::path doc = scratch("FORMAT.md");
+  {
+    std::ofstream out(doc);
+    out << "intro\n<!-- generated: nbsim trace format FEND 2 -->\nstale\n<!-- end generated -->\nend\n";
+  }
+  r = nbsim("trace format --update " + doc.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "refreshed its 1 record tables")) << r.out;
+  std::ifstream in(doc);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "intro\n<!-- generated: nbsim trace format FEND 2 -->\n" + record_table(ChunkType::FrameEnd, 2) +
+                      "<!-- end generated -->\nend\n");
+  r = nbsim("trace format --update " + doc.string());
+  EXPECT_TRUE(has(r.out, "are current")) << r.out;
+}
+
+// `trace dump --records` prints every record of the frame through the schema, field by field.
+TEST(TraceCliTest, DumpRecords) {
+  const CliResult r = nbsim("trace dump " + sample().string() + " --frame 2 --records");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "FRAM FrameBegin\n  frame: 2\n")) << r.out;
+  EXPECT_TRUE(has(r.out, "DRAW DrawRecord\n  index: 2\n")) << r.out;
+  EXPECT_TRUE(has(r.out, "DPTH DepthSnapshot\n  name: \"after_occluders\"\n")) << r.out;
+  EXPECT_TRUE(has(r.out, "NBLV NBufferLevels\n  source: \"after_occluders\"\n  op: 1 (min)")) << r.out;
+  EXPECT_TRUE(has(r.out, "FEND FrameEnd\n  frame: 2\n  draws: 3\n")) << r.out;
+}
+
+// info --json lists a frame's stencil images, light camera and technique records when it has them
+// (nbsim itself registers no technique chunk, so it reads them raw) and omits the keys otherwise.
+TEST(TraceCliTest, InfoShowsVersion2Records) {
+  const fs::path f = scratch("v2_info.nbtrace");
+  write_sample_trace_v2(f);
+  const CliResult r = nbsim("trace info --json " + f.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& frames = j["frames"];
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[0]["draws"], 1029);
+  EXPECT_FALSE(frames[0].contains("stencil") || frames[0].contains("light") || frames[0].contains("technique_records"));
+  EXPECT_EQ(frames[1]["depth"], nlohmann::json({"after_occluders", "final", "litmap_min", "litmap_max"}));
+  EXPECT_EQ(frames[1]["stencil"], nlohmann::json({"shadow_mask", "volumes"}));
+  EXPECT_EQ(frames[1]["light"], true);
+  EXPECT_EQ(frames[1]["technique_records"], nlohmann::json({"TSTX", "RAWX", "TSTX"}));
+  EXPECT_EQ(frames[2]["technique_records"], nlohmann::json({"RAWX"}));
+  const CliResult d = nbsim("trace dump " + f.string() + " --frame 2 --records");
+  ASSERT_EQ(d.status, 0) << d.err;
+  EXPECT_TRUE(has(d.out, "STNC StencilSnapshot\n  name: \"shadow_mask\"\n")) << d.out;
+  EXPECT_TRUE(has(d.out, "LGHT Camera\n  view: [")) << d.out;
+  EXPECT_TRUE(has(d.out, "TSTX (unregistered technique chunk)\n  payload: ")) << d.out;
 }
 
 }  // namespace

@@ -65,12 +65,12 @@ std::size_t chunk_of(const std::vector<std::size_t>& offsets, std::size_t at) {
 struct Builder {
   Bytes b;
   std::uint64_t chunks = 0;
-  Builder() {
-    const auto p = encode_preamble(kFormatVersion);
+  explicit Builder(std::uint32_t version = kFormatVersion) {
+    const auto p = encode_preamble(version);
     b.assign(p.begin(), p.end());
   }
-  Builder& chunk(ChunkType t, const Bytes& payload, bool compress = false) {
-    const Bytes c = encode_chunk(t, payload, compress);
+  Builder& chunk(ChunkType t, const Bytes& payload, bool compress = false, std::uint32_t flags = 0) {
+    const Bytes c = encode_chunk(t, payload, compress, flags);
     b.insert(b.end(), c.begin(), c.end());
     ++chunks;
     return *this;
@@ -79,10 +79,12 @@ struct Builder {
   Builder& add(const R& r) {
     return chunk(RecordChunk<R>::type, encode(r));
   }
+  Builder& technique(const TechniqueRecord& r) { return chunk(static_cast<ChunkType>(r.type), encode(r), false, kFlagTechnique); }
   Builder& end(std::uint32_t frames) { return add(EndMarker{chunks, frames}); }
 };
 
-// One valid chunk of every type: HEAD, SCEN, FRAM, DRAW, DPTH, NBLV, TRTH, FEND (and END).
+// One valid chunk of every type: HEAD, SCEN, FRAM, DRAW, DPTH, NBLV, TRTH, DRWS, STNC, LGHT,
+// FEND (and END). The depth snapshot is named "final" and the levels' source "after_occluders".
 std::vector<std::pair<ChunkType, Bytes>> one_of_each() {
   return {{ChunkType::Header, encode(sample_properties())},
           {ChunkType::Scene, encode(sample_scene())},
@@ -91,7 +93,10 @@ std::vector<std::pair<ChunkType, Bytes>> one_of_each() {
           {ChunkType::Depth, encode(sample_depth(DepthWhich::Final, 32, 16))},
           {ChunkType::Levels, encode(sample_levels(nbsim::FarOp::Max, 8, 4, 3))},
           {ChunkType::Truth, encode(sample_truth(6, 8, 4))},
-          {ChunkType::FrameEnd, encode(FrameEnd{0, 1, 0.5})}};
+          {ChunkType::DrawBatch, encode(DrawBatch{{sample_draw_v2(1, 3), sample_draw_v2(2, 0)}})},
+          {ChunkType::Stencil, encode(sample_stencil("mask", 8, 4))},
+          {ChunkType::Light, encode(sample_light(0))},
+          {ChunkType::FrameEnd, encode(FrameEnd{0, 3, 0.5})}};
 }
 
 // The builder's traces are sound when nothing is broken (so each refusal below has one cause).
@@ -197,7 +202,7 @@ TEST(TraceCorruptionTest, Garbage) {
 TEST(TraceCorruptionTest, LengthPastTheEnd) {
   const Bytes good = sample_bytes();
   const std::vector<std::size_t> offsets = chunk_offsets(good);
-  const std::size_t at = offsets[3];  // a DRAW of frame 0
+  const std::size_t at = offsets[3];  // the DRAW batch of frame 0
   struct Row {
     std::uint64_t stored;
     std::string message;
@@ -212,7 +217,7 @@ TEST(TraceCorruptionTest, LengthPastTheEnd) {
     Bytes b = good;
     put_le64(b, at + 8, row.stored);
     const std::string e = read_error(b);
-    EXPECT_TRUE(has(e, row.message) && has(e, "chunk 3 (DRAW) at byte " + std::to_string(at) + ":")) << e;
+    EXPECT_TRUE(has(e, row.message) && has(e, "chunk 3 (DRWS) at byte " + std::to_string(at) + ":")) << e;
   }
 }
 
@@ -228,7 +233,8 @@ TEST(TraceCorruptionTest, UnknownTypesFlagsAndLengths) {
   const Row rows[] = {
       {[&](Bytes& b) { put_le32(b, at, fourcc("ZZZZ")); }, "chunk 3 (ZZZZ)"},              // unknown type, named
       {[&](Bytes& b) { put_le32(b, at, 0x00000001); }, "chunk 3 (0x00000001)"},          // unprintable type in hex
-      {[&](Bytes& b) { put_le32(b, at + 4, 2); }, "unknown flags 0x00000002"},           // reserved flag bits
+      {[&](Bytes& b) { put_le32(b, at + 4, 4); }, "unknown flags 0x00000004"},           // reserved flag bits
+      {[&](Bytes& b) { put_le32(b, at + 4, kFlagTechnique); }, "core chunk type flagged as a technique"},
       {[&](Bytes& b) { put_le64(b, at + 16, le64_at(b, at + 8) + 1); }, "raw length"},   // raw != stored, uncompressed
       {[&](Bytes& b) { put_le64(b, at + 16, (std::uint64_t{256} << 20) + 1); }, "raw length 268435457 exceeds"},
       {[&](Bytes& b) { put_le32(b, at + 4, kFlagZstd); }, "not a zstd frame"},          // flagged but not zstd
@@ -309,14 +315,24 @@ TEST(TraceCorruptionTest, FieldValuesOutOfRange) {
       {ChunkType::Draw, [](Bytes& p) { p[4] = 7; }, "field 'role' is 7"},                       // DrawRole 0..6
       {ChunkType::Draw, [](Bytes& p) { p[15] = 2; }, "field 'state.write' is 2, not 0 or 1"},   // bools are 0/1
       {ChunkType::Draw, [](Bytes& p) { p[14] = 8; }, "state.func"},                             // DepthFunc 0..7
-      {ChunkType::Draw, [](Bytes& p) { p[13] = 32; }, "level 32"},                              // levels below 32
+      {ChunkType::Draw, [](Bytes& p) { p[13] = 32; }, "field 'level' is 32"},                  // levels below 32
       {ChunkType::FrameBegin, [](Bytes& p) { p[4] = 5; }, "field 'mode' is 5"},                 // TestMode 0..4
-      {ChunkType::Depth, [](Bytes& p) { p[0] = 2; }, "field 'which' is 2"},                     // DepthWhich 0..1
-      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 0); }, "depth snapshot size 0x16"},       // sides >= 1
-      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 100000); }, "depth snapshot size 100000x16"},
-      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 1, 0x80000000u); }, "outside 1x1"},         // negative side
-      {ChunkType::Levels, [](Bytes& p) { p[0] = 2; }, "field 'op' is 2"},                       // FarOp 0..1
-      {ChunkType::Levels, [](Bytes& p) { put_le32(p, 9, 33); }, "level count 33"},              // at most 32 levels
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 0, 0); }, "field 'width' is 1634625894"},  // "fina" read as a width
+      {ChunkType::Depth, [](Bytes& p) { p[4] = ' '; }, "depth image name ' inal' is not"},          // names are like keys
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 9, 0); }, "field 'width' is 0, outside 1 .. 16384"},  // sides >= 1
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 9, 100000); }, "field 'width' is 100000"},
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 9, 0x80000000u); }, "field 'width' is -2147483648"},  // negative side
+      {ChunkType::Depth, [](Bytes& p) { put_le32(p, 0, 65); }, "is a string of 65 bytes, above the limit of 64"},
+      {ChunkType::Levels, [](Bytes& p) { p[19] = 2; }, "field 'op' is 2"},                      // FarOp 0..1
+      {ChunkType::Levels, [](Bytes& p) { put_le32(p, 28, 33); }, "field 'levels' is 33"},       // at most 32 levels
+      {ChunkType::Draw, [](Bytes& p) { p[80 + 48] = 2; }, "field 'topology' is 2"},            // Topology 0..1
+      {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 4] = 9; }, "field 'role' is 9"},               // each draw checked
+      // The batch's first draw: 128 bytes of version 1 fields, topology, 3 point sizes, stencil.test,
+      // stencil.front.func, ref, value_mask, write_mask, then stencil.front.fail at 4 + 159.
+      {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 159] = 8; }, "field 'stencil.front.fail' is 8"},  // StencilOp 0..7
+      {ChunkType::Draw, [](Bytes& p) { p[128] = 1; }, "point draw with 3 vertices and 0 point sizes"},  // sizes per point
+      {ChunkType::Stencil, [](Bytes& p) { put_le32(p, 8, 0); }, "field 'width' is 0"},
+      {ChunkType::Stencil, [](Bytes& p) { put_le32(p, 12, 1000); }, "needs 8000 bytes"},         // texels past the end
       {ChunkType::Truth, [](Bytes& p) { put_le32(p, 0, 0xFFFFFFFFu); }, "counts 4294967295 elements"},  // hostile count
       {ChunkType::Scene, [](Bytes& p) { put_le32(p, 0, 0x7FFFFFFFu); }, "counts 2147483647 elements"},
       {ChunkType::Header, [](Bytes& p) { put_le32(p, 0, 5000); }, "counts 5000 elements"},
@@ -414,7 +430,7 @@ TEST(TraceCorruptionTest, StructureRulesRefused) {
          return Builder().add(P).add(sample_scene()).add(sample_frame_begin(0)).add(draw(0, 6, -1)).add(FrameEnd{0, 1, 0})
              .end(1).b;
        },
-       "chunk 3 (DRAW)", "draw names object 6, but the scene has 6 objects"},
+       "chunk 3 (DRAW)", "names object 6, but the scene has 6 objects"},
       {[&] {
          return Builder().add(P).add(sample_scene()).add(sample_frame_begin(0)).add(draw(0, 1, 3)).add(FrameEnd{0, 1, 0})
              .end(1).b;
@@ -434,6 +450,196 @@ TEST(TraceCorruptionTest, StructureRulesRefused) {
   }
   // Without a scene, object and node ids are not checked against anything.
   EXPECT_EQ(read_error(Builder().add(P).add(sample_frame_begin(0)).add(draw(0, 99, 99)).add(FrameEnd{0, 1, 0}).end(1).b), "");
+}
+
+// Version 2's chunk types and the technique flag do not exist in a version-1 file: refused.
+TEST(TraceCorruptionTest, Version2ChunksRefusedInVersion1Files) {
+  const Properties P;
+  struct Row {
+    std::function<void(Builder&)> add;
+    std::string message;
+  };
+  const Row rows[] = {
+      {[](Builder& t) { t.add(DrawBatch{{sample_draw(0, 3)}}); }, "chunk type DRWS exists since format version 2, the file is version 1"},
+      {[](Builder& t) { t.add(sample_stencil("m", 2, 2)); }, "chunk type STNC exists since format version 2"},
+      {[](Builder& t) { t.add(sample_light(0)); }, "chunk type LGHT exists since format version 2"},
+      {[](Builder& t) { t.technique(sample_raw_record()); }, "unknown flags 0x00000002 (format version 1)"},
+  };
+  for (const Row& row : rows) {
+    Builder t(1);
+    t.add(P).add(sample_frame_begin(0));
+    row.add(t);
+    t.add(FrameEnd{0, 1, 0}).end(1);
+    const std::string e = read_error(t.b);
+    EXPECT_TRUE(has(e, "chunk 2 (") && has(e, row.message)) << "expected '" << row.message << "': " << e;
+  }
+}
+
+// Technique chunks: a registered type decodes into its fields, an unregistered one is kept raw;
+// one outside a frame, one that does not match its registered description, or the flag on an
+// unprintable type is refused naming the chunk.
+TEST(TraceCorruptionTest, TechniqueChunks) {
+  const Properties P;
+  const TechniqueRecord good = sample_technique_record(3);
+  {
+    Builder t;
+    t.add(P).add(sample_frame_begin(0)).technique(good).technique(sample_raw_record()).add(FrameEnd{0, 0, 0}).end(1);
+    FrameReader frames(TraceReader(t.b, "t.nbtrace"));
+    const auto f = frames.next();
+    ASSERT_TRUE(f);
+    ASSERT_EQ(f->technique_records.size(), 2u);
+    expect_same(good, f->technique_records[0]);
+    EXPECT_FALSE(f->technique_records[1].decoded) << "an unregistered type stays raw";
+    EXPECT_EQ(f->technique_records[1].payload, sample_raw_record().payload);
+  }
+  std::string e = read_error(Builder().add(P).technique(good).b);
+  EXPECT_TRUE(has(e, "chunk 1 (TSTX)") && has(e, "outside a frame")) << e;
+  TechniqueRecord shorter = good;
+  shorter.decoded = false;  // written as its payload, one byte short
+  shorter.payload.pop_back();
+  e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(shorter).add(FrameEnd{0, 0, 0}).end(1).b);
+  EXPECT_TRUE(has(e, "chunk 2 (TSTX)") && has(e, "decodes short")) << e;
+  TechniqueRecord longer = shorter;
+  longer.payload = good.payload;
+  longer.payload.push_back(0);
+  e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(longer).add(FrameEnd{0, 0, 0}).end(1).b);
+  EXPECT_TRUE(has(e, "chunk 2 (TSTX)") && has(e, "decodes long")) << e;
+  Builder t;
+  t.add(P).add(sample_frame_begin(0)).chunk(static_cast<ChunkType>(0x01020304u), {1, 2}, false, kFlagTechnique);
+  e = read_error(t.b);
+  EXPECT_TRUE(has(e, "chunk 2 (0x01020304)") && has(e, "four printable characters")) << e;
+}
+
+// Draw batches: empty ones, counts past the payload, indices that do not continue across DRAW and
+// DRWS chunks, and FEND counts that disagree with the batched draws are refused.
+TEST(TraceCorruptionTest, DrawBatchRules) {
+  const Properties P;
+  auto with_index = [](std::uint32_t i) { return sample_draw(i, 3); };
+  struct Row {
+    std::function<Bytes()> build;
+    std::string chunk, message;
+  };
+  const Row rows[] = {
+      {[&] { return Builder().add(P).add(sample_frame_begin(0)).add(DrawBatch{}).add(FrameEnd{0, 0, 0}).end(1).b; },
+       "chunk 2 (DRWS)", "an empty draw batch"},
+      {[&] {
+         return Builder().add(P).add(sample_frame_begin(0)).chunk(ChunkType::DrawBatch, {1, 0}).add(FrameEnd{0, 0, 0}).end(1).b;
+       },
+       "chunk 2 (DRWS)", "too short for a draw count"},
+      {[&] {
+         Bytes p = encode(DrawBatch{{with_index(0)}});
+         put_le32(p, 0, 3);  // three draws announced, one there
+         return Builder().add(P).add(sample_frame_begin(0)).chunk(ChunkType::DrawBatch, p).add(FrameEnd{0, 3, 0}).end(1).b;
+       },
+       "chunk 2 (DRWS)", "decodes short"},
+      {[&] {
+         return Builder().add(P).add(sample_frame_begin(0)).add(with_index(0)).add(DrawBatch{{with_index(2)}})
+             .add(FrameEnd{0, 2, 0}).end(1).b;
+       },
+       "chunk 3 (DRWS)", "draw index 2 in frame 0, expected 1"},
+      {[&] {
+         return Builder().add(P).add(sample_frame_begin(0)).add(DrawBatch{{with_index(0), with_index(1)}})
+             .add(FrameEnd{0, 1, 0}).end(1).b;
+       },
+       "chunk 3 (FEND)", "counts 1 draws, but frame 0 has 2"},
+  };
+  for (const Row& row : rows) {
+    const std::string e = read_error(row.build());
+    EXPECT_TRUE(has(e, row.chunk) && has(e, row.message)) << "expected " << row.chunk << ": '" << row.message << "' in: " << e;
+  }
+  // DRAW chunks and batches mix, indices continuing.
+  EXPECT_EQ(read_error(Builder().add(P).add(sample_frame_begin(0)).add(with_index(0)).add(DrawBatch{{with_index(1), with_index(2)}})
+                           .add(with_index(3)).add(FrameEnd{0, 4, 0}).end(1).b),
+            "");
+}
+
+// Version 2's per-frame rules: names unique per kind, one light, one N-buffer per (source, op).
+TEST(TraceCorruptionTest, Version2FrameRules) {
+  const Properties P;
+  const FrameEnd fend0{0, 0, 0.0};
+  NBufferLevels from_litmap = sample_levels(nbsim::FarOp::Min, 2, 2, 1);
+  from_litmap.source = "litmap_min";
+  struct Row {
+    std::function<Bytes()> build;
+    std::string chunk, message;
+  };
+  const Row rows[] = {
+      {[&] {
+         return Builder().add(P).add(sample_frame_begin(0)).add(sample_stencil("mask", 2, 2)).add(sample_stencil("mask", 1, 1))
+             .add(fend0).end(1).b;
+       },
+       "chunk 3 (STNC)", "a second 'mask' stencil snapshot in frame 0"},
+      {[&] { return Builder().add(P).add(sample_frame_begin(0)).add(sample_light(0)).add(sample_light(1)).add(fend0).end(1).b; },
+       "chunk 3 (LGHT)", "a second light camera in frame 0"},
+      {[&] {
+         return Builder().add(P).add(sample_frame_begin(0)).add(from_litmap).add(from_litmap).add(fend0).end(1).b;
+       },
+       "chunk 3 (NBLV)", "a second N-buffer with op 'min' built from 'litmap_min'"},
+      {[&] { return Builder().add(P).add(sample_light(0)).b; }, "chunk 1 (LGHT)", "outside a frame"},
+      {[&] { return Builder().add(P).add(sample_stencil("m", 1, 1)).b; }, "chunk 1 (STNC)", "outside a frame"},
+  };
+  for (const Row& row : rows) {
+    const std::string e = read_error(row.build());
+    EXPECT_TRUE(has(e, row.chunk) && has(e, row.message)) << "expected " << row.chunk << ": '" << row.message << "' in: " << e;
+  }
+  // The same op from two sources is two level sets.
+  EXPECT_EQ(read_error(Builder().add(P).add(sample_frame_begin(0)).add(sample_levels(nbsim::FarOp::Min, 2, 2, 1)).add(from_litmap)
+                           .add(fend0).end(1).b),
+            "");
+}
+
+// Flipping any byte of a trace made of version 2's chunks (DRWS, STNC, LGHT, a technique chunk)
+// is refused, naming the chunk that holds it.
+TEST(TraceCorruptionTest, EveryFlippedByteOfVersion2ChunksRefused) {
+  Builder t;
+  t.add(Properties{{"viewport", "8x4"}}).add(sample_frame_begin(0));
+  t.add(DrawBatch{{sample_draw_v2(0, 3), sample_draw_v2(1, 2)}}).add(sample_stencil("mask", 8, 4)).add(sample_light(0));
+  t.technique(sample_technique_record(1)).add(FrameEnd{0, 2, 0.0}).end(1);
+  const Bytes good = t.b;
+  ASSERT_EQ(read_error(good), "");
+  const std::vector<std::size_t> offsets = chunk_offsets(good);
+  for (std::size_t i = kPreambleBytes; i < good.size(); ++i) {
+    for (const std::uint8_t mask : {std::uint8_t{0xFF}, std::uint8_t{0x01}}) {
+      Bytes b = good;
+      b[i] ^= mask;
+      const std::string e = read_error(b);
+      ASSERT_FALSE(e.empty()) << "byte " << i << " flipped with mask " << int(mask) << " was not detected";
+      const std::size_t k = chunk_of(offsets, i);
+      EXPECT_TRUE(has(e, "chunk " + std::to_string(k) + " ") && has(e, "at byte " + std::to_string(offsets[k]) + ":"))
+          << "byte " << i << " lies in chunk " << k << " at " << offsets[k] << ": " << e;
+    }
+  }
+}
+
+// Hostile payloads behind intact CRCs: random bytes overwritten in every record type (version 2's
+// included) are either read or refused with an InputError naming the chunk; the reader never
+// aborts or crashes on them (each read runs in this process: an abort fails the whole suite).
+TEST(TraceCorruptionTest, RandomPayloadEditsNeverCrash) {
+  const auto chunks = one_of_each();
+  Lcg rng{2026};
+  int refused = 0, read = 0;
+  for (int round = 0; round < 3000; ++round) {
+    const std::size_t k = rng.next() % chunks.size();
+    Builder t;
+    for (std::size_t i = 0; i < chunks.size(); ++i) {
+      Bytes p = chunks[i].second;
+      if (i == k && !p.empty()) {
+        const std::uint32_t edits = 1 + rng.next() % 4;
+        for (std::uint32_t e = 0; e < edits; ++e) p[rng.next() % p.size()] = static_cast<std::uint8_t>(rng.next() >> 24);
+      }
+      t.chunk(chunks[i].first, p);
+    }
+    t.end(1);
+    const std::string e = read_error(t.b);
+    if (e.empty()) {
+      ++read;
+      continue;
+    }
+    ++refused;
+    EXPECT_TRUE(has(e, "t.nbtrace: chunk ")) << "refusals name the file and chunk: " << e;
+  }
+  EXPECT_GT(refused, 500) << "random edits of ids, counts, enums and names break rules";
+  EXPECT_GT(read, 0) << "edits of float fields read as other values";
 }
 
 }  // namespace

@@ -52,9 +52,15 @@ TEST(TraceFormatTest, PayloadLayoutMatchesFormatDoc) {
   EXPECT_EQ(encode(sample_frame_begin(3)).size(), 145u) << "FRAM";
   EXPECT_EQ(encode(FrameEnd{}).size(), 16u) << "FEND";
   EXPECT_EQ(encode(EndMarker{}).size(), 12u) << "END";
-  for (std::size_t v : {0u, 1u, 9u}) EXPECT_EQ(encode(sample_draw(1, v)).size(), 80u + 16u * v) << "DRAW with " << v;
-  EXPECT_EQ(encode(sample_depth(DepthWhich::Final, 5, 3)).size(), 9u + 4u * 15u) << "DPTH";
-  EXPECT_EQ(encode(sample_levels(nbsim::FarOp::Max, 5, 3, 4)).size(), 13u + 4u * 60u) << "NBLV";
+  for (std::size_t v : {0u, 1u, 9u}) EXPECT_EQ(encode(sample_draw(1, v)).size(), 120u + 16u * v) << "DRAW with " << v;
+  DrawRecord points = sample_draw_v2(1, 5);
+  ASSERT_EQ(points.topology, Topology::Points);
+  EXPECT_EQ(encode(points).size(), 120u + 16u * 5 + 4u * 5) << "DRAW of 5 points with their sizes";
+  EXPECT_EQ(encode(sample_depth(DepthWhich::Final, 5, 3)).size(), 4u + 5u + 8u + 4u * 15u) << "DPTH named 'final'";
+  EXPECT_EQ(encode(sample_levels(nbsim::FarOp::Max, 5, 3, 4)).size(), 4u + 15u + 13u + 4u * 60u) << "NBLV from 'after_occluders'";
+  EXPECT_EQ(encode(sample_stencil("m", 5, 3)).size(), 4u + 1u + 8u + 15u) << "STNC";
+  EXPECT_EQ(encode(sample_light(0)).size(), 140u) << "LGHT";
+  EXPECT_EQ(encode(DrawBatch{{sample_draw(0, 3), sample_draw(1, 0)}}).size(), 4u + 120u + 48u + 120u) << "DRWS";
   EXPECT_EQ(encode(sample_truth(6, 5, 3)).size(), 20u + 4u * 6u + 4u * 15u) << "TRTH with IDs";
   EXPECT_EQ(encode(sample_truth(6, 0, 0)).size(), 20u + 4u * 6u) << "TRTH without IDs";
 
@@ -304,6 +310,77 @@ TEST(TraceFormatTest, ReadsVersion1Fixture) {
   EXPECT_EQ(n, want.size());
 }
 
+// Version 1's two depth images read as the names "after_occluders" and "final" (Frame::depth by
+// DepthWhich still finds them), its N-buffers as built from "after_occluders", and its draws with
+// version 2's defaults (triangles, no stencil test, no discard, no gl_FragDepth).
+TEST(TraceFormatTest, Version1RecordsGetVersion2Defaults) {
+  FrameReader frames(fs::path(NBSIM_TRACE_DATA_DIR) / "sample_v1.nbtrace");
+  frames.next();
+  const auto f = frames.next();  // frame 2: both depth images, max and min levels
+  ASSERT_TRUE(f);
+  ASSERT_NE(f->depth(DepthWhich::AfterOccluders), nullptr);
+  ASSERT_NE(f->depth(DepthWhich::Final), nullptr);
+  EXPECT_EQ(f->depth(DepthWhich::AfterOccluders), f->depth("after_occluders"));
+  ASSERT_EQ(f->levels.size(), 2u);
+  for (const NBufferLevels& l : f->levels) EXPECT_EQ(l.source, "after_occluders");
+  EXPECT_NE(f->nbuffer("after_occluders", nbsim::FarOp::Min), nullptr);
+  for (const DrawRecord& d : f->draws) {
+    EXPECT_EQ(d.topology, Topology::Triangles);
+    EXPECT_TRUE(d.point_sizes.empty());
+    EXPECT_FALSE(d.stencil.test);
+    EXPECT_EQ(d.stencil.front.func, DepthFunc::Always);
+    EXPECT_EQ(d.stencil.back.write_mask, 0xFFFFFFFFu);
+    EXPECT_FALSE(d.discards);
+    EXPECT_FALSE(d.writes_depth);
+  }
+  EXPECT_TRUE(f->stencils.empty());
+  EXPECT_FALSE(f->light);
+  EXPECT_TRUE(f->technique_records.empty());
+}
+
+// Every record and field of version 2 round-trips bit for bit: point and stencil draws in DRWS
+// batches (more draws than one batch holds), named depth images, N-buffers per source and op,
+// stencil images, the light camera, registered and raw technique records.
+TEST(TraceFormatTest, RoundTripsEveryVersion2Record) {
+  const fs::path f = scratch("v2.nbtrace");
+  write_sample_trace_v2(f);
+  FrameReader frames(f);
+  EXPECT_EQ(frames.trace().version(), 2u);
+  const auto want = sample_frames_v2();
+  std::size_t n = 0;
+  while (const auto fr = frames.next()) {
+    ASSERT_LT(n, want.size());
+    expect_same(want[n], *fr);
+    ++n;
+  }
+  EXPECT_EQ(n, want.size());
+  // The draws went in batches: frame 0's 1029 need several, the others one each.
+  TraceReader t(f);
+  std::vector<std::size_t> batch_sizes;
+  while (const auto c = t.next())
+    if (c->type == ChunkType::DrawBatch) batch_sizes.push_back(t.decode<DrawBatch>(*c).draws.size());
+  std::vector<std::size_t> expected;
+  for (std::size_t left = 1029; left > 0; left -= std::min(left, kDrawsPerBatch)) expected.push_back(std::min(left, kDrawsPerBatch));
+  expected.insert(expected.end(), {3, 4});
+  ASSERT_GT(expected.size(), 3u) << "frame 0 needs more than one batch";
+  EXPECT_EQ(batch_sizes, expected) << "frame 0: full batches and the rest; frames 2 and 5: one batch each";
+}
+
+// A trace written by version 2 (committed in tests/trace/data) reads back exactly, so that later
+// versions keep reading it. Regenerate only while kFormatVersion is 2:
+// NBSIM_WRITE_TRACE_FIXTURE_V2=<path> ./trace_tests --gtest_filter='*Version2Fixture'.
+TEST(TraceFormatTest, ReadsVersion2Fixture) {
+  if (const char* out = std::getenv("NBSIM_WRITE_TRACE_FIXTURE_V2"); out && kFormatVersion == 2) write_sample_trace_v2(out);
+  const fs::path fixture = fs::path(NBSIM_TRACE_DATA_DIR) / "sample_v2.nbtrace";
+  ASSERT_TRUE(fs::exists(fixture)) << fixture;
+  FrameReader frames(fixture);
+  EXPECT_EQ(frames.trace().version(), 2u);
+  const auto want = sample_frames_v2();
+  std::size_t n = 0;
+  while (const auto fr = frames.next()) expect_same(want.at(n++), *fr);
+  EXPECT_EQ(n, want.size());
+}
+
 // A writer destroyed without close() leaves a trace without END, which readers refuse.
 TEST(TraceFormatTest, UnclosedWriterLeavesTruncatedTrace) {
   const fs::path f = scratch("unclosed.nbtrace");
@@ -409,7 +486,58 @@ TEST(TraceWriterDeathTest, AbortsOnMisuse) {
         d.texels.pop_back();
         w.write(d);
       },
-      "holds 15 texels");
+      "holds 15 elements");
+  EXPECT_DEATH(
+      {
+        TraceWriter w(f, {});
+        w.begin_frame(sample_frame_begin(0));
+        w.write(sample_depth(DepthWhich::Final, 4, 4));
+        w.write(sample_depth(DepthWhich::Final, 8, 8));
+      },
+      "a second 'final' depth snapshot");
+  EXPECT_DEATH(
+      {
+        TraceWriter w(f, {});
+        w.begin_frame(sample_frame_begin(0));
+        w.write(sample_stencil("mask", 4, 4));
+        w.write(sample_stencil("mask", 4, 4));
+      },
+      "a second 'mask' stencil snapshot");
+  EXPECT_DEATH(
+      {
+        TraceWriter w(f, {});
+        w.begin_frame(sample_frame_begin(0));
+        w.write_light(sample_light(0));
+        w.write_light(sample_light(0));
+      },
+      "a second light camera");
+  EXPECT_DEATH(
+      {
+        TraceWriter w(f, {});
+        w.begin_frame(sample_frame_begin(0));
+        w.write(sample_levels(nbsim::FarOp::Max, 4, 4, 2));
+        w.write(sample_levels(nbsim::FarOp::Max, 4, 4, 2));
+      },
+      "a second N-buffer with op 0 built from 'after_occluders'");
+  EXPECT_DEATH(
+      {
+        TraceWriter w(f, {});
+        w.begin_frame(sample_frame_begin(0));
+        DrawRecord d = sample_draw(0, 3);
+        d.topology = Topology::Points;  // without point sizes
+        w.write(d);
+      },
+      "a point draw with 3 vertices and 0 point sizes");
+  EXPECT_DEATH(
+      {
+        TraceWriter w(f, {});
+        w.begin_frame(sample_frame_begin(0));
+        TechniqueRecord r;
+        r.type = fourcc("NOPE");
+        r.decoded = true;
+        w.write(r);
+      },
+      "NOPE is not registered");
 }
 
 }  // namespace

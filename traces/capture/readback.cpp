@@ -5,7 +5,7 @@ namespace nbsim::capture {
 
 scene::DepthSnapshot read_depth(GLuint framebuffer, int width, int height, scene::DepthWhich which) {
   scene::DepthSnapshot d;
-  d.which = which;
+  d.name = std::string(scene::to_string(which));
   d.width = width;
   d.height = height;
   d.texels.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));

@@ -12,174 +12,20 @@
 #include <limits>
 #include <memory>
 #include <set>
+#include <type_traits>
 
 #include "model/common/depth.h"
 #include "model/common/error.h"
+#include "traces/format/bytes.h"
+#include "traces/format/schema.h"
 
 namespace nbsim::trace {
 
 namespace {
 
-static_assert(sizeof(float) == 4 && std::numeric_limits<float>::is_iec559, "floats are IEEE-754 binary32");
-static_assert(sizeof(double) == 8 && std::numeric_limits<double>::is_iec559, "doubles are IEEE-754 binary64");
-
-constexpr bool kLittleHost = std::endian::native == std::endian::little;
-
-// Appends little-endian fields to a payload.
-class Out {
- public:
-  void u8(std::uint8_t v) { bytes_.push_back(v); }
-  void boolean(bool v) { u8(v ? 1 : 0); }
-  void u32(std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) bytes_.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  }
-  void u64(std::uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes_.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  }
-  void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
-  void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
-  void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
-  void count(std::size_t n) {
-    NBSIM_CHECK(n <= std::numeric_limits<std::uint32_t>::max(), "a vector of more than 2^32-1 elements");
-    u32(static_cast<std::uint32_t>(n));
-  }
-  void str(const std::string& s) {
-    count(s.size());
-    bytes_.insert(bytes_.end(), s.begin(), s.end());
-  }
-  // 4-byte elements (float, int32, uint32) without a count.
-  template <class T>
-  void words(const std::vector<T>& v) {
-    static_assert(sizeof(T) == 4);
-    if constexpr (kLittleHost) {
-      const std::size_t at = bytes_.size();
-      bytes_.resize(at + 4 * v.size());
-      if (!v.empty()) std::memcpy(bytes_.data() + at, v.data(), 4 * v.size());
-    } else {
-      for (const T& x : v) u32(std::bit_cast<std::uint32_t>(x));
-    }
-  }
-  template <class T>
-  void counted_words(const std::vector<T>& v) {
-    count(v.size());
-    words(v);
-  }
-  void aabbs(const std::vector<Aabb>& v) {
-    count(v.size());
-    for (const Aabb& b : v) {
-      for (float x : b.lo) f32(x);
-      for (float x : b.hi) f32(x);
-    }
-  }
-  void reserve(std::size_t n) { bytes_.reserve(n); }
-  std::vector<std::uint8_t> take() { return std::move(bytes_); }
-
- private:
-  std::vector<std::uint8_t> bytes_;
-};
-
-// Reads little-endian fields from a payload; every read is bounds-checked, and counts are checked
-// against the bytes left before anything is allocated.
-class In {
- public:
-  explicit In(std::span<const std::uint8_t> p) : p_(p) {}
-
-  std::size_t left() const { return p_.size() - pos_; }
-
-  std::uint8_t u8(const char* field) {
-    need(1, field);
-    return p_[pos_++];
-  }
-  bool boolean(const char* field) {
-    const std::uint8_t v = u8(field);
-    if (v > 1) throw InputError(fmt::format("field '{}' is {}, not 0 or 1", field, v));
-    return v == 1;
-  }
-  std::uint32_t u32(const char* field) {
-    need(4, field);
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(p_[pos_++]) << (8 * i);
-    return v;
-  }
-  std::uint64_t u64(const char* field) {
-    need(8, field);
-    std::uint64_t v = 0;
-    for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(p_[pos_++]) << (8 * i);
-    return v;
-  }
-  std::int32_t i32(const char* field) { return static_cast<std::int32_t>(u32(field)); }
-  float f32(const char* field) { return std::bit_cast<float>(u32(field)); }
-  double f64(const char* field) { return std::bit_cast<double>(u64(field)); }
-
-  // An enum stored as one byte with values 0..max.
-  template <class E>
-  E enumeration(const char* field, E max) {
-    const std::uint8_t v = u8(field);
-    if (v > static_cast<std::uint8_t>(max))
-      throw InputError(fmt::format("field '{}' is {}, outside the valid values 0..{}", field, v,
-                                   static_cast<unsigned>(max)));
-    return static_cast<E>(v);
-  }
-
-  // A u32 element count whose elements (elem_bytes each) must fit in the bytes left.
-  std::size_t count(std::size_t elem_bytes, const char* field) {
-    const std::uint32_t n = u32(field);
-    if (n > left() / elem_bytes)
-      throw InputError(fmt::format("field '{}' counts {} elements of {} bytes, but only {} payload bytes are left "
-                                   "(it decodes short)", field, n, elem_bytes, left()));
-    return n;
-  }
-  std::string str(std::size_t max_bytes, const char* field) {
-    const std::size_t n = count(1, field);
-    if (n > max_bytes)
-      throw InputError(fmt::format("field '{}' is a string of {} bytes, above the limit of {}", field, n, max_bytes));
-    std::string s(reinterpret_cast<const char*>(p_.data() + pos_), n);
-    pos_ += n;
-    return s;
-  }
-  // n 4-byte elements without a count (n already checked against left() by the caller or here).
-  template <class T>
-  void words(std::vector<T>& v, std::size_t n, const char* field) {
-    static_assert(sizeof(T) == 4);
-    if (n > left() / 4)
-      throw InputError(fmt::format("field '{}' needs {} elements of 4 bytes, but only {} payload bytes are left "
-                                   "(it decodes short)", field, n, left()));
-    v.resize(n);
-    if constexpr (kLittleHost) {
-      if (n) std::memcpy(v.data(), p_.data() + pos_, 4 * n);
-      pos_ += 4 * n;
-    } else {
-      for (T& x : v) x = std::bit_cast<T>(u32(field));
-    }
-  }
-  template <class T>
-  void counted_words(std::vector<T>& v, const char* field) {
-    words(v, count(4, field), field);
-  }
-  void aabbs(std::vector<Aabb>& v, const char* field) {
-    v.resize(count(24, field));
-    for (Aabb& b : v) {
-      for (float& x : b.lo) x = f32(field);
-      for (float& x : b.hi) x = f32(field);
-    }
-  }
-  // The whole payload must be used: bytes left over mean a damaged or mismatched record.
-  void finish() const {
-    if (pos_ != p_.size())
-      throw InputError(fmt::format("{} bytes are left over after the last field (the payload of {} bytes decodes long)",
-                                   p_.size() - pos_, p_.size()));
-  }
-
- private:
-  void need(std::size_t n, const char* field) const {
-    if (left() < n)
-      throw InputError(fmt::format("the payload of {} bytes ends at byte {} while reading field '{}' (it decodes short)",
-                                   p_.size(), pos_, field));
-  }
-
-  std::span<const std::uint8_t> p_;
-  std::size_t pos_ = 0;
-};
+using bytes::In;
+using bytes::kLittleHost;
+using bytes::Out;
 
 void check_version(std::uint32_t version) {
   NBSIM_CHECK(version >= 1 && version <= kFormatVersion, fmt::format("decoding format version {}", version));
@@ -194,19 +40,9 @@ bool good_key_char(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.' || c == '-';
 }
 
-std::string image_size_problem(const char* what, std::int32_t w, std::int32_t h) {
-  if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
-    return fmt::format("{} size {}x{} is outside 1x1 .. {}x{}", what, w, h, kMaxImageSide, kMaxImageSide);
-  return {};
-}
-
-std::uint64_t area(std::int32_t w, std::int32_t h) {
-  return static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-}
-
 }  // namespace
 
-bool is_known_chunk_type(std::uint32_t type) noexcept {
+std::uint32_t chunk_type_since(std::uint32_t type) noexcept {
   switch (static_cast<ChunkType>(type)) {
     case ChunkType::Header:
     case ChunkType::Scene:
@@ -217,10 +53,16 @@ bool is_known_chunk_type(std::uint32_t type) noexcept {
     case ChunkType::Truth:
     case ChunkType::FrameEnd:
     case ChunkType::End:
-      return true;
+      return 1;
+    case ChunkType::DrawBatch:
+    case ChunkType::Stencil:
+    case ChunkType::Light:
+      return 2;
   }
-  return false;
+  return 0;
 }
+
+bool is_known_chunk_type(std::uint32_t type) noexcept { return chunk_type_since(type) != 0; }
 
 std::string chunk_type_name(std::uint32_t type) {
   std::string s;
@@ -245,7 +87,9 @@ std::array<std::uint8_t, kPreambleBytes> encode_preamble(std::uint32_t version) 
   return p;
 }
 
-std::vector<std::uint8_t> encode_chunk(ChunkType type, std::span<const std::uint8_t> payload, bool compress) {
+std::vector<std::uint8_t> encode_chunk(ChunkType type, std::span<const std::uint8_t> payload, bool compress,
+                                       std::uint32_t extra_flags) {
+  NBSIM_CHECK((extra_flags & ~kFlagTechnique) == 0, "encode_chunk: only the technique flag may be added");
   if (payload.size() > kMaxChunkBytes)
     throw InputError(fmt::format("a {} record of {} bytes exceeds the trace format's chunk limit of {} MiB",
                                  chunk_type_name(type), payload.size(), kMaxChunkBytes >> 20));
@@ -270,7 +114,7 @@ std::vector<std::uint8_t> encode_chunk(ChunkType type, std::span<const std::uint
   if (!(flags & kFlagZstd) && !payload.empty()) std::memcpy(body, payload.data(), payload.size());
   Out header;
   header.u32(static_cast<std::uint32_t>(type));
-  header.u32(flags);
+  header.u32(flags | extra_flags);
   header.u64(stored);
   header.u64(payload.size());
   const std::vector<std::uint8_t> head = header.take();
@@ -281,9 +125,158 @@ std::vector<std::uint8_t> encode_chunk(ChunkType type, std::span<const std::uint
   return bytes;
 }
 
-// ---- consistency rules ------------------------------------------------------------------------
+// ---- the visitors (schema.h's Io concept) ------------------------------------------------------
 
-std::string record_problem(const Properties& properties) {
+namespace {
+
+template <class T>
+constexpr const char* int_type_name() {
+  if constexpr (std::is_same_v<T, std::uint8_t>) return "u8";
+  else if constexpr (std::is_same_v<T, std::uint32_t>) return "u32";
+  else if constexpr (std::is_same_v<T, std::int32_t>) return "i32";
+  else return "u64";
+}
+
+template <class T>
+std::string out_of_range(const char* name, T v, T lo, T hi) {
+  if (hi == std::numeric_limits<T>::max())
+    return fmt::format("field '{}' is {}, below {}", name, +v, +lo);
+  return fmt::format("field '{}' is {}, outside {} .. {}", name, +v, +lo, +hi);
+}
+
+template <class E>
+std::string bad_enum(const char* name, unsigned v) {
+  return fmt::format("field '{}' is {}, outside the valid values 0..{} of {}", name, v, EnumInfo<E>::max, EnumInfo<E>::name);
+}
+
+// Writes the fields of the newest layout.
+class EncodeIo {
+ public:
+  explicit EncodeIo(Out& o) : o_(o) {}
+  std::uint32_t version() const { return kFormatVersion; }
+  template <class F> void since(std::uint32_t v, F&& f) { if (kFormatVersion >= v) f(); }
+  template <class F> void until(std::uint32_t v, F&& f) { if (kFormatVersion <= v) f(); }
+  void u8(const char*, std::uint8_t& v, const char*) { o_.u8(v); }
+  void u32(const char*, std::uint32_t& v, const char*) { o_.u32(v); }
+  void u64(const char*, std::uint64_t& v, const char*) { o_.u64(v); }
+  void i32(const char*, std::int32_t& v, const char*) { o_.i32(v); }
+  void f32(const char*, float& v, const char*) { o_.f32(v); }
+  void f64(const char*, double& v, const char*) { o_.f64(v); }
+  void boolean(const char*, bool& v, const char*) { o_.boolean(v); }
+  template <class T> void ranged(const char*, T& v, T, T, const char*, const char*) { put(v); }
+  template <class E> void enumeration(const char*, E& v, const char*) { o_.u8(static_cast<std::uint8_t>(v)); }
+  template <std::size_t N> void floats(const char*, std::array<float, N>& v, const char*) { for (float x : v) o_.f32(x); }
+  void string(const char*, std::string& v, std::size_t, const char*) { o_.str(v); }
+  template <class T> void words(const char*, std::vector<T>& v, const char*, const char*) { o_.counted_words(v); }
+  template <class T> void image(const char* name, std::vector<T>& v, std::uint64_t count, const char*, const char*) {
+    NBSIM_CHECK(v.size() == count, fmt::format("encoding field '{}' of {} elements, the record says {}", name, v.size(), count));
+    if constexpr (sizeof(T) == 1) o_.raw(v);
+    else o_.words(v);
+  }
+  template <class E, class F> void items(const char*, std::vector<E>& v, const char*, Element, F&& f, const char*) {
+    o_.count(v.size());
+    for (E& e : v) f(*this, e);
+  }
+
+ private:
+  template <class T> void put(T v) {
+    if constexpr (std::is_same_v<T, std::uint8_t>) o_.u8(v);
+    else if constexpr (std::is_same_v<T, std::uint32_t>) o_.u32(v);
+    else if constexpr (std::is_same_v<T, std::int32_t>) o_.i32(v);
+    else o_.u64(v);
+  }
+  Out& o_;
+};
+
+// Reads the fields of the file's layout, refusing values outside their types and limits as soon
+// as they are read (so a count is never computed from a bad size).
+class DecodeIo {
+ public:
+  DecodeIo(In& in, std::uint32_t version) : in_(in), version_(version) {}
+  std::uint32_t version() const { return version_; }
+  template <class F> void since(std::uint32_t v, F&& f) { if (version_ >= v) f(); }
+  template <class F> void until(std::uint32_t v, F&& f) { if (version_ <= v) f(); }
+  void u8(const char* n, std::uint8_t& v, const char*) { v = in_.u8(n); }
+  void u32(const char* n, std::uint32_t& v, const char*) { v = in_.u32(n); }
+  void u64(const char* n, std::uint64_t& v, const char*) { v = in_.u64(n); }
+  void i32(const char* n, std::int32_t& v, const char*) { v = in_.i32(n); }
+  void f32(const char* n, float& v, const char*) { v = in_.f32(n); }
+  void f64(const char* n, double& v, const char*) { v = in_.f64(n); }
+  void boolean(const char* n, bool& v, const char*) { v = in_.boolean(n); }
+  template <class T> void ranged(const char* n, T& v, T lo, T hi, const char*, const char*) {
+    if constexpr (std::is_same_v<T, std::uint8_t>) v = in_.u8(n);
+    else if constexpr (std::is_same_v<T, std::uint32_t>) v = in_.u32(n);
+    else if constexpr (std::is_same_v<T, std::int32_t>) v = in_.i32(n);
+    else v = in_.u64(n);
+    if (v < lo || v > hi) throw InputError(out_of_range(n, v, lo, hi));
+  }
+  template <class E> void enumeration(const char* n, E& v, const char*) {
+    const std::uint8_t b = in_.u8(n);
+    if (b > EnumInfo<E>::max) throw InputError(bad_enum<E>(n, b));
+    v = static_cast<E>(b);
+  }
+  template <std::size_t N> void floats(const char* n, std::array<float, N>& v, const char*) { for (float& x : v) x = in_.f32(n); }
+  void string(const char* n, std::string& v, std::size_t max, const char*) { v = in_.str(max, n); }
+  template <class T> void words(const char* n, std::vector<T>& v, const char*, const char*) { in_.counted_words(v, n); }
+  template <class T> void image(const char* n, std::vector<T>& v, std::uint64_t count, const char*, const char*) {
+    if constexpr (sizeof(T) == 1) in_.raw(v, count, n);
+    else in_.words(v, count, n);
+  }
+  template <class E, class F> void items(const char* n, std::vector<E>& v, const char*, Element el, F&& f, const char*) {
+    v.resize(in_.count(el.bytes, n));
+    for (E& e : v) f(*this, e);
+  }
+
+ private:
+  In& in_;
+  std::uint32_t version_;
+};
+
+// Checks a record in memory against the newest layout's limits; keeps the first problem.
+class CheckIo {
+ public:
+  std::string problem;
+  std::uint32_t version() const { return kFormatVersion; }
+  template <class F> void since(std::uint32_t v, F&& f) { if (kFormatVersion >= v) f(); }
+  template <class F> void until(std::uint32_t v, F&& f) { if (kFormatVersion <= v) f(); }
+  template <class T> void u8(const char*, T&, const char*) {}
+  template <class T> void u32(const char*, T&, const char*) {}
+  template <class T> void u64(const char*, T&, const char*) {}
+  template <class T> void i32(const char*, T&, const char*) {}
+  template <class T> void f32(const char*, T&, const char*) {}
+  template <class T> void f64(const char*, T&, const char*) {}
+  template <class T> void boolean(const char*, T&, const char*) {}
+  template <class T> void ranged(const char* n, T& v, T lo, T hi, const char*, const char*) {
+    if (v < lo || v > hi) note(out_of_range(n, v, lo, hi));
+  }
+  template <class E> void enumeration(const char* n, E& v, const char*) {
+    if (static_cast<unsigned>(v) > EnumInfo<E>::max) note(bad_enum<E>(n, static_cast<unsigned>(v)));
+  }
+  template <std::size_t N> void floats(const char*, std::array<float, N>&, const char*) {}
+  void string(const char* n, std::string& v, std::size_t max, const char*) {
+    if (v.size() > max) note(fmt::format("field '{}' is a string of {} bytes, above the limit of {}", n, v.size(), max));
+  }
+  template <class T> void words(const char* n, std::vector<T>& v, const char*, const char*) { count(n, v.size()); }
+  template <class T> void image(const char* n, std::vector<T>& v, std::uint64_t want, const char* text, const char*) {
+    if (v.size() != want) note(fmt::format("field '{}' holds {} elements, but {} is {}", n, v.size(), text, want));
+  }
+  template <class E, class F> void items(const char* n, std::vector<E>& v, const char*, Element, F&& f, const char*) {
+    count(n, v.size());
+    for (E& e : v) f(*this, e);
+  }
+
+ private:
+  void count(const char* n, std::size_t size) {
+    if (size > std::numeric_limits<std::uint32_t>::max()) note(fmt::format("field '{}' has {} elements, above 2^32-1", n, size));
+  }
+  void note(std::string p) {
+    if (problem.empty()) problem = std::move(p);
+  }
+};
+
+// ---- rules that span several fields (the visitor checks each field on its own) ------------------
+
+std::string extra_problem(const Properties& properties) {
   if (properties.size() > kMaxProperties)
     return fmt::format("{} properties, above the limit of {}", properties.size(), kMaxProperties);
   std::set<std::string_view> seen;
@@ -297,7 +290,7 @@ std::string record_problem(const Properties& properties) {
   return {};
 }
 
-std::string record_problem(const SceneObjects& s) {
+std::string extra_problem(const SceneObjects& s) {
   if (s.triangles.size() != s.objects.size())
     return fmt::format("{} triangle counts for {} objects", s.triangles.size(), s.objects.size());
   const std::size_t m = s.node_bounds.size();
@@ -341,323 +334,120 @@ std::string record_problem(const SceneObjects& s) {
   return {};
 }
 
-std::string record_problem(const DrawRecord& d) {
-  if (static_cast<std::uint8_t>(d.role) > static_cast<std::uint8_t>(DrawRole::IdBuffer))
-    return fmt::format("draw role {} is not a DrawRole", static_cast<unsigned>(d.role));
-  if (static_cast<std::uint8_t>(d.state.func) > static_cast<std::uint8_t>(DepthFunc::Always))
-    return fmt::format("depth func {} is not a DepthFunc", static_cast<unsigned>(d.state.func));
-  if (static_cast<std::uint8_t>(d.state.cull) > static_cast<std::uint8_t>(CullFace::FrontAndBack))
-    return fmt::format("cull face {} is not a CullFace", static_cast<unsigned>(d.state.cull));
-  if (static_cast<std::uint8_t>(d.state.clip) > static_cast<std::uint8_t>(ClipControl::ZeroToOne))
-    return fmt::format("clip control {} is not a ClipControl", static_cast<unsigned>(d.state.clip));
-  if (d.level >= kMaxLevels) return fmt::format("N-buffer level {} is not below {}", d.level, kMaxLevels);
-  if (d.object < -1) return fmt::format("object id {} is below -1", d.object);
-  if (d.node < -1) return fmt::format("BVH node id {} is below -1", d.node);
-  if (d.bounds.w < 0 || d.bounds.h < 0)
-    return fmt::format("bounds rectangle {}x{} has a negative side", d.bounds.w, d.bounds.h);
-  return {};
-}
-
-std::string record_problem(const DepthSnapshot& d) {
-  if (static_cast<std::uint8_t>(d.which) > static_cast<std::uint8_t>(DepthWhich::Final))
-    return fmt::format("depth snapshot kind {} is not a DepthWhich", static_cast<unsigned>(d.which));
-  if (auto p = image_size_problem("depth snapshot", d.width, d.height); !p.empty()) return p;
-  if (d.texels.size() != area(d.width, d.height))
-    return fmt::format("depth snapshot of {}x{} holds {} texels", d.width, d.height, d.texels.size());
-  return {};
-}
-
-std::string record_problem(const NBufferLevels& l) {
-  if (l.op > static_cast<std::uint8_t>(FarOp::Min)) return fmt::format("N-buffer op {} is not a FarOp", l.op);
-  if (auto p = image_size_problem("N-buffer", l.width, l.height); !p.empty()) return p;
-  if (l.levels < 1 || l.levels > kMaxLevels)
-    return fmt::format("N-buffer level count {} is outside 1 .. {}", l.levels, kMaxLevels);
-  if (l.texels.size() != area(l.width, l.height) * static_cast<std::uint64_t>(l.levels))
-    return fmt::format("N-buffer of {} levels of {}x{} holds {} texels", l.levels, l.width, l.height, l.texels.size());
-  return {};
-}
-
-std::string record_problem(const GroundTruth& t) {
-  if (t.id_width == 0 && t.id_height == 0) {
-    if (!t.ids.empty()) return fmt::format("ground truth holds {} ID-buffer pixels but no ID-buffer size", t.ids.size());
-    return {};
-  }
-  if (auto p = image_size_problem("ID buffer", t.id_width, t.id_height); !p.empty()) return p;
-  if (t.ids.size() != area(t.id_width, t.id_height))
-    return fmt::format("ID buffer of {}x{} holds {} pixels", t.id_width, t.id_height, t.ids.size());
+std::string extra_problem(const GroundTruth& t) {
+  if ((t.id_width == 0) != (t.id_height == 0))
+    return fmt::format("ID buffer size {}x{}: a side is 0 only when both are (no ID buffer recorded)", t.id_width, t.id_height);
   if (const auto it = std::find_if(t.ids.begin(), t.ids.end(), [](std::int32_t id) { return id < -1; }); it != t.ids.end())
     return fmt::format("ID buffer pixel {} holds id {}, below -1", it - t.ids.begin(), *it);
   return {};
 }
 
-// ---- encoders (layout of kFormatVersion; FORMAT.md has one table per record) ------------------
+std::string name_problem(const char* what, const std::string& name) {
+  if (name.empty() || !std::all_of(name.begin(), name.end(), good_key_char))
+    return fmt::format("{} '{}' is not 1 to {} characters of A-Z a-z 0-9 _ . -", what, name, kMaxNameBytes);
+  return {};
+}
 
-std::vector<std::uint8_t> encode(const Properties& properties) {
+std::string extra_problem(const DrawRecord& d) {
+  if (d.topology == Topology::Points && d.point_sizes.size() != d.clip_positions.size())
+    return fmt::format("a point draw with {} vertices and {} point sizes (one per vertex)", d.clip_positions.size(),
+                       d.point_sizes.size());
+  if (d.topology != Topology::Points && !d.point_sizes.empty())
+    return fmt::format("a {} draw with {} point sizes (only point draws have them)", to_string(d.topology), d.point_sizes.size());
+  return {};
+}
+
+std::string extra_problem(const DrawBatch& b) {
+  for (std::size_t i = 0; i < b.draws.size(); ++i)
+    if (std::string p = extra_problem(b.draws[i]); !p.empty()) return fmt::format("draw {} of the batch: {}", i, p);
+  return {};
+}
+
+std::string extra_problem(const DepthSnapshot& d) { return name_problem("depth image name", d.name); }
+std::string extra_problem(const StencilSnapshot& s) { return name_problem("stencil image name", s.name); }
+std::string extra_problem(const NBufferLevels& l) { return name_problem("N-buffer source name", l.source); }
+
+template <class R>
+std::string extra_problem(const R&) {
+  return {};
+}
+
+template <class R>
+std::string problem_of(const R& r) {
+  if (std::string p = extra_problem(r); !p.empty()) return p;  // the more specific message first
+  CheckIo io;
+  fields(io, const_cast<R&>(r));  // CheckIo only reads
+  return io.problem;
+}
+
+template <class R>
+std::vector<std::uint8_t> encode_record(const R& r, std::size_t reserve) {
   Out o;
-  o.count(properties.size());
-  for (const auto& [key, value] : properties) {
-    o.str(key);
-    o.str(value);
-  }
+  o.reserve(reserve);
+  EncodeIo io(o);
+  fields(io, const_cast<R&>(r));  // EncodeIo only reads
   return o.take();
 }
 
+template <class R>
+R decode_record(std::span<const std::uint8_t> payload, std::uint32_t version) {
+  check_version(version);
+  In in(payload);
+  DecodeIo io(in, version);
+  R r{};
+  fields(io, r);
+  in.finish();
+  refuse_problem(extra_problem(r));
+  return r;
+}
+
+}  // namespace
+
+std::string record_problem(const Properties& r) { return problem_of(r); }
+std::string record_problem(const SceneObjects& r) { return problem_of(r); }
+std::string record_problem(const FrameBegin& r) { return problem_of(r); }
+std::string record_problem(const DrawRecord& r) { return problem_of(r); }
+std::string record_problem(const DepthSnapshot& r) { return problem_of(r); }
+std::string record_problem(const NBufferLevels& r) { return problem_of(r); }
+std::string record_problem(const GroundTruth& r) { return problem_of(r); }
+std::string record_problem(const DrawBatch& r) { return problem_of(r); }
+std::string record_problem(const StencilSnapshot& r) { return problem_of(r); }
+std::string record_problem(const Camera& r) { return problem_of(r); }
+
+std::vector<std::uint8_t> encode(const Properties& r) { return encode_record(r, 256); }
 std::vector<std::uint8_t> encode(const SceneObjects& s) {
-  Out o;
-  o.reserve(28 + 28 * s.objects.size() + 40 * s.node_bounds.size() + 4 * s.leaf_objects.size());
-  o.aabbs(s.objects);
-  o.counted_words(s.triangles);
-  o.aabbs(s.node_bounds);
-  o.counted_words(s.node_left);
-  o.counted_words(s.node_right);
-  o.counted_words(s.node_first);
-  o.counted_words(s.node_count);
-  o.counted_words(s.leaf_objects);
-  return o.take();
+  return encode_record(s, 28 + 28 * s.objects.size() + 40 * s.node_bounds.size() + 4 * s.leaf_objects.size());
 }
-
-std::vector<std::uint8_t> encode(const FrameBegin& f) {
-  Out o;
-  o.u32(f.frame);
-  o.u8(static_cast<std::uint8_t>(f.mode));
-  for (float v : f.view) o.f32(v);
-  for (float v : f.proj) o.f32(v);
-  for (float v : f.eye) o.f32(v);
-  return o.take();
-}
-
-std::vector<std::uint8_t> encode(const DrawRecord& d) {
-  Out o;
-  o.reserve(96 + 16 * d.clip_positions.size());
-  o.u32(d.index);
-  o.u8(static_cast<std::uint8_t>(d.role));
-  o.i32(d.object);
-  o.i32(d.node);
-  o.u8(d.level);
-  o.u8(static_cast<std::uint8_t>(d.state.func));
-  o.boolean(d.state.write);
-  o.boolean(d.state.test);
-  o.u8(static_cast<std::uint8_t>(d.state.cull));
-  o.boolean(d.state.front_ccw);
-  o.u8(static_cast<std::uint8_t>(d.state.clip));
-  o.boolean(d.state.depth_clamp);
-  o.count(d.clip_positions.size());
-  for (const auto& p : d.clip_positions)
-    for (float v : p) o.f32(v);
-  o.boolean(d.has_bounds);
-  o.i32(d.bounds.x);
-  o.i32(d.bounds.y);
-  o.i32(d.bounds.w);
-  o.i32(d.bounds.h);
-  o.f32(d.bounds.nearest_depth);
-  o.boolean(d.bounds.crosses_near);
-  o.boolean(d.bounds.visible);
-  o.u64(d.gl.fragments);
-  o.u64(d.gl.samples_passed);
-  o.u64(d.gl.clip_prims_in);
-  o.u64(d.gl.clip_prims_out);
-  return o.take();
-}
-
-std::vector<std::uint8_t> encode(const DepthSnapshot& d) {
-  Out o;
-  o.reserve(9 + 4 * d.texels.size());
-  o.u8(static_cast<std::uint8_t>(d.which));
-  o.i32(d.width);
-  o.i32(d.height);
-  o.words(d.texels);
-  return o.take();
-}
-
-std::vector<std::uint8_t> encode(const NBufferLevels& l) {
-  Out o;
-  o.reserve(13 + 4 * l.texels.size());
-  o.u8(l.op);
-  o.i32(l.width);
-  o.i32(l.height);
-  o.i32(l.levels);
-  o.words(l.texels);
-  return o.take();
-}
-
+std::vector<std::uint8_t> encode(const FrameBegin& r) { return encode_record(r, 160); }
+std::vector<std::uint8_t> encode(const DrawRecord& d) { return encode_record(d, 96 + 16 * d.clip_positions.size()); }
+std::vector<std::uint8_t> encode(const DepthSnapshot& d) { return encode_record(d, 16 + 4 * d.texels.size()); }
+std::vector<std::uint8_t> encode(const NBufferLevels& l) { return encode_record(l, 16 + 4 * l.texels.size()); }
 std::vector<std::uint8_t> encode(const GroundTruth& t) {
-  Out o;
-  o.reserve(24 + 4 * t.visible_pixels.size() + 4 * t.ids.size());
-  o.counted_words(t.visible_pixels);
-  o.u64(t.covered_pixels);
-  o.i32(t.id_width);
-  o.i32(t.id_height);
-  o.words(t.ids);
-  return o.take();
+  return encode_record(t, 24 + 4 * t.visible_pixels.size() + 4 * t.ids.size());
 }
-
-std::vector<std::uint8_t> encode(const FrameEnd& f) {
-  Out o;
-  o.u32(f.frame);
-  o.u32(f.draws);
-  o.f64(f.gl_ms);
-  return o.take();
+std::vector<std::uint8_t> encode(const FrameEnd& r) { return encode_record(r, 16); }
+std::vector<std::uint8_t> encode(const DrawBatch& b) {
+  std::size_t n = 4;
+  for (const DrawRecord& d : b.draws) n += 160 + 20 * d.clip_positions.size();
+  return encode_record(b, n);
 }
+std::vector<std::uint8_t> encode(const StencilSnapshot& s) { return encode_record(s, 16 + s.name.size() + s.texels.size()); }
+std::vector<std::uint8_t> encode(const Camera& c) { return encode_record(c, 140); }
+std::vector<std::uint8_t> encode(const EndMarker& r) { return encode_record(r, 12); }
 
-std::vector<std::uint8_t> encode(const EndMarker& e) {
-  Out o;
-  o.u64(e.chunks);
-  o.u32(e.frames);
-  return o.take();
-}
-
-// ---- decoders ---------------------------------------------------------------------------------
-// Each reads the fields of version 1 in order. A field added in version N is read under
-// `if (version >= N)` (older files keep its default), so every older version still reads.
-
-Properties decode_properties(std::span<const std::uint8_t> payload, std::uint32_t version) {
-  check_version(version);
-  In in(payload);
-  Properties props;
-  const std::size_t n = in.count(8, "property count");  // a key and a value: two u32 lengths at least
-  if (n > kMaxProperties) throw InputError(fmt::format("{} properties, above the limit of {}", n, kMaxProperties));
-  props.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    std::string key = in.str(kMaxKeyBytes, "property key");
-    std::string value = in.str(kMaxValueBytes, "property value");
-    props.emplace_back(std::move(key), std::move(value));
-  }
-  in.finish();
-  refuse_problem(record_problem(props));
-  return props;
-}
-
-SceneObjects decode_scene(std::span<const std::uint8_t> payload, std::uint32_t version) {
-  check_version(version);
-  In in(payload);
-  SceneObjects s;
-  in.aabbs(s.objects, "objects");
-  in.counted_words(s.triangles, "triangles");
-  in.aabbs(s.node_bounds, "node_bounds");
-  in.counted_words(s.node_left, "node_left");
-  in.counted_words(s.node_right, "node_right");
-  in.counted_words(s.node_first, "node_first");
-  in.counted_words(s.node_count, "node_count");
-  in.counted_words(s.leaf_objects, "leaf_objects");
-  in.finish();
-  refuse_problem(record_problem(s));
-  return s;
-}
-
-FrameBegin decode_frame_begin(std::span<const std::uint8_t> payload, std::uint32_t version) {
-  check_version(version);
-  In in(payload);
-  FrameBegin f;
-  f.frame = in.u32("frame");
-  f.mode = in.enumeration("mode", TestMode::None);
-  for (float& v : f.view) v = in.f32("view");
-  for (float& v : f.proj) v = in.f32("proj");
-  for (float& v : f.eye) v = in.f32("eye");
-  in.finish();
-  return f;
-}
-
-DrawRecord decode_draw(std::span<const std::uint8_t> payload, std::uint32_t version) {
-  check_version(version);
-  In in(payload);
-  DrawRecord d;
-  d.index = in.u32("index");
-  d.role = in.enumeration("role", DrawRole::IdBuffer);
-  d.object = in.i32("object");
-  d.node = in.i32("node");
-  d.level = in.u8("level");
-  d.state.func = in.enumeration("state.func", DepthFunc::Always);
-  d.state.write = in.boolean("state.write");
-  d.state.test = in.boolean("state.test");
-  d.state.cull = in.enumeration("state.cull", CullFace::FrontAndBack);
-  d.state.front_ccw = in.boolean("state.front_ccw");
-  d.state.clip = in.enumeration("state.clip", ClipControl::ZeroToOne);
-  d.state.depth_clamp = in.boolean("state.depth_clamp");
-  d.clip_positions.resize(in.count(16, "clip_positions"));
-  for (auto& p : d.clip_positions)
-    for (float& v : p) v = in.f32("clip_positions");
-  d.has_bounds = in.boolean("has_bounds");
-  d.bounds.x = in.i32("bounds.x");
-  d.bounds.y = in.i32("bounds.y");
-  d.bounds.w = in.i32("bounds.w");
-  d.bounds.h = in.i32("bounds.h");
-  d.bounds.nearest_depth = in.f32("bounds.nearest_depth");
-  d.bounds.crosses_near = in.boolean("bounds.crosses_near");
-  d.bounds.visible = in.boolean("bounds.visible");
-  d.gl.fragments = in.u64("gl.fragments");
-  d.gl.samples_passed = in.u64("gl.samples_passed");
-  d.gl.clip_prims_in = in.u64("gl.clip_prims_in");
-  d.gl.clip_prims_out = in.u64("gl.clip_prims_out");
-  in.finish();
-  refuse_problem(record_problem(d));
-  return d;
-}
-
-DepthSnapshot decode_depth(std::span<const std::uint8_t> payload, std::uint32_t version) {
-  check_version(version);
-  In in(payload);
-  DepthSnapshot d;
-  d.which = in.enumeration("which", DepthWhich::Final);
-  d.width = in.i32("width");
-  d.height = in.i32("height");
-  refuse_problem(image_size_problem("depth snapshot", d.width, d.height));
-  in.words(d.texels, area(d.width, d.height), "texels");
-  in.finish();
-  return d;
-}
-
-NBufferLevels decode_levels(std::span<const std::uint8_t> payload, std::uint32_t version) {
-  check_version(version);
-  In in(payload);
-  NBufferLevels l;
-  l.op = static_cast<std::uint8_t>(in.enumeration("op", FarOp::Min));
-  l.width = in.i32("width");
-  l.height = in.i32("height");
-  l.levels = in.i32("levels");
-  refuse_problem(image_size_problem("N-buffer", l.width, l.height));
-  if (l.levels < 1 || l.levels > kMaxLevels)
-    throw InputError(fmt::format("N-buffer level count {} is outside 1 .. {}", l.levels, kMaxLevels));
-  in.words(l.texels, area(l.width, l.height) * static_cast<std::uint64_t>(l.levels), "texels");
-  in.finish();
-  return l;
-}
-
-GroundTruth decode_truth(std::span<const std::uint8_t> payload, std::uint32_t version) {
-  check_version(version);
-  In in(payload);
-  GroundTruth t;
-  in.counted_words(t.visible_pixels, "visible_pixels");
-  t.covered_pixels = in.u64("covered_pixels");
-  t.id_width = in.i32("id_width");
-  t.id_height = in.i32("id_height");
-  if (t.id_width != 0 || t.id_height != 0) {
-    refuse_problem(image_size_problem("ID buffer", t.id_width, t.id_height));
-    in.words(t.ids, area(t.id_width, t.id_height), "ids");
-  }
-  in.finish();
-  refuse_problem(record_problem(t));
-  return t;
-}
-
-FrameEnd decode_frame_end(std::span<const std::uint8_t> payload, std::uint32_t version) {
-  check_version(version);
-  In in(payload);
-  FrameEnd f;
-  f.frame = in.u32("frame");
-  f.draws = in.u32("draws");
-  f.gl_ms = in.f64("gl_ms");
-  in.finish();
-  return f;
-}
-
-EndMarker decode_end(std::span<const std::uint8_t> payload, std::uint32_t version) {
-  check_version(version);
-  In in(payload);
-  EndMarker e;
-  e.chunks = in.u64("chunks");
-  e.frames = in.u32("frames");
-  in.finish();
-  return e;
-}
+// Each decoder reads the layout of the file's version: the visitor reads a field added in version
+// N only when version >= N (older files keep its default), so every older version still reads.
+Properties decode_properties(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<Properties>(p, v); }
+SceneObjects decode_scene(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<SceneObjects>(p, v); }
+FrameBegin decode_frame_begin(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<FrameBegin>(p, v); }
+DrawRecord decode_draw(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<DrawRecord>(p, v); }
+DepthSnapshot decode_depth(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<DepthSnapshot>(p, v); }
+NBufferLevels decode_levels(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<NBufferLevels>(p, v); }
+GroundTruth decode_truth(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<GroundTruth>(p, v); }
+FrameEnd decode_frame_end(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<FrameEnd>(p, v); }
+EndMarker decode_end(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<EndMarker>(p, v); }
+DrawBatch decode_draw_batch(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<DrawBatch>(p, v); }
+StencilSnapshot decode_stencil(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<StencilSnapshot>(p, v); }
+Camera decode_light(std::span<const std::uint8_t> p, std::uint32_t v) { return decode_record<Camera>(p, v); }
 
 }  // namespace nbsim::trace

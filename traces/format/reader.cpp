@@ -9,10 +9,12 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <system_error>
 
 #include "model/common/error.h"
 #include "traces/format/codec.h"
+#include "traces/format/technique_chunks.h"
 
 namespace nbsim::trace {
 
@@ -102,12 +104,6 @@ TraceReader::~TraceReader() = default;
 TraceReader::TraceReader(TraceReader&&) noexcept = default;
 TraceReader& TraceReader::operator=(TraceReader&&) noexcept = default;
 
-const std::string* TraceReader::property(std::string_view key) const noexcept {
-  for (const auto& [k, v] : properties_)
-    if (k == key) return &v;
-  return nullptr;
-}
-
 std::size_t TraceReader::read_bytes(std::uint8_t* dst, std::size_t n) {
   const std::size_t got = src_->read(dst, n);
   pos_ += got;
@@ -146,7 +142,12 @@ void TraceReader::open() {
 
   Chunk head = read_chunk();
   if (head.type != ChunkType::Header) fail(head, "the first chunk must be HEAD");
-  properties_ = decode<Properties>(head);
+  Properties properties = decode<Properties>(head);
+  try {
+    header_ = parse_header(properties);
+  } catch (const InputError& e) {
+    fail(head, e.what());
+  }
   if (auto c = next(); c && c->type == ChunkType::Scene)
     scene_ = decode<SceneObjects>(*c);
   else
@@ -193,9 +194,21 @@ Chunk TraceReader::read_chunk() {
             fmt::format("CRC-32 mismatch (stored 0x{:08x}, computed 0x{:08x}): the chunk is damaged", stored_crc, crc));
 
   // The bytes are what the writer wrote; now check they mean something this version knows.
-  if (!is_known_chunk_type(type)) fail_at(c.index, c.offset, type_name, "unknown chunk type");
-  if (flags & ~kKnownFlags)
-    fail_at(c.index, c.offset, type_name, fmt::format("unknown flags 0x{:08x}", flags & ~kKnownFlags));
+  const std::uint32_t known_flags = version_ >= 2 ? kKnownFlags : kKnownFlagsV1;
+  if (flags & ~known_flags)
+    fail_at(c.index, c.offset, type_name,
+            fmt::format("unknown flags 0x{:08x} (format version {})", flags & ~known_flags, version_));
+  c.technique = (flags & kFlagTechnique) != 0;
+  if (c.technique) {
+    if (is_known_chunk_type(type)) fail_at(c.index, c.offset, type_name, "a core chunk type flagged as a technique's chunk");
+    if (type_name.size() != 4) fail_at(c.index, c.offset, type_name, "a technique's chunk type must be four printable characters");
+  } else if (!is_known_chunk_type(type)) {
+    fail_at(c.index, c.offset, type_name, "unknown chunk type");
+  } else if (chunk_type_since(type) > version_) {
+    fail_at(c.index, c.offset, type_name,
+            fmt::format("chunk type {} exists since format version {}, the file is version {}", type_name,
+                        chunk_type_since(type), version_));
+  }
   c.type = static_cast<ChunkType>(type);
   c.stored_bytes = stored;
   c.compressed = (flags & kFlagZstd) != 0;
@@ -223,6 +236,10 @@ Chunk TraceReader::read_chunk() {
 }
 
 void TraceReader::check_structure(const Chunk& c) {
+  if (c.technique) {
+    if (!in_frame_) fail(c, "a technique's chunk outside a frame (no FRAM before it)");
+    return;
+  }
   switch (c.type) {
     case ChunkType::Header:
       fail(c, "a second HEAD chunk: HEAD is chunk 0 only");
@@ -240,13 +257,26 @@ void TraceReader::check_structure(const Chunk& c) {
       return;
     }
     case ChunkType::Draw:
+    case ChunkType::DrawBatch:
     case ChunkType::Depth:
     case ChunkType::Levels:
     case ChunkType::Truth:
+    case ChunkType::Stencil:
+    case ChunkType::Light:
       if (!in_frame_) fail(c, "a frame record outside a frame (no FRAM before it)");
       if (c.type == ChunkType::Draw) {
         ++frame_draws_;
         ++stats_.draws;
+      } else if (c.type == ChunkType::DrawBatch) {
+        // The batch's draw count leads its payload; FrameReader checks it against the draws.
+        if (c.payload.size() < 4) fail(c, fmt::format("the payload of {} bytes is too short for a draw count (it decodes short)",
+                                                      c.payload.size()));
+        const std::uint32_t n = le32(c.payload.data());
+        if (n == 0) fail(c, "an empty draw batch");
+        if (n > std::numeric_limits<std::uint32_t>::max() - frame_draws_)
+          fail(c, fmt::format("the batch's {} draws overflow frame {}'s draw count", n, frame_));
+        frame_draws_ += n;
+        stats_.draws += n;
       }
       return;
     case ChunkType::FrameEnd: {
@@ -254,7 +284,8 @@ void TraceReader::check_structure(const Chunk& c) {
       const auto f = decode<FrameEnd>(c);
       if (f.frame != frame_) fail(c, fmt::format("FEND of frame {} closes frame {}", f.frame, frame_));
       if (f.draws != frame_draws_)
-        fail(c, fmt::format("FEND counts {} draws, but frame {} has {} DRAW chunks", f.draws, frame_, frame_draws_));
+        fail(c, fmt::format("FEND counts {} draws, but frame {} has {} (DRAW chunks and DRWS batches)", f.draws, frame_,
+                            frame_draws_));
       in_frame_ = false;
       ++stats_.frames;
       return;
@@ -302,6 +333,9 @@ Record TraceReader::decode(const Chunk& chunk) const {
     else if constexpr (std::is_same_v<Record, NBufferLevels>) return decode_levels(chunk.payload, version_);
     else if constexpr (std::is_same_v<Record, GroundTruth>) return decode_truth(chunk.payload, version_);
     else if constexpr (std::is_same_v<Record, FrameEnd>) return decode_frame_end(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, DrawBatch>) return decode_draw_batch(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, StencilSnapshot>) return decode_stencil(chunk.payload, version_);
+    else if constexpr (std::is_same_v<Record, Camera>) return decode_light(chunk.payload, version_);
     else return decode_end(chunk.payload, version_);
   } catch (const InputError& e) {
     fail(chunk, e.what());
@@ -317,6 +351,9 @@ template NBufferLevels TraceReader::decode<NBufferLevels>(const Chunk&) const;
 template GroundTruth TraceReader::decode<GroundTruth>(const Chunk&) const;
 template FrameEnd TraceReader::decode<FrameEnd>(const Chunk&) const;
 template EndMarker TraceReader::decode<EndMarker>(const Chunk&) const;
+template DrawBatch TraceReader::decode<DrawBatch>(const Chunk&) const;
+template StencilSnapshot TraceReader::decode<StencilSnapshot>(const Chunk&) const;
+template Camera TraceReader::decode<Camera>(const Chunk&) const;
 
 // ---- FrameReader ------------------------------------------------------------------------------
 
@@ -335,34 +372,59 @@ std::optional<Frame> FrameReader::next() {
   const SceneObjects* scene = trace_.scene();
   const auto objects = scene ? static_cast<std::int64_t>(scene->objects.size()) : 0;
   const auto nodes = scene ? static_cast<std::int64_t>(scene->node_bounds.size()) : 0;
+  const auto add_draw = [&](DrawRecord d, const Chunk& chunk) {
+    if (d.index != f.draws.size())
+      trace_.fail(chunk, fmt::format("draw index {} in frame {}, expected {} (draws count from 0 in file order)", d.index,
+                                     f.begin.frame, f.draws.size()));
+    if (scene && d.object >= objects)
+      trace_.fail(chunk, fmt::format("draw {} names object {}, but the scene has {} objects", d.index, d.object, objects));
+    if (scene && d.node >= nodes)
+      trace_.fail(chunk, fmt::format("draw {} names BVH node {}, but the scene has {} nodes", d.index, d.node, nodes));
+    f.draws.push_back(std::move(d));
+  };
   for (;;) {
     c = trace_.next();
     NBSIM_CHECK(c.has_value(), "TraceReader ended inside a frame");
+    if (c->technique) {
+      try {
+        f.technique_records.push_back(decode_technique(static_cast<std::uint32_t>(c->type), c->payload));
+      } catch (const InputError& e) {
+        trace_.fail(*c, e.what());
+      }
+      continue;
+    }
     switch (c->type) {
-      case ChunkType::Draw: {
-        DrawRecord d = trace_.decode<DrawRecord>(*c);
-        if (d.index != f.draws.size())
-          trace_.fail(*c, fmt::format("draw index {} in frame {}, expected {} (draws count from 0 in file order)",
-                                      d.index, f.begin.frame, f.draws.size()));
-        if (scene && d.object >= objects)
-          trace_.fail(*c, fmt::format("draw names object {}, but the scene has {} objects", d.object, objects));
-        if (scene && d.node >= nodes)
-          trace_.fail(*c, fmt::format("draw names BVH node {}, but the scene has {} nodes", d.node, nodes));
-        f.draws.push_back(std::move(d));
+      case ChunkType::Draw:
+        add_draw(trace_.decode<DrawRecord>(*c), *c);
+        break;
+      case ChunkType::DrawBatch: {
+        DrawBatch batch = trace_.decode<DrawBatch>(*c);
+        for (DrawRecord& d : batch.draws) add_draw(std::move(d), *c);
         break;
       }
       case ChunkType::Depth: {
         DepthSnapshot d = trace_.decode<DepthSnapshot>(*c);
-        if (f.depth(d.which))
-          trace_.fail(*c, fmt::format("a second '{}' depth snapshot in frame {}", to_string(d.which), f.begin.frame));
+        if (f.depth(d.name))
+          trace_.fail(*c, fmt::format("a second '{}' depth snapshot in frame {}", d.name, f.begin.frame));
         f.depths.push_back(std::move(d));
         break;
       }
+      case ChunkType::Stencil: {
+        StencilSnapshot s = trace_.decode<StencilSnapshot>(*c);
+        if (f.stencil(s.name))
+          trace_.fail(*c, fmt::format("a second '{}' stencil snapshot in frame {}", s.name, f.begin.frame));
+        f.stencils.push_back(std::move(s));
+        break;
+      }
+      case ChunkType::Light:
+        if (f.light) trace_.fail(*c, fmt::format("a second light camera in frame {}", f.begin.frame));
+        f.light = trace_.decode<Camera>(*c);
+        break;
       case ChunkType::Levels: {
         NBufferLevels l = trace_.decode<NBufferLevels>(*c);
-        if (f.nbuffer(static_cast<FarOp>(l.op)))
-          trace_.fail(*c, fmt::format("a second N-buffer with op '{}' in frame {}", to_string(static_cast<FarOp>(l.op)),
-                                      f.begin.frame));
+        if (f.nbuffer(l.source, static_cast<FarOp>(l.op)))
+          trace_.fail(*c, fmt::format("a second N-buffer with op '{}' built from '{}' in frame {}",
+                                      to_string(static_cast<FarOp>(l.op)), l.source, f.begin.frame));
         f.levels.push_back(std::move(l));
         break;
       }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "model/common/depth.h"
+#include "traces/format/header.h"
 #include "traces/format/records.h"
 
 namespace nbsim::trace {
@@ -24,6 +25,7 @@ struct Chunk {
   std::uint64_t offset = 0;        // byte offset of the chunk header in the file
   std::uint64_t stored_bytes = 0;  // payload bytes in the file (compressed or not)
   bool compressed = false;
+  bool technique = false;          // a technique's chunk type (kFlagTechnique): `type` is its fourcc
   std::vector<std::uint8_t> payload;  // the decoded payload
 };
 
@@ -39,8 +41,9 @@ struct TraceStats {
 
 class TraceReader {
  public:
-  // Opens the file and reads the preamble, HEAD and (when it follows) SCEN. Throws InputError when
-  // the file is missing, not a trace, damaged there, or of a newer format version.
+  // Opens the file and reads the preamble, HEAD (parsed into the typed header) and (when it
+  // follows) SCEN. Throws InputError when the file is missing, not a trace, damaged there, of a
+  // newer format version, or when a header property has a malformed value.
   explicit TraceReader(const std::filesystem::path& file);
   // The same over bytes in memory (tests, fuzzing); `name` stands for the file in messages.
   TraceReader(std::vector<std::uint8_t> bytes, std::string name);
@@ -51,9 +54,11 @@ class TraceReader {
   const std::string& name() const noexcept { return name_; }
   std::uint64_t file_bytes() const noexcept { return size_; }
   std::uint32_t version() const noexcept { return version_; }
-  const Properties& properties() const noexcept { return properties_; }
-  // The value of a header property, or nullptr.
-  const std::string* property(std::string_view key) const noexcept;
+  // The header, parsed and checked once when the trace was opened (header.h).
+  const Header& header() const noexcept { return header_; }
+  const Properties& properties() const noexcept { return header_.properties; }
+  // The value of a header property as written, or nullptr.
+  const std::string* property(std::string_view key) const noexcept { return header_.property(key); }
   // The scene, or nullptr when the trace has no SCEN chunk.
   const SceneObjects* scene() const noexcept { return scene_ ? &*scene_ : nullptr; }
 
@@ -89,7 +94,7 @@ class TraceReader {
   std::uint64_t size_ = 0;
   std::uint64_t pos_ = 0;
   std::uint32_t version_ = 0;
-  Properties properties_;
+  Header header_;
   std::optional<SceneObjects> scene_;
   std::optional<Chunk> pending_;  // read by the constructor after HEAD, not SCEN
   std::optional<EndMarker> end_;
@@ -98,7 +103,7 @@ class TraceReader {
   bool in_frame_ = false;
   bool any_frame_ = false;
   std::uint32_t frame_ = 0;        // the open (or last) frame's number
-  std::uint32_t frame_draws_ = 0;  // DRAW chunks in the open frame
+  std::uint32_t frame_draws_ = 0;  // draws in the open frame (DRAW chunks and DRWS batches)
 };
 
 // One frame, FRAM .. FEND, decoded (model/scene/frame.h).

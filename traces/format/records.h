@@ -32,6 +32,9 @@ enum class ChunkType : std::uint32_t {
   Truth = fourcc("TRTH"),       // GroundTruth
   FrameEnd = fourcc("FEND"),    // FrameEnd
   End = fourcc("END "),         // EndMarker; always the last chunk
+  DrawBatch = fourcc("DRWS"),   // DrawBatch: consecutive DrawRecords of a frame (version 2)
+  Stencil = fourcc("STNC"),     // StencilSnapshot (version 2)
+  Light = fourcc("LGHT"),       // Camera: the frame's light (version 2)
 };
 
 // Key/value properties of the header, in order (GL_RENDERER, viewport, technique, seed, ...).
@@ -55,7 +58,21 @@ using scene::GroundTruth;
 using scene::NBufferLevels;
 using scene::SceneObjects;
 using scene::TestMode;
+using scene::Camera;
+using scene::StencilFace;
+using scene::StencilOp;
+using scene::StencilSnapshot;
+using scene::StencilState;
+using scene::TechniqueField;
+using scene::TechniqueRecord;
+using scene::Topology;
 using scene::to_string;
+
+// A batch of a frame's consecutive draws in one chunk (version 2), so that zstd compresses them
+// together; FEND.draws counts the draws, not the chunks.
+struct DrawBatch {
+  std::vector<DrawRecord> draws;
+};
 
 struct EndMarker {
   std::uint64_t chunks = 0;  // chunks before this one, header included

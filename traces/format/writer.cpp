@@ -8,14 +8,11 @@
 
 #include "model/common/error.h"
 #include "traces/format/codec.h"
+#include "traces/format/technique_chunks.h"
 
 namespace nbsim::trace {
 
 namespace {
-
-constexpr std::uint32_t kSeenTruth = 1u << 2;
-std::uint32_t seen_depth_bit(DepthWhich w) { return 1u << static_cast<unsigned>(w); }
-std::uint32_t seen_levels_bit(std::uint8_t op) { return 1u << (3u + op); }
 
 void check_record(const std::string& problem, const char* what) {
   NBSIM_CHECK(problem.empty(), fmt::format("TraceWriter: inconsistent {} record: {}", what, problem));
@@ -44,10 +41,10 @@ void TraceWriter::put_bytes(const std::uint8_t* data, std::size_t n) {
   bytes_ += n;
 }
 
-void TraceWriter::put(ChunkType type, const std::vector<std::uint8_t>& payload) {
+void TraceWriter::put(ChunkType type, const std::vector<std::uint8_t>& payload, std::uint32_t extra_flags) {
   std::vector<std::uint8_t> chunk;
   try {
-    chunk = encode_chunk(type, payload);
+    chunk = encode_chunk(type, payload, true, extra_flags);
   } catch (const InputError& e) {
     throw InputError(fmt::format("cannot write trace '{}': {}", name_, e.what()));
   }
@@ -57,6 +54,13 @@ void TraceWriter::put(ChunkType type, const std::vector<std::uint8_t>& payload) 
 
 void TraceWriter::require_frame(const char* what) const {
   NBSIM_CHECK(in_frame_, fmt::format("TraceWriter: {} written outside begin_frame() .. end_frame()", what));
+}
+
+void TraceWriter::flush_draws() {
+  if (pending_.draws.empty()) return;
+  put(ChunkType::DrawBatch, encode(pending_));
+  pending_.draws.clear();
+  pending_bytes_ = 0;
 }
 
 void TraceWriter::write(const SceneObjects& scene) {
@@ -78,7 +82,10 @@ void TraceWriter::begin_frame(const FrameBegin& frame) {
   in_frame_ = any_frame_ = true;
   frame_ = frame.frame;
   draws_ = 0;
-  seen_ = 0;
+  depths_.clear();
+  stencils_.clear();
+  levels_.clear();
+  light_ = truth_ = false;
 }
 
 void TraceWriter::write(const DrawRecord& draw) {
@@ -92,32 +99,62 @@ void TraceWriter::write(const DrawRecord& draw) {
     NBSIM_CHECK(draw.node < static_cast<std::int64_t>(scene_nodes_),
                 fmt::format("TraceWriter: draw {} names BVH node {} of {}", draw.index, draw.node, scene_nodes_));
   }
-  put(ChunkType::Draw, encode(draw));
+  pending_.draws.push_back(draw);
+  pending_bytes_ += 160 + 20 * draw.clip_positions.size();
   ++draws_;
+  if (pending_.draws.size() >= kDrawsPerBatch || pending_bytes_ >= kBatchBytes) flush_draws();
 }
 
 void TraceWriter::write(const DepthSnapshot& depth) {
   require_frame("a DPTH record");
   check_record(record_problem(depth), "DPTH");
-  NBSIM_CHECK(!(seen_ & seen_depth_bit(depth.which)),
-              fmt::format("TraceWriter: a second '{}' depth snapshot in frame {}", to_string(depth.which), frame_));
+  NBSIM_CHECK(depths_.insert(depth.name).second,
+              fmt::format("TraceWriter: a second '{}' depth snapshot in frame {}", depth.name, frame_));
+  flush_draws();
   put(ChunkType::Depth, encode(depth));
-  seen_ |= seen_depth_bit(depth.which);
 }
 
 void TraceWriter::write(const NBufferLevels& levels) {
   require_frame("an NBLV record");
   check_record(record_problem(levels), "NBLV");
-  NBSIM_CHECK(!(seen_ & seen_levels_bit(levels.op)),
-              fmt::format("TraceWriter: a second N-buffer with op {} in frame {}", levels.op, frame_));
+  NBSIM_CHECK(levels_.emplace(levels.source, levels.op).second,
+              fmt::format("TraceWriter: a second N-buffer with op {} built from '{}' in frame {}", levels.op, levels.source, frame_));
+  flush_draws();
   put(ChunkType::Levels, encode(levels));
-  seen_ |= seen_levels_bit(levels.op);
+}
+
+void TraceWriter::write(const StencilSnapshot& stencil) {
+  require_frame("an STNC record");
+  check_record(record_problem(stencil), "STNC");
+  NBSIM_CHECK(stencils_.insert(stencil.name).second,
+              fmt::format("TraceWriter: a second '{}' stencil snapshot in frame {}", stencil.name, frame_));
+  flush_draws();
+  put(ChunkType::Stencil, encode(stencil));
+}
+
+void TraceWriter::write_light(const Camera& light) {
+  require_frame("an LGHT record");
+  NBSIM_CHECK(!light_, fmt::format("TraceWriter: a second light camera in frame {}", frame_));
+  light_ = true;
+  flush_draws();
+  put(ChunkType::Light, encode(light));
+}
+
+void TraceWriter::write(const TechniqueRecord& record) {
+  require_frame("a technique's record");
+  NBSIM_CHECK(!is_known_chunk_type(record.type) && chunk_type_name(record.type).size() == 4,
+              fmt::format("TraceWriter: technique record type {} is a core type or not four printable characters",
+                          chunk_type_name(record.type)));
+  NBSIM_CHECK(!record.decoded || find_technique_chunk(record.type) != nullptr,
+              fmt::format("TraceWriter: technique record type {} is not registered", chunk_type_name(record.type)));
+  flush_draws();
+  put(static_cast<ChunkType>(record.type), encode(record), kFlagTechnique);
 }
 
 void TraceWriter::write(const GroundTruth& truth) {
   require_frame("a TRTH record");
   check_record(record_problem(truth), "TRTH");
-  NBSIM_CHECK(!(seen_ & kSeenTruth), fmt::format("TraceWriter: a second ground truth in frame {}", frame_));
+  NBSIM_CHECK(!truth_, fmt::format("TraceWriter: a second ground truth in frame {}", frame_));
   if (has_scene_) {
     NBSIM_CHECK(truth.visible_pixels.size() == scene_objects_,
                 fmt::format("TraceWriter: ground truth for {} objects, the scene has {}", truth.visible_pixels.size(),
@@ -126,8 +163,9 @@ void TraceWriter::write(const GroundTruth& truth) {
       NBSIM_CHECK(id < static_cast<std::int64_t>(scene_objects_),
                   fmt::format("TraceWriter: ID buffer holds object {} of {}", id, scene_objects_));
   }
+  flush_draws();
   put(ChunkType::Truth, encode(truth));
-  seen_ |= kSeenTruth;
+  truth_ = true;
 }
 
 void TraceWriter::end_frame(const FrameEnd& frame) {
@@ -135,6 +173,7 @@ void TraceWriter::end_frame(const FrameEnd& frame) {
   NBSIM_CHECK(frame.frame == frame_, fmt::format("TraceWriter: end_frame({}) closes frame {}", frame.frame, frame_));
   NBSIM_CHECK(frame.draws == draws_,
               fmt::format("TraceWriter: FrameEnd.draws is {}, but frame {} has {} DRAW records", frame.draws, frame_, draws_));
+  flush_draws();
   put(ChunkType::FrameEnd, encode(frame));
   in_frame_ = false;
   ++frames_;

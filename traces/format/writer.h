@@ -5,7 +5,10 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "traces/format/records.h"
 
@@ -28,9 +31,14 @@ class TraceWriter {
   // I/O failures and records above the chunk limit throw InputError naming the file.
   void write(const SceneObjects& scene);
   void begin_frame(const FrameBegin& frame);
+  // Draws are stored in DRWS batches (kDrawsPerBatch, kBatchBytes): a batch is flushed when it is
+  // full, before any other record of the frame and at end_frame.
   void write(const DrawRecord& draw);  // draw.index must count the frame's draws from 0
-  void write(const DepthSnapshot& depth);
-  void write(const NBufferLevels& levels);
+  void write(const DepthSnapshot& depth);        // names unique in the frame
+  void write(const NBufferLevels& levels);       // (source, op) unique in the frame
+  void write(const StencilSnapshot& stencil);    // names unique in the frame
+  void write_light(const Camera& light);         // at most once a frame
+  void write(const TechniqueRecord& record);     // a registered type, or a raw record read from a file
   void write(const GroundTruth& truth);
   void end_frame(const FrameEnd& frame);  // frame.frame and frame.draws must match the frame
   // Writes END and closes the file; throws InputError when the data cannot be flushed.
@@ -41,7 +49,8 @@ class TraceWriter {
   std::uint32_t frames_written() const noexcept { return frames_; }
 
  private:
-  void put(ChunkType type, const std::vector<std::uint8_t>& payload);
+  void put(ChunkType type, const std::vector<std::uint8_t>& payload, std::uint32_t extra_flags = 0);
+  void flush_draws();
   void put_bytes(const std::uint8_t* data, std::size_t n);
   void require_frame(const char* what) const;
 
@@ -56,7 +65,12 @@ class TraceWriter {
   bool any_frame_ = false;
   std::uint32_t frame_ = 0;  // the open (or last) frame's number
   std::uint32_t draws_ = 0;
-  std::uint32_t seen_ = 0;  // bits: DPTH per DepthWhich (0, 1), TRTH (2), NBLV per FarOp (3, 4)
+  DrawBatch pending_;               // draws not yet written
+  std::size_t pending_bytes_ = 0;   // their payload bytes, about
+  // What the open frame holds already (the format allows one of each).
+  std::set<std::string> depths_, stencils_;
+  std::set<std::pair<std::string, std::uint8_t>> levels_;
+  bool light_ = false, truth_ = false;
 };
 
 }  // namespace nbsim::trace

@@ -17,11 +17,9 @@ using scene::TestItem;
 std::filesystem::path sample(const char* name) { return std::filesystem::path(NBSIM_SAMPLES) / name; }
 
 FrameView view_of(const trace::TraceReader& tr, const trace::FrameBegin& b) {
-  int w = 0, h = 0;
-  std::sscanf(tr.property("viewport")->c_str(), "%dx%d", &w, &h);
-  const bool reversed = *tr.property("depth_func") == "GREATER";
-  return FrameView::make(b, w, h, std::stod(*tr.property("near")), std::stod(*tr.property("nearest_margin")),
-                         *tr.property("clip_control") == "ZERO_TO_ONE", reversed);
+  const trace::Header& h = tr.header();
+  return FrameView::make(b, h.viewport->width, h.viewport->height, h.near_m, h.nearest_margin,
+                         h.clip_control == trace::ClipControl::ZeroToOne, h.far_op() == FarOp::Min);
 }
 
 // Every mode name parses back to its mode, and an unknown name does not parse.

@@ -20,11 +20,6 @@ static_assert(static_cast<int>(trace::DepthFunc::Gequal) == static_cast<int>(ras
 static_assert(static_cast<int>(trace::CullFace::FrontAndBack) == static_cast<int>(geometry::CullFace::FrontAndBack));
 static_assert(static_cast<int>(trace::ClipControl::ZeroToOne) == static_cast<int>(geometry::ClipControl::ZeroToOne));
 
-void parse_viewport(const std::string& s, int& w, int& h) {
-  if (std::sscanf(s.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1)
-    throw InputError("trace: bad viewport property '" + s + "' (want WxH)");
-}
-
 void compare_depth(const DepthImage& model, const trace::DepthSnapshot& gl, double tolerance, CompareSummary& s) {
   if (gl.width != model.width || gl.height != model.height)
     throw InputError("trace: depth snapshot size does not match the viewport");
@@ -65,12 +60,10 @@ bool CompareSummary::within_thresholds() const {
 
 CompareSummary compare_trace(const std::filesystem::path& path, const CompareOptions& options) {
   trace::FrameReader frames(path);
-  const std::string* vp = frames.trace().property("viewport");
-  if (!vp) throw InputError("trace: no viewport property");
-  int width = 0, height = 0;
-  parse_viewport(*vp, width, height);
-  float clear = 1.0f;
-  if (const std::string* c = frames.trace().property("depth_clear")) clear = std::stof(*c);
+  const trace::Header& head = frames.trace().header();
+  if (!head.viewport) throw InputError("trace: no viewport property");
+  const int width = head.viewport->width, height = head.viewport->height;
+  const float clear = head.depth_clear;
 
   raster::RasterPathConfig config;
   config.width_px = width;

@@ -75,7 +75,7 @@ TEST(CaptureTest, GlslLevelsEqualCoreLevels) {
       const scene::Frame fr = r.render(f, s.poses[f]).frame;
       ASSERT_EQ(fr.levels.size(), 1u) << "levels every frame";
       const auto& d = fr.depths.at(0);
-      ASSERT_EQ(d.which, trace::DepthWhich::AfterOccluders);
+      ASSERT_EQ(d.name, "after_occluders");
       DepthImage img(d.width, d.height, 0.0f);
       img.texels = d.texels;
       const NBuffer core(img, {reversed ? FarOp::Min : FarOp::Max, StorageFormat::F32, -1});

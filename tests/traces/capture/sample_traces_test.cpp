@@ -20,9 +20,8 @@ TEST_P(SampleTraceTest, ChecksItself) {
   const std::filesystem::path file = std::filesystem::path(NBSIM_SAMPLES) / GetParam();
   ASSERT_TRUE(std::filesystem::exists(file)) << file << " missing: run scripts/make_samples";
   trace::FrameReader frames(file);
-  const std::string* func = frames.trace().property("depth_func");
-  ASSERT_NE(func, nullptr);
-  const FarOp op = *func == "GREATER" ? FarOp::Min : FarOp::Max;
+  ASSERT_NE(frames.trace().property("depth_func"), nullptr);
+  const FarOp op = frames.trace().header().far_op();
   int count = 0, with_levels = 0;
   while (auto f = frames.next()) {
     ++count;

@@ -1,0 +1,124 @@
+// TraceHeaderTest: the HEAD properties are parsed into the typed header once, when a trace is
+// opened; a malformed value is refused naming the file, chunk 0 (HEAD), the property and its value.
+#include <gtest/gtest.h>
+
+#include "model/common/error.h"
+#include "tests/trace/sample_trace.h"
+
+namespace {
+
+using namespace nbsim::trace;
+using namespace nbsim::trace::testing;
+using nbsim::InputError;
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// A trace holding only a header with these properties, in memory.
+Bytes header_only(const Properties& props) {
+  Bytes b;
+  const auto pre = encode_preamble(kFormatVersion);
+  b.assign(pre.begin(), pre.end());
+  for (const Bytes& c : {encode_chunk(ChunkType::Header, encode(props)), encode_chunk(ChunkType::End, encode(EndMarker{1, 0}))})
+    b.insert(b.end(), c.begin(), c.end());
+  return b;
+}
+
+std::string open_error(const Properties& props) {
+  try {
+    TraceReader t(header_only(props), "h.nbtrace");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A capture's header reads into typed fields; unknown keys stay as written.
+TEST(TraceHeaderTest, TypedFields) {
+  const Properties props = {{"viewport", "640x480"},   {"depth_format", "DEPTH_COMPONENT32F"},
+                            {"depth_func", "GREATER"}, {"clip_control", "ZERO_TO_ONE"},
+                            {"depth_clear", "0"},      {"technique", "occlusion_culling"},
+                            {"test_mode", "nb_hier"},  {"scene", "city"},
+                            {"path", "fly"},           {"seed", "18446744073709551615"},
+                            {"objects", "6000"},       {"frames", "10"},
+                            {"levels_every", "0"},     {"fov_y_deg", "60"},
+                            {"near", "0.5"},           {"far", "4000"},
+                            {"nearest_margin", "1e-06"}, {"my.key", "kept as it is"}};
+  const TraceReader t(header_only(props), "h");
+  const Header& h = t.header();
+  ASSERT_TRUE(h.viewport);
+  EXPECT_EQ(h.viewport->width, 640);
+  EXPECT_EQ(h.viewport->height, 480);
+  EXPECT_EQ(h.depth_format, "DEPTH_COMPONENT32F");
+  EXPECT_EQ(h.depth_func, DepthFunc::Greater);
+  EXPECT_EQ(h.far_op(), nbsim::FarOp::Min) << "GREATER is reversed Z";
+  EXPECT_EQ(h.clip_control, ClipControl::ZeroToOne);
+  EXPECT_EQ(h.depth_clear, 0.0f);
+  EXPECT_EQ(h.technique, "occlusion_culling");
+  EXPECT_EQ(h.test_mode, TestMode::NBufferHier);
+  EXPECT_EQ(h.scene, "city");
+  EXPECT_EQ(h.path, "fly");
+  EXPECT_EQ(h.seed, 18446744073709551615ull);
+  EXPECT_EQ(h.objects, 6000u);
+  EXPECT_EQ(h.frames, 10u);
+  EXPECT_EQ(h.levels_every, 0u);
+  EXPECT_EQ(h.fov_y_deg, 60.0);
+  EXPECT_EQ(h.near_m, 0.5);
+  EXPECT_EQ(h.far_m, 4000.0);
+  EXPECT_EQ(h.nearest_margin, 1e-6);
+  ASSERT_NE(t.property("my.key"), nullptr);
+  EXPECT_EQ(*t.property("my.key"), "kept as it is");
+  EXPECT_EQ(h.properties, props) << "every property kept in order";
+}
+
+// Absent keys keep the defaults a capture without them meant (LESS, clear 1, no viewport).
+TEST(TraceHeaderTest, Defaults) {
+  const TraceReader t(header_only({}), "h");
+  const Header& h = t.header();
+  EXPECT_FALSE(h.viewport);
+  EXPECT_EQ(h.depth_func, DepthFunc::Less);
+  EXPECT_EQ(h.far_op(), nbsim::FarOp::Max);
+  EXPECT_EQ(h.clip_control, ClipControl::NegativeOneToOne);
+  EXPECT_EQ(h.depth_clear, 1.0f);
+  EXPECT_FALSE(h.frames);
+  EXPECT_FALSE(h.test_mode);
+}
+
+// Malformed values are refused with the property, its value and what it must be.
+TEST(TraceHeaderTest, RefusesMalformedValues) {
+  struct Row {
+    const char* key;
+    const char* value;
+    const char* expected;
+  };
+  const Row rows[] = {
+      {"viewport", "128x96x", "WIDTHxHEIGHT"},       // trailing text
+      {"viewport", "0x5", "each 1 .. 16384"},        // a side of 0
+      {"viewport", "128", "WIDTHxHEIGHT"},           // no height
+      {"viewport", "-4x4", "each 1 .. 16384"},       // negative side
+      {"viewport", "20000x4", "each 1 .. 16384"},    // above the image limit
+      {"viewport", " 8x8", "WIDTHxHEIGHT"},          // spaces
+      {"depth_func", "less", "one of NEVER, LESS"},  // GL names are upper case
+      {"clip_control", "ZERO", "NEGATIVE_ONE_TO_ONE, ZERO_TO_ONE"},
+      {"depth_format", "RGBA8", "DEPTH_COMPONENT32F"},
+      {"depth_clear", "2", "a depth in 0 .. 1"},
+      {"depth_clear", "nan", "a depth in 0 .. 1"},
+      {"test_mode", "hier", "one of oq, oq_hier"},
+      {"seed", "-1", "a whole number"},
+      {"frames", "10 frames", "a whole number"},
+      {"objects", "", "a whole number"},
+      {"near", "0", "a distance above 0"},
+      {"near", "inf", "a distance above 0"},
+      {"fov_y_deg", "180", "above 0 and below 180"},
+      {"nearest_margin", "-1e-6", "0 .. 1"},
+  };
+  for (const Row& row : rows) {
+    const std::string e = open_error({{"scene", "city"}, {row.key, row.value}});
+    EXPECT_TRUE(has(e, std::string("header property '") + row.key + "' is '" + row.value + "': expected")) << e;
+    EXPECT_TRUE(has(e, row.expected)) << "expected '" << row.expected << "' in: " << e;
+    EXPECT_TRUE(has(e, "h.nbtrace: chunk 0 (HEAD) at byte 16:")) << "names the file, chunk and offset: " << e;
+  }
+  const std::string e = open_error({{"near", "10"}, {"far", "5"}});
+  EXPECT_TRUE(has(e, "header property 'far' is '5'") && has(e, "above near (10)")) << e;
+}
+
+}  // namespace

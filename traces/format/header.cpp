@@ -1,0 +1,174 @@
+// The typed header: one table of the keys it knows, each with its parser; see header.h.
+#include "traces/format/header.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <vector>
+
+#include "model/common/error.h"
+#include "model/common/names.h"
+#include "traces/format/schema.h"
+
+namespace nbsim::trace {
+
+namespace {
+
+// GL's names, indexed by the enums' fixed values.
+constexpr std::array<std::string_view, 8> kGlDepthFuncs = {"NEVER",   "LESS",     "EQUAL",  "LEQUAL",
+                                                           "GREATER", "NOTEQUAL", "GEQUAL", "ALWAYS"};
+constexpr std::array<std::string_view, 2> kGlClipControls = {"NEGATIVE_ONE_TO_ONE", "ZERO_TO_ONE"};
+constexpr std::array<std::string_view, 6> kGlDepthFormats = {"DEPTH_COMPONENT16", "DEPTH_COMPONENT24", "DEPTH_COMPONENT32",
+                                                             "DEPTH_COMPONENT32F", "DEPTH24_STENCIL8", "DEPTH32F_STENCIL8"};
+
+[[noreturn]] void refuse(std::string_view key, std::string_view value, std::string_view expected) {
+  throw InputError(fmt::format("header property '{}' is '{}': expected {}", key, value, expected));
+}
+
+// The whole string is one number of type T (no sign for unsigned, no spaces, no trailing text).
+template <class T>
+std::optional<T> number(std::string_view s) {
+  T v{};
+  if (s.empty() || s.front() == '+' || s.front() == ' ') return std::nullopt;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+  if constexpr (std::is_floating_point_v<T>)
+    if (!std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+std::uint64_t count(std::string_view key, std::string_view v, std::string_view expected) {
+  if (v.starts_with('-')) refuse(key, v, expected);
+  if (const auto n = number<std::uint64_t>(v)) return *n;
+  refuse(key, v, expected);
+}
+
+double real(std::string_view key, std::string_view v, std::string_view expected, double lo, double hi, bool open_lo) {
+  const auto x = number<double>(v);
+  if (!x || *x < lo || *x > hi || (open_lo && *x == lo)) refuse(key, v, expected);
+  return *x;
+}
+
+Viewport viewport(std::string_view key, std::string_view v, std::string_view expected) {
+  const std::size_t x = v.find('x');
+  if (x == std::string_view::npos) refuse(key, v, expected);
+  const auto w = number<std::int32_t>(v.substr(0, x)), h = number<std::int32_t>(v.substr(x + 1));
+  if (!w || !h || *w < 1 || *h < 1 || *w > kMaxImageSide || *h > kMaxImageSide) refuse(key, v, expected);
+  return {*w, *h};
+}
+
+template <class E, std::size_t N>
+E named(std::string_view key, std::string_view v, std::string_view expected, const std::array<std::string_view, N>& names) {
+  if (const auto e = parse_enum_name<E>(names, v)) return *e;
+  refuse(key, v, expected);
+}
+
+// One row per known key: its name, the values it takes (also what a refusal says is expected),
+// an example, what it means and how it sets the typed header (nothing for free text).
+struct Key {
+  std::string_view name;
+  std::string_view values;
+  std::string_view example;
+  std::string_view meaning;
+  void (*parse)(Header&, std::string_view key, std::string_view value, std::string_view values);
+};
+
+const std::vector<Key>& keys() {
+  static const std::vector<Key> table = {
+      {"gl_renderer", "text", "llvmpipe (LLVM 15.0.6, 256 bits)", "GL_RENDERER", nullptr},
+      {"gl_version", "text", "4.5 (Core Profile) Mesa 22.3.6", "GL_VERSION", nullptr},
+      {"gl_vendor", "text", "Mesa", "GL_VENDOR", nullptr},
+      {"mesa_version", "text", "22.3.6", "Mesa's version, from GL_VERSION", nullptr},
+      {"viewport", "WIDTHxHEIGHT, each 1 .. 16384", "512x512", "the frame's size in pixels; replay needs it",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.viewport = viewport(k, v, e); }},
+      {"depth_format", "one of DEPTH_COMPONENT16, DEPTH_COMPONENT24, DEPTH_COMPONENT32, DEPTH_COMPONENT32F, DEPTH24_STENCIL8, DEPTH32F_STENCIL8",
+       "DEPTH_COMPONENT32F", "the depth buffer's GL format",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         if (!parse_enum_name<std::uint8_t>(kGlDepthFormats, v)) refuse(k, v, e);
+         h.depth_format = std::string(v);
+       }},
+      {"depth_func", "one of NEVER, LESS, EQUAL, LEQUAL, GREATER, NOTEQUAL, GEQUAL, ALWAYS", "LESS",
+       "the frame's depth func: LESS, or GREATER with reversed Z (default LESS)",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.depth_func = named<DepthFunc>(k, v, e, kGlDepthFuncs); }},
+      {"clip_control", "one of NEGATIVE_ONE_TO_ONE, ZERO_TO_ONE", "NEGATIVE_ONE_TO_ONE",
+       "glClipControl's depth mode (default NEGATIVE_ONE_TO_ONE)",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.clip_control = named<ClipControl>(k, v, e, kGlClipControls);
+       }},
+      {"depth_clear", "a depth in 0 .. 1", "1", "the depth buffer's clear value (default 1)",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.depth_clear = static_cast<float>(real(k, v, e, 0.0, 1.0, false));
+       }},
+      {"technique", "text", "occlusion_culling", "the technique the capture ran",
+       [](Header& h, std::string_view, std::string_view v, std::string_view) { h.technique = std::string(v); }},
+      {"test_mode", "one of oq, oq_hier, nb, nb_hier, none", "nb_hier", "occlusion culling's test mode",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.test_mode = scene::parse_test_mode(v);
+         if (!h.test_mode) refuse(k, v, e);
+       }},
+      {"scene", "text", "city", "the scene",
+       [](Header& h, std::string_view, std::string_view v, std::string_view) { h.scene = std::string(v); }},
+      {"seed", "a whole number, at least 0", "1", "the scene's and path's random seed",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.seed = count(k, v, e); }},
+      {"objects", "a whole number, at least 0", "5000", "the scene's object count",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.objects = count(k, v, e); }},
+      {"path", "text", "walk", "the camera path",
+       [](Header& h, std::string_view, std::string_view v, std::string_view) { h.path = std::string(v); }},
+      {"frames", "a whole number, at least 0", "60", "the frames the capture was asked for",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.frames = count(k, v, e); }},
+      {"fov_y_deg", "an angle in degrees, above 0 and below 180", "60", "the camera's vertical field of view",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.fov_y_deg = real(k, v, e, 0.0, 180.0, true);
+         if (h.fov_y_deg == 180.0) refuse(k, v, e);
+       }},
+      {"near", "a distance above 0", "0.5", "the near plane, m",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.near_m = real(k, v, e, 0.0, 1e300, true); }},
+      {"far", "a distance above near", "4000", "the far plane, m",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.far_m = real(k, v, e, 0.0, 1e300, true); }},
+      {"nearest_margin", "a depth margin in 0 .. 1", "1e-06", "margin subtracted from a bounds test's nearest depth",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.nearest_margin = real(k, v, e, 0.0, 1.0, false);
+       }},
+      {"levels_every", "a whole number, at least 0", "1", "the N-buffer levels are recorded every k-th frame (0: never)",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.levels_every = count(k, v, e); }},
+      {"nbsim_version", "text", "0.1.0", "the capturing nbsim's version", nullptr},
+      {"command_line", "text", "nbsim capture city --frames 60 -o walk.nbtrace", "the capture's command line", nullptr},
+  };
+  return table;
+}
+
+}  // namespace
+
+FarOp Header::far_op() const noexcept {
+  return depth_func == DepthFunc::Greater || depth_func == DepthFunc::Gequal ? FarOp::Min : FarOp::Max;
+}
+
+const std::string* Header::property(std::string_view key) const noexcept {
+  for (const auto& [k, v] : properties)
+    if (k == key) return &v;
+  return nullptr;
+}
+
+Header parse_header(const Properties& properties) {
+  Header h;
+  h.properties = properties;
+  for (const auto& [k, v] : properties)
+    for (const Key& key : keys())
+      if (key.name == k && key.parse) key.parse(h, k, v, key.values);
+  if (h.far_m != 0.0 && h.near_m != 0.0 && h.far_m <= h.near_m)
+    refuse("far", *h.property("far"), fmt::format("a distance above near ({})", *h.property("near")));
+  return h;
+}
+
+std::string header_keys_table() {
+  std::string t = "| Key | Values | Example | Meaning |\n|-----|--------|---------|---------|\n";
+  for (const Key& k : keys()) t += fmt::format("| `{}` | {} | `{}` | {} |\n", k.name, k.values, k.example, k.meaning);
+  return t;
+}
+
+std::string_view gl_name(DepthFunc func) noexcept { return enum_name(kGlDepthFuncs, func); }
+std::string_view gl_name(ClipControl clip) noexcept { return enum_name(kGlClipControls, clip); }
+
+}  // namespace nbsim::trace

@@ -1,0 +1,60 @@
+// The typed trace header: the HEAD chunk's key/value properties parsed and checked once, when a
+// trace is opened (TraceReader), so that replay, `nbsim trace` and tests read numbers and enums
+// instead of parsing strings. Keys the table in header.cpp does not know stay as they are in
+// `properties`. That table also writes FORMAT.md's list of keys (header_keys_table).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "traces/format/records.h"
+
+namespace nbsim::trace {
+
+struct Viewport {
+  std::int32_t width = 0, height = 0;  // 1 .. 16384 each
+};
+
+struct Header {
+  Properties properties;  // every property, in file order, as written
+
+  // The typed ones. An absent key keeps the default (which is what a capture without it meant).
+  std::optional<Viewport> viewport;             // "viewport": "512x512"
+  std::string depth_format;                     // "depth_format": a GL depth format name, "" when absent
+  DepthFunc depth_func = DepthFunc::Less;       // "depth_func": GL name, "LESS", "GREATER", ...
+  ClipControl clip_control = ClipControl::NegativeOneToOne;  // "clip_control": "NEGATIVE_ONE_TO_ONE" or "ZERO_TO_ONE"
+  float depth_clear = 1.0f;                     // "depth_clear": 0 .. 1
+  std::string technique;                        // "technique": "occlusion_culling"
+  std::optional<TestMode> test_mode;            // "test_mode": "oq", "oq_hier", "nb", "nb_hier", "none"
+  std::string scene;                            // "scene": "city"
+  std::string path;                             // "path": the camera path, "walk"
+  std::optional<std::uint64_t> seed;            // "seed"
+  std::optional<std::uint64_t> objects;         // "objects"
+  std::optional<std::uint64_t> frames;          // "frames": frames the capture was asked for
+  std::optional<std::uint64_t> levels_every;    // "levels_every"
+  double fov_y_deg = 0.0;                       // "fov_y_deg": (0, 180), 0 when absent
+  double near_m = 0.0;                          // "near": > 0, 0 when absent
+  double far_m = 0.0;                           // "far": > near, 0 when absent
+  double nearest_margin = 0.0;                  // "nearest_margin": >= 0
+
+  // "Farthest" under this header's depth func: FarOp::Min under GREATER/GEQUAL (reversed Z).
+  FarOp far_op() const noexcept;
+  // The value of any property as written, or nullptr.
+  const std::string* property(std::string_view key) const noexcept;
+};
+
+// Parses and checks the typed keys. Throws InputError naming the property, its value and what it
+// must be ("header property 'viewport' is '128x96x': expected WIDTHxHEIGHT, each 1 .. 16384");
+// TraceReader adds the file and chunk.
+Header parse_header(const Properties& properties);
+
+// The Markdown table of the keys the header knows (FORMAT.md "HEAD"): key, values, example, meaning.
+std::string header_keys_table();
+
+// The GL names of the header's depth funcs and clip controls ("LESS", "ZERO_TO_ONE").
+std::string_view gl_name(DepthFunc func) noexcept;
+std::string_view gl_name(ClipControl clip) noexcept;
+
+}  // namespace nbsim::trace

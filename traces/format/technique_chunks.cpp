@@ -1,0 +1,167 @@
+// The registry of technique chunk types and their generic codec; see technique_chunks.h.
+#include "traces/format/technique_chunks.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <mutex>
+#include <set>
+
+#include "model/common/error.h"
+#include "traces/format/bytes.h"
+#include "traces/format/codec.h"
+
+namespace nbsim::trace {
+
+namespace {
+
+constexpr std::array<const char*, 9> kKindNames = {"u32", "i32", "u64", "f32", "f64", "string", "vec<f32>", "vec<u32>", "vec<i32>"};
+constexpr std::size_t kMaxStringBytes = 64 * 1024;
+
+const char* kind_name(FieldKind k) { return kKindNames[static_cast<std::size_t>(k)]; }
+
+struct Registry {
+  std::mutex mutex;
+  std::vector<ChunkSpec> specs;
+};
+
+Registry& registry() {
+  static Registry r;
+  return r;
+}
+
+// The variant alternative each kind holds.
+bool holds(FieldKind k, const TechniqueField& f) {
+  switch (k) {
+    case FieldKind::U32:
+    case FieldKind::U64: return std::holds_alternative<std::uint64_t>(f.value);
+    case FieldKind::I32: return std::holds_alternative<std::int64_t>(f.value);
+    case FieldKind::F32:
+    case FieldKind::F64: return std::holds_alternative<double>(f.value);
+    case FieldKind::String: return std::holds_alternative<std::string>(f.value);
+    case FieldKind::VecF32: return std::holds_alternative<std::vector<float>>(f.value);
+    case FieldKind::VecU32: return std::holds_alternative<std::vector<std::uint32_t>>(f.value);
+    case FieldKind::VecI32: return std::holds_alternative<std::vector<std::int32_t>>(f.value);
+  }
+  return false;
+}
+
+}  // namespace
+
+void register_technique_chunk(ChunkSpec spec) {
+  NBSIM_CHECK(!is_known_chunk_type(spec.type), fmt::format("technique chunk {} reuses a core chunk type", chunk_type_name(spec.type)));
+  NBSIM_CHECK(chunk_type_name(spec.type).size() == 4, fmt::format("technique chunk type {} is not four printable characters",
+                                                                  chunk_type_name(spec.type)));
+  NBSIM_CHECK(!spec.fields.empty(), fmt::format("technique chunk {} describes no fields", chunk_type_name(spec.type)));
+  std::set<std::string> names;
+  for (const FieldSpec& f : spec.fields)
+    NBSIM_CHECK(names.insert(f.name).second && !f.name.empty(),
+                fmt::format("technique chunk {}: field name '{}' empty or repeated", chunk_type_name(spec.type), f.name));
+  Registry& r = registry();
+  const std::lock_guard lock(r.mutex);
+  for (const ChunkSpec& s : r.specs)
+    NBSIM_CHECK(s.type != spec.type, fmt::format("technique chunk {} registered twice", chunk_type_name(spec.type)));
+  r.specs.push_back(std::move(spec));
+}
+
+const ChunkSpec* find_technique_chunk(std::uint32_t type) {
+  Registry& r = registry();
+  const std::lock_guard lock(r.mutex);
+  for (const ChunkSpec& s : r.specs)
+    if (s.type == type) return &s;
+  return nullptr;
+}
+
+const std::vector<ChunkSpec>& technique_chunks() { return registry().specs; }
+
+std::vector<std::uint8_t> encode(const TechniqueRecord& record) {
+  if (!record.decoded) return record.payload;
+  const ChunkSpec* spec = find_technique_chunk(record.type);
+  NBSIM_CHECK(spec != nullptr, fmt::format("encoding technique chunk {}, which is not registered", chunk_type_name(record.type)));
+  NBSIM_CHECK(record.fields.size() == spec->fields.size(),
+              fmt::format("technique chunk {}: {} fields, its description has {}", spec->record, record.fields.size(),
+                          spec->fields.size()));
+  bytes::Out o;
+  for (std::size_t i = 0; i < spec->fields.size(); ++i) {
+    const FieldSpec& fs = spec->fields[i];
+    const TechniqueField& f = record.fields[i];
+    NBSIM_CHECK(f.name == fs.name && holds(fs.kind, f),
+                fmt::format("technique chunk {}: field {} is '{}', its description says '{}' of type {}", spec->record, i,
+                            f.name, fs.name, kind_name(fs.kind)));
+    switch (fs.kind) {
+      case FieldKind::U32: o.u32(static_cast<std::uint32_t>(std::get<std::uint64_t>(f.value))); break;
+      case FieldKind::U64: o.u64(std::get<std::uint64_t>(f.value)); break;
+      case FieldKind::I32: o.i32(static_cast<std::int32_t>(std::get<std::int64_t>(f.value))); break;
+      case FieldKind::F32: o.f32(static_cast<float>(std::get<double>(f.value))); break;
+      case FieldKind::F64: o.f64(std::get<double>(f.value)); break;
+      case FieldKind::String: o.str(std::get<std::string>(f.value)); break;
+      case FieldKind::VecF32: o.counted_words(std::get<std::vector<float>>(f.value)); break;
+      case FieldKind::VecU32: o.counted_words(std::get<std::vector<std::uint32_t>>(f.value)); break;
+      case FieldKind::VecI32: o.counted_words(std::get<std::vector<std::int32_t>>(f.value)); break;
+    }
+  }
+  return o.take();
+}
+
+TechniqueRecord decode_technique(std::uint32_t type, std::span<const std::uint8_t> payload) {
+  TechniqueRecord r;
+  r.type = type;
+  r.payload.assign(payload.begin(), payload.end());
+  const ChunkSpec* spec = find_technique_chunk(type);
+  if (!spec) return r;
+  bytes::In in(payload);
+  for (const FieldSpec& fs : spec->fields) {
+    TechniqueField f;
+    f.name = fs.name;
+    const char* n = fs.name.c_str();
+    switch (fs.kind) {
+      case FieldKind::U32: f.value = std::uint64_t{in.u32(n)}; break;
+      case FieldKind::U64: f.value = in.u64(n); break;
+      case FieldKind::I32: f.value = std::int64_t{in.i32(n)}; break;
+      case FieldKind::F32: f.value = static_cast<double>(in.f32(n)); break;
+      case FieldKind::F64: f.value = in.f64(n); break;
+      case FieldKind::String: f.value = in.str(kMaxStringBytes, n); break;
+      case FieldKind::VecF32: in.counted_words(f.value.emplace<std::vector<float>>(), n); break;
+      case FieldKind::VecU32: in.counted_words(f.value.emplace<std::vector<std::uint32_t>>(), n); break;
+      case FieldKind::VecI32: in.counted_words(f.value.emplace<std::vector<std::int32_t>>(), n); break;
+    }
+    r.fields.push_back(std::move(f));
+  }
+  in.finish();
+  r.decoded = true;
+  return r;
+}
+
+std::string technique_table(const ChunkSpec& spec) {
+  std::string t = fmt::format("### {}: {} (technique {})\n\n| # | Type | Field | Meaning |\n|---|------|-------|---------|\n",
+                              chunk_type_name(spec.type), spec.record, spec.technique);
+  for (std::size_t i = 0; i < spec.fields.size(); ++i)
+    t += fmt::format("| {} | {} | `{}` | {} |\n", i + 1, kind_name(spec.fields[i].kind), spec.fields[i].name,
+                     spec.fields[i].meaning);
+  return t;
+}
+
+std::string dump_technique(const TechniqueRecord& record) {
+  const ChunkSpec* spec = find_technique_chunk(record.type);
+  std::string s = fmt::format("{} {}\n", chunk_type_name(record.type), spec ? spec->record : "(unregistered technique chunk)");
+  if (!record.decoded) return s + fmt::format("  payload: {} bytes (raw)\n", record.payload.size());
+  for (const TechniqueField& f : record.fields) {
+    std::string v = std::visit(
+        [](const auto& x) -> std::string {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, std::string>) return fmt::format("\"{}\"", x);
+          else if constexpr (std::is_arithmetic_v<T>) return fmt::format("{}", x);
+          else {
+            const std::size_t k = std::min(x.size(), std::size_t{8});
+            return fmt::format("{} elements [{}{}]", x.size(), fmt::join(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(k), ", "),
+                               x.size() > k ? ", ..." : "");
+          }
+        },
+        f.value);
+    s += fmt::format("  {}: {}\n", f.name, v);
+  }
+  return s;
+}
+
+}  // namespace nbsim::trace

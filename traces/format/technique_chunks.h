@@ -1,0 +1,56 @@
+// Chunk types a technique adds to a trace (format version 2): a small registry of fourcc, record
+// name and field description. A technique registers its chunk types once (capture and replay
+// both link the registration); the writer encodes a TechniqueRecord from its fields, the reader
+// decodes a registered type's payload into fields and keeps an unregistered one raw, and `nbsim
+// trace format` / `dump --records` show them. Technique chunks carry the chunk flag
+// kFlagTechnique (FORMAT.md "Chunks"), which is what lets a reader keep an unknown one instead of
+// refusing it as damage.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "traces/format/records.h"
+
+namespace nbsim::trace {
+
+// The field types a technique record may use (little-endian, as the core records).
+enum class FieldKind : std::uint8_t { U32, I32, U64, F32, F64, String, VecF32, VecU32, VecI32 };
+
+struct FieldSpec {
+  std::string name;
+  FieldKind kind;
+  std::string meaning;
+};
+
+struct ChunkSpec {
+  std::uint32_t type = 0;    // fourcc("PRTC"): four printable ASCII characters, not a core type
+  std::string technique;     // "particles"
+  std::string record;        // "ParticleCulling"
+  std::vector<FieldSpec> fields;
+};
+
+// Registers a chunk type. A bad spec (a core or already registered type, an unprintable fourcc,
+// no fields, duplicate field names) is a bug of the technique: it aborts.
+void register_technique_chunk(ChunkSpec spec);
+// The spec of a registered type, or nullptr.
+const ChunkSpec* find_technique_chunk(std::uint32_t type);
+// Every registered spec, in registration order. Techniques register at start-up, before traces are
+// read or written on other threads (registration locks; this listing does not).
+const std::vector<ChunkSpec>& technique_chunks();
+
+// The payload of a record of a registered type, from its fields (which must match the spec's
+// names and kinds, in order: a mismatch is a bug and aborts); the stored payload when the record
+// was not decoded (an unregistered type read from a file is written back as it was).
+std::vector<std::uint8_t> encode(const TechniqueRecord& record);
+// A chunk's payload -> record: fields decoded when the type is registered (InputError when the
+// payload does not match the description), raw otherwise.
+TechniqueRecord decode_technique(std::uint32_t type, std::span<const std::uint8_t> payload);
+// The Markdown table of a registered type's fields (as FORMAT.md's core tables).
+std::string technique_table(const ChunkSpec& spec);
+// "  name: value" lines (raw: the payload's size).
+std::string dump_technique(const TechniqueRecord& record);
+
+}  // namespace nbsim::trace
