@@ -7,7 +7,7 @@
 #include <functional>
 
 #include "model/common/error.h"
-#include "tests/trace/sample_trace.h"
+#include "tests/traces/format/sample_trace.h"
 
 namespace {
 
@@ -293,7 +293,7 @@ TEST(TraceFormatTest, RefusesVersionZero) {
   EXPECT_TRUE(has(e, "version 0")) << e;
 }
 
-// A trace written by version 1 (committed in tests/trace/data) reads back exactly. When the format
+// A trace written by version 1 (committed in tests/traces/format/data) reads back exactly. When the format
 // moves to version 2, this fixture must keep reading: that is the older-version guarantee.
 // Regenerate it only while kFormatVersion is 1: NBSIM_WRITE_TRACE_FIXTURE=<path> ./trace_tests.
 TEST(TraceFormatTest, ReadsVersion1Fixture) {
@@ -366,7 +366,7 @@ TEST(TraceFormatTest, RoundTripsEveryVersion2Record) {
   EXPECT_EQ(batch_sizes, expected) << "frame 0: full batches and the rest; frames 2 and 5: one batch each";
 }
 
-// A trace written by version 2 (committed in tests/trace/data) reads back exactly, so that later
+// A trace written by version 2 (committed in tests/traces/format/data) reads back exactly, so that later
 // versions keep reading it. Regenerate only while kFormatVersion is 2:
 // NBSIM_WRITE_TRACE_FIXTURE_V2=<path> ./trace_tests --gtest_filter='*Version2Fixture'.
 TEST(TraceFormatTest, ReadsVersion2Fixture) {

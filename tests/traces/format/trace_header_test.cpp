@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "model/common/error.h"
-#include "tests/trace/sample_trace.h"
+#include "tests/traces/format/sample_trace.h"
 
 namespace {
 

@@ -11,7 +11,7 @@
 
 #include "pipeline/io/image_io.h"
 #include "tests/common/run_nbsim.h"
-#include "tests/trace/sample_trace.h"
+#include "tests/traces/format/sample_trace.h"
 #include "traces/format/describe.h"
 
 namespace {

@@ -6,7 +6,7 @@
 #include <functional>
 
 #include "model/common/error.h"
-#include "tests/trace/sample_trace.h"
+#include "tests/traces/format/sample_trace.h"
 
 namespace {
 

@@ -1,6 +1,6 @@
 // Deterministic sample records and traces for the trace tests (format, corruption, CLI), and
 // bit-exact comparisons of records. Header-only: each test binary includes it once.
-// tests/trace/data/sample_v1.nbtrace was written from these values (write_sample_trace): change
+// tests/traces/format/data/sample_v1.nbtrace was written from these values (write_sample_trace): change
 // them and TraceFormatTest.ReadsVersion1Fixture fails; add new samples instead.
 #pragma once
 

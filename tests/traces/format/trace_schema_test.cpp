@@ -8,7 +8,7 @@
 #include <regex>
 
 #include "model/common/error.h"
-#include "tests/trace/sample_trace.h"
+#include "tests/traces/format/sample_trace.h"
 #include "traces/format/describe.h"
 
 namespace {
