@@ -13,6 +13,7 @@
 #include "traces/capture/renderer.h"
 #include "traces/capture/scenes.h"
 #include "traces/capture/technique.h"
+#include "traces/format/header.h"
 #include "traces/format/writer.h"
 
 namespace nbsim::capture {
@@ -75,8 +76,8 @@ CaptureSummary capture(const CaptureOptions& o, const std::string& out_path, con
       {"mesa_version", mesa},
       {"viewport", fmt::format("{}x{}", o.width, o.height)},
       {"depth_format", "DEPTH_COMPONENT32F"},
-      {"depth_func", o.reversed_z ? "GREATER" : "LESS"},
-      {"clip_control", o.reversed_z ? "ZERO_TO_ONE" : "NEGATIVE_ONE_TO_ONE"},
+      {"depth_func", trace::gl_name(o.reversed_z ? trace::DepthFunc::Greater : trace::DepthFunc::Less)},
+      {"clip_control", trace::gl_name(o.reversed_z ? trace::ClipControl::ZeroToOne : trace::ClipControl::NegativeOneToOne)},
       {"depth_clear", o.reversed_z ? "0" : "1"},
       {"technique", technique_row.info.name},
   };

@@ -5,7 +5,9 @@
 
 #include <array>
 #include <charconv>
+#include <cctype>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "model/common/error.h"
@@ -16,15 +18,27 @@ namespace nbsim::trace {
 
 namespace {
 
-// GL's names, indexed by the enums' fixed values.
-constexpr std::array<std::string_view, 8> kGlDepthFuncs = {"NEVER",   "LESS",     "EQUAL",  "LEQUAL",
-                                                           "GREATER", "NOTEQUAL", "GEQUAL", "ALWAYS"};
-constexpr std::array<std::string_view, 2> kGlClipControls = {"NEGATIVE_ONE_TO_ONE", "ZERO_TO_ONE"};
 constexpr std::array<std::string_view, 6> kGlDepthFormats = {"DEPTH_COMPONENT16", "DEPTH_COMPONENT24", "DEPTH_COMPONENT32",
                                                              "DEPTH_COMPONENT32F", "DEPTH24_STENCIL8", "DEPTH32F_STENCIL8"};
 
 [[noreturn]] void refuse(std::string_view key, std::string_view value, std::string_view expected) {
   throw InputError(fmt::format("header property '{}' is '{}': expected {}", key, value, expected));
+}
+
+// GL's spelling of a model enum's name: its one name table (model/scene/frame.cpp) in upper case.
+template <class E>
+std::string gl_spelling(E e) {
+  std::string s(scene::to_string(e));
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// The value whose GL spelling is exactly `v` ("LESS"; "less" is refused).
+template <class E>
+E gl_named(std::string_view key, std::string_view v, std::string_view expected) {
+  for (int i = 0; scene::to_string(static_cast<E>(i)) != "?"; ++i)
+    if (gl_spelling(static_cast<E>(i)) == v) return static_cast<E>(i);
+  refuse(key, v, expected);
 }
 
 // The whole string is one number of type T (no sign for unsigned, no spaces, no trailing text).
@@ -91,11 +105,11 @@ const std::vector<Key>& keys() {
        }},
       {"depth_func", "one of NEVER, LESS, EQUAL, LEQUAL, GREATER, NOTEQUAL, GEQUAL, ALWAYS", "LESS",
        "the frame's depth func: LESS, or GREATER with reversed Z (default LESS)",
-       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.depth_func = named<DepthFunc>(k, v, e, kGlDepthFuncs); }},
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.depth_func = gl_named<DepthFunc>(k, v, e); }},
       {"clip_control", "one of NEGATIVE_ONE_TO_ONE, ZERO_TO_ONE", "NEGATIVE_ONE_TO_ONE",
        "glClipControl's depth mode (default NEGATIVE_ONE_TO_ONE)",
        [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
-         h.clip_control = named<ClipControl>(k, v, e, kGlClipControls);
+         h.clip_control = gl_named<ClipControl>(k, v, e);
        }},
       {"depth_clear", "a depth in 0 .. 1", "1", "the depth buffer's clear value (default 1)",
        [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
@@ -168,7 +182,7 @@ std::string header_keys_table() {
   return t;
 }
 
-std::string_view gl_name(DepthFunc func) noexcept { return enum_name(kGlDepthFuncs, func); }
-std::string_view gl_name(ClipControl clip) noexcept { return enum_name(kGlClipControls, clip); }
+std::string gl_name(DepthFunc func) { return gl_spelling(func); }
+std::string gl_name(ClipControl clip) { return gl_spelling(clip); }
 
 }  // namespace nbsim::trace

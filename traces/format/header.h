@@ -54,7 +54,7 @@ Header parse_header(const Properties& properties);
 std::string header_keys_table();
 
 // The GL names of the header's depth funcs and clip controls ("LESS", "ZERO_TO_ONE").
-std::string_view gl_name(DepthFunc func) noexcept;
-std::string_view gl_name(ClipControl clip) noexcept;
+std::string gl_name(DepthFunc func);
+std::string gl_name(ClipControl clip);
 
 }  // namespace nbsim::trace

@@ -83,6 +83,26 @@ TEST(TraceHeaderTest, Defaults) {
   EXPECT_FALSE(h.test_mode);
 }
 
+// The header spells depth funcs and clip controls as GL does, from the model's one name table per
+// enum (upper case): every value round-trips, and the refusal lists every spelling.
+TEST(TraceHeaderTest, GlNamesComeFromTheModelsTables) {
+  for (int i = 0; i <= static_cast<int>(DepthFunc::Always); ++i) {
+    const auto f = static_cast<DepthFunc>(i);
+    const Header h = parse_header({{"depth_func", gl_name(f)}});
+    EXPECT_EQ(h.depth_func, f) << gl_name(f);
+    try {
+      parse_header({{"depth_func", "SOMETIMES"}});
+      ADD_FAILURE() << "depth_func SOMETIMES accepted";
+    } catch (const nbsim::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(gl_name(f)), std::string::npos) << "the refusal does not list " << gl_name(f);
+    }
+  }
+  EXPECT_EQ(gl_name(DepthFunc::Lequal), "LEQUAL");
+  for (const auto c : {ClipControl::NegativeOneToOne, ClipControl::ZeroToOne})
+    EXPECT_EQ(parse_header({{"clip_control", gl_name(c)}}).clip_control, c) << gl_name(c);
+  EXPECT_EQ(gl_name(ClipControl::ZeroToOne), "ZERO_TO_ONE");
+}
+
 // Malformed values are refused with the property, its value and what it must be.
 TEST(TraceHeaderTest, RefusesMalformedValues) {
   struct Row {
