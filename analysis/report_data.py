@@ -255,6 +255,11 @@ def technique_results(d, path):
     need = ["metrics", "headline_cost", "headline_error", "fallback_error", "memory_cost", "report"]
     if not isinstance(t, dict) or any(k not in t for k in need):
         raise BadInput(f"{f}: techniques[0] lacks one of {', '.join(need)}")
+    if not isinstance(t["metrics"], list) or not all(isinstance(m, dict) and isinstance(m.get("name"), str) for m in t["metrics"]):
+        raise BadInput(f"{f}: techniques[0].metrics must be a list of objects with a name")
+    labels = LEGACY_TECHNIQUE["report"].keys()
+    if not isinstance(t["report"], dict) or any(not isinstance(t["report"].get(k), str) for k in labels):
+        raise BadInput(f"{f}: techniques[0].report needs the labels {', '.join(labels)}")
     return t
 
 

@@ -356,6 +356,17 @@ class TechniqueDeclarations(unittest.TestCase):
         self.assertIn("declare no results", err)
         self.assertIn("technique 'relief'", err)
 
+    def test_incomplete_declaration_exit_2(self):
+        # a technique_results.json whose technique lacks the report's labels: exit 2 naming the file
+        shutil.copytree(FIXTURE / "sweeps" / "small", self.dir / "sweeps" / "small")
+        f = self.dir / "sweeps" / "small" / "technique_results.json"
+        j = json.loads(f.read_text())
+        del j["techniques"][0]["report"]["cost_axis"]
+        f.write_text(json.dumps(j))
+        rc, _, err = run_report(self.dir)
+        self.assertBroken(rc, err, "technique_results.json")
+        self.assertIn("cost_axis", err)
+
     def assertBroken(self, rc, err, name):
         self.assertEqual(rc, 2, f"{name}: exit 2")
         self.assertIn(name, err, "the message must name the file")
