@@ -8,7 +8,7 @@ marks). The inputs, and the nbsim commands that write them:
   DIR/table1.jsonl                   nbsim bench nbuffer --only build --json-out DIR/table1.jsonl
   DIR/figure4_map.csv                nbsim nbuffer coverage --size 256x256 --out DIR/figure4_map.png
   DIR/table2/table2.json             nbsim table2 TRACE --out DIR/table2  (and DIR/table2/MODE/run.json)
-  DIR/sweeps/NAME/results.csv        nbsim explore SWEEP.json --out DIR/sweeps/NAME  (and sweep.json)
+  DIR/sweeps/NAME/results.csv        nbsim explore SWEEP.json --out DIR/sweeps/NAME  (and sweep.json, technique_results.json)
   DIR/results.csv                    nbsim explore SWEEP.json --out DIR  (DIR is then one sweep, named after it)
 The data side (reading, Pareto marks, labels, headline.md) is in report_data.py; plot helpers in
 report_plots.py. Every section whose inputs exist is rendered; the page names the inputs the others were missing.
@@ -35,6 +35,7 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 import plot_coverage  # noqa: E402
 import table1  # noqa: E402
 from report_data import (FIDELITY_KNOBS, NUMERIC, BadInput, Missing, fmt, headline_sweep, headline_table2,  # noqa: E402
+                         kib_key, technique_results,
                          load_json, mark_pareto, number, pct, read_csv, short_label, sorted_modes, table2_ratios,
                          trace_name)
 
@@ -364,10 +365,16 @@ class Report:
             self.used(d / "sweep.json", f"sweep {d.name}")
             if meta.get("nbsim_version"):
                 self.versions.add(str(meta["nbsim_version"]))
+        # The technique's declared results (technique_results.json): its headline cost and error,
+        # the error to fall back on, its memory cost and its correctness count.
+        tech = technique_results(d, path)
+        lab = tech["report"]
+        herr, ferr, hcost, mcost = tech["headline_error"], tech["fallback_error"], tech["headline_cost"], tech["memory_cost"]
+        zero = next((m["name"] for m in tech["metrics"] if m.get("must_be_zero")), None)
         header, raw = read_csv(path, ["trace", "status", "cycles_per_frame"])
-        has_eff = "efficiency_lost" in header
-        if not has_eff and "culling_efficiency" not in header:
-            raise BadInput(f"{path}: the header lacks culling_efficiency (or efficiency_lost)")
+        has_eff = herr in header
+        if not has_eff and ferr not in header:
+            raise BadInput(f"{path}: the header lacks {ferr} (or {herr})")
         if params is None:  # without sweep.json: the columns between nbsim_version and status
             i0 = header.index("nbsim_version") + 1 if "nbsim_version" in header else header.index("trace") + 1
             params = header[i0:header.index("status")]
@@ -378,7 +385,7 @@ class Report:
         rows = []
         for n, r in enumerate(raw, 2):
             rr = dict(r)
-            for k in NUMERIC:
+            for k in NUMERIC + [m["name"] for m in tech["metrics"]]:
                 if k in r:
                     try:
                         rr[k] = number(r[k])
@@ -415,31 +422,29 @@ class Report:
             if r["role"] == "reference":
                 r["label"] = "ref " + r["label"]
         # Error: culling efficiency lost against the reference N-buffer, or the hidden objects not culled.
-        use_eff = has_eff and any(r.get("efficiency_lost") is not None for r in ok)
+        use_eff = has_eff and any(r.get(herr) is not None for r in ok)
         if use_eff:
             for r in rows:
-                e = r.get("efficiency_lost")
+                e = r.get(herr)
                 r["error_axis"] = None if e is None else 100 * e
-            err_label = "culling efficiency lost vs full-res f32 N-buffer (points of %)"
-            err_text = "culling efficiency lost against the full-resolution float32 N-buffer (efficiency_lost)"
+            err_label, err_text = lab["error_axis"], lab["error_text"]
         else:
             for r in rows:
-                ce = r.get("culling_efficiency")
+                ce = r.get(ferr)
                 r["error_axis"] = None if ce is None else 100 * (1 - ce)
-            err_label = "hidden objects not culled (%, = 1 - culling efficiency)"
-            err_text = "hidden objects left unculled, 1 - culling efficiency (no efficiency_lost column)"
+            err_label, err_text = lab["fallback_axis"], lab["fallback_text"]
         no_err = sum(1 for r in ok if r["error_axis"] is None)
         for r in rows:
             fe, pe = r.get("fragment_error"), r.get("passed_error")
             r["counter_err"] = r.get("counter_error") if r.get("counter_error") is not None else (
                 None if fe is None and pe is None else max(abs(fe or 0), abs(pe or 0)))
         costs = [("cycles_per_frame", "pareto", "cycles per frame", "cycles"),
-                 ("total_depth_tests_per_frame", "pareto_depth_tests", "total depth tests per frame", "tests")]
-        if "nbuffer_memory_bytes" in header and any(r.get("nbuffer_memory_bytes") is not None for r in ok):
+                 (hcost, lab["cost_pareto"], lab["cost_axis"], lab["cost_short"])]
+        if mcost and mcost in header and any(r.get(mcost) is not None for r in ok):
             for r in rows:
-                b = r.get("nbuffer_memory_bytes")
-                r["nbuffer_memory_kib"] = None if b is None else b / 1024
-            costs.append(("nbuffer_memory_kib", "pareto_memory", "N-buffer memory (KiB)", "memory"))
+                b = r.get(mcost)
+                r[kib_key(mcost)] = None if b is None else b / 1024
+            costs.append((kib_key(mcost), lab["memory_pareto"], lab["memory_axis"], lab["memory_short"]))
         for key, col, _, _ in costs:
             for r, f in zip(rows, mark_pareto(rows, key, "error_axis")):
                 r[col] = f
@@ -463,20 +468,22 @@ class Report:
             cols.append(("role", "role", None))
         cols += [(p, p, None) for p in varying]
         cols += [("status", "status_text", None), ("cycles/frame", "cycles_per_frame", None),
-                 ("total depth tests/frame", "total_depth_tests_per_frame", None)]
-        if any(c[0] == "nbuffer_memory_kib" for c in costs):
-            cols.append(("N-buffer memory (KiB)", "nbuffer_memory_kib", None))
+                 (lab["cost_column"], hcost, None)]
+        if mcost and any(c[0] == kib_key(mcost) for c in costs):
+            cols.append((lab["memory_axis"], kib_key(mcost), None))
         cols += [("memory bytes/frame", "memory_bytes_per_frame", None),
-                 ("culling efficiency", "culling_efficiency", pct),
-                 ("efficiency lost (points)" if use_eff else "not culled (%)", "error_axis", lambda v: "-" if v is None else f"{v:.2f}"),
-                 ("false culls", "false_culls", None),
-                 ("counter error", "counter_err", lambda v: "-" if v is None else f"{v:.2%}")]
+                 (lab["quality_column"], ferr, pct),
+                 (lab["error_column"] if use_eff else lab["fallback_column"], "error_axis",
+                  lambda v: "-" if v is None else f"{v:.2f}")]
+        if zero:
+            cols.append((lab["must_be_zero"], zero, None))
+        cols += [("counter error", "counter_err", lambda v: "-" if v is None else f"{v:.2%}")]
         if "cycle_error" in header:
             cols.append(("cycle error", "cycle_error", lambda v: "-" if v is None else f"{v:+.3%}" if abs(v) >= 5e-6 else "0.000%"))
         cols += [("host s", "host_seconds", lambda v: "-" if v is None else f"{v:.3f}"),
                  ("Pareto (cost vs error)", "pareto_marks", None)]
         tab = self.table(f"{d.name}_points", cols, rows,
-                         row_class=lambda r: "bad" if r["status"] != "ok" or (r.get("false_culls") or 0) > 0
+                         row_class=lambda r: "bad" if r["status"] != "ok" or (zero and (r.get(zero) or 0) > 0)
                          else ("pareto" if r["pareto_marks"] else ("ref" if r["role"] == "reference" else "")),
                          note=f"Pareto marks ({', '.join(s for *_, s in costs)}): optimal for that cost against the "
                          f"error, per trace. Every row with its marks: <a href=\"{d.name}_pareto.csv\">{d.name}_pareto.csv</a>. ")
@@ -495,13 +502,14 @@ class Report:
             f"{' <b class=bad>' + str(len(failed)) + ' failed point(s)</b>, listed below, left out of the plots.' if failed else ''}</p>")
         parts.append(tab)
         for key, col, label, short in costs:
-            parts.append(self.figure(self.pareto_plot(d.name, rows, traces, key, col, label, err_label, short),
+            parts.append(self.figure(self.pareto_plot(d.name, rows, traces, key, col, label, err_label, short,
+                                                      zero, lab["must_be_zero"]),
                                      f"{label[0].upper() + label[1:]} against the error, one panel per trace. Pareto-optimal points "
                                      "(no other point of the trace is as cheap and as accurate, and strictly better in one) are "
                                      "filled red and joined by the front; grey circles are dominated"
                                      f"{'; stars are reference runs, not in the front' if any(r['role'] == 'reference' for r in rows) else ''}. "
                                      "Read off: the cheapest design for an accepted loss, and what each step down the front costs."))
-        self.headline.append(headline_sweep(d.name, rows, traces, err_label))
+        self.headline.append(headline_sweep(d.name, rows, traces, err_label, tech))
         speed = self.speed_plot(d.name, rows, params, header)
         if speed:
             parts.append(speed)
@@ -514,7 +522,8 @@ class Report:
         nrows = math.ceil(n / cols)
         return plt.subplots(nrows, cols, figsize=(12, 4.8 * nrows), constrained_layout=True, squeeze=False)
 
-    def pareto_plot(self, name, rows, traces, key, col, label, err_label, short):
+    def pareto_plot(self, name, rows, traces, key, col, label, err_label, short, zero=None, zero_label=None):
+        """One Pareto panel per trace; zero: the technique's correctness count (must be 0), marked when it is not."""
         fig, axes = self.panels(len(traces))
         flat = axes.ravel()
         label_jobs = []
@@ -535,10 +544,10 @@ class Report:
             if ref:
                 ax.scatter([r[key] for r in ref], [r["error_axis"] for r in ref], s=90, marker="*", color="#1f4e96",
                            label="reference run", zorder=3)
-            bad = [r for r in pts if (r.get("false_culls") or 0) > 0]
+            bad = [r for r in pts if zero and (r.get(zero) or 0) > 0]
             if bad:
                 ax.scatter([r[key] for r in bad], [r["error_axis"] for r in bad], s=110, marker="x", color="red",
-                           label="false culls", zorder=4)
+                           label=zero_label, zorder=4)
             if spans_decades([r[key] for r in pts]):
                 ax.set_xscale("log")
             else:
@@ -563,10 +572,10 @@ class Report:
             # the sweep's points table names every point.
             crowded = len(pts) > MAX_LABELLED_POINTS
             named = [r for r in pts if not crowded or r.get(col) or r["role"] == "reference"
-                     or (r.get("false_culls") or 0) > 0]
+                     or (zero and (r.get(zero) or 0) > 0)]
             rest = [r for r in pts if not any(r is n for n in named)]
             if named:
-                labs = [r["label"] + (f" ({int(r['false_culls'])} false culls)" if (r.get("false_culls") or 0) > 0 else "")
+                labs = [r["label"] + (f" ({int(r[zero])} {zero_label})" if zero and (r.get(zero) or 0) > 0 else "")
                         for r in named]
                 place_labels(ax, [r[key] for r in named], [r["error_axis"] for r in named], labs,
                              avoid=[(r[key], r["error_axis"]) for r in rest])

@@ -21,11 +21,37 @@ SHORT = {
     "depth.fused_interpolation": "fma-z", "gpu.fifo_depth": "fifo", "gpu.quantum_cycles": "quantum",
     "hiz.tile_px": "tile", "hiz.format": "hiz",
 }
-# Sweep metric columns the report reads as numbers (when present).
-NUMERIC = ["cycles_per_frame", "depth_tests_per_frame", "query_depth_tests_per_frame", "update_texels_per_frame",
-           "total_depth_tests_per_frame", "false_culls", "culling_efficiency", "memory_bytes_per_frame",
-           "nbuffer_bytes_per_frame", "fragment_error", "passed_error", "host_seconds", "cycles_per_host_second",
-           "nbuffer_memory_bytes", "efficiency_lost", "cycle_error", "counter_error"]
+# The technique-independent sweep columns the report reads as numbers (when present); each
+# technique's declared metrics (technique_results.json) are read as numbers too.
+NUMERIC = ["cycles_per_frame", "depth_tests_per_frame", "memory_bytes_per_frame", "nbuffer_bytes_per_frame",
+           "fragment_error", "passed_error", "host_seconds", "cycles_per_host_second", "cycle_error", "counter_error"]
+# The declared results of occlusion culling as nbsim wrote them before technique_results.json
+# existed (pipeline/techniques/results.cpp holds the declaration; only what the report reads is
+# here): a sweep folder without that file is read with these. AnalysisTest checks that they agree
+# with the file nbsim explore writes today.
+LEGACY_TECHNIQUE = {
+    "technique": "occlusion_culling",
+    "metrics": [{"name": n, "must_be_zero": n == "false_culls"} for n in (
+        "query_depth_tests_per_frame", "update_texels_per_frame", "total_depth_tests_per_frame", "false_culls",
+        "culling_efficiency", "culled", "candidates_not_visible", "max_lookups_per_test", "nbuffer_memory_bytes",
+        "structure_memory_bytes", "efficiency_lost")],
+    "headline_cost": "total_depth_tests_per_frame",
+    "headline_error": "efficiency_lost",
+    "fallback_error": "culling_efficiency",
+    "memory_cost": "nbuffer_memory_bytes",
+    "report": {
+        "error_axis": "culling efficiency lost vs full-res f32 N-buffer (points of %)",
+        "error_text": "culling efficiency lost against the full-resolution float32 N-buffer (efficiency_lost)",
+        "error_column": "efficiency lost (points)",
+        "fallback_axis": "hidden objects not culled (%, = 1 - culling efficiency)",
+        "fallback_text": "hidden objects left unculled, 1 - culling efficiency (no efficiency_lost column)",
+        "fallback_column": "not culled (%)",
+        "cost_axis": "total depth tests per frame", "cost_column": "total depth tests/frame",
+        "cost_pareto": "pareto_depth_tests", "cost_short": "tests",
+        "memory_axis": "N-buffer memory (KiB)", "memory_pareto": "pareto_memory", "memory_short": "memory",
+        "quality_column": "culling efficiency", "must_be_zero": "false culls", "alike": "culls alike",
+    },
+}
 
 
 
@@ -212,11 +238,43 @@ def cell(r, key, spec):
     return "-" if v is None else format(v, spec)
 
 
-def headline_sweep(name, rows, traces, err_label):
+def technique_results(d, path):
+    """The declared results of the technique of sweep folder d's traces (its technique_results.json,
+    the first technique that declares any), LEGACY_TECHNIQUE when the folder has no such file, or
+    BadInput when its traces' techniques declare no results (no cost or error axis to plot)."""
+    f = os.path.join(d, "technique_results.json")
+    if not os.path.exists(f):
+        return LEGACY_TECHNIQUE
+    j = load_json(f)
+    if not isinstance(j, dict) or not isinstance(j.get("techniques"), list):
+        raise BadInput(f"{f}: expected an object with a \"techniques\" list (nbsim explore)")
+    if not j["techniques"]:
+        notes = "; ".join(str(n) for n in j.get("notes", [])) or "no technique named"
+        raise BadInput(f"{path}: its traces' techniques declare no results, nothing to plot against ({notes})")
+    t = j["techniques"][0]
+    need = ["metrics", "headline_cost", "headline_error", "fallback_error", "memory_cost", "report"]
+    if not isinstance(t, dict) or any(k not in t for k in need):
+        raise BadInput(f"{f}: techniques[0] lacks one of {', '.join(need)}")
+    if not isinstance(t["metrics"], list) or not all(isinstance(m, dict) and isinstance(m.get("name"), str) for m in t["metrics"]):
+        raise BadInput(f"{f}: techniques[0].metrics must be a list of objects with a name")
+    labels = LEGACY_TECHNIQUE["report"].keys()
+    if not isinstance(t["report"], dict) or any(not isinstance(t["report"].get(k), str) for k in labels):
+        raise BadInput(f"{f}: techniques[0].report needs the labels {', '.join(labels)}")
+    return t
+
+
+def kib_key(metric):
+    """The row key of a memory metric in KiB: nbuffer_memory_bytes -> nbuffer_memory_kib."""
+    return (metric[:-len("_bytes")] if metric.endswith("_bytes") else metric) + "_kib"
+
+
+def headline_sweep(name, rows, traces, err_label, tech=LEGACY_TECHNIQUE):
     """The Pareto-optimal points of a sweep (cycles per frame against its error), as a Markdown table;
-    a sweep whose points all cull alike (a fidelity sweep) gets its cycle error and host time instead."""
+    a sweep whose points all cull alike (a fidelity sweep) gets its cycle error and host time instead.
+    tech: the technique's declared results (technique_results)."""
+    lab = tech["report"]
     lines = [f"Sweep {name}: Pareto-optimal points, cycles per frame against {err_label}", "",
-             "| trace | point | cycles per frame | error | total depth tests per frame | N-buffer memory (KiB) | host s |",
+             f"| trace | point | cycles per frame | error | {lab['cost_axis']} | {lab['memory_axis']} | host s |",
              "|---|---|---:|---:|---:|---:|---:|"]
     alike = []
     for t in traces:
@@ -225,7 +283,7 @@ def headline_sweep(name, rows, traces, err_label):
         if ok and len(errs) <= 1:  # no culling trade-off here: timing error and speed instead
             ce = [abs(r["cycle_error"]) for r in ok if r.get("cycle_error") is not None]
             hs = [r["host_seconds"] for r in ok if r.get("host_seconds") is not None]
-            alike.append(f"- {trace_name(t)}: every point culls alike; cycles per frame "
+            alike.append(f"- {trace_name(t)}: every point {lab['alike']}; cycles per frame "
                          f"{min(r['cycles_per_frame'] for r in ok):,.0f} to {max(r['cycles_per_frame'] for r in ok):,.0f}"
                          + (f", largest |cycle error| {max(ce):.3%}" if ce else "")
                          + (f", host {min(hs):.2f} to {max(hs):.2f} s" if hs else ""))
@@ -233,8 +291,8 @@ def headline_sweep(name, rows, traces, err_label):
         front = sorted((r for r in rows if r["trace"] == t and r.get("pareto")), key=lambda r: r["cycles_per_frame"])
         for r in front:
             lines.append(f"| {trace_name(t)} | {r['label']} | {cell(r, 'cycles_per_frame', ',.0f')} | "
-                         f"{cell(r, 'error_axis', '.2f')} | {cell(r, 'total_depth_tests_per_frame', ',.0f')} | "
-                         f"{cell(r, 'nbuffer_memory_kib', ',.0f')} | {cell(r, 'host_seconds', '.2f')} |")
+                         f"{cell(r, 'error_axis', '.2f')} | {cell(r, tech['headline_cost'], ',.0f')} | "
+                         f"{cell(r, kib_key(tech['memory_cost']), ',.0f')} | {cell(r, 'host_seconds', '.2f')} |")
     if len(lines) == 4:  # no front anywhere: the fidelity summary alone
         lines = lines[:2]
     elif alike:

@@ -1,6 +1,7 @@
 // `nbsim explore SWEEP.json --out DIR`: architecture exploration runs. Validates the whole sweep
 // file against the config schema, then replays every point in a child process (pipeline/explore/)
-// and writes DIR/points/<id>/, DIR/sweep.json and the tidy DIR/results.csv.
+// and writes DIR/points/<id>/, DIR/sweep.json, DIR/technique_results.json (the results the traces'
+// techniques declare: pipeline/techniques/results.h) and the tidy DIR/results.csv.
 #include <fmt/format.h>
 
 #include <chrono>
@@ -68,6 +69,7 @@ int run_explore(const ExploreOptions& o) {
     }
   }
   std::vector<explore::Point> points = explore::expand(spec);
+  for (auto& p : points) p.technique = traces.at(p.trace).technique;
   explore::check_points(spec, points, check_config, o.sweep);
   const std::vector<std::string> parameters = explore::parameter_keys(spec);
   const std::size_t sweep_points = points.size();
@@ -76,6 +78,9 @@ int run_explore(const ExploreOptions& o) {
   const fs::path out(o.out);
   fs::create_directories(out / "points");
   explore::write_sweep_json(out / "sweep.json", o.sweep, spec, points, parameters, traces, NBSIM_VERSION);
+  explore::write_technique_results_json(out / "technique_results.json", points, traces);
+  for (const auto& t : spec.traces)
+    if (!traces.at(t).note.empty()) fmt::print(stderr, "explore: note: {}\n", traces.at(t).note);
   if (o.dry_run) {
     for (const auto& p : points) fmt::print("{} {} {} {}\n", p.id, p.role, p.trace, p.settings.dump());
     fmt::print("explore: {} points and {} reference points, none run (--dry-run); wrote {}\n", sweep_points,
@@ -124,9 +129,11 @@ void add_explore_command(CLI::App& app, Action& action) {
   cmd->footer("Sweep file: {\"traces\": [...], \"set\": {key: value}, \"axes\": {key: [values]}} (every combination)\n"
               "or {\"traces\": [...], \"points\": [{key: value, \"trace\": optional}, ...]}; keys as `nbsim config\n"
               "--defaults` lists them. Exit 0 when every point ran, 1 when some failed (see results.csv), 2 on a bad sweep.\n"
-              "Errors in results.csv: efficiency_lost against nb_hier on the full-resolution float32 N-buffer (every\n"
-              "level), cycle_error against gpu.quantum_cycles=0, batch 85, FMA on, counter_error against GL's counters;\n"
-              "a reference the sweep lacks is run as an extra point (role=reference). Plots and Pareto fronts: nbsim report DIR.");
+              "Errors in results.csv: the columns the trace's technique declares (pipeline/techniques/results.cpp;\n"
+              "occlusion_culling: efficiency_lost against nb_hier on the full-resolution float32 N-buffer, every level),\n"
+              "cycle_error against gpu.quantum_cycles=0, batch 85, FMA on, counter_error against GL's counters; a\n"
+              "reference the sweep lacks is run as an extra point (role=reference). A trace whose technique declares no\n"
+              "results gets the generic columns only (a note says so). Plots and Pareto fronts: nbsim report DIR.");
   cmd->callback([&action, o] { action = [o] { return run_explore(*o); }; });
 }
 

@@ -1,8 +1,11 @@
 // `nbsim replay`, `nbsim compare`, `nbsim table2` and `nbsim config`: the SystemC model from the
-// command line. table2 runs one replay per culling mode, each in a child process of this executable
-// (SystemC allows one elaboration per process), and prints the paper's Table 2 beside ours.
+// command line. table2 runs one replay per row of the table the trace's technique declares
+// (pipeline/techniques/results.h; occlusion culling: one per culling mode), each in a child process
+// of this executable (SystemC allows one elaboration per process), and prints the paper's Table 2
+// beside ours.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -10,12 +13,13 @@
 #include <optional>
 
 #include "model/common/error.h"
-#include "model/cull/primitive.h"
 #include "pipeline/cli/command.h"
 #include "pipeline/cli/progress.h"
 #include "pipeline/explore/child.h"
 #include "pipeline/explore/runner.h"
 #include "pipeline/sim/replay.h"
+#include "pipeline/techniques/results.h"
+#include "traces/format/reader.h"
 
 namespace nbsim::cli {
 
@@ -46,59 +50,89 @@ struct ModelOptions {
   }
 };
 
-// Table 2 of Décoret 2005: average depth comparisons per frame, city walkthrough at 512x512 with
-// back-face culling. Fixed by the paper; the Hi-Z baselines have no paper value.
-struct Table2Row {
-  const char* mode;
-  const char* paper_label;
-  std::optional<double> paper;
-};
-constexpr Table2Row kTable2[] = {
-    {"oq_hier", "occlusion queries with hierarchy", 1'100'000.0},
-    {"oq", "occlusion queries", 200'000.0},
-    {"nb_hier", "N-buffer with hierarchy", 350.0},
-    {"nb", "N-buffer", 500.0},
-    {"hiz_tile", "tile Hi-Z (baseline, not in the paper)", std::nullopt},
-    {"hiz_pyramid", "Hi-Z pyramid (baseline, not in the paper)", std::nullopt},
-};
+// The effective value of a flat config key ("unit.field") in the nested values, as text ("" when
+// the config has no such key).
+std::string config_value(const nlohmann::ordered_json& values, const std::string& key) {
+  const auto dot = key.find('.');
+  if (dot == std::string::npos) return {};
+  const std::string unit = key.substr(0, dot), field = key.substr(dot + 1);
+  if (!values.contains(unit) || !values[unit].contains(field)) return {};
+  const auto& v = values[unit][field];
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
 
-// Runs every Table 2 mode as `nbsim replay TRACE --out DIR/MODE [config] --set cull.mode=MODE`, in
-// child processes (pipeline/explore/child.h), `parallel` at a time; returns each mode's run.json summary.
-// `config` is the checked config the options give (its cull.mode is overwritten per row).
-std::vector<nlohmann::json> run_table2(const std::string& trace, const std::filesystem::path& out, const ModelOptions& mo,
-                                       pipeline::GpuConfig config, int parallel) {
-  const std::size_t n = std::size(kTable2);
-  const bool primitive = cull::parse_granularity(config.cull.granularity) == cull::Granularity::Primitive;
+// The declared table of the trace's technique (pipeline/techniques/results.h); throws InputError
+// when the trace names no technique or its technique declares no table.
+const techniques::TableSpec& table_of(const std::string& trace_file) {
+  const trace::TraceReader reader(trace_file);
+  const std::string* technique = reader.property("technique");
+  if (!technique || technique->empty())
+    throw InputError(fmt::format("trace '{}' names no technique in its header: table2 takes its rows from the technique's "
+                                 "declared results (pipeline/techniques/results.cpp)",
+                                 trace_file));
+  const techniques::TechniqueResults* t = techniques::find_technique_results(*technique);
+  if (!t || !t->table)
+    throw InputError(fmt::format("trace '{}': technique '{}' declares no Table-2 rows (pipeline/techniques/results.cpp): "
+                                 "nothing for table2 to run",
+                                 trace_file, *technique));
+  return *t->table;
+}
+
+// Runs every row of the table as `nbsim replay TRACE --out DIR/VALUE [config] --set KEY=VALUE`, in
+// child processes (pipeline/explore/child.h), `parallel` at a time; returns each row's run.json.
+// `values` are the checked config the options give (the row key is overwritten per row).
+std::vector<nlohmann::json> run_table(const techniques::TableSpec& table, const std::string& trace, const std::filesystem::path& out,
+                                      const ModelOptions& mo, const nlohmann::ordered_json& values, int parallel) {
   std::vector<explore::ChildJob> jobs;
-  for (const Table2Row& row : kTable2) {
-    const std::filesystem::path dir = out / row.mode;
+  for (const techniques::TableRow& row : table.rows) {
+    const std::filesystem::path dir = out / row.value;
     std::vector<std::string> args = {"replay", trace, "--out", dir.string()};
     if (!mo.config_file.empty()) args.insert(args.end(), {"--config", mo.config_file});
     for (const auto& s : mo.sets) args.insert(args.end(), {"--set", s});
-    args.insert(args.end(), {"--set", std::string("cull.mode=") + row.mode});
-    // Per-primitive culling where the mode has a depth-query structure; the occlusion-query rows stay
-    // at object granularity (a query per triangle would rasterize it), so one setting runs every row.
-    config.cull.mode = row.mode;
-    if (primitive && !cull::supports_primitive_granularity(config.cull.parsed_mode()))
-      args.insert(args.end(), {"--set", "cull.granularity=object"});
+    args.insert(args.end(), {"--set", table.row_key + "=" + row.value});
+    for (const auto& o : row.overrides)
+      if (config_value(values, o.key) == o.when) args.insert(args.end(), {"--set", o.key + "=" + o.set});
     jobs.push_back({std::move(args), dir});
   }
-  std::vector<nlohmann::json> results(n);
+  std::vector<nlohmann::json> results(table.rows.size());
   std::string failures;
   explore::run_children(explore::self_executable(), jobs, parallel, [&](std::size_t i, const explore::ChildOutcome& outcome) {
+    const std::string row = table.row_key + "=" + table.rows[i].value;
     if (!outcome.ok) {
-      failures += fmt::format("cull.mode={}: replay failed: {}\n", kTable2[i].mode, outcome.error);
+      failures += fmt::format("{}: replay failed: {}\n", row, outcome.error);
       return;
     }
     std::ifstream in(jobs[i].dir / "run.json");
     const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-    if (j.is_discarded() || !j.contains("summary") || !j["summary"].contains("cull"))
-      failures += fmt::format("cull.mode={}: {}/run.json has no cull summary\n", kTable2[i].mode, jobs[i].dir.string());
+    if (j.is_discarded() || !techniques::at_pointer(j, table.section))
+      failures += fmt::format("{}: {}/run.json has no {}\n", row, jobs[i].dir.string(), table.section);
     else
-      results[i] = j["summary"];
+      results[i] = j;
   });
   if (!failures.empty()) throw InputError(failures.substr(0, failures.size() - 1));
   return results;
+}
+
+// One cell of the text table.
+std::string format_cell(const techniques::PrintedColumn& c, const nlohmann::ordered_json& v) {
+  using techniques::CellFormat;
+  switch (c.format) {
+    case CellFormat::Text: return fmt::format("{:<{}}", v.is_string() ? v.get<std::string>() : v.dump(), c.width);
+    case CellFormat::Paper:
+      return fmt::format("{:>{}}", v.is_number() ? fmt::format("{:.0f}", v.get<double>()) : std::string("-"), c.width);
+    case CellFormat::Fixed0: return fmt::format("{:>{}.0f}", v.is_number() ? v.get<double>() : 0.0, c.width);
+    case CellFormat::Fixed1: return fmt::format("{:>{}.1f}", v.is_number() ? v.get<double>() : 0.0, c.width);
+    case CellFormat::Count: return fmt::format("{:>{}}", v.is_number() ? v.get<std::uint64_t>() : 0, c.width);
+    case CellFormat::Percent: return fmt::format("{:>{}.1f}%", v.is_number() ? 100.0 * v.get<double>() : 0.0, c.width - 1);
+  }
+  return {};
+}
+
+// The row whose value is `value`, or nullptr.
+const nlohmann::ordered_json* row_named(const techniques::TableSpec& table, const nlohmann::ordered_json& list, const std::string& value) {
+  for (const auto& r : list)
+    if (r[table.row_column] == value) return &r;
+  return nullptr;
 }
 
 }  // namespace
@@ -190,17 +224,17 @@ void add_model_commands(CLI::App& app, Action& action) {
     cmd->add_flag("--json", *json, "Print a JSON list, one object per mode");
     cmd->add_option("--jobs", *jobs, "Replays run at a time (one process each)")->check(CLI::Range(1, 16));
     mo->add_options(cmd);
-    cmd->footer("Modes: oq_hier, oq, nb_hier, nb (the paper's rows), hiz_tile, hiz_pyramid. Query depth tests are the\n"
-                "paper's count (box fragments, or N-buffer/Hi-Z texels compared); the total adds the N-buffer/Hi-Z\n"
-                "update texels and the depth tests of the drawn objects. Exit 1 when any mode has a false cull.");
+    // The rows and columns come from the trace's technique (pipeline/techniques/results.cpp); the
+    // footer names today's only table.
+    if (const auto* oc = techniques::find_technique_results("occlusion_culling"); oc && oc->table)
+      cmd->footer(oc->table->footer + "\nRows and columns: the trace's technique's declared table; a technique without one exits 2.");
     cmd->callback([&action, trace, out, json, jobs, mo] {
       action = [trace, out, json, jobs, mo] {
         pipeline::GpuConfig config;  // a bad config is refused here, before any child starts
-        {
-          nlohmann::ordered_json values;
-          mo->apply(config, values);
-        }
+        nlohmann::ordered_json values;
+        mo->apply(config, values);
         if (!std::filesystem::exists(*trace)) throw InputError(fmt::format("trace '{}' does not exist", *trace));
+        const techniques::TableSpec& table = table_of(*trace);
         std::filesystem::path dir;
         const bool temporary = out->empty();
         if (temporary) {
@@ -210,28 +244,31 @@ void add_model_commands(CLI::App& app, Action& action) {
         } else {
           dir = *out;
         }
-        std::vector<nlohmann::json> rows;
+        std::vector<nlohmann::json> runs;
         try {
-          rows = run_table2(std::filesystem::absolute(*trace).string(), dir, *mo, config, *jobs);
+          runs = run_table(table, std::filesystem::absolute(*trace).string(), dir, *mo, values, *jobs);
         } catch (...) {
           if (temporary) std::filesystem::remove_all(dir);
           throw;
         }
         if (temporary) std::filesystem::remove_all(dir);
         nlohmann::ordered_json list = nlohmann::ordered_json::array();
-        std::uint64_t false_culls = 0;
-        for (std::size_t i = 0; i < rows.size(); ++i) {
-          const nlohmann::json& c = rows[i]["cull"];
+        std::uint64_t must_be_zero = 0;
+        for (std::size_t i = 0; i < runs.size(); ++i) {
+          const techniques::TableRow& row = table.rows[i];
           nlohmann::ordered_json r;
-          r["mode"] = kTable2[i].mode;
-          r["paper"] = kTable2[i].paper_label;
-          r["paper_depth_tests_per_frame"] = kTable2[i].paper ? nlohmann::ordered_json(*kTable2[i].paper) : nullptr;
-          for (const char* k : {"query_depth_tests_per_frame", "update_texels_per_frame", "total_depth_tests_per_frame",
-                                "cycles_per_frame", "false_culls", "culling_efficiency", "frames", "bounds_tests",
-                                "candidates", "culled", "candidates_not_visible", "undrawable", "max_lookups_per_test", "granularity"})
-            r[k] = c[k];
-          r["host_seconds"] = rows[i]["host_seconds"];
-          false_culls += c["false_culls"].get<std::uint64_t>();
+          r[table.row_column] = row.value;
+          r[table.paper_label_column] = row.paper_label;
+          r[table.paper_value_column] = row.paper ? nlohmann::ordered_json(*row.paper) : nullptr;
+          for (const auto& [name, pointer] : table.columns) {
+            const nlohmann::json* v = techniques::at_pointer(runs[i], pointer);
+            if (v)
+              r[name] = *v;
+            else
+              r[name] = nullptr;
+          }
+          if (!table.must_be_zero.empty() && r[table.must_be_zero].is_number_unsigned())
+            must_be_zero += r[table.must_be_zero].get<std::uint64_t>();
           list.push_back(std::move(r));
         }
         if (!temporary) {  // the report (analysis/report.py) reads it: rows plus what produced them
@@ -249,24 +286,36 @@ void add_model_commands(CLI::App& app, Action& action) {
         if (*json) {
           fmt::print("{}\n", list.dump());
         } else {
-          fmt::print("Table 2: average depth comparisons per frame ({}, {} frames)\n", *trace, list[0]["frames"].get<std::uint64_t>());
-          fmt::print("{:<12} {:>12} {:>14} {:>14} {:>14} {:>12} {:>6} {:>8} {:>7}\n", "mode", "paper", "query tests",
-                     "update texels", "total tests", "cycles", "false", "culling", "undraw");
-          for (const auto& r : list)
-            fmt::print("{:<12} {:>12} {:>14.1f} {:>14.1f} {:>14.1f} {:>12.0f} {:>6} {:>7.1f}% {:>7}\n", r["mode"].get<std::string>(),
-                       r["paper_depth_tests_per_frame"].is_null() ? std::string("-")
-                                                                  : fmt::format("{:.0f}", r["paper_depth_tests_per_frame"].get<double>()),
-                       r["query_depth_tests_per_frame"].get<double>(), r["update_texels_per_frame"].get<double>(),
-                       r["total_depth_tests_per_frame"].get<double>(), r["cycles_per_frame"].get<double>(),
-                       r["false_culls"].get<std::uint64_t>(), 100.0 * r["culling_efficiency"].get<double>(),
-                       r["undrawable"].get<std::uint64_t>());
-          const double oq = list[1]["query_depth_tests_per_frame"].get<double>(), nb = list[3]["query_depth_tests_per_frame"].get<double>();
-          fmt::print("occlusion queries / N-buffer query depth tests: {:.0f}x (paper: 400x); false culls: {}\n",
-                     nb > 0 ? oq / nb : 0.0, false_culls);
-          if (list[2]["granularity"] == "primitive")
-            fmt::print("cull.granularity=primitive in nb_hier, nb, hiz_tile and hiz_pyramid; oq_hier and oq test objects only\n");
+          const nlohmann::ordered_json& frames = list[0]["frames"];
+          fmt::print("{} ({}, {} frames)\n", table.title, *trace, frames.is_number() ? frames.dump() : std::string("?"));
+          std::string header;
+          for (const auto& c : table.printed)
+            header += (header.empty() ? "" : " ") +
+                      (c.format == techniques::CellFormat::Text ? fmt::format("{:<{}}", c.header, c.width) : fmt::format("{:>{}}", c.header, c.width));
+          fmt::print("{}\n", header);
+          for (const auto& r : list) {
+            std::string line;
+            for (const auto& c : table.printed) line += (line.empty() ? "" : " ") + format_cell(c, r[c.column]);
+            fmt::print("{}\n", line);
+          }
+          std::string summary;
+          if (table.ratio) {
+            const auto* num = row_named(table, list, table.ratio->numerator);
+            const auto* den = row_named(table, list, table.ratio->denominator);
+            const double a = num && (*num)[table.ratio->column].is_number() ? (*num)[table.ratio->column].get<double>() : 0.0;
+            const double b = den && (*den)[table.ratio->column].is_number() ? (*den)[table.ratio->column].get<double>() : 0.0;
+            summary = fmt::format("{}: {:.0f}x (paper: {})", table.ratio->label, b > 0 ? a / b : 0.0, table.ratio->paper);
+          }
+          if (!table.must_be_zero.empty()) {
+            std::string label = table.must_be_zero;
+            std::replace(label.begin(), label.end(), '_', ' ');
+            summary += fmt::format("{}{}: {}", summary.empty() ? "" : "; ", label, must_be_zero);
+          }
+          if (!summary.empty()) fmt::print("{}\n", summary);
+          for (const auto& n : table.notes)
+            if (const auto* r = row_named(table, list, n.row); r && (*r)[n.column] == n.value) fmt::print("{}\n", n.text);
         }
-        return false_culls == 0 ? 0 : 1;
+        return must_be_zero == 0 ? 0 : 1;
       };
     });
   }

@@ -33,8 +33,15 @@ const nlohmann::json* find(const nlohmann::json& j, std::initializer_list<const 
   return at;
 }
 
-// The metric cells of a finished point, in metric_columns() order.
-std::map<std::string, std::string> metrics_of(const nlohmann::json& run) {
+// The generic columns of results.csv (technique-independent), by block; see metric_columns().
+const std::vector<std::string> kRunColumns = {"frames", "draws", "cycles", "cycles_per_frame", "depth_tests", "depth_tests_per_frame"};
+const std::vector<std::string> kMemoryColumns = {"memory_bytes_per_frame", "depth_bytes_per_frame", "nbuffer_bytes_per_frame"};
+const std::vector<std::string> kFidelityColumns = {"fragment_error",  "passed_error", "counter_error", "within_thresholds",
+                                                   "host_seconds", "cycles_per_host_second"};
+const std::vector<std::string> kTimingColumns = {"timing_reference", "reference_cycles", "cycle_error"};
+
+// The generic metric cells of a finished point.
+std::map<std::string, std::string> generic_metrics_of(const nlohmann::json& run) {
   std::map<std::string, std::string> m;
   const nlohmann::json& s = run["summary"];
   const double frames = s.value("frames", 0.0);
@@ -44,12 +51,6 @@ std::map<std::string, std::string> metrics_of(const nlohmann::json& run) {
     if (s.contains(k)) m[k] = cell(s[k]);
   if (s.contains("cycles")) m["cycles_per_frame"] = per_frame(s["cycles"].get<double>());
   if (s.contains("depth_tests")) m["depth_tests_per_frame"] = per_frame(s["depth_tests"].get<double>());
-  if (const auto* c = find(s, {"cull"})) {
-    for (const char* k : {"query_depth_tests_per_frame", "update_texels_per_frame", "total_depth_tests_per_frame", "false_culls",
-                          "culling_efficiency", "culled", "candidates_not_visible", "max_lookups_per_test",
-                          "nbuffer_memory_bytes", "structure_memory_bytes"})
-      if (c->contains(k)) m[k] = cell((*c)[k]);
-  }
   if (s.contains("fragment_error") && s.contains("passed_error"))
     m["counter_error"] = number(std::max(s["fragment_error"].get<double>(), s["passed_error"].get<double>()));
   if (const auto* mem = find(run, {"stats", "gpu.memory"}); mem && mem->is_object()) {
@@ -63,6 +64,30 @@ std::map<std::string, std::string> metrics_of(const nlohmann::json& run) {
   return m;
 }
 
+// The declared metric cells of a finished point of technique `t` that are read as they are.
+void technique_metrics_of(const nlohmann::json& run, const techniques::TechniqueResults& t, std::map<std::string, std::string>& m) {
+  for (const auto& metric : t.metrics)
+    if (metric.derivation == techniques::Derivation::None)
+      if (const nlohmann::json* v = techniques::at_pointer(run, metric.source)) m[metric.name] = cell(*v);
+}
+
+// A derived error from the point's value p and its reference's r; nullopt when it has no value.
+std::optional<double> derive(techniques::Derivation d, double p, double r) {
+  switch (d) {
+    case techniques::Derivation::ReferenceMinusPoint: return r - p;
+    case techniques::Derivation::PointMinusReference: return p - r;
+    case techniques::Derivation::RelativeToReference:
+      if (r > 0) return (p - r) / r;
+      return std::nullopt;
+    case techniques::Derivation::None: break;
+  }
+  return std::nullopt;
+}
+
+void append_unique(std::vector<std::string>& columns, const std::string& c) {
+  if (std::find(columns.begin(), columns.end(), c) == columns.end()) columns.push_back(c);
+}
+
 std::optional<nlohmann::json> read_json(const fs::path& file) {
   std::ifstream in(file);
   if (!in) return std::nullopt;
@@ -73,15 +98,38 @@ std::optional<nlohmann::json> read_json(const fs::path& file) {
 
 }  // namespace
 
-const std::vector<std::string>& metric_columns() {
-  static const std::vector<std::string> columns = {
-      "frames", "draws", "cycles", "cycles_per_frame", "depth_tests", "depth_tests_per_frame", "query_depth_tests_per_frame",
-      "update_texels_per_frame", "total_depth_tests_per_frame", "false_culls", "culling_efficiency", "culled",
-      "candidates_not_visible", "max_lookups_per_test", "memory_bytes_per_frame", "depth_bytes_per_frame",
-      "nbuffer_bytes_per_frame", "nbuffer_memory_bytes", "structure_memory_bytes", "fragment_error", "passed_error",
-      "counter_error", "within_thresholds", "host_seconds", "cycles_per_host_second", "culling_reference",
-      "reference_culling_efficiency", "efficiency_lost", "timing_reference", "reference_cycles", "cycle_error"};
+std::vector<std::string> metric_columns(const std::vector<const techniques::TechniqueResults*>& ts) {
+  using techniques::Derivation;
+  using techniques::Section;
+  std::vector<std::string> columns = kRunColumns;
+  const auto section = [&](Section which) {
+    for (const auto* t : ts)
+      for (const auto& m : t->metrics)
+        if (m.derivation == Derivation::None && m.section == which) append_unique(columns, m.name);
+  };
+  section(Section::Work);
+  for (const auto& c : kMemoryColumns) append_unique(columns, c);
+  section(Section::Memory);
+  for (const auto& c : kFidelityColumns) append_unique(columns, c);
+  for (const auto* t : ts) {
+    if (!t->reference) continue;
+    append_unique(columns, t->reference->column);
+    for (const auto& m : t->metrics)
+      if (m.derivation != Derivation::None) {
+        append_unique(columns, m.reference_column);
+        append_unique(columns, m.name);
+      }
+  }
+  for (const auto& c : kTimingColumns) append_unique(columns, c);
   return columns;
+}
+
+std::vector<const techniques::TechniqueResults*> sweep_techniques(const std::vector<Point>& points) {
+  std::vector<const techniques::TechniqueResults*> ts;
+  for (const Point& p : points)
+    if (const auto* t = techniques::find_technique_results(p.technique); t && std::find(ts.begin(), ts.end(), t) == ts.end())
+      ts.push_back(t);
+  return ts;
 }
 
 std::string csv_field(const std::string& text) {
@@ -97,34 +145,43 @@ void write_results_csv(const fs::path& file, const fs::path& out, const std::vec
   std::ofstream csv(file);
   if (!csv) throw std::runtime_error(fmt::format("cannot write {}", file.string()));
   // Every finished run first: the error columns compare a point with its reference points.
-  std::map<std::string, nlohmann::json> summaries;
+  std::map<std::string, nlohmann::json> runs;
   for (const Point& p : points)
     if (point_done(out, p))
-      if (const auto run = read_json(point_dir(out, p) / "run.json")) summaries[p.id] = (*run)["summary"];
-  const auto reference_value = [&summaries](const std::string& id, std::initializer_list<const char*> path) -> std::optional<double> {
-    const auto it = summaries.find(id);
-    if (id.empty() || it == summaries.end()) return std::nullopt;
-    const nlohmann::json* v = find(it->second, path);
+      if (auto run = read_json(point_dir(out, p) / "run.json")) runs[p.id] = std::move(*run);
+  const auto value_of = [&runs](const std::string& id, const std::string& pointer) -> std::optional<double> {
+    const auto it = runs.find(id);
+    if (id.empty() || it == runs.end()) return std::nullopt;
+    const nlohmann::json* v = techniques::at_pointer(it->second, pointer);
     if (!v || !v->is_number()) return std::nullopt;
     return v->get<double>();
   };
-  const auto errors = [&](const Point& p, std::map<std::string, std::string>& m) {
-    m["culling_reference"] = p.culling_reference;
+  const auto errors = [&](const Point& p, const techniques::TechniqueResults* t, std::map<std::string, std::string>& m) {
+    if (t && t->reference) {
+      m[t->reference->column] = p.technique_reference;
+      for (const auto& metric : t->metrics) {
+        if (metric.derivation == techniques::Derivation::None) continue;
+        const auto mine = value_of(p.id, metric.source);
+        const auto ref = value_of(p.technique_reference, metric.source);
+        if (ref) m[metric.reference_column] = number(*ref);
+        if (mine && ref)
+          if (const auto e = derive(metric.derivation, *mine, *ref)) m[metric.name] = number(*e);
+      }
+    }
+    // The generic timing reference: cycle_error = (cycles - reference cycles) / reference cycles.
     m["timing_reference"] = p.timing_reference;
-    const auto eff = reference_value(p.id, {"cull", "culling_efficiency"});
-    const auto ref_eff = reference_value(p.culling_reference, {"cull", "culling_efficiency"});
-    if (ref_eff) m["reference_culling_efficiency"] = number(*ref_eff);
-    if (eff && ref_eff) m["efficiency_lost"] = number(*ref_eff - *eff);
-    const auto cycles = reference_value(p.id, {"cycles"});
-    const auto ref_cycles = reference_value(p.timing_reference, {"cycles"});
+    const auto cycles = value_of(p.id, "/summary/cycles");
+    const auto ref_cycles = value_of(p.timing_reference, "/summary/cycles");
     if (ref_cycles) m["reference_cycles"] = number(*ref_cycles);
-    if (cycles && ref_cycles && *ref_cycles > 0) m["cycle_error"] = number((*cycles - *ref_cycles) / *ref_cycles);
+    if (cycles && ref_cycles)
+      if (const auto e = derive(techniques::Derivation::RelativeToReference, *cycles, *ref_cycles)) m["cycle_error"] = number(*e);
   };
+  const std::vector<std::string> columns = metric_columns(sweep_techniques(points));
 
   std::vector<std::string> header = {"point_id", "role", "trace", "trace_crc32", "nbsim_version"};
   header.insert(header.end(), parameters.begin(), parameters.end());
   header.push_back("status");
-  header.insert(header.end(), metric_columns().begin(), metric_columns().end());
+  header.insert(header.end(), columns.begin(), columns.end());
   header.push_back("error");
   for (std::size_t i = 0; i < header.size(); ++i) csv << (i ? "," : "") << csv_field(header[i]);
   csv << '\n';
@@ -136,14 +193,16 @@ void write_results_csv(const fs::path& file, const fs::path& out, const std::vec
     for (const auto& k : parameters) row.push_back(cell(p.parameters.value(k, nlohmann::json())));
     if (run) {
       row.push_back("ok");
-      auto m = metrics_of(*run);
-      errors(p, m);
-      for (const auto& c : metric_columns()) row.push_back(m.count(c) ? m.at(c) : "");
+      const techniques::TechniqueResults* t = techniques::find_technique_results(p.technique);
+      auto m = generic_metrics_of(*run);
+      if (t) technique_metrics_of(*run, *t, m);
+      errors(p, t, m);
+      for (const auto& c : columns) row.push_back(m.count(c) ? m.at(c) : "");
       row.emplace_back();
     } else {
       std::string error = tail_lines(dir / "error.txt", 5);
       row.push_back(error.empty() ? "not_run" : "failed");
-      row.insert(row.end(), metric_columns().size(), "");
+      row.insert(row.end(), columns.size(), "");
       row.push_back(error);
     }
     for (std::size_t i = 0; i < row.size(); ++i) csv << (i ? "," : "") << csv_field(row[i]);
@@ -162,12 +221,40 @@ void write_sweep_json(const fs::path& file, const std::string& sweep_file, const
   j["nbsim_version"] = version;
   j["parameters"] = parameters;
   j["points"] = nlohmann::ordered_json::array();
-  for (const Point& p : points)
-    j["points"].push_back({{"id", p.id}, {"role", p.role}, {"trace", p.trace}, {"trace_file", traces.at(p.trace).path.string()},
-                           {"trace_crc32", traces.at(p.trace).crc32}, {"settings", p.settings}, {"parameters", p.parameters},
-                           {"culling_reference", p.culling_reference}, {"timing_reference", p.timing_reference}});
-  j["culling_reference_settings"] = culling_reference_settings();
+  for (const Point& p : points) {
+    nlohmann::ordered_json e = {{"id", p.id}, {"role", p.role}, {"trace", p.trace}, {"trace_file", traces.at(p.trace).path.string()},
+                                {"trace_crc32", traces.at(p.trace).crc32}, {"technique", p.technique}, {"settings", p.settings},
+                                {"parameters", p.parameters}};
+    if (const auto* t = techniques::find_technique_results(p.technique); t && t->reference) e[t->reference->column] = p.technique_reference;
+    e["timing_reference"] = p.timing_reference;
+    j["points"].push_back(std::move(e));
+  }
+  for (const auto* t : sweep_techniques(points))
+    if (t->reference) j[t->reference->column + "_settings"] = t->reference->settings;
   j["timing_reference_settings"] = timing_reference_settings();
+  std::ofstream f(file);
+  f << j.dump(2) << '\n';
+  if (!f) throw std::runtime_error(fmt::format("cannot write {}", file.string()));
+}
+
+void write_technique_results_json(const fs::path& file, const std::vector<Point>& points, const std::map<std::string, TraceFile>& traces) {
+  nlohmann::ordered_json j;
+  j["traces"] = nlohmann::ordered_json::object();
+  std::vector<std::string> notes;
+  for (const Point& p : points) {
+    if (j["traces"].contains(p.trace)) continue;
+    const TraceFile& tf = traces.at(p.trace);
+    j["traces"][p.trace] = tf.technique.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(tf.technique);
+    if (!tf.note.empty()) notes.push_back(tf.note);
+  }
+  j["techniques"] = nlohmann::ordered_json::array();
+  for (const auto* t : sweep_techniques(points)) j["techniques"].push_back(techniques::to_json(*t));
+  j["generic_columns"] = {{"run", kRunColumns},
+                          {"memory", kMemoryColumns},
+                          {"fidelity", kFidelityColumns},
+                          {"timing_reference", kTimingColumns}};
+  j["timing_reference_settings"] = timing_reference_settings();
+  j["notes"] = notes;
   std::ofstream f(file);
   f << j.dump(2) << '\n';
   if (!f) throw std::runtime_error(fmt::format("cannot write {}", file.string()));

@@ -8,6 +8,8 @@
 
 #include "model/common/error.h"
 #include "pipeline/explore/child.h"
+#include "pipeline/techniques/results.h"
+#include "traces/format/reader.h"
 
 namespace nbsim::explore {
 
@@ -26,7 +28,22 @@ TraceFile inspect_trace(const std::string& as_written) {
     const auto n = in.gcount();
     if (n > 0) crc = crc32(crc, reinterpret_cast<const Bytef*>(buf.data()), static_cast<uInt>(n));
   }
-  return {p, fmt::format("{:08x}", static_cast<std::uint32_t>(crc))};
+  TraceFile t{p, fmt::format("{:08x}", static_cast<std::uint32_t>(crc)), "", ""};
+  try {
+    const trace::TraceReader reader(p);
+    if (const std::string* technique = reader.property("technique")) t.technique = *technique;
+  } catch (const std::exception& e) {  // InputError, or a read error: the replay will say more
+    t.note = fmt::format("trace '{}': its header cannot be read ({}): generic columns only", as_written, e.what());
+    return t;
+  }
+  if (t.technique.empty())
+    t.note = fmt::format("trace '{}' names no technique in its header: results.csv has the generic columns only for it", as_written);
+  else if (!techniques::find_technique_results(t.technique))
+    t.note = fmt::format(
+        "trace '{}': technique '{}' declares no results (pipeline/techniques/results.cpp): results.csv has the generic "
+        "columns only for it",
+        as_written, t.technique);
+  return t;
 }
 
 fs::path point_dir(const fs::path& out, const Point& p) { return out / "points" / p.id; }

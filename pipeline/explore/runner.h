@@ -14,14 +14,21 @@
 
 namespace nbsim::explore {
 
-// A trace of the sweep: where it is and its checksum (zlib crc32 of the whole file, 8 hex digits).
+// A trace of the sweep: where it is, its checksum (zlib crc32 of the whole file, 8 hex digits)
+// and the technique its header names.
 struct TraceFile {
   std::filesystem::path path;  // absolute
   std::string crc32;
+  std::string technique;  // the header's `technique` property; "" when absent or unreadable
+  // Why the trace's results have the generic columns only ("" when its technique declares its
+  // results): no technique property, a technique without a row in pipeline/techniques/results.cpp,
+  // or a header that cannot be read (its replay then fails and says why).
+  std::string note;
 };
 
-// Resolves a trace named in a sweep (relative: from the current directory) and checksums it;
-// throws InputError when it does not exist or cannot be read.
+// Resolves a trace named in a sweep (relative: from the current directory), checksums it and
+// reads its technique; throws InputError when it does not exist or cannot be read. A damaged
+// header is not refused here (the note says so): its points fail one by one in results.csv.
 TraceFile inspect_trace(const std::string& as_written);
 
 struct RunOptions {

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "model/common/error.h"
+#include "pipeline/techniques/results.h"
 
 namespace nbsim::explore {
 
@@ -34,6 +35,16 @@ nlohmann::ordered_json flatten(const nlohmann::ordered_json& j, const std::strin
     }
   }
   return flat;
+}
+
+// False when the point's `skip_key` is absent or one of `skip_values`: it runs nothing the
+// technique's errors measure.
+bool has_reference(const techniques::ReferenceSetting& r, const nlohmann::json& effective) {
+  if (r.skip_key.empty()) return true;
+  if (!effective.contains(r.skip_key)) return false;
+  const nlohmann::json& v = effective[r.skip_key];
+  const std::string value = v.is_string() ? v.get<std::string>() : v.dump();
+  return std::find(r.skip_values.begin(), r.skip_values.end(), value) == r.skip_values.end();
 }
 
 std::string describe_settings(const std::string& trace, const nlohmann::json& settings) {
@@ -193,12 +204,6 @@ void check_points(const SweepSpec& spec, std::vector<Point>& points, const Confi
   }
 }
 
-const nlohmann::json& culling_reference_settings() {
-  static const nlohmann::json s = {
-      {"cull.mode", "nb_hier"}, {"nbuffer.resolution_divisor", 1}, {"nbuffer.format", "f32"}, {"nbuffer.level_cap", -1}};
-  return s;
-}
-
 const nlohmann::json& timing_reference_settings() {
   static const nlohmann::json s = {{"gpu.quantum_cycles", 0},
                                    {"geometry.batch_triangles", 85},
@@ -217,6 +222,7 @@ void add_reference_points(std::vector<Point>& points, const std::vector<std::str
   const auto reference = [&](std::size_t i, const nlohmann::json& overrides) -> std::string {
     Point r;
     r.trace = points[i].trace;
+    r.technique = points[i].technique;
     r.settings = points[i].settings;
     bool changed = false;
     for (const auto& [k, v] : overrides.items()) {
@@ -235,21 +241,23 @@ void add_reference_points(std::vector<Point>& points, const std::vector<std::str
     by_config.emplace(config_key(r), points.size());
     points.push_back(std::move(r));
     const std::size_t added = points.size() - 1;
-    points[added].culling_reference = points[added].timing_reference = points[added].id;  // errors of a reference: none
+    points[added].technique_reference = points[added].timing_reference = points[added].id;  // errors of a reference: none
     return points[added].id;
   };
 
   const nlohmann::json defaults = check(nlohmann::json::object(), origin + ": defaults");
   const std::size_t sweep_points = points.size();
   for (std::size_t i = 0; i < sweep_points; ++i) {
-    const std::string mode = points[i].effective.value("cull.mode", std::string("trace"));
-    if (mode != "trace" && mode != "none") {
-      // One reference for every mode (the flat nb query's loss shows too). The Hi-Z keys mean
-      // nothing to it: one reference for every Hi-Z variant.
-      nlohmann::json overrides = culling_reference_settings();
+    const techniques::TechniqueResults* t = techniques::find_technique_results(points[i].technique);
+    if (t && t->reference && has_reference(*t->reference, points[i].effective)) {
+      // One reference for every variant the setting does not name (for occlusion culling, every
+      // mode: the flat nb query's loss shows too); keys under reset_prefixes mean nothing to it
+      // (the Hi-Z keys): they go back to their defaults, one reference for all their variants.
+      nlohmann::json overrides = t->reference->settings;
       for (const auto& [k, v] : defaults.items())
-        if (k.rfind("hiz.", 0) == 0) overrides[k] = v;
-      points[i].culling_reference = reference(i, overrides);
+        for (const auto& prefix : t->reference->reset_prefixes)
+          if (k.rfind(prefix, 0) == 0) overrides[k] = v;
+      points[i].technique_reference = reference(i, overrides);
     }
     points[i].timing_reference = reference(i, timing_reference_settings());
   }

@@ -37,9 +37,14 @@ struct Point {
   nlohmann::json parameters = nlohmann::json::object();
   nlohmann::json effective = nlohmann::json::object();  // every config key's value (check_points fills it)
   std::string role = "sweep";  // "reference": added by add_reference_points, not in the sweep file
+  // The technique of the trace as its header names it ("" when it names none or cannot be read):
+  // its declared results (pipeline/techniques/results.h) give the technique's columns.
+  std::string technique;
   // Ids of the points this one's errors are measured against (itself when it is its own
-  // reference; empty when there is none): see add_reference_points.
-  std::string culling_reference, timing_reference;
+  // reference; empty when there is none): see add_reference_points. technique_reference is the
+  // technique's reference setting (results.csv names its column after the declaration:
+  // culling_reference for occlusion culling), timing_reference the generic timing one.
+  std::string technique_reference, timing_reference;
 };
 
 // Checks the structure of a sweep file (parsed keeping its key order); throws InputError naming
@@ -66,20 +71,20 @@ void check_points(const SweepSpec& spec, std::vector<Point>& points, const Confi
 std::vector<std::string> parameter_keys(const SweepSpec& spec);
 
 // The settings each point's errors are measured against (results.csv):
-//  - culling: cull.mode=nb_hier on the full-resolution float32 N-buffer with every level
-//    (culling_reference_settings(), the Hi-Z keys at their defaults), for a point in any mode; points
-//    in the trace and none modes cull nothing and have no culling reference.
-//    efficiency_lost = reference culling efficiency - the point's.
-//  - timing: the model's most detailed fidelity (timing_reference_settings(): no temporal
-//    decoupling, llvmpipe's batch size, fused multiply-adds as llvmpipe on FMA hosts).
+//  - the technique's: its declared reference setting (pipeline/techniques/results.h; for occlusion
+//    culling cull.mode=nb_hier on the full-resolution float32 N-buffer with every level, the Hi-Z
+//    keys at their defaults, none in the trace and none modes). A point whose technique declares
+//    no reference has none. Its derived errors (efficiency_lost) compare the two points.
+//  - timing, for every technique: the model's most detailed fidelity (timing_reference_settings():
+//    no temporal decoupling, llvmpipe's batch size, fused multiply-adds as llvmpipe on FMA hosts).
 //    cycle_error = (cycles - reference cycles) / reference cycles.
 // Keys the config does not have are left out.
-const nlohmann::json& culling_reference_settings();
 const nlohmann::json& timing_reference_settings();
 
-// Sets each point's culling_reference and timing_reference, appending a point with role
+// Sets each point's technique_reference and timing_reference, appending a point with role
 // "reference" for every reference configuration the sweep does not already hold (compared on the
-// effective config, so {} and an explicit default are the same point). Call after check_points.
+// effective config, so {} and an explicit default are the same point). Call after check_points,
+// with each point's technique set.
 void add_reference_points(std::vector<Point>& points, const std::vector<std::string>& parameters, const ConfigCheck& check,
                           const std::string& origin);
 

@@ -45,7 +45,7 @@ EOF
 sweep() {  # name, sweep file
   "$nbsim" explore "$2" --jobs 2 --out "$tmp/sweeps/$1" >/dev/null
   mkdir -p "$out/sweeps/$1"
-  cp "$tmp/sweeps/$1/results.csv" "$tmp/sweeps/$1/sweep.json" "$out/sweeps/$1/"
+  cp "$tmp/sweeps/$1/results.csv" "$tmp/sweeps/$1/sweep.json" "$tmp/sweeps/$1/technique_results.json" "$out/sweeps/$1/"
 }
 small_traces() {  # sweep file -> the same sweep over the small samples, in $tmp
   $py - "$1" "$tmp/$(basename "$1")" <<'EOF'

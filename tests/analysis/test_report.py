@@ -283,6 +283,96 @@ class Table2Ratio(unittest.TestCase):
         self.assertEqual(report_data.table2_ratios([{"mode": "oq", "query_depth_tests_per_frame": 1.0}]), [])
 
 
+class TechniqueDeclarations(unittest.TestCase):
+    """The sweep section takes its cost and error metrics from technique_results.json (nbsim explore writes
+    it from pipeline/techniques/results.cpp), not from fixed names."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = Path(self.tmp.name)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_legacy_declaration_matches_what_explore_writes(self):
+        # folders without the file are read with LEGACY_TECHNIQUE: it must say what nbsim declares
+        legacy = report_data.LEGACY_TECHNIQUE
+        for name in ["small", "nbuffer_resolution", "fidelity"]:
+            j = json.loads((FIXTURE / "sweeps" / name / "technique_results.json").read_text())
+            self.assertEqual(len(j["techniques"]), 1, name)
+            t = j["techniques"][0]
+            for k in ["technique", "headline_cost", "headline_error", "fallback_error", "memory_cost", "report"]:
+                self.assertEqual(t[k], legacy[k], f"{name}: {k} differs from LEGACY_TECHNIQUE")
+            self.assertEqual([(m["name"], m["must_be_zero"]) for m in t["metrics"]],
+                             [(m["name"], m["must_be_zero"]) for m in legacy["metrics"]], name)
+
+    def test_metric_names_come_from_the_declaration(self):
+        # a made-up technique with its own names: its columns are plotted, labelled and flagged
+        header = ["point_id", "role", "trace", "nbsim_version", "x.y", "status", "cycles_per_frame",
+                  "sprite_tests_per_frame", "popping", "sprite_efficiency", "popping_lost", "sprite_memory_bytes"]
+        rows = [["a", "sweep", "t.nbt", "0", "1", "ok", "100", "50", "0", "0.9", "0.05", "4096"],
+                ["b", "sweep", "t.nbt", "0", "2", "ok", "80", "70", "0", "0.8", "0.15", "2048"],
+                ["c", "sweep", "t.nbt", "0", "3", "ok", "60", "90", "2", "0.7", "0.25", "1024"]]
+        s = write_sweep(self.dir, "p", header, rows, ["x.y"])
+        labels = {"error_axis": "popping lost (points of %)", "error_text": "sprites popping lost (popping_lost)",
+                  "error_column": "popping lost (points)", "fallback_axis": "sprites not culled (%)",
+                  "fallback_text": "1 - sprite efficiency", "fallback_column": "not culled (%)",
+                  "cost_axis": "sprite depth tests per frame", "cost_column": "sprite tests/frame",
+                  "cost_pareto": "pareto_sprite_tests", "cost_short": "sprites", "memory_axis": "sprite memory (KiB)",
+                  "memory_pareto": "pareto_sprite_memory", "memory_short": "spritemem",
+                  "quality_column": "sprite efficiency", "must_be_zero": "popped sprites", "alike": "pops alike"}
+        metrics = [{"name": n, "must_be_zero": n == "popping"} for n in
+                   ["sprite_tests_per_frame", "popping", "sprite_efficiency", "popping_lost", "sprite_memory_bytes"]]
+        (s / "technique_results.json").write_text(json.dumps({"traces": {"t.nbt": "particles"}, "techniques": [{
+            "technique": "particles", "metrics": metrics, "headline_cost": "sprite_tests_per_frame",
+            "headline_error": "popping_lost", "fallback_error": "sprite_efficiency",
+            "memory_cost": "sprite_memory_bytes", "report": labels}], "notes": []}))
+        rc, _, err = run_report(self.dir)
+        self.assertEqual(rc, 0, err)
+        html = (self.dir / "report" / "index.html").read_text()
+        for text in ["sprites popping lost (popping_lost)", "sprite tests/frame", "popping lost (points)",
+                     "sprite efficiency", "popped sprites", "sprite memory (KiB)"]:
+            self.assertIn(text, html, f"the declared label {text!r} is not in the page")
+        self.assertNotIn("culling efficiency", html.split("<h2 id=\"sweep-p\">")[1])
+        for png in ["p_sprites_vs_error.png", "p_spritemem_vs_error.png", "p_cycles_vs_error.png"]:
+            png_size(self.dir / "report" / png)
+        with open(self.dir / "report" / "p_pareto.csv") as f:
+            pareto = list(csv.DictReader(f))
+        self.assertIn("pareto_sprite_tests", pareto[0])
+        self.assertEqual([float(r["error_axis"]) for r in pareto], [5.0, 15.0, 25.0], "the error axis is popping_lost in points")
+        with open(self.dir / "report" / "p_points.csv") as f:
+            points = f.read()
+        self.assertIn("sprite_memory_kib", points.splitlines()[0])
+        headline = (self.dir / "report" / "headline.md").read_text()
+        self.assertIn("| sprite depth tests per frame | sprite memory (KiB) |", headline, "the headline uses the declared words")
+
+    def test_techniques_without_declarations_exit_2(self):
+        # every trace of the sweep names a technique without declared results: no axis to plot, clear message
+        s = write_sweep(self.dir, "u", ["trace", "status", "cycles_per_frame"], [["t.nbt", "ok", "1"]], [])
+        (s / "technique_results.json").write_text(json.dumps({"traces": {"t.nbt": "relief"}, "techniques": [],
+                                                              "notes": ["technique 'relief' declares no results"]}))
+        rc, _, err = run_report(self.dir)
+        self.assertBroken(rc, err, str(Path("sweeps") / "u" / "results.csv"))
+        self.assertIn("declare no results", err)
+        self.assertIn("technique 'relief'", err)
+
+    def test_incomplete_declaration_exit_2(self):
+        # a technique_results.json whose technique lacks the report's labels: exit 2 naming the file
+        shutil.copytree(FIXTURE / "sweeps" / "small", self.dir / "sweeps" / "small")
+        f = self.dir / "sweeps" / "small" / "technique_results.json"
+        j = json.loads(f.read_text())
+        del j["techniques"][0]["report"]["cost_axis"]
+        f.write_text(json.dumps(j))
+        rc, _, err = run_report(self.dir)
+        self.assertBroken(rc, err, "technique_results.json")
+        self.assertIn("cost_axis", err)
+
+    def assertBroken(self, rc, err, name):
+        self.assertEqual(rc, 2, f"{name}: exit 2")
+        self.assertIn(name, err, "the message must name the file")
+        self.assertNotIn("Traceback", err)
+
+
 class MissingAndBroken(unittest.TestCase):
     """Missing inputs are named in the page; malformed ones exit 2 naming the file, without a traceback."""
 

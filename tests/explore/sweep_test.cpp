@@ -110,21 +110,41 @@ TEST(SweepTest, ReferencePoints) {
   const ex::SweepSpec spec = ex::parse_sweep(j, "s");
   std::vector<Point> points = ex::expand(spec);
   ex::check_points(spec, points, toy_check, "s");
+  for (Point& p : points) p.technique = "occlusion_culling";
   ex::add_reference_points(points, ex::parameter_keys(spec), toy_check, "s");
   ASSERT_EQ(points.size(), 8u) << "one reference added: nb_hier at full resolution";
   const Point& added = points[7];
-  for (int i = 0; i < 3; ++i) EXPECT_EQ(points[i].culling_reference, added.id) << "point " << i << ": the flat nb query is measured too";
-  EXPECT_EQ(points[6].culling_reference, added.id) << "Hi-Z keys go back to their defaults: one reference";
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(points[i].technique_reference, added.id) << "point " << i << ": the flat nb query is measured too";
+  EXPECT_EQ(points[6].technique_reference, added.id) << "Hi-Z keys go back to their defaults: one reference";
   EXPECT_EQ(added.role, "reference");
   EXPECT_EQ(added.settings, json::parse(R"({"cull.mode": "nb_hier"})")) << "only what differs is set";
   EXPECT_EQ(added.parameters["nbuffer.resolution_divisor"], 1);
-  EXPECT_EQ(added.culling_reference, added.id);
-  EXPECT_EQ(points[3].culling_reference, added.id);
-  EXPECT_EQ(points[4].culling_reference, added.id) << "the divisor goes back to 1 as well";
-  EXPECT_TRUE(points[5].culling_reference.empty()) << "the trace mode culls nothing";
+  EXPECT_EQ(added.technique_reference, added.id);
+  EXPECT_EQ(points[3].technique_reference, added.id);
+  EXPECT_EQ(points[4].technique_reference, added.id) << "the divisor goes back to 1 as well";
+  EXPECT_TRUE(points[5].technique_reference.empty()) << "the trace mode culls nothing";
   for (const Point& p : points) {
     EXPECT_EQ(p.timing_reference, p.id) << "no timing key in this config: every point is its own";
     EXPECT_EQ(p.role, &p == &added ? "reference" : "sweep");
+    EXPECT_EQ(p.technique, "occlusion_culling") << "a reference point keeps its trace's technique";
+  }
+}
+
+// A trace whose technique declares no results (or names none) has no technique reference: no point
+// is added for it, and the generic timing reference still applies.
+TEST(SweepTest, NoTechniqueReferenceWithoutADeclaration) {
+  const ojson j = ojson::parse(R"({"traces": ["t.nbt"], "points": [{"cull.mode": "nb"}, {"cull.mode": "oq"}]})");
+  const ex::SweepSpec spec = ex::parse_sweep(j, "s");
+  for (const char* technique : {"", "particles_not_declared"}) {
+    std::vector<Point> points = ex::expand(spec);
+    ex::check_points(spec, points, toy_check, "s");
+    for (Point& p : points) p.technique = technique;
+    ex::add_reference_points(points, ex::parameter_keys(spec), toy_check, "s");
+    ASSERT_EQ(points.size(), 2u) << "technique '" << technique << "': no reference point";
+    for (const Point& p : points) {
+      EXPECT_TRUE(p.technique_reference.empty()) << technique;
+      EXPECT_EQ(p.timing_reference, p.id);
+    }
   }
 }
 

@@ -1,0 +1,229 @@
+// The results each technique declares; see results.h. One row per technique.
+#include "pipeline/techniques/results.h"
+
+#include <algorithm>
+
+namespace nbsim::techniques {
+
+namespace {
+
+// Occlusion culling (Décoret 2005, 4.2; ARCHITECTURE.md "Shared definitions"): depth tests per
+// frame against culling efficiency, with false culls as the correctness count (must be 0).
+TechniqueResults occlusion_culling() {
+  TechniqueResults t;
+  t.technique = "occlusion_culling";
+  t.description = "Object (or primitive) culling by depth queries: occlusion queries, N-buffer, Hi-Z";
+  const auto cull = [](const char* key) { return std::string("/summary/cull/") + key; };
+  using K = MetricKind;
+  const auto metric = [](const char* name, const char* unit, const char* description, MetricKind kind, std::string source) {
+    Metric m;
+    m.name = name;
+    m.unit = unit;
+    m.description = description;
+    m.kind = kind;
+    m.source = std::move(source);
+    return m;
+  };
+  Metric false_culls = metric("false_culls", "objects",
+                              "objects culled while visible in the ground truth (ID buffer); 0 for a conservative query", K::Error,
+                              cull("false_culls"));
+  false_culls.must_be_zero = true;
+  Metric nbuffer_memory = metric("nbuffer_memory_bytes", "bytes", "memory of the N-buffer levels", K::Cost, cull("nbuffer_memory_bytes"));
+  nbuffer_memory.section = Section::Memory;
+  Metric structure_memory = metric("structure_memory_bytes", "bytes", "memory of the query structure (N-buffer levels or Hi-Z)",
+                                   K::Cost, cull("structure_memory_bytes"));
+  structure_memory.section = Section::Memory;
+  Metric efficiency_lost = metric("efficiency_lost", "fraction",
+                                  "reference culling_efficiency - the point's (lost to resolution, format, level cap or mode)",
+                                  K::Error, cull("culling_efficiency"));
+  efficiency_lost.derivation = Derivation::ReferenceMinusPoint;
+  efficiency_lost.reference_column = "reference_culling_efficiency";
+  t.metrics = {
+      metric("query_depth_tests_per_frame", "depth tests",
+             "the paper's count: box fragments, or N-buffer/Hi-Z texels compared, per frame", K::Cost,
+             cull("query_depth_tests_per_frame")),
+      metric("update_texels_per_frame", "texels", "N-buffer/Hi-Z texels written to keep the levels up to date, per frame", K::Cost,
+             cull("update_texels_per_frame")),
+      metric("total_depth_tests_per_frame", "depth tests",
+             "query depth tests + update texels + depth tests of the drawn objects, per frame", K::Cost,
+             cull("total_depth_tests_per_frame")),
+      false_culls,
+      metric("culling_efficiency", "fraction", "objects culled / objects not visible", K::Error, cull("culling_efficiency")),
+      metric("culled", "objects", "objects (or primitives) culled, over every frame", K::Outcome, cull("culled")),
+      metric("candidates_not_visible", "objects", "candidates not visible in the ground truth, over every frame", K::Outcome,
+             cull("candidates_not_visible")),
+      metric("max_lookups_per_test", "lookups", "most texel lookups one bounds test made", K::Cost, cull("max_lookups_per_test")),
+      nbuffer_memory,
+      structure_memory,
+      efficiency_lost,
+  };
+  ReferenceSetting r;
+  r.column = "culling_reference";
+  r.description =
+      "nb_hier on the full-resolution float32 N-buffer with every level (Hi-Z keys at their defaults), for a point in "
+      "any culling mode; the trace and none modes cull nothing and have no culling reference";
+  r.settings = {{"cull.mode", "nb_hier"}, {"nbuffer.resolution_divisor", 1}, {"nbuffer.format", "f32"}, {"nbuffer.level_cap", -1}};
+  r.reset_prefixes = {"hiz."};
+  r.skip_key = "cull.mode";
+  r.skip_values = {"trace", "none"};
+  t.reference = std::move(r);
+
+  // Table 2 of Décoret 2005: average depth comparisons per frame, city walkthrough at 512x512 with
+  // back-face culling. The paper's numbers are fixed by the paper; the Hi-Z baselines have none.
+  TableSpec tab;
+  tab.command = "table2";
+  tab.title = "Table 2: average depth comparisons per frame";
+  tab.row_key = "cull.mode";
+  tab.row_column = "mode";
+  tab.paper_label_column = "paper";
+  tab.paper_value_column = "paper_depth_tests_per_frame";
+  tab.section = "/summary/cull";
+  for (const char* k : {"query_depth_tests_per_frame", "update_texels_per_frame", "total_depth_tests_per_frame", "cycles_per_frame",
+                        "false_culls", "culling_efficiency", "frames", "bounds_tests", "candidates", "culled", "candidates_not_visible",
+                        "undrawable", "max_lookups_per_test", "granularity"})
+    tab.columns.emplace_back(k, cull(k));
+  tab.columns.emplace_back("host_seconds", "/summary/host_seconds");
+  // Occlusion queries cannot test per primitive (a query per triangle would rasterize it): with
+  // cull.granularity=primitive their rows run per object, so one setting runs every row.
+  const std::vector<TableRow::Override> object_only = {{"cull.granularity", "primitive", "object"}};
+  tab.rows = {
+      {"oq_hier", "occlusion queries with hierarchy", 1'100'000.0, object_only},
+      {"oq", "occlusion queries", 200'000.0, object_only},
+      {"nb_hier", "N-buffer with hierarchy", 350.0, {}},
+      {"nb", "N-buffer", 500.0, {}},
+      {"hiz_tile", "tile Hi-Z (baseline, not in the paper)", std::nullopt, {}},
+      {"hiz_pyramid", "Hi-Z pyramid (baseline, not in the paper)", std::nullopt, {}},
+  };
+  tab.printed = {
+      {"mode", "mode", 12, CellFormat::Text},
+      {"paper", "paper_depth_tests_per_frame", 12, CellFormat::Paper},
+      {"query tests", "query_depth_tests_per_frame", 14, CellFormat::Fixed1},
+      {"update texels", "update_texels_per_frame", 14, CellFormat::Fixed1},
+      {"total tests", "total_depth_tests_per_frame", 14, CellFormat::Fixed1},
+      {"cycles", "cycles_per_frame", 12, CellFormat::Fixed0},
+      {"false", "false_culls", 6, CellFormat::Count},
+      {"culling", "culling_efficiency", 8, CellFormat::Percent},
+      {"undraw", "undrawable", 7, CellFormat::Count},
+  };
+  tab.ratio = TableSpec::Ratio{"occlusion queries / N-buffer query depth tests", "oq", "nb", "query_depth_tests_per_frame", "400x"};
+  tab.notes = {{"nb_hier", "granularity", "primitive",
+                "cull.granularity=primitive in nb_hier, nb, hiz_tile and hiz_pyramid; oq_hier and oq test objects only"}};
+  tab.must_be_zero = "false_culls";
+  tab.footer =
+      "Modes: oq_hier, oq, nb_hier, nb (the paper's rows), hiz_tile, hiz_pyramid. Query depth tests are the\n"
+      "paper's count (box fragments, or N-buffer/Hi-Z texels compared); the total adds the N-buffer/Hi-Z\n"
+      "update texels and the depth tests of the drawn objects. Exit 1 when any mode has a false cull.";
+  t.table = std::move(tab);
+
+  t.headline_cost = "total_depth_tests_per_frame";
+  t.headline_error = "efficiency_lost";
+  t.fallback_error = "culling_efficiency";
+  t.memory_cost = "nbuffer_memory_bytes";
+  ReportLabels& l = t.report;
+  l.error_axis = "culling efficiency lost vs full-res f32 N-buffer (points of %)";
+  l.error_text = "culling efficiency lost against the full-resolution float32 N-buffer (efficiency_lost)";
+  l.error_column = "efficiency lost (points)";
+  l.fallback_axis = "hidden objects not culled (%, = 1 - culling efficiency)";
+  l.fallback_text = "hidden objects left unculled, 1 - culling efficiency (no efficiency_lost column)";
+  l.fallback_column = "not culled (%)";
+  l.cost_axis = "total depth tests per frame";
+  l.cost_column = "total depth tests/frame";
+  l.cost_pareto = "pareto_depth_tests";
+  l.cost_short = "tests";
+  l.memory_axis = "N-buffer memory (KiB)";
+  l.memory_pareto = "pareto_memory";
+  l.memory_short = "memory";
+  l.quality_column = "culling efficiency";
+  l.must_be_zero = "false culls";
+  l.alike = "culls alike";
+  return t;
+}
+
+}  // namespace
+
+const std::vector<TechniqueResults>& technique_results() {
+  static const std::vector<TechniqueResults> table = {occlusion_culling()};
+  return table;
+}
+
+const TechniqueResults* find_technique_results(std::string_view technique) {
+  for (const auto& t : technique_results())
+    if (t.technique == technique) return &t;
+  return nullptr;
+}
+
+const Metric* find_metric(const TechniqueResults& t, std::string_view name) {
+  const auto it = std::find_if(t.metrics.begin(), t.metrics.end(), [name](const Metric& m) { return m.name == name; });
+  return it == t.metrics.end() ? nullptr : &*it;
+}
+
+std::string_view name_of(MetricKind k) {
+  switch (k) {
+    case MetricKind::Cost: return "cost";
+    case MetricKind::Error: return "error";
+    case MetricKind::Outcome: return "outcome";
+  }
+  return "?";
+}
+
+std::string_view name_of(Section s) { return s == Section::Work ? "work" : "memory"; }
+
+std::string_view name_of(Derivation d) {
+  switch (d) {
+    case Derivation::None: return "none";
+    case Derivation::ReferenceMinusPoint: return "reference_minus_point";
+    case Derivation::PointMinusReference: return "point_minus_reference";
+    case Derivation::RelativeToReference: return "relative_to_reference";
+  }
+  return "?";
+}
+
+nlohmann::ordered_json to_json(const TechniqueResults& t) {
+  nlohmann::ordered_json j;
+  j["technique"] = t.technique;
+  j["description"] = t.description;
+  j["metrics"] = nlohmann::ordered_json::array();
+  for (const Metric& m : t.metrics) {
+    nlohmann::ordered_json e = {{"name", m.name},     {"unit", m.unit},    {"description", m.description},
+                                {"kind", name_of(m.kind)}, {"source", m.source}, {"section", name_of(m.section)},
+                                {"derivation", name_of(m.derivation)}};
+    if (!m.reference_column.empty()) e["reference_column"] = m.reference_column;
+    e["must_be_zero"] = m.must_be_zero;
+    j["metrics"].push_back(std::move(e));
+  }
+  if (t.reference) {
+    j["reference"] = {{"column", t.reference->column},
+                      {"description", t.reference->description},
+                      {"settings", t.reference->settings},
+                      {"reset_prefixes", t.reference->reset_prefixes},
+                      {"skip_key", t.reference->skip_key},
+                      {"skip_values", t.reference->skip_values}};
+  } else {
+    j["reference"] = nullptr;
+  }
+  j["table"] = t.table ? nlohmann::ordered_json(t.table->command) : nlohmann::ordered_json(nullptr);
+  j["headline_cost"] = t.headline_cost;
+  j["headline_error"] = t.headline_error;
+  j["fallback_error"] = t.fallback_error;
+  j["memory_cost"] = t.memory_cost;
+  const ReportLabels& l = t.report;
+  j["report"] = {{"error_axis", l.error_axis},         {"error_text", l.error_text},       {"error_column", l.error_column},
+                 {"fallback_axis", l.fallback_axis},   {"fallback_text", l.fallback_text}, {"fallback_column", l.fallback_column},
+                 {"cost_axis", l.cost_axis},           {"cost_column", l.cost_column},     {"cost_pareto", l.cost_pareto},
+                 {"cost_short", l.cost_short},         {"memory_axis", l.memory_axis},     {"memory_pareto", l.memory_pareto},
+                 {"memory_short", l.memory_short},     {"quality_column", l.quality_column}, {"must_be_zero", l.must_be_zero},
+                 {"alike", l.alike}};
+  return j;
+}
+
+const nlohmann::json* at_pointer(const nlohmann::json& j, const std::string& pointer) {
+  try {
+    const nlohmann::json::json_pointer p(pointer);
+    if (!j.contains(p)) return nullptr;
+    return &j.at(p);
+  } catch (const nlohmann::json::exception&) {
+    return nullptr;  // malformed pointer, or an array index that is not a number
+  }
+}
+
+}  // namespace nbsim::techniques

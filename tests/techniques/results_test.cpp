@@ -1,0 +1,273 @@
+// TechniqueResultsTest: the declaration table of technique results (pipeline/techniques/results.h):
+// every row's metrics have names, units and sources that point into a real run.json, the headlines
+// name declared metrics, the reference setting and table rows are valid config settings; and
+// `nbsim explore` / `nbsim table2` on a trace whose technique declares nothing degrade clearly.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "pipeline/techniques/results.h"
+#include "tests/common/run_nbsim.h"
+#include "traces/format/reader.h"
+#include "traces/format/writer.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace tq = nbsim::techniques;
+using nbsim::testing::CliResult;
+using nbsim::testing::has;
+using nbsim::testing::run_nbsim;
+
+fs::path scratch(const std::string& name) { return nbsim::testing::scratch_path("nbsim_techniques", name); }
+
+const std::string kSample = (fs::path(NBSIM_SAMPLES) / "city_small_oq.nbt").string();
+
+// A copy of `src` whose header's technique property is `technique` (left out when empty): every
+// other property and every record as they are.
+void retag(const fs::path& src, const fs::path& dst, const std::string& technique) {
+  namespace tr = nbsim::trace;
+  tr::TraceReader in(src);
+  tr::Properties props;
+  for (const auto& [k, v] : in.properties())
+    if (k != "technique") props.emplace_back(k, v);
+  if (!technique.empty()) props.emplace_back("technique", technique);
+  tr::TraceWriter out(dst, props);
+  if (in.scene()) out.write(*in.scene());
+  while (const auto chunk = in.next()) {
+    switch (chunk->type) {
+      case tr::ChunkType::FrameBegin: out.begin_frame(in.decode<tr::FrameBegin>(*chunk)); break;
+      case tr::ChunkType::Draw: out.write(in.decode<tr::DrawRecord>(*chunk)); break;
+      case tr::ChunkType::Depth: out.write(in.decode<tr::DepthSnapshot>(*chunk)); break;
+      case tr::ChunkType::Levels: out.write(in.decode<tr::NBufferLevels>(*chunk)); break;
+      case tr::ChunkType::Truth: out.write(in.decode<tr::GroundTruth>(*chunk)); break;
+      case tr::ChunkType::FrameEnd: out.end_frame(in.decode<tr::FrameEnd>(*chunk)); break;
+      default: break;  // HEAD, SCEN (consumed by the reader) and END (written by close)
+    }
+  }
+  out.close();
+}
+
+// The config schema: key -> its entry in `nbsim config --defaults --json`.
+std::map<std::string, nlohmann::json> schema() {
+  const CliResult r = run_nbsim("config --defaults --json");
+  EXPECT_EQ(r.status, 0) << r.err;
+  std::map<std::string, nlohmann::json> keys;
+  for (const auto& e : nlohmann::json::parse(r.out)) keys[e["key"].get<std::string>()] = e;
+  return keys;
+}
+
+std::vector<std::string> csv_header(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> cells;
+  std::string cell;
+  for (const char ch : line) {
+    if (ch == ',') cells.push_back(std::move(cell)), cell.clear();
+    else cell += ch;
+  }
+  cells.push_back(cell);
+  return cells;
+}
+
+bool contains(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+
+// Every row: a unique technique name; every metric a unique name, a unit, a description and a JSON
+// pointer; derived errors name their reference column; headlines name metrics of the right kind.
+TEST(TechniqueResultsTest, EveryRowIsComplete) {
+  ASSERT_FALSE(tq::technique_results().empty());
+  std::set<std::string> techniques;
+  for (const auto& t : tq::technique_results()) {
+    EXPECT_TRUE(techniques.insert(t.technique).second) << t.technique << " has two rows";
+    EXPECT_EQ(tq::find_technique_results(t.technique), &t);
+    EXPECT_FALSE(t.description.empty()) << t.technique;
+    std::set<std::string> names;
+    for (const auto& m : t.metrics) {
+      EXPECT_TRUE(names.insert(m.name).second) << t.technique << ": metric " << m.name << " is declared twice";
+      EXPECT_FALSE(m.name.empty()) << t.technique;
+      EXPECT_FALSE(m.unit.empty()) << t.technique << "." << m.name << " has no unit";
+      EXPECT_FALSE(m.description.empty()) << t.technique << "." << m.name << " has no description";
+      EXPECT_EQ(m.source.rfind("/", 0), 0u) << t.technique << "." << m.name << ": the source is a JSON pointer into run.json";
+      if (m.derivation != tq::Derivation::None) {
+        EXPECT_FALSE(m.reference_column.empty()) << m.name << ": a derived error shows its reference's value";
+        EXPECT_EQ(m.kind, tq::MetricKind::Error) << m.name;
+        EXPECT_TRUE(t.reference.has_value()) << m.name << ": a derived error needs the technique's reference setting";
+      }
+      if (m.must_be_zero) {
+        EXPECT_EQ(m.kind, tq::MetricKind::Error) << m.name << ": a correctness count is an error";
+      }
+    }
+    const auto* cost = tq::find_metric(t, t.headline_cost);
+    ASSERT_NE(cost, nullptr) << t.technique << ": headline cost '" << t.headline_cost << "' is not a metric";
+    EXPECT_EQ(cost->kind, tq::MetricKind::Cost);
+    const auto* error = tq::find_metric(t, t.headline_error);
+    ASSERT_NE(error, nullptr) << t.technique << ": headline error '" << t.headline_error << "' is not a metric";
+    EXPECT_EQ(error->kind, tq::MetricKind::Error);
+    if (!t.fallback_error.empty()) {
+      ASSERT_NE(tq::find_metric(t, t.fallback_error), nullptr) << t.fallback_error;
+      EXPECT_EQ(tq::find_metric(t, t.fallback_error)->unit, "fraction") << "plotted as 1 - value";
+    }
+    if (!t.memory_cost.empty()) {
+      ASSERT_NE(tq::find_metric(t, t.memory_cost), nullptr) << t.memory_cost;
+      EXPECT_EQ(tq::find_metric(t, t.memory_cost)->unit, "bytes");
+    }
+    if (t.table) {
+      EXPECT_FALSE(t.table->rows.empty()) << t.technique;
+      std::set<std::string> columns = {t.table->row_column, t.table->paper_label_column, t.table->paper_value_column};
+      for (const auto& [name, pointer] : t.table->columns) {
+        EXPECT_EQ(pointer.rfind("/", 0), 0u) << name;
+        columns.insert(name);
+      }
+      for (const auto& c : t.table->printed) {
+        EXPECT_TRUE(columns.count(c.column)) << "printed column " << c.column << " is not in the table";
+      }
+      if (!t.table->must_be_zero.empty()) {
+        EXPECT_TRUE(columns.count(t.table->must_be_zero));
+      }
+      const auto row = [&](const std::string& v) {
+        return std::any_of(t.table->rows.begin(), t.table->rows.end(), [&](const tq::TableRow& r) { return r.value == v; });
+      };
+      if (t.table->ratio) {
+        EXPECT_TRUE(row(t.table->ratio->numerator) && row(t.table->ratio->denominator)) << "the ratio's rows exist";
+      }
+      for (const auto& n : t.table->notes) EXPECT_TRUE(row(n.row)) << n.row;
+    }
+    const auto j = tq::to_json(t);
+    EXPECT_EQ(j["metrics"].size(), t.metrics.size());
+    EXPECT_EQ(j["headline_error"], t.headline_error);
+  }
+  EXPECT_EQ(tq::find_technique_results("no_such_technique"), nullptr);
+  EXPECT_EQ(tq::find_technique_results(""), nullptr);
+}
+
+// The reference settings, the table's row key with every row value and the row overrides are keys
+// of the config schema, and the whole reference setting is accepted by the real config check
+// (explore --dry-run validates every point before anything runs).
+TEST(TechniqueResultsTest, ReferenceSettingParsesAgainstTheConfigSchema) {
+  const auto keys = schema();
+  ASSERT_FALSE(keys.empty());
+  int n = 0;
+  for (const auto& t : tq::technique_results()) {
+    nlohmann::json points = nlohmann::json::array();
+    if (t.reference) {
+      for (const auto& [k, v] : t.reference->settings.items()) EXPECT_TRUE(keys.count(k)) << t.technique << ": reference key " << k;
+      for (const auto& prefix : t.reference->reset_prefixes)
+        EXPECT_TRUE(std::any_of(keys.begin(), keys.end(), [&](const auto& e) { return e.first.rfind(prefix, 0) == 0; })) << prefix;
+      if (!t.reference->skip_key.empty()) {
+        EXPECT_TRUE(keys.count(t.reference->skip_key)) << t.reference->skip_key;
+      }
+      points.push_back(t.reference->settings);
+    }
+    if (t.table) {
+      EXPECT_TRUE(keys.count(t.table->row_key)) << t.table->row_key;
+      for (const auto& r : t.table->rows) {
+        nlohmann::json p = {{t.table->row_key, r.value}};
+        for (const auto& o : r.overrides) {
+          EXPECT_TRUE(keys.count(o.key)) << o.key;
+          p[o.key] = o.set;
+        }
+        points.push_back(p);
+      }
+    }
+    if (points.empty()) continue;
+    const fs::path sweep = scratch("schema_" + std::to_string(n) + ".json");
+    std::ofstream(sweep) << nlohmann::json{{"traces", {kSample}}, {"points", points}}.dump(2);
+    const CliResult r = run_nbsim("explore " + sweep.string() + " --dry-run --out " + scratch("schema_out_" + std::to_string(n++)).string());
+    EXPECT_EQ(r.status, 0) << t.technique << ": " << r.err;
+  }
+}
+
+// Every declared source points at a value in a real run.json of the technique (the sample trace,
+// nb_hier), and so does every column of its table.
+TEST(TechniqueResultsTest, SourcesPointIntoARealRun) {
+  const auto* t = tq::find_technique_results("occlusion_culling");
+  ASSERT_NE(t, nullptr);
+  const fs::path out = scratch("run");
+  const CliResult r = run_nbsim("replay " + kSample + " --out " + out.string() + " --set cull.mode=nb_hier");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto run = nlohmann::json::parse(std::ifstream(out / "run.json"));
+  EXPECT_EQ(run["trace_properties"]["technique"], "occlusion_culling") << "the sample is an occlusion-culling trace";
+  for (const auto& m : t->metrics) EXPECT_NE(tq::at_pointer(run, m.source), nullptr) << m.name << ": " << m.source << " is not in run.json";
+  ASSERT_TRUE(t->table.has_value());
+  EXPECT_NE(tq::at_pointer(run, t->table->section), nullptr);
+  for (const auto& [name, pointer] : t->table->columns) EXPECT_NE(tq::at_pointer(run, pointer), nullptr) << name << ": " << pointer;
+  EXPECT_EQ(tq::at_pointer(run, "/summary/no_such_key"), nullptr);
+  EXPECT_EQ(tq::at_pointer(run, "not a pointer"), nullptr) << "a malformed pointer finds nothing";
+}
+
+// A trace whose technique declares no results, and one with no technique at all: explore runs them
+// with the generic columns only and says so; mixed with an occlusion-culling trace, only that
+// trace's rows fill the culling columns. table2 refuses both with exit 2.
+TEST(TechniqueResultsTest, UndeclaredTechniquesDegradeClearly) {
+  const fs::path unknown = scratch("unknown.nbt"), none = scratch("none.nbt");
+  retag(kSample, unknown, "particles_not_declared");
+  retag(kSample, none, "");
+  const nlohmann::json points = {{{"gpu.quantum_cycles", 0}}};
+
+  const fs::path out = scratch("unknown_out");
+  std::ofstream(scratch("unknown.json")) << nlohmann::json{{"traces", {unknown.string()}}, {"points", points}}.dump();
+  CliResult r = run_nbsim("explore " + scratch("unknown.json").string() + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "technique 'particles_not_declared' declares no results")) << r.err;
+  auto header = csv_header(out / "results.csv");
+  for (const char* c : {"frames", "cycles_per_frame", "counter_error", "cycle_error", "memory_bytes_per_frame"})
+    EXPECT_TRUE(contains(header, c)) << "generic column " << c;
+  for (const char* c : {"culling_efficiency", "efficiency_lost", "culling_reference", "false_culls"})
+    EXPECT_FALSE(contains(header, c)) << c << " belongs to occlusion culling";
+  const auto tr = nlohmann::json::parse(std::ifstream(out / "technique_results.json"));
+  EXPECT_TRUE(tr["techniques"].empty());
+  EXPECT_EQ(tr["traces"][unknown.string()], "particles_not_declared");
+  ASSERT_EQ(tr["notes"].size(), 1u);
+
+  std::vector<std::string> lines;
+  {
+    std::ifstream csv(out / "results.csv");
+    for (std::string line; std::getline(csv, line);) lines.push_back(line);
+  }
+  EXPECT_EQ(lines.size(), 2u) << "one point, no technique reference point added for it";
+
+  // Mixed with the occlusion-culling sample (culling there): its row has a culling reference, the
+  // trace without a technique has none and adds no reference point.
+  const fs::path mixed = scratch("mixed_out");
+  const nlohmann::json mixed_points = {{{"trace", none.string()}}, {{"trace", kSample}, {"cull.mode", "nb"}}};
+  std::ofstream(scratch("mixed.json")) << nlohmann::json{{"traces", {none.string(), kSample}}, {"points", mixed_points}}.dump();
+  r = run_nbsim("explore " + scratch("mixed.json").string() + " --out " + mixed.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "names no technique in its header")) << r.err;
+  EXPECT_TRUE(has(r.out, "3 points (1 of them references)")) << "only the sample's nb point gets a culling reference: " << r.out;
+  header = csv_header(mixed / "results.csv");
+  EXPECT_TRUE(contains(header, "culling_efficiency") && contains(header, "efficiency_lost")) << "the sample's technique declares them";
+  std::ifstream csv(mixed / "results.csv");
+  std::string line;
+  std::getline(csv, line);
+  const auto col = static_cast<std::size_t>(std::find(header.begin(), header.end(), "culling_reference") - header.begin());
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    std::string cell;
+    for (const char ch : line) {
+      if (ch == ',') cells.push_back(std::move(cell)), cell.clear();
+      else cell += ch;
+    }
+    cells.push_back(cell);
+    ASSERT_EQ(cells.size(), header.size());
+    EXPECT_EQ(cells[col].empty(), !has(line, kSample)) << "only occlusion-culling rows have a culling reference: " << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 3);
+
+  for (const auto& [trace, message] : {std::pair{unknown, "declares no Table-2 rows"}, std::pair{none, "names no technique"}}) {
+    r = run_nbsim("table2 " + trace.string());
+    EXPECT_EQ(r.status, 2) << r.out << r.err;
+    EXPECT_TRUE(has(r.err, message)) << r.err;
+  }
+}
+
+}  // namespace
