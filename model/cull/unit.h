@@ -16,25 +16,25 @@
 // It listens to the depth unit (clears, dirty rectangles, draw results) and passes the changes of
 // the occluder draws on to its query structure. What it did is in its statistics (the only result
 // channel: per frame, they are final when the frame's FrameEnd leaves the depth unit, because the
-// next frame's tests wait for that) and, when asked, in a log of every bounds test (culls.csv). The query structure (model/query/structure.h) is a
-// separate unit that the top level builds for the mode and hands over.
+// next frame's tests wait for that) and, when asked, in a log of every bounds test (culls.csv).
+// The query structure (model/query/structure.h) is a separate unit that the top level builds for
+// the mode and hands over.
 #pragma once
 
 #include <memory>
-#include <ostream>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <unordered_map>
 
 #include "model/config/schema.h"
 #include "model/cp/unit.h"
-#include "model/cull/report.h"
-#include "model/cull/primitive.h"
-#include "model/depth/unit.h"
 #include "model/cull/false_cull_check.h"
+#include "model/cull/primitive.h"
+#include "model/cull/report.h"
+#include "model/depth/unit.h"
 #include "model/query/structure.h"
 #include "model/raster/primitive_tester.h"
-#include "model/raster/rasterizer.h"
 
 namespace nbsim::cull {
 
