@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -264,6 +265,27 @@ TEST(ExploreCliTest, SweepSizeLimited) {
   r = run_nbsim("explore " + f.string() + " --dry-run --max-points 3 --out " + scratch("three_ok").string());
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(has(r.out, "explore: 3 points")) << r.out;
+}
+
+// A JSON library exception on the user's files (here a resumed point's run.json with a string where
+// a number belongs) exits 2 with its message and the file, never 1, and leaves no partial results.csv.
+TEST(ExploreCliTest, JsonLibraryErrorExits2) {
+  const nlohmann::json sweep = {{"traces", {kSample}}, {"points", {{{"cull.mode", "nb_hier"}}}}};
+  const fs::path f = write_sweep("tampered.json", sweep), out = scratch("tampered_out");
+  CliResult r = run_nbsim("explore " + f.string() + " --dry-run --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  int points = 0;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line) && line.rfind("explore:", 0) != 0; ++points) {
+    const fs::path dir = out / "points" / line.substr(0, line.find(' '));
+    fs::create_directories(dir);
+    std::ofstream(dir / "run.json") << R"({"summary": {"frames": 8, "cycles": "many"}})";
+  }
+  ASSERT_GT(points, 0) << r.out;
+  r = run_nbsim("explore " + f.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "run.json: [json.exception.type_error.302]")) << "the message names the file: " << r.err;
+  EXPECT_FALSE(fs::exists(out / "results.csv")) << "no partial results.csv";
 }
 
 // Every sample sweep in pipeline/sweeps/ is valid (real keys, real traces): --dry-run runs nothing.
