@@ -3,11 +3,11 @@
 
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <system_error>
 #include <vector>
-#include <filesystem>
 
 #include "model/common/error.h"
 

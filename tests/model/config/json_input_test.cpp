@@ -3,11 +3,11 @@
 #include "model/config/json_input.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "model/common/error.h"
 
@@ -107,6 +107,16 @@ TEST(JsonInputTest, ReadsWholeFilesOnly) {
   std::ofstream(dir / "nul.json", std::ios::binary) << bytes;
   EXPECT_EQ(read_input_file((dir / "nul.json").string(), "config file"), bytes) << "read whole, past the NUL";
   fs::remove_all(dir);
+}
+
+// A file or device larger than the limit is refused after reading just past the limit, not read to its end.
+TEST(JsonInputTest, FileSizeLimited) {
+  try {
+    read_input_file("/dev/zero", "config file");
+    ADD_FAILURE() << "an endless device was read";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(has(e.what(), "is larger than 64 MiB (the limit)")) << e.what();
+  }
 }
 
 }  // namespace
