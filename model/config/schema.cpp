@@ -8,10 +8,17 @@
 #include <cmath>
 
 #include "model/common/error.h"
+#include "model/config/json_input.h"
 
 namespace nbsim::config {
 
 namespace {
+
+// Tunable. Longest key an unknown key is compared with for a "did you mean" hint: declared keys
+// are under 64 characters, and the edit distance below is quadratic in the lengths.
+constexpr std::size_t kMaxHintKeyChars = 256;
+// Hints are given only for keys this close (edit distance below it).
+constexpr std::size_t kHintDistance = 4;
 
 // Edit distance, for "did you mean" hints on unknown keys.
 std::size_t distance(const std::string& a, const std::string& b) {
@@ -42,9 +49,9 @@ void Schema::add(const std::string& key, int& field, const std::string& unit, co
   Entry e{key, "int", unit, fmt::format("{} to {}", min, max), description, {}, {}, {}};
   e.set = [&field, key, min, max](const nlohmann::json& v, const std::string& origin) {
     if (!v.is_number_integer() && !(v.is_number_float() && std::floor(v.get<double>()) == v.get<double>()))
-      throw InputError(fmt::format("{}: {} must be an integer, got {}", origin, key, v.dump()));
+      throw InputError(fmt::format("{}: {} must be an integer, got {}", origin, key, excerpt(v)));
     const double d = v.get<double>();
-    if (d < min || d > max) throw InputError(fmt::format("{}: {} = {} is outside its limits {} to {}", origin, key, v.dump(), min, max));
+    if (d < min || d > max) throw InputError(fmt::format("{}: {} = {} is outside its limits {} to {}", origin, key, excerpt(v), min, max));
     field = static_cast<int>(d);
   };
   e.get = [&field] { return nlohmann::ordered_json(field); };
@@ -54,10 +61,10 @@ void Schema::add(const std::string& key, int& field, const std::string& unit, co
 void Schema::add(const std::string& key, double& field, const std::string& unit, const std::string& description, double min, double max) {
   Entry e{key, "float", unit, fmt::format("{} to {}", min, max), description, {}, {}, {}};
   e.set = [&field, key, min, max](const nlohmann::json& v, const std::string& origin) {
-    if (!v.is_number()) throw InputError(fmt::format("{}: {} must be a number, got {}", origin, key, v.dump()));
+    if (!v.is_number()) throw InputError(fmt::format("{}: {} must be a number, got {}", origin, key, excerpt(v)));
     const double d = v.get<double>();
     if (!std::isfinite(d) || d < min || d > max)
-      throw InputError(fmt::format("{}: {} = {} is outside its limits {} to {}", origin, key, v.dump(), min, max));
+      throw InputError(fmt::format("{}: {} = {} is outside its limits {} to {}", origin, key, excerpt(v), min, max));
     field = d;
   };
   e.get = [&field] { return nlohmann::ordered_json(field); };
@@ -67,7 +74,7 @@ void Schema::add(const std::string& key, double& field, const std::string& unit,
 void Schema::add(const std::string& key, bool& field, const std::string& description) {
   Entry e{key, "bool", "", "true or false", description, {}, {}, {}};
   e.set = [&field, key](const nlohmann::json& v, const std::string& origin) {
-    if (!v.is_boolean()) throw InputError(fmt::format("{}: {} must be true or false, got {}", origin, key, v.dump()));
+    if (!v.is_boolean()) throw InputError(fmt::format("{}: {} must be true or false, got {}", origin, key, excerpt(v)));
     field = v.get<bool>();
   };
   e.get = [&field] { return nlohmann::ordered_json(field); };
@@ -80,7 +87,7 @@ void Schema::add(const std::string& key, std::string& field, const std::string& 
   Entry e{key, "enum", "", all, description, {}, {}, {}};
   e.set = [&field, key, labels, all](const nlohmann::json& v, const std::string& origin) {
     if (!v.is_string() || std::find(labels.begin(), labels.end(), v.get<std::string>()) == labels.end())
-      throw InputError(fmt::format("{}: {} must be one of {}, got {}", origin, key, all, v.dump()));
+      throw InputError(fmt::format("{}: {} must be one of {}, got {}", origin, key, all, excerpt(v)));
     field = v.get<std::string>();
   };
   e.get = [&field] { return nlohmann::ordered_json(field); };
@@ -105,12 +112,16 @@ void Schema::unknown(const std::string& key, const std::string& origin) const {
     if (key == old_key)
       throw InputError(fmt::format("{}: config key '{}' is now '{}' (same meaning and limits)", origin, key, new_key));
   const Entry* best = nullptr;
-  std::size_t best_d = 4;  // suggest only close matches
-  for (const auto& e : entries_) {
-    const std::size_t d = distance(key, e.key);
-    if (d < best_d) best_d = d, best = &e;
-  }
-  throw InputError(fmt::format("{}: unknown config key '{}'{} (nbsim config --defaults lists every key)", origin, key,
+  std::size_t best_d = kHintDistance;  // suggest only close matches
+  if (key.size() <= kMaxHintKeyChars)
+    for (const auto& e : entries_) {
+      // The length difference bounds the distance from below: skip keys that cannot be close.
+      const std::size_t gap = key.size() > e.key.size() ? key.size() - e.key.size() : e.key.size() - key.size();
+      if (gap >= best_d) continue;
+      const std::size_t d = distance(key, e.key);
+      if (d < best_d) best_d = d, best = &e;
+    }
+  throw InputError(fmt::format("{}: unknown config key '{}'{} (nbsim config --defaults lists every key)", origin, excerpt_text(key),
                                best ? fmt::format("; did you mean '{}'?", best->key) : ""));
 }
 
@@ -133,9 +144,12 @@ void Schema::apply(const nlohmann::json& config, const std::string& origin) {
 }
 
 void Schema::set(const std::string& assignment) {
+  if (std::size_t bad = 0; !valid_utf8(assignment, &bad))
+    throw InputError(fmt::format("--set: the argument is not valid UTF-8 (byte 0x{:02x} at offset {}, after '{}')",
+                                 static_cast<unsigned char>(assignment[bad]), bad, excerpt_text(std::string_view(assignment).substr(0, bad))));
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
-    throw InputError(fmt::format("--set '{}': expected unit.field=value", assignment));
+    throw InputError(fmt::format("--set '{}': expected unit.field=value", excerpt_text(assignment)));
   const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
   const Entry* e = find(key);
   if (!e) unknown(key, "--set");
@@ -143,8 +157,11 @@ void Schema::set(const std::string& assignment) {
   if (e->type == "enum") {
     v = text;
   } else {
-    v = nlohmann::json::parse(text, nullptr, false);
-    if (v.is_discarded()) throw InputError(fmt::format("--set {}: '{}' is not a valid {} value", key, text, e->type));
+    // accept() checks the syntax without building a value; parse_input then applies the limits
+    // (nesting depth, repeated keys) before anything walks the value.
+    if (!nlohmann::json::accept(text))
+      throw InputError(fmt::format("--set {}: '{}' is not a valid {} value", key, excerpt_text(text), e->type));
+    v = parse_input(text, fmt::format("--set {}: the value", key));
   }
   e->set(v, "--set");
 }

@@ -6,12 +6,14 @@
 
 #include <chrono>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
 #include <thread>
 
 #include "model/common/error.h"
+#include "model/config/json_input.h"
 #include "pipeline/cli/command.h"
 #include "pipeline/cli/progress.h"
 #include "pipeline/explore/child.h"
@@ -49,17 +51,16 @@ struct ExploreOptions {
   std::string sweep, out;
   int jobs = 0;
   bool dry_run = false;
+  std::uint64_t max_points = explore::kDefaultMaxSweepPoints;
 };
 
 int run_explore(const ExploreOptions& o) {
   const auto start = std::chrono::steady_clock::now();
-  std::ifstream in(o.sweep);
-  if (!in) throw InputError(fmt::format("sweep file '{}' cannot be read", o.sweep));
-  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(in, nullptr, false, true);
-  if (j.is_discarded()) throw InputError(fmt::format("sweep file '{}' is not valid JSON", o.sweep));
+  const std::string text = config::read_input_file(o.sweep, "sweep file");
+  const nlohmann::ordered_json j = config::parse_input_ordered(text, fmt::format("sweep file '{}'", config::excerpt_text(o.sweep, 1024)), true);
 
   // Everything is checked before the first child starts.
-  const explore::SweepSpec spec = explore::parse_sweep(j, o.sweep);
+  const explore::SweepSpec spec = explore::parse_sweep(j, o.sweep, o.max_points);
   std::map<std::string, explore::TraceFile> traces;
   for (const auto& t : spec.traces) {
     try {
@@ -126,6 +127,11 @@ void add_explore_command(CLI::App& app, Action& action) {
   cmd->add_option("--jobs", o->jobs, "Replays run at a time, one process each (default: the number of cores)")
       ->check(CLI::Range(1, 1024));
   cmd->add_flag("--dry-run", o->dry_run, "Validate and expand the sweep, write sweep.json and list the points; run nothing");
+  cmd->add_option("--max-points", o->max_points,
+                  "Refuse a sweep of more points than this (traces x axis sizes, or listed points x traces; reference "
+                  "points not counted)")
+      ->check(CLI::Range(std::uint64_t{1}, std::numeric_limits<std::uint64_t>::max()))
+      ->capture_default_str();
   cmd->footer("Sweep file: {\"traces\": [...], \"set\": {key: value}, \"axes\": {key: [values]}} (every combination)\n"
               "or {\"traces\": [...], \"points\": [{key: value, \"trace\": optional}, ...]}; keys as `nbsim config\n"
               "--defaults` lists them. Exit 0 when every point ran, 1 when some failed (see results.csv), 2 on a bad sweep.\n"

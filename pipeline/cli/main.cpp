@@ -1,6 +1,7 @@
 // nbsim: the one command-line entry point. Wires the subcommand modules and maps failures to exit
 // statuses (0 success, 2 bad usage or bad input, 1 other failures).
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <charconv>
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "model/common/error.h"
+#include "model/config/json_input.h"
 #include "pipeline/cli/command.h"
 
 namespace nbsim::cli {
@@ -111,6 +113,12 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::fflush(stdout);
     std::fprintf(stderr, "nbsim: error: %s\n", e.what());
+    return 2;
+  } catch (const nlohmann::json::exception& e) {
+    // The JSON nbsim reads is the user's (configs, sweeps, run outputs given back to it): a value
+    // the JSON library refuses is bad input, never an internal failure. The message is cut.
+    std::fflush(stdout);
+    std::fprintf(stderr, "nbsim: error: bad JSON input: %s\n", nbsim::config::excerpt_text(e.what(), 400).c_str());
     return 2;
   } catch (const std::exception& e) {
     std::fflush(stdout);

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "model/common/error.h"
+#include "model/config/json_input.h"
 #include "pipeline/cli/command.h"
 #include "pipeline/cli/progress.h"
 #include "pipeline/explore/child.h"
@@ -39,11 +40,8 @@ struct ModelOptions {
     config::Schema schema;
     pipeline::GpuConfig::describe(schema, c);
     if (!config_file.empty()) {
-      std::ifstream in(config_file);
-      if (!in) throw InputError(fmt::format("config file '{}' cannot be read", config_file));
-      const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-      if (j.is_discarded()) throw InputError(fmt::format("config file '{}' is not valid JSON", config_file));
-      schema.apply(j, config_file);
+      const std::string text = config::read_input_file(config_file, "config file");
+      schema.apply(config::parse_input(text, fmt::format("config file '{}'", config::excerpt_text(config_file, 1024))), config_file);
     }
     for (const auto& s : sets) schema.set(s);
     values = schema.values();
@@ -325,8 +323,10 @@ void add_model_commands(CLI::App& app, Action& action) {
     auto json = std::make_shared<bool>(false);
     cmd->add_flag("--defaults", *defaults, "List the defaults (the only listing there is today)");
     cmd->add_flag("--json", *json, "As a JSON array");
-    cmd->callback([&action, json] {
-      action = [json] {
+    // Every option's storage is captured by the callback: it must outlive this set-up function,
+    // since CLI11 writes into it while parsing.
+    cmd->callback([&action, defaults, json] {
+      action = [defaults, json] {
         pipeline::GpuConfig c;
         config::Schema schema;
         pipeline::GpuConfig::describe(schema, c);

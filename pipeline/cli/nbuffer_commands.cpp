@@ -24,6 +24,15 @@ namespace {
 namespace fs = std::filesystem;
 using ojson = nlohmann::ordered_json;
 
+// Tunable. Largest side of the built-in scene (query and build): a full N-buffer of WxH has
+// ceil(log2(max(W, H))) float levels of W x H, so 4096x4096 holds 12 x 64 MiB = 768 MiB (Table 1's
+// largest size is 1024x1024).
+constexpr int kMaxSceneSide = 4096;
+// Tunable. Largest box side of `coverage` (each box size is one CSV row: 4096x4096 is 16.7 M rows,
+// about 0.6 GB of CSV) and the most pixels of its image (64 M pixels: 192 MiB of RGB).
+constexpr int kMaxCoverageSide = 4096;
+constexpr long long kMaxCoveragePixels = 64LL << 20;
+
 // Where the depth comes from: a file, or the built-in scene.
 struct DepthSource {
   std::string file;
@@ -35,7 +44,8 @@ struct DepthSource {
     auto* f = cmd->add_option("--depth", file, "Single-channel float depth image (EXR, TIFF, PFM, ...), values in [0,1], y up");
     auto* s = cmd->add_option("--scene", scene, "Built-in depth scene instead of a file")->check(CLI::IsMember({"city"}));
     f->excludes(s);
-    cmd->add_option("--size", size, "Size of the built-in scene, WxH")->capture_default_str();
+    cmd->add_option("--size", size, fmt::format("Size of the built-in scene, WxH, each side at most {}", kMaxSceneSide))
+        ->capture_default_str();
     cmd->add_option("--seed", seed, "Seed of the built-in scene")->capture_default_str();
   }
 
@@ -43,6 +53,8 @@ struct DepthSource {
     if (!file.empty()) return io::read_depth(file);
     if (scene.empty()) throw InputError("no depth given: pass --depth FILE or --scene city");
     const auto [w, h] = parse_size(size, "--size");
+    if (w > kMaxSceneSide || h > kMaxSceneSide)
+      throw InputError(fmt::format("--size {} is too large: the built-in scene is at most {}x{}", size, kMaxSceneSide, kMaxSceneSide));
     return scenes::city_depth(w, h, seed);
   }
 };
@@ -142,8 +154,16 @@ std::array<std::uint8_t, 3> colour(double t) {
 
 int run_coverage(const std::string& size, const fs::path& png, fs::path csv, int scale) {
   const auto [bw, bh] = parse_size(size, "--size");
-  if (static_cast<long long>(bw) * bh > 4096LL * 4096LL)
-    throw InputError(fmt::format("--size {} is too large: at most 4096x4096 box sizes", size));
+  if (bw > kMaxCoverageSide || bh > kMaxCoverageSide)
+    throw InputError(fmt::format("--size {} is too large: at most {}x{} box sizes", size, kMaxCoverageSide, kMaxCoverageSide));
+  // The image's size, checked before anything is written: two panels of (box sizes x scale) pixels,
+  // a gap and a colour ramp.
+  if (scale < 1) scale = std::max(1, 512 / std::max(bw, bh));
+  const int gap = 8 * scale, pw = bw * scale, ph = bh * scale, ramp = std::max(12, ph / 16);
+  const int iw = 2 * pw + gap, ih = ph + gap + ramp;
+  if (static_cast<long long>(iw) * ih > kMaxCoveragePixels)
+    throw InputError(fmt::format("--size {} with --scale {} makes a {}x{} image: at most {} M pixels (lower --scale)", size, scale, iw,
+                                 ih, kMaxCoveragePixels >> 20));
   if (csv.empty()) csv = fs::path(png).replace_extension(".csv");
   // Box sizes never exceed the image, so the covering never clamps: use an unbounded top level.
   const int top = 30;
@@ -174,9 +194,6 @@ int run_coverage(const std::string& size, const fs::path& png, fs::path csv, int
   // ramp. Colour = log2(1 + extra / area), scaled by the largest value of both panels.
   const double vmax = std::log2(1.0 + std::max(*std::max_element(one_ratio.begin(), one_ratio.end()),
                                                *std::max_element(four_ratio.begin(), four_ratio.end())));
-  if (scale < 1) scale = std::max(1, 512 / std::max(bw, bh));
-  const int gap = 8 * scale, pw = bw * scale, ph = bh * scale, ramp = std::max(12, ph / 16);
-  const int iw = 2 * pw + gap, ih = ph + gap + ramp;
   std::vector<std::uint8_t> rgb(static_cast<std::size_t>(iw) * ih * 3, 255);
   auto put = [&](int x, int y, std::array<std::uint8_t, 3> c) {
     std::copy(c.begin(), c.end(), rgb.begin() + 3 * (static_cast<std::ptrdiff_t>(y) * iw + x));
@@ -248,10 +265,15 @@ void add_nbuffer_commands(CLI::App& app, Action& action) {
     auto out = std::make_shared<std::string>();
     auto csv = std::make_shared<std::string>();
     auto scale = std::make_shared<int>(0);
-    cmd->add_option("--size", *size, "Largest box, WxH: every box from 1x1 to WxH is covered")->capture_default_str();
+    cmd->add_option("--size", *size,
+                    fmt::format("Largest box, WxH: every box from 1x1 to WxH is covered; each side at most {}", kMaxCoverageSide))
+        ->capture_default_str();
     cmd->add_option("--out", *out, "False-colour image (PNG or any format OpenImageIO writes)")->required();
     cmd->add_option("--csv", *csv, "CSV of the same numbers (default: the image path with .csv)");
-    cmd->add_option("--scale", *scale, "Pixels per box size in the image (default: fit about 512 px)")->check(CLI::Range(0, 16));
+    cmd->add_option("--scale", *scale,
+                    fmt::format("Pixels per box size in the image (default: fit about 512 px); the image is at most {} M pixels",
+                                kMaxCoveragePixels >> 20))
+        ->check(CLI::Range(0, 16));
     cmd->callback([&action, size, out, csv, scale] { action = [=] { return run_coverage(*size, *out, *csv, *scale); }; });
   }
 }

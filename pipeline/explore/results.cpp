@@ -7,7 +7,10 @@
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <sstream>
 
+#include "model/common/error.h"
+#include "model/config/json_input.h"
 #include "pipeline/explore/child.h"
 
 namespace nbsim::explore {
@@ -142,8 +145,8 @@ std::string csv_field(const std::string& text) {
 void write_results_csv(const fs::path& file, const fs::path& out, const std::vector<Point>& points,
                        const std::vector<std::string>& parameters, const std::map<std::string, TraceFile>& traces,
                        const std::string& version) {
-  std::ofstream csv(file);
-  if (!csv) throw std::runtime_error(fmt::format("cannot write {}", file.string()));
+  // The file is written only when whole: a run.json that cannot be read leaves no partial results.csv.
+  std::ostringstream csv;
   // Every finished run first: the error columns compare a point with its reference points.
   std::map<std::string, nlohmann::json> runs;
   for (const Point& p : points)
@@ -194,9 +197,14 @@ void write_results_csv(const fs::path& file, const fs::path& out, const std::vec
     if (run) {
       row.push_back("ok");
       const techniques::TechniqueResults* t = techniques::find_technique_results(p.technique);
-      auto m = generic_metrics_of(*run);
-      if (t) technique_metrics_of(*run, *t, m);
-      errors(p, t, m);
+      std::map<std::string, std::string> m;
+      try {
+        m = generic_metrics_of(*run);
+        if (t) technique_metrics_of(*run, *t, m);
+        errors(p, t, m);
+      } catch (const nlohmann::json::exception& e) {  // a run.json edited or damaged since its run
+        throw InputError(fmt::format("{}: {}", (dir / "run.json").string(), config::excerpt_text(e.what())));
+      }
       for (const auto& c : columns) row.push_back(m.count(c) ? m.at(c) : "");
       row.emplace_back();
     } else {
@@ -208,7 +216,9 @@ void write_results_csv(const fs::path& file, const fs::path& out, const std::vec
     for (std::size_t i = 0; i < row.size(); ++i) csv << (i ? "," : "") << csv_field(row[i]);
     csv << '\n';
   }
-  if (!csv) throw std::runtime_error(fmt::format("cannot write {}", file.string()));
+  std::ofstream f(file);
+  f << csv.str();
+  if (!f) throw std::runtime_error(fmt::format("cannot write {}", file.string()));
 }
 
 void write_sweep_json(const fs::path& file, const std::string& sweep_file, const SweepSpec& spec, const std::vector<Point>& points,

@@ -32,9 +32,8 @@ TraceFile inspect_trace(const std::string& as_written) {
   try {
     const trace::TraceReader reader(p);
     if (const std::string* technique = reader.property("technique")) t.technique = *technique;
-  } catch (const std::exception& e) {  // InputError, or a read error: the replay will say more
-    t.note = fmt::format("trace '{}': its header cannot be read ({}): generic columns only", as_written, e.what());
-    return t;
+  } catch (const std::exception& e) {  // InputError, or a read error: every point would fail
+    throw InputError(fmt::format("trace '{}' cannot be opened as a trace: {}", as_written, e.what()));
   }
   if (t.technique.empty())
     t.note = fmt::format("trace '{}' names no technique in its header: results.csv has the generic columns only for it", as_written);

@@ -19,16 +19,17 @@ namespace nbsim::explore {
 struct TraceFile {
   std::filesystem::path path;  // absolute
   std::string crc32;
-  std::string technique;  // the header's `technique` property; "" when absent or unreadable
+  std::string technique;  // the header's `technique` property; "" when absent
   // Why the trace's results have the generic columns only ("" when its technique declares its
-  // results): no technique property, a technique without a row in pipeline/techniques/results.cpp,
-  // or a header that cannot be read (its replay then fails and says why).
+  // results): no technique property, or a technique without a row in pipeline/techniques/results.cpp.
   std::string note;
 };
 
 // Resolves a trace named in a sweep (relative: from the current directory), checksums it and
-// reads its technique; throws InputError when it does not exist or cannot be read. A damaged
-// header is not refused here (the note says so): its points fail one by one in results.csv.
+// reads its technique; throws InputError naming the file when it does not exist, cannot be read,
+// or cannot be opened as a trace (TraceReader: preamble, header and scene), so that a sweep over
+// a file that is not a trace is refused before any point runs. Damage after the header is found
+// by the replay: its points fail one by one in results.csv.
 TraceFile inspect_trace(const std::string& as_written);
 
 struct RunOptions {

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "model/common/error.h"
+#include "model/config/json_input.h"
 #include "pipeline/techniques/results.h"
 
 namespace nbsim::explore {
@@ -21,7 +22,7 @@ nlohmann::ordered_json flatten(const nlohmann::ordered_json& j, const std::strin
   nlohmann::ordered_json flat = nlohmann::ordered_json::object();
   const auto put = [&](const std::string& key, const nlohmann::ordered_json& v) {
     if (v.is_object() || v.is_array() || v.is_null())
-      throw InputError(fmt::format("{}: {} must be a single value, got {}", where, key, v.dump()));
+      throw InputError(fmt::format("{}: {} must be a single value, got {}", where, key, config::excerpt(v)));
     if (flat.contains(key)) throw InputError(fmt::format("{}: {} is given twice", where, key));
     flat[key] = v;
   };
@@ -58,7 +59,7 @@ nlohmann::json sorted(const nlohmann::ordered_json& v) { return nlohmann::json::
 
 }  // namespace
 
-SweepSpec parse_sweep(const nlohmann::ordered_json& j, const std::string& origin) {
+SweepSpec parse_sweep(const nlohmann::ordered_json& j, const std::string& origin, std::uint64_t max_points) {
   if (!j.is_object()) throw InputError(fmt::format("{}: a sweep is a JSON object, got {}", origin, j.type_name()));
   static const std::set<std::string> known = {"name", "description", "traces", "set", "axes", "points"};
   for (const auto& [k, v] : j.items())
@@ -72,11 +73,14 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& j, const std::string& origin
   }
   if (!j.contains("traces") || !j["traces"].is_array() || j["traces"].empty())
     throw InputError(fmt::format("{}: traces must be a non-empty list of trace files", origin));
+  std::set<std::string> trace_names;
   for (const auto& t : j["traces"]) {
     if (!t.is_string() || t.get<std::string>().empty())
-      throw InputError(fmt::format("{}: traces: every entry must be a file name, got {}", origin, t.dump()));
-    if (std::find(s.traces.begin(), s.traces.end(), t.get<std::string>()) != s.traces.end())
-      throw InputError(fmt::format("{}: traces: '{}' is listed twice", origin, t.get<std::string>()));
+      throw InputError(fmt::format("{}: traces: every entry must be a file name, got {}", origin, config::excerpt(t)));
+    if (!trace_names.insert(t.get<std::string>()).second)
+      throw InputError(fmt::format("{}: traces: '{}' is listed twice", origin, config::excerpt_text(t.get<std::string>(), 1024)));
+    if (trace_names.size() > max_points)  // bounded like the points, which are mostly one or more per trace
+      throw InputError(fmt::format("{}: traces: more than {} traces, the limit of points (--max-points N raises it)", origin, max_points));
     s.traces.push_back(t.get<std::string>());
   }
   if (j.contains("set")) s.set = flatten(j["set"], origin + ": set");
@@ -85,14 +89,28 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& j, const std::string& origin
   if (j.contains("axes")) {
     const auto& axes = j["axes"];
     if (!axes.is_object() || axes.empty()) throw InputError(fmt::format("{}: axes must be a non-empty object of key: [values]", origin));
+    // Count the points before building any: traces x the product of the axis sizes, saturating.
+    std::uint64_t count = s.traces.size();
+    std::string product = fmt::format("{} trace{}", s.traces.size(), s.traces.size() == 1 ? "" : "s");
+    for (const auto& [key, values] : axes.items()) {
+      const std::uint64_t n = values.is_array() ? values.size() : 1;
+      count = n != 0 && count > UINT64_MAX / n ? UINT64_MAX : count * n;
+      product += fmt::format(" x {}", n);
+    }
+    if (count > max_points)
+      throw InputError(fmt::format("{}: the sweep has {} = {}{} points, more than the limit of {} (--max-points N raises it)",
+                                   origin, product, count == UINT64_MAX ? "more than " : "", count, max_points));
     for (const auto& [key, values] : axes.items()) {
       if (!values.is_array() || values.empty())
         throw InputError(fmt::format("{}: axes.{} must be a non-empty list of values", origin, key));
       if (s.set.contains(key)) throw InputError(fmt::format("{}: {} is both in set and in axes", origin, key));
       std::vector<nlohmann::json> list;
+      std::set<std::string> seen;  // each value as JSON text
       for (const auto& v : values) {
         if (v.is_object() || v.is_array() || v.is_null())
-          throw InputError(fmt::format("{}: axes.{}: {} is not a single value", origin, key, v.dump()));
+          throw InputError(fmt::format("{}: axes.{}: {} is not a single value", origin, key, config::excerpt(v)));
+        if (!seen.insert(v.dump()).second)
+          throw InputError(fmt::format("{}: axes.{}: {} is listed twice (at [{}] again)", origin, key, config::excerpt(v), list.size()));
         list.push_back(sorted(v));
       }
       s.axes.emplace_back(key, std::move(list));
@@ -100,14 +118,23 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& j, const std::string& origin
   } else {
     const auto& points = j["points"];
     if (!points.is_array() || points.empty()) throw InputError(fmt::format("{}: points must be a non-empty list of objects", origin));
+    std::uint64_t count = 0;  // points run: one per listed point that names its trace, one per trace otherwise
+    std::map<std::string, std::size_t> seen;  // each point as sorted JSON text -> its index
     for (std::size_t i = 0; i < points.size(); ++i) {
       const std::string where = fmt::format("{}: points[{}]", origin, i);
       nlohmann::ordered_json p = flatten(points[i], where, {"trace"});
       if (p.contains("trace")) {
         if (!p["trace"].is_string()) throw InputError(fmt::format("{}: trace must be a file name", where));
-        if (std::find(s.traces.begin(), s.traces.end(), p["trace"].get<std::string>()) == s.traces.end())
+        if (!trace_names.count(p["trace"].get<std::string>()))
           throw InputError(fmt::format("{}: trace '{}' is not one of traces", where, p["trace"].get<std::string>()));
       }
+      count += p.contains("trace") ? 1 : s.traces.size();
+      if (count > max_points)
+        throw InputError(fmt::format("{}: the sweep has more than {} points by points[{}], more than the limit (--max-points N "
+                                     "raises it)",
+                                     origin, max_points, i));
+      if (const auto [at, added] = seen.emplace(sorted(p).dump(), i); !added)
+        throw InputError(fmt::format("{}: this point is listed twice (the same as points[{}])", where, at->second));
       s.points.push_back(std::move(p));
     }
   }

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <utility>
@@ -47,9 +48,17 @@ struct Point {
   std::string technique_reference, timing_reference;
 };
 
+// Tunable. Most points a sweep may expand to (traces x the product of the axis sizes, or the
+// listed points run on each trace), reference points not counted; `nbsim explore --max-points N`
+// raises it. Each point is one replay, and expanding and checking 10,000 takes about a second.
+inline constexpr std::uint64_t kDefaultMaxSweepPoints = 10000;
+
 // Checks the structure of a sweep file (parsed keeping its key order); throws InputError naming
-// `origin` and the bad entry.
-SweepSpec parse_sweep(const nlohmann::ordered_json& sweep, const std::string& origin);
+// `origin` and the bad entry. A sweep of more than `max_points` points is refused before any
+// point is built (counted with no overflow), and an axis value or a listed point given twice is
+// refused where it is met.
+SweepSpec parse_sweep(const nlohmann::ordered_json& sweep, const std::string& origin,
+                      std::uint64_t max_points = kDefaultMaxSweepPoints);
 
 // Every point, trace-major, in file order (ids set from the raw values; check_points normalizes).
 std::vector<Point> expand(const SweepSpec& spec);

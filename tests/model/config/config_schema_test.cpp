@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <functional>
+#include <string>
+
 #include "model/common/error.h"
 
 namespace nbsim::config {
@@ -84,6 +88,57 @@ TEST(ConfigSchemaTest, DescribesDefaults) {
   EXPECT_EQ(d[0]["default"], 4);
   EXPECT_EQ(d[0]["unit"], "cycles");
   EXPECT_EQ(f.s.values()["nbuffer"]["lookup_latency_cycles"], 9);
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+// A wrong value nested 10,000 deep is refused with a short message (the echo is cut, not dumped whole).
+TEST(ConfigSchemaTest, DeepValueEchoedBriefly) {
+  nlohmann::json deep = 1;
+  for (int i = 0; i < 10000; ++i) deep = nlohmann::json::array({std::move(deep)});
+  Fixture f;
+  const std::string e = error_of([&] { f.s.apply({{"nbuffer.lookup_latency_cycles", deep}}); });
+  EXPECT_NE(e.find("must be an integer, got [[[["), std::string::npos) << e;
+  EXPECT_LT(e.size(), 300u) << "the value is echoed as a short excerpt";
+}
+
+// --set with a deeply nested value is refused by the nesting limit before anything walks it.
+TEST(ConfigSchemaTest, SetRefusesDeepValue) {
+  Fixture f;
+  const std::string e = error_of([&] { f.s.set("nbuffer.lookup_latency_cycles=" + std::string(100000, '[') + std::string(100000, ']')); });
+  EXPECT_NE(e.find("deeper than 64 levels"), std::string::npos) << e.substr(0, 300);
+  EXPECT_LT(e.size(), 300u);
+}
+
+// --set with bytes that are not UTF-8 is refused as the user's error (not a JSON library exception).
+TEST(ConfigSchemaTest, SetRefusesNonUtf8) {
+  for (const char* a : {"nbuffer.update_policy=\xff", "nbuffer.lookup_latency_cycles=\"\xfe\"", "nbuffer.\xc0=1"}) {
+    Fixture f;
+    const std::string e = error_of([&] { f.s.set(a); });
+    EXPECT_NE(e.find("not valid UTF-8"), std::string::npos) << e;
+  }
+}
+
+// A 20 MB unknown key is refused at once, echoed as a short excerpt, with no quadratic "did you mean" search.
+TEST(ConfigSchemaTest, HugeKeyRefusedQuickly) {
+  Fixture f;
+  const std::string key = "nbuffer." + std::string(20 << 20, 'k');
+  const auto start = std::chrono::steady_clock::now();
+  const std::string e = error_of([&] { f.s.apply({{key, 1}}); });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_NE(e.find("unknown config key 'nbuffer.kkk"), std::string::npos) << e.substr(0, 300);
+  EXPECT_LT(e.size(), 400u) << "the key is echoed as a short excerpt";
+  EXPECT_LT(seconds, 2.0) << "the hint search must not be quadratic in the key's length";
+  EXPECT_NE(error_of([&] { f.s.set("nbuffer.lookup_latency_cyclesX=1"); }).find("did you mean 'nbuffer.lookup_latency_cycles'"),
+            std::string::npos)
+      << "close keys still get a hint";
 }
 
 }  // namespace

@@ -206,6 +206,29 @@ TEST(NBufferCliTest, RefusesBadArguments) {
   }
 }
 
+// Sizes beyond the stated bounds are refused before anything is allocated or written (they used
+// to reach 8.4 GB and std::bad_alloc, or a 3.5 GB image); the bounds are stated in --help.
+TEST(NBufferCliTest, SizesBounded) {
+  const fs::path out = scratch("big_out");
+  struct Row { std::string args, message; };
+  const Row rows[] = {
+      {"nbuffer query --scene city --size 46341x46341 --rect 0,0,1,1", "the built-in scene is at most 4096x4096"},
+      {"nbuffer build --scene city --size 4097x16 --out " + out.string(), "at most 4096x4096"},
+      {"nbuffer query --scene city --size 16x99999999999 --rect 0,0,1,1", "--size"},
+      {"nbuffer coverage --size 1024x1024 --scale 16 --out " + (out / "c.png").string(), "makes a 32896x17536 image: at most 64 M pixels"},
+      {"nbuffer coverage --size 16777216x1 --out " + (out / "c.png").string(), "at most 4096x4096 box sizes"},
+  };
+  for (const Row& row : rows) {
+    const CliResult r = nbsim(row.args);
+    EXPECT_EQ(r.status, 2) << row.args << "\n" << r.err;
+    EXPECT_TRUE(has(r.err, row.message)) << row.args << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out)) << "nothing is written for a refused size";
+  EXPECT_TRUE(has(nbsim("nbuffer query --help").out, "each side at most 4096"));
+  EXPECT_TRUE(has(nbsim("nbuffer build --help").out, "each side at most 4096"));
+  EXPECT_TRUE(has(nbsim("nbuffer coverage --help").out, "at most 64 M pixels"));
+}
+
 // A partly outside rectangle is clipped: it answers from the pixels inside only.
 TEST(NBufferCliTest, ClipsPartlyOutsideRect) {
   const fs::path f = small_depth("clip.exr");

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -184,11 +185,12 @@ TEST(ExploreCliTest, SmallSweepAndResume) {
   EXPECT_EQ(rows[2].at("status"), "ok");
 }
 
-// A point whose replay fails (a corrupt trace passes the sweep's checks) is recorded with its
-// message; the other point completes and the exit status is 1.
+// A point whose replay fails (a trace damaged after its header passes the sweep's checks) is
+// recorded with its message; the other point completes and the exit status is 1.
 TEST(ExploreCliTest, FailingPointRecorded) {
   const fs::path corrupt = scratch("corrupt.nbt");
-  std::ofstream(corrupt) << "not a trace at all";
+  fs::copy_file(kSample, corrupt, fs::copy_options::overwrite_existing);
+  fs::resize_file(corrupt, fs::file_size(corrupt) / 2);
   const fs::path out = scratch("failing");
   const nlohmann::json sweep = {{"traces", {kSample, corrupt.string()}},
                                 {"points", {{{"cull.mode", "nb_hier"}, {"trace", kSample}}, {{"cull.mode", "nb_hier"}, {"trace", corrupt.string()}}}}};
@@ -205,6 +207,85 @@ TEST(ExploreCliTest, FailingPointRecorded) {
   EXPECT_TRUE(rows[1].at("frames").empty());
   EXPECT_TRUE(fs::exists(out / "points" / rows[1].at("point_id") / "error.txt"));
   EXPECT_FALSE(fs::exists(out / "points" / rows[1].at("point_id") / "run.json"));
+}
+
+// A sweep naming a file that is not a trace is refused at validation, naming the file, before
+// any point runs (it used to pass, then fail every point).
+TEST(ExploreCliTest, NotATraceRefused) {
+  const fs::path junk = scratch("junk.nbt");
+  std::ofstream(junk) << "not a trace at all";
+  const fs::path out = scratch("junk_out");
+  const fs::path f = write_sweep("junk.json", {{"traces", {kSample, junk.string()}}, {"axes", {{"cull.mode", {"nb"}}}}});
+  const CliResult r = run_nbsim("explore " + f.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "trace '" + junk.string() + "' cannot be opened as a trace")) << r.err;
+  EXPECT_FALSE(fs::exists(out / "points")) << "nothing may run";
+}
+
+// Sweep files the JSON reader must not take whole are refused with exit 2 and a short message: a
+// directory, a value nested 200,000 deep under a key nobody reads, a repeated key, a NUL byte.
+TEST(ExploreCliTest, BadSweepFilesRefused) {
+  const fs::path deep = scratch("deep.json"), dup = scratch("dup.json"), nul = scratch("nul.json"), dir = scratch("a_dir");
+  std::ofstream(deep) << R"({"traces": [")" << kSample << R"("], "axes": {"cull.mode": ["nb"]}, "description": )"
+                      << std::string(200000, '[') << std::string(200000, ']') << "}";
+  std::ofstream(dup) << R"({"traces": [")" << kSample << R"("], "axes": {"cull.mode": ["nb"]}, "axes": {"cull.mode": ["oq"]}})";
+  std::ofstream(nul, std::ios::binary) << std::string(R"({"traces": [")") + kSample + R"("], "axes": {"cull.mode": ["nb"]}})" + '\0' + "junk";
+  fs::create_directories(dir);
+  struct Row { fs::path file; std::string message; };
+  const Row rows[] = {{deep, "deeper than 64 levels"}, {dup, "gives the key \"axes\" twice"}, {nul, "holds a NUL byte"}, {dir, "is a directory"}};
+  for (const Row& row : rows) {
+    const fs::path out = scratch("bad_file_out");
+    const CliResult r = run_nbsim("explore " + row.file.string() + " --dry-run --out " + out.string());
+    EXPECT_EQ(r.status, 2) << row.file << ": " << r.err;
+    EXPECT_TRUE(has(r.err, row.message)) << row.file << ": " << r.err;
+    EXPECT_TRUE(has(r.err, row.file.string())) << "the message names the file: " << r.err;
+    EXPECT_LT(r.err.size(), 1000u);
+    EXPECT_FALSE(fs::exists(out)) << "nothing written for a refused sweep";
+  }
+}
+
+// A sweep of 1,000 x 1,000 points is refused at once by counting (it used to take minutes and
+// gigabytes in --dry-run); --max-points raises the limit.
+TEST(ExploreCliTest, SweepSizeLimited) {
+  nlohmann::json sweep = {{"traces", {kSample}}, {"axes", nlohmann::json::object()}};
+  for (const char* key : {"nbuffer.lookup_latency_cycles", "memory.latency_cycles"}) {
+    sweep["axes"][key] = nlohmann::json::array();
+    for (int i = 1; i <= 1000; ++i) sweep["axes"][key].push_back(i);
+  }
+  const fs::path out = scratch("big_out");
+  CliResult r = run_nbsim("explore " + write_sweep("big.json", sweep).string() + " --dry-run --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "1 trace x 1000 x 1000 = 1000000 points, more than the limit of 10000 (--max-points N raises it)")) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  const nlohmann::json three = {{"traces", {kSample}}, {"axes", {{"nbuffer.lookup_latency_cycles", {1, 2, 3}}}}};
+  const fs::path f = write_sweep("three.json", three);
+  r = run_nbsim("explore " + f.string() + " --dry-run --max-points 2 --out " + scratch("three_refused").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "more than the limit of 2")) << r.err;
+  r = run_nbsim("explore " + f.string() + " --dry-run --max-points 3 --out " + scratch("three_ok").string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "explore: 3 points")) << r.out;
+}
+
+// A JSON library exception on the user's files (here a resumed point's run.json with a string where
+// a number belongs) exits 2 with its message and the file, never 1, and leaves no partial results.csv.
+TEST(ExploreCliTest, JsonLibraryErrorExits2) {
+  const nlohmann::json sweep = {{"traces", {kSample}}, {"points", {{{"cull.mode", "nb_hier"}}}}};
+  const fs::path f = write_sweep("tampered.json", sweep), out = scratch("tampered_out");
+  CliResult r = run_nbsim("explore " + f.string() + " --dry-run --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  int points = 0;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line) && line.rfind("explore:", 0) != 0; ++points) {
+    const fs::path dir = out / "points" / line.substr(0, line.find(' '));
+    fs::create_directories(dir);
+    std::ofstream(dir / "run.json") << R"({"summary": {"frames": 8, "cycles": "many"}})";
+  }
+  ASSERT_GT(points, 0) << r.out;
+  r = run_nbsim("explore " + f.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "run.json: [json.exception.type_error.302]")) << "the message names the file: " << r.err;
+  EXPECT_FALSE(fs::exists(out / "results.csv")) << "no partial results.csv";
 }
 
 // Every sample sweep in pipeline/sweeps/ is valid (real keys, real traces): --dry-run runs nothing.

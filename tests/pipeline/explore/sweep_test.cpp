@@ -187,6 +187,43 @@ TEST(SweepTest, RefusedFiles) {
   }
 }
 
+// A sweep of 1,000 x 1,000 (or 1,000^3, whose count overflows nothing) is refused by counting,
+// before any point is built; the limit is a parameter (explore's --max-points).
+TEST(SweepTest, PointCountLimited) {
+  ojson big = ojson::parse(R"({"traces": ["a", "b"], "axes": {}})");
+  for (const char* key : {"nbuffer.resolution_divisor", "memory.bandwidth_bytes_per_cycle", "hiz.tile_px"}) {
+    big["axes"][key] = ojson::array();
+    for (int i = 0; i < 1000; ++i) big["axes"][key].push_back(i);
+  }
+  try {
+    ex::parse_sweep(big, "sweep.json");
+    ADD_FAILURE() << "2 x 1000^3 points were accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("2 traces x 1000 x 1000 x 1000 = 2000000000 points, more than the limit of 10000"),
+              std::string::npos)
+        << e.what();
+  }
+  const ojson small = ojson::parse(R"({"traces": ["a"], "axes": {"hiz.tile_px": [1, 2, 4], "nbuffer.resolution_divisor": [1, 2]}})");
+  EXPECT_NO_THROW(ex::parse_sweep(small, "sweep.json", 6)) << "exactly at the limit";
+  EXPECT_THROW(ex::parse_sweep(small, "sweep.json", 5), InputError) << "one over the limit";
+  ojson listed = ojson::parse(R"({"traces": ["a", "b"], "points": [{"hiz.tile_px": 1}, {"hiz.tile_px": 2, "trace": "a"}]})");
+  EXPECT_NO_THROW(ex::parse_sweep(listed, "sweep.json", 3)) << "2 traces for the first point, 1 for the second";
+  EXPECT_THROW(ex::parse_sweep(listed, "sweep.json", 2), InputError);
+}
+
+// A value repeated in one axis is refused where it is met, naming the value and its place,
+// before the rest of a long axis is read.
+TEST(SweepTest, RepeatedAxisValueRefusedWhereMet) {
+  ojson j = ojson::parse(R"({"traces": ["a"], "axes": {"hiz.tile_px": [8, 16, 8]}})");
+  for (int i = 0; i < 5000; ++i) j["axes"]["hiz.tile_px"].push_back(8);
+  try {
+    ex::parse_sweep(j, "sweep.json");
+    ADD_FAILURE() << "a repeated axis value was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("axes.hiz.tile_px: 8 is listed twice (at [2] again)"), std::string::npos) << e.what();
+  }
+}
+
 // CSV fields with commas, quotes or line breaks are quoted; others are left alone.
 TEST(SweepTest, CsvFieldQuoting) {
   EXPECT_EQ(ex::csv_field("nb_hier"), "nb_hier");

@@ -101,6 +101,42 @@ TEST(ReplayCliTest, ConfigKeysAndRefusals) {
   EXPECT_TRUE(has(r.err, "must be a number")) << r.err;
 }
 
+// The storage of every option of `nbsim config` outlives parsing: valgrind sees no write into freed
+// memory (the --defaults flag was bound to a shared_ptr its callback did not capture).
+TEST(ReplayCliTest, ConfigFlagsWriteLiveMemory) {
+  if (!fs::exists("/usr/bin/valgrind")) GTEST_SKIP() << "valgrind is not installed (apt-get install valgrind)";
+  const CliResult r = nbsim::testing::run_nbsim_env("/usr/bin/valgrind -q --error-exitcode=99 ", "config --defaults --json");
+  EXPECT_EQ(r.status, 0) << r.err.substr(0, 2000);
+  EXPECT_FALSE(has(r.err, "Invalid write")) << r.err.substr(0, 2000);
+}
+
+// Config files and --set values the JSON library cannot take, or that break a limit, exit 2 with a
+// message naming the problem (never exit 1 with a library exception, a crash, or a silent cut).
+TEST(ReplayCliTest, BadConfigInputsRefused) {
+  const std::string t = sample("city_small_oq.nbt");
+  const fs::path dup = scratch("dup.json"), nul = scratch("nul.json"), deep = scratch("deep.json"), dir = scratch("config_dir");
+  std::ofstream(dup) << R"({"depth": {"latency_cycles": 3, "latency_cycles": 4}})";
+  std::ofstream(nul, std::ios::binary) << std::string(R"({"depth": {"latency_cycles": 3}})") + '\0' + R"(, "x": 1)";
+  std::ofstream(deep) << R"({"depth": {"latency_cycles": )" << std::string(10000, '[') << std::string(10000, ']') << "}}";
+  fs::create_directories(dir);
+  struct Row { std::string args, message; };
+  const Row rows[] = {
+      {"--config " + dup.string(), "gives the key \"latency_cycles\" twice"},
+      {"--config " + nul.string(), "NUL byte at offset 32"},
+      {"--config " + deep.string(), "deeper than 64 levels"},
+      {"--config " + dir.string(), "is a directory"},
+      {"--set 'depth.latency_cycles=" + std::string(20000, '[') + std::string(20000, ']') + "'", "deeper than 64 levels"},
+      {"--set \"$(printf 'cull.mode=\\377')\"", "not valid UTF-8"},
+      {"--set \"$(printf 'depth.latency_cycles=\\042\\376\\042')\"", "not valid UTF-8"},
+  };
+  for (const Row& row : rows) {
+    const CliResult r = run_nbsim("compare " + t + " " + row.args);
+    EXPECT_EQ(r.status, 2) << row.args.substr(0, 200) << ": " << r.err;
+    EXPECT_TRUE(has(r.err, row.message)) << row.args.substr(0, 200) << ": " << r.err;
+    EXPECT_LT(r.err.size(), 1000u) << "a message, not a dump";
+  }
+}
+
 // In a culling mode, culls.csv lists every bounds test with its decision, cost and ground truth;
 // the N-buffer compares at most four texels a test and culls nothing visible.
 // Bounds that cross the near plane are never culled, in any mode.
