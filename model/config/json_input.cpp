@@ -79,8 +79,9 @@ J parse_limited(std::string_view text, const std::string& origin, bool comments)
   };
   try {
     return J::parse(text.begin(), text.end(), check, true, comments);
-  } catch (const nlohmann::json::parse_error& e) {
-    // The parser's message names line and column; its "last read" part can be long.
+  } catch (const nlohmann::json::exception& e) {
+    // A syntax error (its message names line and column; its "last read" part can be long), or a
+    // number out of range such as 1E999 (out_of_range.406).
     throw InputError(fmt::format("{} is not valid JSON: {}", origin, excerpt_text(e.what(), 2 * kMaxEchoChars)));
   }
 }

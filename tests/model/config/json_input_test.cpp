@@ -63,6 +63,14 @@ TEST(JsonInputTest, NotUtf8OrNotJsonRefusedBriefly) {
   EXPECT_LT(e.size(), 400u) << "a message, not the input";
 }
 
+// A number out of the double range is refused as an InputError, not the library's out_of_range
+// (found by fuzz_sweep: the sweep file "444E2222ce").
+TEST(JsonInputTest, NumberOutOfRangeRefused) {
+  EXPECT_TRUE(has(error_of("444E2222ce"), "is not valid JSON")) << error_of("444E2222ce");
+  EXPECT_TRUE(has(error_of(R"({"nbuffer": {"level_cap": 1E999}})"), "is not valid JSON"));
+  EXPECT_THROW(parse_input_ordered("-1e400", "input"), nbsim::InputError);
+}
+
 // UTF-8 validation: well-formed sequences pass; bad bytes, overlongs, surrogates and cut sequences fail at their offset.
 TEST(JsonInputTest, Utf8Validation) {
   std::size_t at = 0;
