@@ -75,7 +75,7 @@ void fields(Io& io, Properties& p) {
   io.items("properties", p, "P", Element{"(string key, string value)", 8, false},
            [](Io& e, std::pair<std::string, std::string>& kv) {
              e.string("key", kv.first, kMaxKeyBytes, "1 to 64 characters of A-Z a-z 0-9 _ . -, unique");
-             e.string("value", kv.second, kMaxValueBytes, "at most 64 KiB");
+             e.string("value", kv.second, kMaxValueBytes, "at most 64 KiB of UTF-8");
            },
            "key/value pairs in order, at most 1024");
 }

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "tests/common/run_nbsim.h"
+#include "traces/format/codec.h"
 #include "traces/format/writer.h"
 
 namespace {
@@ -189,6 +190,27 @@ TEST(ReplayCliTest, RefusesDamagedTrace) {
   const CliResult r = run_nbsim("compare " + t.string());
   EXPECT_EQ(r.status, 2) << r.out << r.err;
   EXPECT_TRUE(has(r.err, "chunk")) << r.err;
+}
+
+// A header value that is not UTF-8 is refused by replay with exit 2 naming the key, before any
+// output is written (it used to fail in the JSON library and leave an empty run.json).
+TEST(ReplayCliTest, RefusesNonUtf8HeaderWithoutOutput) {
+  namespace tr = nbsim::trace;
+  const fs::path t = scratch("latin1.nbt");
+  {
+    std::vector<std::uint8_t> b;
+    const auto pre = tr::encode_preamble(tr::kFormatVersion);
+    b.assign(pre.begin(), pre.end());
+    for (const auto& c : {tr::encode_chunk(tr::ChunkType::Header, tr::encode(tr::Properties{{"viewport", "8x8"}, {"scene", "caf\xe9"}})),
+                          tr::encode_chunk(tr::ChunkType::End, tr::encode(tr::EndMarker{1, 0}))})
+      b.insert(b.end(), c.begin(), c.end());
+    std::ofstream(t, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  }
+  const fs::path out = scratch("latin1_out");
+  const CliResult r = run_nbsim("replay " + t.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "property 'scene' has a value that is not UTF-8")) << r.err;
+  EXPECT_FALSE(fs::exists(out / "run.json")) << "no empty run.json";
 }
 
 }  // namespace

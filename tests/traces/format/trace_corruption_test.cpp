@@ -642,4 +642,30 @@ TEST(TraceCorruptionTest, RandomPayloadEditsNeverCrash) {
   EXPECT_GT(read, 0) << "edits of float fields read as other values";
 }
 
+// A header property value that is not UTF-8 is refused at chunk 0, naming the key and the byte
+// (run.json and `trace info --json` hold the values, and JSON is UTF-8); valid UTF-8 reads.
+TEST(TraceCorruptionTest, NonUtf8PropertyValueRefused) {
+  const struct {
+    const char* value;
+    const char* why;
+  } bad[] = {
+      {"city\xff", "0xff never occurs in UTF-8"},
+      {"\x80lone", "a continuation byte without a lead byte"},
+      {"\xc0\xaf", "an overlong encoding of '/'"},
+      {"\xed\xa0\x80", "a UTF-16 surrogate (U+D800)"},
+      {"\xf4\x90\x80\x80", "above U+10FFFF"},
+      {"ab\xe2\x82", "a sequence cut short by the end"},
+      {"\xe2(\xa1", "a lead byte followed by ASCII"},
+  };
+  for (const auto& row : bad) {
+    Builder t;
+    t.add(Properties{{"viewport", "8x8"}, {"scene", row.value}}).end(0);
+    const std::string e = read_error(t.b);
+    EXPECT_TRUE(has(e, "chunk 0 (HEAD)") && has(e, "property 'scene'") && has(e, "not UTF-8")) << row.why << ": " << e;
+  }
+  Builder good;
+  good.add(Properties{{"viewport", "8x8"}, {"scene", "na\xc3\xafve \xe2\x9c\x93 \xf0\x9d\x84\x9e"}}).end(0);
+  EXPECT_EQ(read_error(good.b), "") << "two-, three- and four-byte UTF-8 read";
+}
+
 }  // namespace

@@ -540,4 +540,18 @@ TEST(TraceWriterDeathTest, AbortsOnMisuse) {
       "NOPE is not registered");
 }
 
+// A property value that is not UTF-8 is refused by the writer too (an InputError naming the key).
+TEST(TraceFormatTest, WriterRefusesNonUtf8Property) {
+  EXPECT_THROW(
+      {
+        try {
+          TraceWriter w(scratch("latin1.nbtrace"), {{"scene", "caf\xe9"}});
+        } catch (const InputError& e) {
+          EXPECT_NE(std::string(e.what()).find("property 'scene' has a value that is not UTF-8"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      InputError);
+}
+
 }  // namespace
