@@ -360,6 +360,10 @@ template Camera TraceReader::decode<Camera>(const Chunk&) const;
 FrameReader::FrameReader(const std::filesystem::path& file) : trace_(file) {}
 FrameReader::FrameReader(TraceReader trace) : trace_(std::move(trace)) {}
 
+void FrameReader::require_viewport_depths(std::vector<std::string> depth_names) {
+  viewport_depths_ = std::move(depth_names);
+}
+
 std::optional<Frame> FrameReader::next() {
   std::optional<Chunk> c = trace_.next();
   if (!c) return std::nullopt;
@@ -404,6 +408,12 @@ std::optional<Frame> FrameReader::next() {
       }
       case ChunkType::Depth: {
         DepthSnapshot d = trace_.decode<DepthSnapshot>(*c);
+        if (const std::optional<Viewport>& v = trace_.header().viewport;
+            v && (d.width != v->width || d.height != v->height) &&
+            std::find(viewport_depths_.begin(), viewport_depths_.end(), d.name) != viewport_depths_.end())
+          trace_.fail(*c, fmt::format("depth image '{}' is {}x{}, but the header's viewport is {}x{}: replay compares it "
+                                      "with the model's depth buffer, which has the viewport's size",
+                                      d.name, d.width, d.height, v->width, v->height));
         if (f.depth(d.name))
           trace_.fail(*c, fmt::format("a second '{}' depth snapshot in frame {}", d.name, f.begin.frame));
         f.depths.push_back(std::move(d));

@@ -115,6 +115,13 @@ class FrameReader {
   explicit FrameReader(const std::filesystem::path& file);
   explicit FrameReader(TraceReader trace);
 
+  // From now on, refuses (naming the chunk) a depth image named in `depth_names` whose size is
+  // not the header's viewport. Replay asks for it for the depth images it compares with the
+  // model's depth buffer, which has the viewport's size ("after_occluders", "final"); the format
+  // itself allows any size (a technique's litmaps need not match the viewport). No effect when
+  // the header has no viewport.
+  void require_viewport_depths(std::vector<std::string> depth_names);
+
   // The next frame, or nullopt after the last one (END read and checked).
   std::optional<Frame> next();
   TraceReader& trace() noexcept { return trace_; }
@@ -123,6 +130,7 @@ class FrameReader {
  private:
   TraceReader trace_;
   std::uint64_t ordinal_ = 0;
+  std::vector<std::string> viewport_depths_;  // require_viewport_depths()
 };
 
 }  // namespace nbsim::trace

@@ -213,4 +213,43 @@ TEST(ReplayCliTest, RefusesNonUtf8HeaderWithoutOutput) {
   EXPECT_FALSE(fs::exists(out / "run.json")) << "no empty run.json";
 }
 
+// A trace whose final depth image is h x w under a w x h viewport: one frame with one draw.
+fs::path swapped_depth_trace(const std::string& name) {
+  namespace tr = nbsim::trace;
+  const fs::path t = scratch(name);
+  tr::TraceWriter w(t, {{"viewport", "16x8"}, {"depth_func", "LESS"}, {"depth_clear", "1"}, {"frames", "1"}});
+  tr::FrameBegin b;
+  w.begin_frame(b);
+  tr::DrawRecord d;
+  d.clip_positions = {{-1, -1, 0, 1}, {1, -1, 0, 1}, {0, 1, 0, 1}};
+  d.state.test = d.state.write = true;
+  w.write(d);
+  tr::DepthSnapshot depth;
+  depth.name = "final";
+  depth.width = 8;
+  depth.height = 16;
+  depth.texels.assign(8 * 16, 1.0f);
+  w.write(depth);
+  tr::FrameEnd e;
+  e.draws = 1;
+  w.end_frame(e);
+  w.close();
+  return t;
+}
+
+// A depth snapshot of another size than the viewport (swapped sides) is refused with exit 2 and
+// the chunk named, not an abort from the depth unit's thread, and the failed run leaves no output
+// file behind (no empty run.json, no partial CSV).
+TEST(ReplayCliTest, RefusesDepthOfAnotherSizeThanTheViewport) {
+  const fs::path t = swapped_depth_trace("swapped.nbt");
+  const fs::path out = scratch("swapped_out");
+  const CliResult r = run_nbsim("replay " + t.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "chunk 3 (DPTH)") && has(r.err, "depth image 'final' is 8x16, but the header's viewport is 16x8"))
+      << r.err;
+  for (const char* f : {"run.json", "draws.csv", "frames.csv"}) EXPECT_FALSE(fs::exists(out / f)) << f << " left by a failed run";
+  const CliResult c = run_nbsim("compare " + t.string());
+  EXPECT_EQ(c.status, 2) << c.out << c.err;
+}
+
 }  // namespace

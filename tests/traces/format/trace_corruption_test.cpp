@@ -668,4 +668,44 @@ TEST(TraceCorruptionTest, NonUtf8PropertyValueRefused) {
   EXPECT_EQ(read_error(good.b), "") << "two-, three- and four-byte UTF-8 read";
 }
 
+// Replay compares the depth images "after_occluders" and "final" with a depth buffer of the
+// viewport's size: a reader asked for them refuses one of another size (swapped sides, 1xN, a
+// viewport edited in the header), naming the chunk; other images, and the same file read without
+// the request, may have any size (a technique's litmaps need not match the viewport).
+TEST(TraceCorruptionTest, ReplayedDepthOfAnotherSizeThanTheViewportRefused) {
+  const auto read = [](const Bytes& b) {
+    try {
+      FrameReader frames(TraceReader(b, "t.nbtrace"));
+      frames.require_viewport_depths({"after_occluders", "final"});
+      while (frames.next()) {
+      }
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const struct {
+    const char* viewport;
+    DepthSnapshot depth;
+    const char* what;
+  } rows[] = {
+      {"8x4", sample_depth(DepthWhich::Final, 4, 8), "depth image 'final' is 4x8, but the header's viewport is 8x4"},
+      {"8x4", sample_depth(DepthWhich::AfterOccluders, 1, 32), "depth image 'after_occluders' is 1x32"},
+      {"9x4", sample_depth(DepthWhich::Final, 8, 4), "depth image 'final' is 8x4, but the header's viewport is 9x4"},
+  };
+  for (const auto& row : rows) {
+    Builder t;
+    t.add(Properties{{"viewport", row.viewport}}).add(sample_frame_begin(0)).add(row.depth).add(FrameEnd{0, 0, 0.0}).end(1);
+    EXPECT_EQ(read_error(t.b), "") << row.what << ": the format itself allows any size";
+    const std::string e = read(t.b);
+    EXPECT_TRUE(has(e, "t.nbtrace: chunk 2 (DPTH)") && has(e, row.what)) << e;
+  }
+  DepthSnapshot litmap = sample_depth(DepthWhich::Final, 4, 8);
+  litmap.name = "litmap_min";
+  Builder ok;
+  ok.add(Properties{{"viewport", "8x4"}}).add(sample_frame_begin(0)).add(sample_depth(DepthWhich::Final, 8, 4)).add(litmap);
+  ok.add(sample_stencil("volumes", 3, 1)).add(FrameEnd{0, 0, 0.0}).end(1);
+  EXPECT_EQ(read(ok.b), "") << "a replayed depth of the viewport's size and other images of any size read";
+}
+
 }  // namespace
