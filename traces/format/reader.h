@@ -104,6 +104,8 @@ class TraceReader {
   bool any_frame_ = false;
   std::uint32_t frame_ = 0;        // the open (or last) frame's number
   std::uint32_t frame_draws_ = 0;  // draws in the open frame (DRAW chunks and DRWS batches)
+  std::uint64_t frame_bytes_ = 0;  // raw bytes of the open frame's chunks so far
+  std::uint64_t frame_limit_ = 0;  // header_.frame_byte_limit()
 };
 
 // One frame, FRAM .. FEND, decoded (model/scene/frame.h).
