@@ -46,11 +46,7 @@ void CommandProcessor::issue_snapshot(const std::shared_ptr<const scene::Frame>&
 }
 
 void CommandProcessor::run() {
-  try {
-    issue();
-  } catch (...) {
-    sim::thread_failed(std::current_exception());
-  }
+  sim::guard_thread([this] { issue(); });
 }
 
 void CommandProcessor::issue() {

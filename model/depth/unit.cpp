@@ -63,6 +63,10 @@ Rect DepthUnit::test(const raster::BlockBatch& b, DrawResult& r) {
 }
 
 void DepthUnit::run() {
+  sim::guard_thread([this] { serve(); });
+}
+
+void DepthUnit::serve() {
   for (;;) {
     const raster::BlockBatchPtr b = sim::blocking([&] { return in.read(); });
     const cp::Work& w = *b->work;

@@ -68,7 +68,8 @@ class DepthUnit : public sim::Unit {
   void set_listener(DepthListener* l) noexcept { listener_ = l; }
 
  private:
-  void run();
+  void run();    // SC_THREAD: serve() under sim::guard_thread
+  void serve();
   // Tests one draw's blocks; returns the bounding rectangle of the blocks that wrote a depth.
   Rect test(const raster::BlockBatch& b, DrawResult& r);
   DepthListener* listener_ = nullptr;

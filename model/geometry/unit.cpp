@@ -51,6 +51,10 @@ GeometryUnit::GeometryUnit(const sc_core::sc_module_name& name, stats::Registry&
 }
 
 void GeometryUnit::run() {
+  sim::guard_thread([this] { serve(); });
+}
+
+void GeometryUnit::serve() {
   for (;;) {
     const cp::WorkPtr w = sim::blocking([&] { return in.read(); });
     auto batch = std::make_shared<TriangleBatch>();

@@ -44,7 +44,8 @@ class GeometryUnit : public sim::Unit {
                int width_px, int height_px);
 
  private:
-  void run();
+  void run();    // SC_THREAD: serve() under sim::guard_thread
+  void serve();
   GeometryUnitConfig config_;
   sim::DelayLine<TriangleBatchPtr> delay_;
   GeometryStage stage_;

@@ -42,6 +42,10 @@ UpdateWork NBufferUnit::post(UpdateWork w) {
 }
 
 void NBufferUnit::engine() {
+  sim::guard_thread([this] { update_loop(); });
+}
+
+void NBufferUnit::update_loop() {
   const NBufferUnitConfig& c = core_.config();
   for (;;) {
     sim::blocking([&] {

@@ -57,7 +57,8 @@ class NBufferUnit : public sim::Unit {
   // Waits until the engine has done the work posted before the caller arrived and the query port
   // is free, then takes the port; returns the arrival cycle (the wait is counted).
   std::uint64_t acquire_port();
-  void engine();  // SC_THREAD: the update engine
+  void engine();  // SC_THREAD: the update engine, update_loop() under sim::guard_thread
+  void update_loop();
   UpdateWork post(UpdateWork w);
   // Waits until `done` (a cycle), counting the wait in `counter`.
   void wait_until(std::uint64_t done, stats::Counter& counter);

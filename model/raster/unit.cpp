@@ -29,6 +29,10 @@ RasterUnit::RasterUnit(const sc_core::sc_module_name& name, stats::Registry& reg
 }
 
 void RasterUnit::run() {
+  sim::guard_thread([this] { serve(); });
+}
+
+void RasterUnit::serve() {
   for (;;) {
     const geometry::TriangleBatchPtr in_batch = sim::blocking([&] { return in.read(); });
     auto b = std::make_shared<BlockBatch>();

@@ -58,7 +58,8 @@ class RasterUnit : public sim::Unit {
   void set_primitive_tester(PrimitiveTester* tester) noexcept { tester_ = tester; }
 
  private:
-  void run();
+  void run();    // SC_THREAD: serve() under sim::guard_thread
+  void serve();
   RasterUnitConfig config_;
   sim::DelayLine<BlockBatchPtr> delay_;
   TriangleSetup setup_;

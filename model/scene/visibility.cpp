@@ -49,7 +49,10 @@ BoundsTest bounds_test(const Aabb& b, const FrameView& v) {
     const auto p = corner(b, i);
     std::array<double, 4> c{};
     for (std::size_t r = 0; r < 4; ++r) c[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
-    if (c[3] < v.near_m * 0.999) {
+    // A NaN or infinite corner or matrix (a damaged trace) has no place on screen: treated as
+    // crossing the near plane, so the bounds are never culled and nothing non-finite reaches the
+    // integer rectangle below.
+    if (!std::all_of(c.begin(), c.end(), [](double x) { return std::isfinite(x); }) || c[3] < v.near_m * 0.999) {
       t.crosses_near = true;
       continue;
     }
@@ -63,10 +66,11 @@ BoundsTest bounds_test(const Aabb& b, const FrameView& v) {
     t.nearest_depth = v.reversed ? 1.0f : 0.0f;
     return t;
   }
-  const int ix0 = std::clamp(static_cast<int>(std::floor(x0)), 0, v.width_px);
-  const int iy0 = std::clamp(static_cast<int>(std::floor(y0)), 0, v.height_px);
-  const int ix1 = std::clamp(static_cast<int>(std::ceil(x1)), 0, v.width_px);
-  const int iy1 = std::clamp(static_cast<int>(std::ceil(y1)), 0, v.height_px);
+  // Clamped in double first: a corner far outside the viewport (or x / w overflowing to infinity)
+  // must not be converted to int out of its range.
+  const auto pixel = [](double x, int hi) { return static_cast<int>(std::clamp(x, 0.0, static_cast<double>(hi))); };
+  const int ix0 = pixel(std::floor(x0), v.width_px), iy0 = pixel(std::floor(y0), v.height_px);
+  const int ix1 = pixel(std::ceil(x1), v.width_px), iy1 = pixel(std::ceil(y1), v.height_px);
   t.x = ix0, t.y = iy0, t.w = std::max(0, ix1 - ix0), t.h = std::max(0, iy1 - iy0);
   const double margin = v.reversed ? nearest + v.nearest_margin : nearest - v.nearest_margin;
   t.nearest_depth = static_cast<float>(std::clamp(margin, 0.0, 1.0));

@@ -30,4 +30,19 @@ void install_report_handler();
 void thread_failed(std::exception_ptr e);
 void rethrow_thread_failure();
 
+// Runs the body of a unit's SC_THREAD so that an exception escaping it (a trace record the model
+// cannot replay, a SystemC error) ends the run cleanly through thread_failed() instead of reaching
+// SystemC, which terminates the process. Every unit thread's body goes through it. SystemC's own
+// unwinding of a killed or reset thread passes through untouched.
+template <class Body>
+void guard_thread(Body&& body) {
+  try {
+    body();
+  } catch (const sc_core::sc_unwind_exception&) {
+    throw;
+  } catch (...) {
+    thread_failed(std::current_exception());
+  }
+}
+
 }  // namespace nbsim::sim

@@ -124,11 +124,13 @@ class DelayLine : public sc_core::sc_module {
 
  private:
   void run() {
-    for (;;) {
-      const auto item = blocking([&] { return queue_.read(); });
-      spend_until(item.second);
-      blocking([&] { out.write(item.first); });
-    }
+    guard_thread([this] {
+      for (;;) {
+        const auto item = blocking([&] { return queue_.read(); });
+        spend_until(item.second);
+        blocking([&] { out.write(item.first); });
+      }
+    });
   }
   struct Item : std::pair<T, std::uint64_t> {
     using std::pair<T, std::uint64_t>::pair;

@@ -4,16 +4,45 @@
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
+#include <cctype>
 #include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string_view>
 
 namespace nbsim::io::backend {
 namespace {
 
 namespace OIIO = OIIO_NAMESPACE;
 
+// OpenImageIO's message, or `fallback` when it gives none (its readers do not all say why).
+std::string reason(const std::string& error, std::string_view fallback) {
+  return error.empty() ? std::string(fallback) : error;
+}
+
+// The byte where a PFM's pixels start, 0 when the file is not a PFM (OpenImageIO reads PFM with
+// its PNM reader, so the magic tells): the header is four whitespace-separated tokens ("Pf" or
+// "PF", width, height, scale) and one whitespace byte.
+std::uintmax_t pfm_pixels_offset(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::string head(256, '\0');
+  f.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(f.gcount()));
+  if (head.size() < 3 || head[0] != 'P' || (head[1] != 'f' && head[1] != 'F')) return 0;
+  const auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+  std::size_t i = 0;
+  for (int token = 0; token < 4; ++token) {
+    while (i < head.size() && space(head[i])) ++i;
+    if (i == head.size()) return 0;
+    while (i < head.size() && !space(head[i])) ++i;
+  }
+  return i < head.size() ? i + 1 : 0;
+}
+
 std::string read(const std::string& path, FloatImage& image) try {
   auto in = OIIO::ImageInput::open(path);
-  if (!in) return fmt::format("cannot be read: {}", OIIO::geterror());
+  if (!in) return fmt::format("cannot be read: {}", reason(OIIO::geterror(), "OpenImageIO reads no image format from it"));
   const OIIO::ImageSpec& spec = in->spec();
   image.width = spec.width;
   image.height = spec.height;
@@ -21,9 +50,26 @@ std::string read(const std::string& path, FloatImage& image) try {
   image.channels = spec.nchannels;
   image.pixels.clear();
   if (spec.nchannels != 1 || spec.depth > 1 || spec.width < 1 || spec.height < 1) return "";
-  image.pixels.resize(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height));
+  const long long w = spec.width, h = spec.height;
+  if (w > kMaxDepthSide || h > kMaxDepthSide || w * h > kMaxDepthPixels)
+    return fmt::format("declares {}x{} pixels, above the depth image limit of {} pixels a side and {} pixels in all "
+                       "(refused before reading any pixel)",
+                       w, h, kMaxDepthSide, kMaxDepthPixels);
+  // An uncompressed format must hold every pixel its header declares: a short file is refused
+  // here, with the sizes, instead of by a decoder that may not say why.
+  if (const std::uintmax_t offset = pfm_pixels_offset(path); offset != 0) {
+    std::error_code ec;
+    const std::uintmax_t file_bytes = std::filesystem::file_size(path, ec);
+    const std::uintmax_t pixel_bytes = static_cast<std::uintmax_t>(w * h) * 4u;
+    if (!ec && file_bytes < offset + pixel_bytes)
+      return fmt::format("is a PFM of {} bytes, too short for the {}-byte header and the {}x{} float pixels ({} bytes) "
+                         "it declares (the pixel data is truncated)",
+                         file_bytes, offset, w, h, pixel_bytes);
+  }
+  image.pixels.resize(static_cast<std::size_t>(w * h));
   if (!in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, image.pixels.data()))
-    return fmt::format("cannot be read: {}", in->geterror());
+    return fmt::format("cannot be read: {}",
+                       reason(in->geterror(), "OpenImageIO cannot decode its pixel data (a truncated or damaged file?)"));
   in->close();
   return "";
 } catch (const std::exception& e) {

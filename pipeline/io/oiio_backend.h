@@ -15,6 +15,12 @@ namespace nbsim::io::backend {
 
 inline constexpr int kAbiVersion = 1;
 
+// The largest depth image read (README "Limits"), checked against the file's header before any
+// pixel is allocated: a side of at most 16384 pixels (the trace format's image limit) and at most
+// 4096 x 4096 pixels in all (64 MiB of floats; `nbsim capture` renders at most 4096x4096). Tunable.
+inline constexpr long long kMaxDepthSide = 16384;
+inline constexpr long long kMaxDepthPixels = 4096LL * 4096LL;
+
 // An image as the file holds it: rows top-down, channels interleaved, as floats.
 struct FloatImage {
   int width = 0;
@@ -29,7 +35,9 @@ enum class PixelType : int { Float = 0, UInt16 = 1, UInt8 = 2 };
 struct Table {
   int abi = kAbiVersion;
   const char* openimageio_version = "";
-  // Opens `path`, fills `image`; reads the pixels when the image is 2D with one channel.
+  // Opens `path`, fills `image`; reads the pixels when the image is 2D with one channel, within
+  // kMaxDepthSide and kMaxDepthPixels, and (an uncompressed PFM) the file holds all of them.
+  // Every refusal says why.
   std::string (*read)(const std::string& path, FloatImage& image) = nullptr;
   // Writes top-down `data` (width x height x channels of `type`); `depth_channel` names the single
   // channel "Z" and asks for zip compression (EXR).

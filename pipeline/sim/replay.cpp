@@ -128,6 +128,25 @@ class Collector : public depth::ResultSink {
   std::uint64_t last_cycle_ = 0;
 };
 
+// The files a run writes, each added before it is opened and removed again unless the run
+// completes: a failed run (a damaged trace found mid-run, a record the model cannot replay) leaves
+// no empty or partial CSV, JSON or timeline behind for analysis/ to mistake for a result.
+class RunOutputs {
+ public:
+  RunOutputs() = default;
+  void add(std::filesystem::path file) { files_.push_back(std::move(file)); }
+  ~RunOutputs() {
+    std::error_code ec;
+    for (const std::filesystem::path& f : files_) std::filesystem::remove(f, ec);
+  }
+  RunOutputs(const RunOutputs&) = delete;
+  RunOutputs& operator=(const RunOutputs&) = delete;
+  void keep() noexcept { files_.clear(); }
+
+ private:
+  std::vector<std::filesystem::path> files_;
+};
+
 // The cull stage's run totals (summary "cull", the columns of Table 2 and of explore's results),
 // derived from its statistics and the depth unit's when the run is done.
 nlohmann::ordered_json cull_summary(const nlohmann::ordered_json& cull, const nlohmann::ordered_json& depth,
@@ -227,8 +246,14 @@ ReplaySummary replay(const ReplayOptions& o) {
   const trace::Header& head = tr.header();  // parsed and checked when the trace was opened
   if (!head.viewport) throw InputError(fmt::format("{}: the header has no 'viewport' property", o.trace.string()));
   const int w = head.viewport->width, h = head.viewport->height;
+  // The depth images compared with the model's buffer must have its size: checked as each is read.
+  frames->require_viewport_depths(
+      {std::string(to_string(trace::DepthWhich::AfterOccluders)), std::string(to_string(trace::DepthWhich::Final))});
   const float clear_depth = head.depth_clear;
 
+  RunOutputs outputs;  // declared before the writers, so that it removes their files after they close
+  if (o.out)
+    for (const char* f : {"draws.csv", "frames.csv", "culls.csv", "run.json"}) outputs.add(*o.out / f);
   ReplaySummary s;
   stats::Registry registry;
   Collector sink(s, o, registry);
@@ -251,6 +276,8 @@ ReplaySummary replay(const ReplayOptions& o) {
   if (o.timeline || o.vcd) {
     sim::TimelineOptions to;
     to.json = o.timeline, to.vcd = o.vcd;
+    if (o.timeline) outputs.add(*o.timeline);
+    if (o.vcd) outputs.add(*o.vcd);
     timeline.emplace(std::move(to));
     timeline->attach_units();
   }
@@ -283,8 +310,10 @@ ReplaySummary replay(const ReplayOptions& o) {
     run["stats"] = s.stats;
     run["stats_described"] = registry.describe();
     run["frames"] = sink.per_frame_;
-    std::ofstream(*o.out / "run.json") << run.dump(2) << "\n";
+    const std::string text = run.dump(2) + "\n";  // before the file is opened: a failure leaves none
+    std::ofstream(*o.out / "run.json") << text;
   }
+  outputs.keep();
   return s;
 }
 

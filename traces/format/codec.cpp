@@ -40,6 +40,35 @@ bool good_key_char(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.' || c == '-';
 }
 
+// The byte offset of the first byte that breaks UTF-8 (RFC 3629: no overlong forms, no
+// surrogates, nothing above U+10FFFF), or npos when `s` is valid UTF-8. Header values end up in
+// JSON (run.json, `trace info --json`), which holds only valid UTF-8.
+std::size_t invalid_utf8_at(std::string_view s) {
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(s[i]); };
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const unsigned char c = byte(i);
+    std::size_t n = 0;      // continuation bytes
+    unsigned lo = 0x80, hi = 0xBF;  // the range of the first continuation byte
+    if (c < 0x80) n = 0;
+    else if (c >= 0xC2 && c <= 0xDF) n = 1;
+    else if (c == 0xE0) n = 2, lo = 0xA0;
+    else if ((c >= 0xE1 && c <= 0xEC) || c == 0xEE || c == 0xEF) n = 2;
+    else if (c == 0xED) n = 2, hi = 0x9F;  // not the surrogates U+D800 .. U+DFFF
+    else if (c == 0xF0) n = 3, lo = 0x90;
+    else if (c >= 0xF1 && c <= 0xF3) n = 3;
+    else if (c == 0xF4) n = 3, hi = 0x8F;  // not above U+10FFFF
+    else return i;
+    if (s.size() - i - 1 < n) return i;
+    for (std::size_t k = 1; k <= n; ++k) {
+      const unsigned b = byte(i + k);
+      if (b < (k == 1 ? lo : 0x80u) || b > (k == 1 ? hi : 0xBFu)) return i;
+    }
+    i += n + 1;
+  }
+  return std::string_view::npos;
+}
+
 }  // namespace
 
 std::uint32_t chunk_type_since(std::uint32_t type) noexcept {
@@ -286,6 +315,9 @@ std::string extra_problem(const Properties& properties) {
     if (!seen.insert(key).second) return fmt::format("property key '{}' appears twice", key);
     if (value.size() > kMaxValueBytes)
       return fmt::format("property '{}' has a value of {} bytes, above the limit of {}", key, value.size(), kMaxValueBytes);
+    if (const std::size_t at = invalid_utf8_at(value); at != std::string_view::npos)
+      return fmt::format("property '{}' has a value that is not UTF-8 (byte {} of the value, 0x{:02x})", key, at,
+                         static_cast<unsigned char>(value[at]));
   }
   return {};
 }

@@ -159,6 +159,18 @@ FarOp Header::far_op() const noexcept {
   return depth_func == DepthFunc::Greater || depth_func == DepthFunc::Gequal ? FarOp::Min : FarOp::Max;
 }
 
+std::uint64_t Header::frame_byte_limit() const noexcept {
+  const std::uint64_t pixels = viewport ? static_cast<std::uint64_t>(viewport->width) * static_cast<std::uint64_t>(viewport->height)
+                                        : kFramePixelsWithoutViewport;
+  return kFrameBaseBytes + kFrameBytesPerPixel * pixels;
+}
+
+std::string Header::frame_byte_limit_rule() const {
+  const std::string of = viewport ? fmt::format("the {}x{} viewport", viewport->width, viewport->height)
+                                  : std::string("a 1024x1024 viewport (the header has none)");
+  return fmt::format("{} MiB + {} bytes a pixel of {}", kFrameBaseBytes >> 20, kFrameBytesPerPixel, of);
+}
+
 const std::string* Header::property(std::string_view key) const noexcept {
   for (const auto& [k, v] : properties)
     if (k == key) return &v;

@@ -41,6 +41,10 @@ struct Header {
 
   // "Farthest" under this header's depth func: FarOp::Min under GREATER/GEQUAL (reversed Z).
   FarOp far_op() const noexcept;
+  // The most bytes a frame's chunks may decode to (schema.h kFrameBaseBytes, FORMAT.md "Limits"),
+  // and the rule in words for messages ("64 MiB + 128 bytes a pixel of the 512x512 viewport").
+  std::uint64_t frame_byte_limit() const noexcept;
+  std::string frame_byte_limit_rule() const;
   // The value of any property as written, or nullptr.
   const std::string* property(std::string_view key) const noexcept;
 };

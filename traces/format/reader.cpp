@@ -148,6 +148,7 @@ void TraceReader::open() {
   } catch (const InputError& e) {
     fail(head, e.what());
   }
+  frame_limit_ = header_.frame_byte_limit();
   if (auto c = next(); c && c->type == ChunkType::Scene)
     scene_ = decode<SceneObjects>(*c);
   else
@@ -182,6 +183,13 @@ Chunk TraceReader::read_chunk() {
   if (raw > kMaxChunkBytes)
     fail_at(c.index, c.offset, type_name,
             fmt::format("raw length {} exceeds the format's chunk limit of {} bytes", raw, kMaxChunkBytes));
+  // A frame is held in memory whole (FrameReader): its chunks together stay within the frame limit,
+  // checked before this one is read or decompressed.
+  if (in_frame_ && raw > frame_limit_ - frame_bytes_)
+    fail_at(c.index, c.offset, type_name,
+            fmt::format("frame {}'s chunks decode to {} bytes with this one ({} raw bytes), above the per-frame limit of "
+                        "{} bytes ({})",
+                        frame_, frame_bytes_ + raw, raw, frame_limit_, header_.frame_byte_limit_rule()));
 
   std::vector<std::uint8_t> data(static_cast<std::size_t>(stored));
   if (read_bytes(data.data(), data.size()) != data.size() ||
@@ -227,6 +235,7 @@ Chunk TraceReader::read_chunk() {
     if (ZSTD_isError(n)) fail(c, fmt::format("zstd cannot decompress the payload: {}", ZSTD_getErrorName(n)));
     if (n != raw) fail(c, fmt::format("the payload decompresses to {} bytes, the chunk header says {}", n, raw));
   }
+  if (in_frame_) frame_bytes_ += raw;
   ++next_index_;
   ++stats_.chunks;
   stats_.compressed_chunks += c.compressed;
@@ -254,6 +263,7 @@ void TraceReader::check_structure(const Chunk& c) {
       in_frame_ = any_frame_ = true;
       frame_ = f.frame;
       frame_draws_ = 0;
+      frame_bytes_ = 0;
       return;
     }
     case ChunkType::Draw:
@@ -265,6 +275,8 @@ void TraceReader::check_structure(const Chunk& c) {
     case ChunkType::Light:
       if (!in_frame_) fail(c, "a frame record outside a frame (no FRAM before it)");
       if (c.type == ChunkType::Draw) {
+        if (frame_draws_ >= kMaxDrawsPerFrame)
+          fail(c, fmt::format("frame {} holds more than the per-frame limit of {} draws", frame_, kMaxDrawsPerFrame));
         ++frame_draws_;
         ++stats_.draws;
       } else if (c.type == ChunkType::DrawBatch) {
@@ -273,8 +285,9 @@ void TraceReader::check_structure(const Chunk& c) {
                                                       c.payload.size()));
         const std::uint32_t n = le32(c.payload.data());
         if (n == 0) fail(c, "an empty draw batch");
-        if (n > std::numeric_limits<std::uint32_t>::max() - frame_draws_)
-          fail(c, fmt::format("the batch's {} draws overflow frame {}'s draw count", n, frame_));
+        if (n > kMaxDrawsPerFrame - frame_draws_)
+          fail(c, fmt::format("the batch's {} draws bring frame {} to {} draws, above the per-frame limit of {} draws", n,
+                              frame_, std::uint64_t{frame_draws_} + n, kMaxDrawsPerFrame));
         frame_draws_ += n;
         stats_.draws += n;
       }
@@ -360,6 +373,10 @@ template Camera TraceReader::decode<Camera>(const Chunk&) const;
 FrameReader::FrameReader(const std::filesystem::path& file) : trace_(file) {}
 FrameReader::FrameReader(TraceReader trace) : trace_(std::move(trace)) {}
 
+void FrameReader::require_viewport_depths(std::vector<std::string> depth_names) {
+  viewport_depths_ = std::move(depth_names);
+}
+
 std::optional<Frame> FrameReader::next() {
   std::optional<Chunk> c = trace_.next();
   if (!c) return std::nullopt;
@@ -404,6 +421,12 @@ std::optional<Frame> FrameReader::next() {
       }
       case ChunkType::Depth: {
         DepthSnapshot d = trace_.decode<DepthSnapshot>(*c);
+        if (const std::optional<Viewport>& v = trace_.header().viewport;
+            v && (d.width != v->width || d.height != v->height) &&
+            std::find(viewport_depths_.begin(), viewport_depths_.end(), d.name) != viewport_depths_.end())
+          trace_.fail(*c, fmt::format("depth image '{}' is {}x{}, but the header's viewport is {}x{}: replay compares it "
+                                      "with the model's depth buffer, which has the viewport's size",
+                                      d.name, d.width, d.height, v->width, v->height));
         if (f.depth(d.name))
           trace_.fail(*c, fmt::format("a second '{}' depth snapshot in frame {}", d.name, f.begin.frame));
         f.depths.push_back(std::move(d));

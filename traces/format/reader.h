@@ -104,6 +104,8 @@ class TraceReader {
   bool any_frame_ = false;
   std::uint32_t frame_ = 0;        // the open (or last) frame's number
   std::uint32_t frame_draws_ = 0;  // draws in the open frame (DRAW chunks and DRWS batches)
+  std::uint64_t frame_bytes_ = 0;  // raw bytes of the open frame's chunks so far
+  std::uint64_t frame_limit_ = 0;  // header_.frame_byte_limit()
 };
 
 // One frame, FRAM .. FEND, decoded (model/scene/frame.h).
@@ -115,6 +117,13 @@ class FrameReader {
   explicit FrameReader(const std::filesystem::path& file);
   explicit FrameReader(TraceReader trace);
 
+  // From now on, refuses (naming the chunk) a depth image named in `depth_names` whose size is
+  // not the header's viewport. Replay asks for it for the depth images it compares with the
+  // model's depth buffer, which has the viewport's size ("after_occluders", "final"); the format
+  // itself allows any size (a technique's litmaps need not match the viewport). No effect when
+  // the header has no viewport.
+  void require_viewport_depths(std::vector<std::string> depth_names);
+
   // The next frame, or nullopt after the last one (END read and checked).
   std::optional<Frame> next();
   TraceReader& trace() noexcept { return trace_; }
@@ -123,6 +132,7 @@ class FrameReader {
  private:
   TraceReader trace_;
   std::uint64_t ordinal_ = 0;
+  std::vector<std::string> viewport_depths_;  // require_viewport_depths()
 };
 
 }  // namespace nbsim::trace

@@ -37,6 +37,19 @@ inline constexpr std::size_t kMaxProperties = 1024;
 inline constexpr std::int32_t kMaxImageSide = 16384;
 inline constexpr std::int32_t kMaxLevels = 32;
 
+// Per frame (FORMAT.md "Limits"), so that a frame reader's memory stays bounded: a frame's chunks
+// (FRAM excluded, FEND included) decode to at most kFrameBaseBytes plus kFrameBytesPerPixel bytes
+// a pixel of the header's viewport (Header::frame_byte_limit; a 1024x1024 viewport when the
+// header has none), and hold at most kMaxDrawsPerFrame draws. Derived from the largest real
+// frames: a 2048x2048 occlusion-culling frame holds two depth images (8 bytes a pixel), 11 N-buffer
+// planes (44), an ID buffer (4) and a few MiB of draws, about 60 bytes a pixel; the city's frames
+// have about 15,000 draws of 1 KiB or less. Twice that leaves room for a stencil image or a
+// second level set.
+inline constexpr std::uint64_t kFrameBaseBytes = std::uint64_t{64} << 20;
+inline constexpr std::uint64_t kFrameBytesPerPixel = 128;
+inline constexpr std::uint64_t kFramePixelsWithoutViewport = 1024 * 1024;
+inline constexpr std::uint32_t kMaxDrawsPerFrame = std::uint32_t{1} << 20;
+
 // The element type of a counted vector visited by items(): its name in the tables, its size in
 // bytes (the least size when it varies) and whether every element has that size.
 struct Element {
@@ -75,7 +88,7 @@ void fields(Io& io, Properties& p) {
   io.items("properties", p, "P", Element{"(string key, string value)", 8, false},
            [](Io& e, std::pair<std::string, std::string>& kv) {
              e.string("key", kv.first, kMaxKeyBytes, "1 to 64 characters of A-Z a-z 0-9 _ . -, unique");
-             e.string("value", kv.second, kMaxValueBytes, "at most 64 KiB");
+             e.string("value", kv.second, kMaxValueBytes, "at most 64 KiB of UTF-8");
            },
            "key/value pairs in order, at most 1024");
 }

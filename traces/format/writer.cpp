@@ -23,6 +23,12 @@ void check_record(const std::string& problem, const char* what) {
 TraceWriter::TraceWriter(const std::filesystem::path& file, const Properties& properties) : name_(file.string()) {
   if (const std::string p = record_problem(properties); !p.empty())
     throw InputError(fmt::format("cannot write trace '{}': {}", name_, p));
+  try {
+    header_ = parse_header(properties);
+  } catch (const InputError&) {
+    // A malformed typed value: readers refuse the file anyway (tests write such files on purpose).
+    header_ = Header{};
+  }
   file_ = std::fopen(name_.c_str(), "wb");
   if (!file_) throw InputError(fmt::format("cannot create trace '{}': {}", name_, std::strerror(errno)));
   const auto pre = encode_preamble(kFormatVersion);
@@ -42,6 +48,14 @@ void TraceWriter::put_bytes(const std::uint8_t* data, std::size_t n) {
 }
 
 void TraceWriter::put(ChunkType type, const std::vector<std::uint8_t>& payload, std::uint32_t extra_flags) {
+  if (in_frame_) {
+    if (payload.size() > header_.frame_byte_limit() - frame_bytes_)
+      throw InputError(fmt::format("cannot write trace '{}': frame {}'s records come to {} bytes with this {} record, above "
+                                   "the per-frame limit of {} bytes ({})",
+                                   name_, frame_, frame_bytes_ + payload.size(), chunk_type_name(type),
+                                   header_.frame_byte_limit(), header_.frame_byte_limit_rule()));
+    frame_bytes_ += payload.size();
+  }
   std::vector<std::uint8_t> chunk;
   try {
     chunk = encode_chunk(type, payload, true, extra_flags);
@@ -82,6 +96,7 @@ void TraceWriter::begin_frame(const FrameBegin& frame) {
   in_frame_ = any_frame_ = true;
   frame_ = frame.frame;
   draws_ = 0;
+  frame_bytes_ = 0;
   depths_.clear();
   stencils_.clear();
   levels_.clear();
@@ -99,6 +114,9 @@ void TraceWriter::write(const DrawRecord& draw) {
     NBSIM_CHECK(draw.node < static_cast<std::int64_t>(scene_nodes_),
                 fmt::format("TraceWriter: draw {} names BVH node {} of {}", draw.index, draw.node, scene_nodes_));
   }
+  if (draws_ >= kMaxDrawsPerFrame)
+    throw InputError(fmt::format("cannot write trace '{}': frame {} holds more than the per-frame limit of {} draws", name_,
+                                 frame_, kMaxDrawsPerFrame));
   pending_.draws.push_back(draw);
   pending_bytes_ += 160 + 20 * draw.clip_positions.size();
   ++draws_;

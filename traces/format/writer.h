@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "traces/format/header.h"
 #include "traces/format/records.h"
 
 namespace nbsim::trace {
@@ -71,6 +72,10 @@ class TraceWriter {
   std::set<std::string> depths_, stencils_;
   std::set<std::pair<std::string, std::uint8_t>> levels_;
   bool light_ = false, truth_ = false;
+  // The per-frame limit readers enforce (FORMAT.md "Limits"): a frame the reader would refuse is
+  // refused here, with an InputError, instead of written.
+  Header header_;                  // the typed header (defaults when a property is malformed)
+  std::uint64_t frame_bytes_ = 0;  // payload bytes of the open frame's chunks so far
 };
 
 }  // namespace nbsim::trace

@@ -163,6 +163,51 @@ TEST(NBufferCliTest, RefusesUnreadableFiles) {
   EXPECT_TRUE(has(r.err, empty.string())) << r.err;
 }
 
+// A PFM whose header says `header` ("Pf\nW H\n-1.0\n") followed by `pixel_bytes` bytes of 0.5f.
+fs::path pfm_with(const std::string& name, const std::string& header, std::size_t pixel_bytes) {
+  const fs::path f = scratch(name);
+  std::ofstream o(f, std::ios::binary);
+  o << header;
+  const float half = 0.5f;
+  for (std::size_t i = 0; i < pixel_bytes / 4; ++i) o.write(reinterpret_cast<const char*>(&half), 4);
+  return f;
+}
+
+// A depth image whose header declares more than the limit (16384 a side, 4096x4096 pixels in all)
+// is refused with exit 2 before its pixels are allocated, the message naming the file, the size
+// and the limit (a tiny PFM declaring 32768x32768 used to allocate 4 GiB and then fail with an
+// empty reason). The sizes here stay small enough that the old code would not allocate much.
+TEST(NBufferCliTest, RefusesDepthImageAboveSizeLimit) {
+  const struct {
+    const char* header;
+    const char* size;
+  } rows[] = {{"Pf\n20000 1\n-1.0\n", "20000x1"}, {"Pf\n1 16385\n-1.0\n", "1x16385"}, {"Pf\n4097 4097\n-1.0\n", "4097x4097"}};
+  int i = 0;
+  for (const auto& row : rows) {
+    const fs::path f = pfm_with("huge" + std::to_string(i++) + ".pfm", row.header, 64);
+    const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
+    EXPECT_EQ(r.status, 2) << row.size << ": " << r.err;
+    EXPECT_TRUE(has(r.err, f.string()) && has(r.err, "declares " + std::string(row.size) + " pixels") &&
+                has(r.err, "above the depth image limit of 16384 pixels a side and 16777216 pixels in all"))
+        << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+// A PFM with fewer pixel bytes than its header declares is refused with exit 2 and a reason that
+// gives the sizes (it used to end in an empty "cannot be read: ").
+TEST(NBufferCliTest, RefusesTruncatedPfm) {
+  const fs::path f = pfm_with("short.pfm", "Pf\n4 4\n-1.0\n", 40);
+  const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, f.string()) && has(r.err, "is a PFM of 52 bytes, too short for the 12-byte header and the 4x4 float "
+                                                    "pixels (64 bytes) it declares (the pixel data is truncated)"))
+      << r.err;
+  EXPECT_FALSE(has(r.err, "cannot be read: \n")) << "a refusal always says why: " << r.err;
+  const fs::path whole = pfm_with("whole.pfm", "Pf\n4 4\n-1.0\n", 64);
+  EXPECT_EQ(nbsim("nbuffer query --depth " + whole.string() + " --rect 0,0,1,1").status, 0) << "the complete file reads";
+}
+
 // The OpenImageIO backend is loaded only when an image is touched: without it, a query on the
 // built-in scene still runs, and an image read names the missing backend (exit 2, no crash).
 TEST(NBufferCliTest, ImageBackendLoadedOnlyWhenNeeded) {

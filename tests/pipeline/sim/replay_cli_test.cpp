@@ -11,6 +11,7 @@
 #include <string>
 
 #include "tests/common/run_nbsim.h"
+#include "traces/format/codec.h"
 #include "traces/format/writer.h"
 
 namespace {
@@ -225,6 +226,66 @@ TEST(ReplayCliTest, RefusesDamagedTrace) {
   const CliResult r = run_nbsim("compare " + t.string());
   EXPECT_EQ(r.status, 2) << r.out << r.err;
   EXPECT_TRUE(has(r.err, "chunk")) << r.err;
+}
+
+// A header value that is not UTF-8 is refused by replay with exit 2 naming the key, before any
+// output is written (it used to fail in the JSON library and leave an empty run.json).
+TEST(ReplayCliTest, RefusesNonUtf8HeaderWithoutOutput) {
+  namespace tr = nbsim::trace;
+  const fs::path t = scratch("latin1.nbt");
+  {
+    std::vector<std::uint8_t> b;
+    const auto pre = tr::encode_preamble(tr::kFormatVersion);
+    b.assign(pre.begin(), pre.end());
+    for (const auto& c : {tr::encode_chunk(tr::ChunkType::Header, tr::encode(tr::Properties{{"viewport", "8x8"}, {"scene", "caf\xe9"}})),
+                          tr::encode_chunk(tr::ChunkType::End, tr::encode(tr::EndMarker{1, 0}))})
+      b.insert(b.end(), c.begin(), c.end());
+    std::ofstream(t, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  }
+  const fs::path out = scratch("latin1_out");
+  const CliResult r = run_nbsim("replay " + t.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "property 'scene' has a value that is not UTF-8")) << r.err;
+  EXPECT_FALSE(fs::exists(out / "run.json")) << "no empty run.json";
+}
+
+// A trace whose final depth image is h x w under a w x h viewport: one frame with one draw.
+fs::path swapped_depth_trace(const std::string& name) {
+  namespace tr = nbsim::trace;
+  const fs::path t = scratch(name);
+  tr::TraceWriter w(t, {{"viewport", "16x8"}, {"depth_func", "LESS"}, {"depth_clear", "1"}, {"frames", "1"}});
+  tr::FrameBegin b;
+  w.begin_frame(b);
+  tr::DrawRecord d;
+  d.clip_positions = {{-1, -1, 0, 1}, {1, -1, 0, 1}, {0, 1, 0, 1}};
+  d.state.test = d.state.write = true;
+  w.write(d);
+  tr::DepthSnapshot depth;
+  depth.name = "final";
+  depth.width = 8;
+  depth.height = 16;
+  depth.texels.assign(8 * 16, 1.0f);
+  w.write(depth);
+  tr::FrameEnd e;
+  e.draws = 1;
+  w.end_frame(e);
+  w.close();
+  return t;
+}
+
+// A depth snapshot of another size than the viewport (swapped sides) is refused with exit 2 and
+// the chunk named, not an abort from the depth unit's thread, and the failed run leaves no output
+// file behind (no empty run.json, no partial CSV).
+TEST(ReplayCliTest, RefusesDepthOfAnotherSizeThanTheViewport) {
+  const fs::path t = swapped_depth_trace("swapped.nbt");
+  const fs::path out = scratch("swapped_out");
+  const CliResult r = run_nbsim("replay " + t.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "chunk 3 (DPTH)") && has(r.err, "depth image 'final' is 8x16, but the header's viewport is 16x8"))
+      << r.err;
+  for (const char* f : {"run.json", "draws.csv", "frames.csv"}) EXPECT_FALSE(fs::exists(out / f)) << f << " left by a failed run";
+  const CliResult c = run_nbsim("compare " + t.string());
+  EXPECT_EQ(c.status, 2) << c.out << c.err;
 }
 
 }  // namespace

@@ -301,4 +301,24 @@ TEST(TraceCliTest, InfoShowsVersion2Records) {
   EXPECT_TRUE(has(d.out, "TSTX (unregistered technique chunk)\n  payload: ")) << d.out;
 }
 
+// A header value that is not UTF-8 is refused by verify and by info --json with exit 2, naming the
+// key and chunk 0, and nothing goes to stdout (info --json used to fail in the JSON library).
+TEST(TraceCliTest, RefusesNonUtf8Header) {
+  const fs::path f = scratch("latin1.nbtrace");
+  Bytes b;
+  const auto pre = encode_preamble(kFormatVersion);
+  b.assign(pre.begin(), pre.end());
+  for (const Bytes& c : {encode_chunk(ChunkType::Header, encode(Properties{{"viewport", "8x8"}, {"command_line", "nbsim -o caf\xe9.nbt"}})),
+                         encode_chunk(ChunkType::End, encode(EndMarker{1, 0}))})
+    b.insert(b.end(), c.begin(), c.end());
+  write_file(f, b);
+  for (const char* cmd : {"trace verify ", "trace info --json ", "trace info "}) {
+    const CliResult r = nbsim(cmd + f.string());
+    EXPECT_EQ(r.status, 2) << cmd << r.out << r.err;
+    EXPECT_TRUE(has(r.err, "chunk 0 (HEAD)") && has(r.err, "property 'command_line' has a value that is not UTF-8"))
+        << cmd << r.err;
+    EXPECT_TRUE(r.out.empty()) << cmd << r.out;
+  }
+}
+
 }  // namespace

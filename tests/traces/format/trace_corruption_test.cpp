@@ -642,4 +642,129 @@ TEST(TraceCorruptionTest, RandomPayloadEditsNeverCrash) {
   EXPECT_GT(read, 0) << "edits of float fields read as other values";
 }
 
+// A header property value that is not UTF-8 is refused at chunk 0, naming the key and the byte
+// (run.json and `trace info --json` hold the values, and JSON is UTF-8); valid UTF-8 reads.
+TEST(TraceCorruptionTest, NonUtf8PropertyValueRefused) {
+  const struct {
+    const char* value;
+    const char* why;
+  } bad[] = {
+      {"city\xff", "0xff never occurs in UTF-8"},
+      {"\x80lone", "a continuation byte without a lead byte"},
+      {"\xc0\xaf", "an overlong encoding of '/'"},
+      {"\xed\xa0\x80", "a UTF-16 surrogate (U+D800)"},
+      {"\xf4\x90\x80\x80", "above U+10FFFF"},
+      {"ab\xe2\x82", "a sequence cut short by the end"},
+      {"\xe2(\xa1", "a lead byte followed by ASCII"},
+  };
+  for (const auto& row : bad) {
+    Builder t;
+    t.add(Properties{{"viewport", "8x8"}, {"scene", row.value}}).end(0);
+    const std::string e = read_error(t.b);
+    EXPECT_TRUE(has(e, "chunk 0 (HEAD)") && has(e, "property 'scene'") && has(e, "not UTF-8")) << row.why << ": " << e;
+  }
+  Builder good;
+  good.add(Properties{{"viewport", "8x8"}, {"scene", "na\xc3\xafve \xe2\x9c\x93 \xf0\x9d\x84\x9e"}}).end(0);
+  EXPECT_EQ(read_error(good.b), "") << "two-, three- and four-byte UTF-8 read";
+}
+
+// Replay compares the depth images "after_occluders" and "final" with a depth buffer of the
+// viewport's size: a reader asked for them refuses one of another size (swapped sides, 1xN, a
+// viewport edited in the header), naming the chunk; other images, and the same file read without
+// the request, may have any size (a technique's litmaps need not match the viewport).
+TEST(TraceCorruptionTest, ReplayedDepthOfAnotherSizeThanTheViewportRefused) {
+  const auto read = [](const Bytes& b) {
+    try {
+      FrameReader frames(TraceReader(b, "t.nbtrace"));
+      frames.require_viewport_depths({"after_occluders", "final"});
+      while (frames.next()) {
+      }
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const struct {
+    const char* viewport;
+    DepthSnapshot depth;
+    const char* what;
+  } rows[] = {
+      {"8x4", sample_depth(DepthWhich::Final, 4, 8), "depth image 'final' is 4x8, but the header's viewport is 8x4"},
+      {"8x4", sample_depth(DepthWhich::AfterOccluders, 1, 32), "depth image 'after_occluders' is 1x32"},
+      {"9x4", sample_depth(DepthWhich::Final, 8, 4), "depth image 'final' is 8x4, but the header's viewport is 9x4"},
+  };
+  for (const auto& row : rows) {
+    Builder t;
+    t.add(Properties{{"viewport", row.viewport}}).add(sample_frame_begin(0)).add(row.depth).add(FrameEnd{0, 0, 0.0}).end(1);
+    EXPECT_EQ(read_error(t.b), "") << row.what << ": the format itself allows any size";
+    const std::string e = read(t.b);
+    EXPECT_TRUE(has(e, "t.nbtrace: chunk 2 (DPTH)") && has(e, row.what)) << e;
+  }
+  DepthSnapshot litmap = sample_depth(DepthWhich::Final, 4, 8);
+  litmap.name = "litmap_min";
+  Builder ok;
+  ok.add(Properties{{"viewport", "8x4"}}).add(sample_frame_begin(0)).add(sample_depth(DepthWhich::Final, 8, 4)).add(litmap);
+  ok.add(sample_stencil("volumes", 3, 1)).add(FrameEnd{0, 0, 0.0}).end(1);
+  EXPECT_EQ(read(ok.b), "") << "a replayed depth of the viewport's size and other images of any size read";
+}
+
+// A draw of `vertices` identical clip-space vertices: 16 bytes each raw, compressing to almost
+// nothing (a hostile file's cheap way to declare a big frame).
+DrawRecord flat_draw(std::uint32_t index, std::size_t vertices) {
+  DrawRecord d;
+  d.index = index;
+  d.clip_positions.assign(vertices, {0.0f, 0.0f, 0.5f, 1.0f});
+  return d;
+}
+
+// A frame whose chunks are each within the chunk limit but together above the per-frame limit
+// (64 MiB + 128 bytes a viewport pixel) is refused at the chunk that crosses it, before that chunk
+// is decompressed, naming the frame and the limit.
+TEST(TraceCorruptionTest, FrameAboveByteLimitRefused) {
+  const Properties p{{"viewport", "8x8"}};
+  const std::uint64_t limit = (std::uint64_t{64} << 20) + 128 * 64;
+  const std::size_t vertices = 1500000;  // 24 MB raw a draw: the third crosses the limit
+  Builder t;
+  t.add(p).add(sample_frame_begin(0));
+  for (std::uint32_t i = 0; i < 3; ++i) t.chunk(ChunkType::Draw, encode(flat_draw(i, vertices)), true);
+  t.add(FrameEnd{0, 3, 0.0}).end(1);
+  ASSERT_LT(t.b.size(), 1u << 20) << "the hostile file itself is small";
+  const std::string e = read_error(t.b);
+  EXPECT_TRUE(has(e, "chunk 4 (DRAW)")) << "the third DRAW crosses the limit: " << e;
+  EXPECT_TRUE(has(e, "per-frame limit of " + std::to_string(limit) + " bytes")) << e;
+  EXPECT_TRUE(has(e, "64 MiB + 128 bytes a pixel of the 8x8 viewport")) << "the rule in words: " << e;
+  // The same draws in a frame of a 1024x1024 viewport (192 MiB) read.
+  Builder big;
+  big.add(Properties{{"viewport", "1024x1024"}}).add(sample_frame_begin(0));
+  for (std::uint32_t i = 0; i < 3; ++i) big.chunk(ChunkType::Draw, encode(flat_draw(i, vertices)), true);
+  big.add(FrameEnd{0, 3, 0.0}).end(1);
+  EXPECT_EQ(read_error(big.b), "") << "72 MB of draws fit a 1024x1024 frame";
+}
+
+// The per-frame byte count starts again at every frame: frames of 48 MB each read, however many.
+TEST(TraceCorruptionTest, FrameByteLimitIsPerFrame) {
+  Builder t;
+  t.add(Properties{{"viewport", "8x8"}});
+  for (std::uint32_t f = 0; f < 3; ++f) {
+    t.add(sample_frame_begin(f));
+    for (std::uint32_t i = 0; i < 2; ++i) t.chunk(ChunkType::Draw, encode(flat_draw(i, 1500000)), true);
+    t.add(FrameEnd{f, 2, 0.0});
+  }
+  t.end(3);
+  EXPECT_EQ(read_error(t.b), "");
+}
+
+// A draw batch whose count takes the frame above the per-frame draw limit (2^20) is refused
+// before its draws are decoded, naming the limit.
+TEST(TraceCorruptionTest, FrameAboveDrawLimitRefused) {
+  Bytes batch(8, 0);
+  put_le32(batch, 0, (1u << 20) + 1);
+  Builder t;
+  t.add(Properties{{"viewport", "8x8"}}).add(sample_frame_begin(0)).chunk(ChunkType::DrawBatch, batch);
+  t.add(FrameEnd{0, (1u << 20) + 1, 0.0}).end(1);
+  const std::string e = read_error(t.b);
+  EXPECT_TRUE(has(e, "chunk 2 (DRWS)")) << e;
+  EXPECT_TRUE(has(e, "above the per-frame limit of 1048576 draws")) << e;
+}
+
 }  // namespace

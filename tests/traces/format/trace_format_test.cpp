@@ -540,4 +540,55 @@ TEST(TraceWriterDeathTest, AbortsOnMisuse) {
       "NOPE is not registered");
 }
 
+// A property value that is not UTF-8 is refused by the writer too (an InputError naming the key).
+TEST(TraceFormatTest, WriterRefusesNonUtf8Property) {
+  EXPECT_THROW(
+      {
+        try {
+          TraceWriter w(scratch("latin1.nbtrace"), {{"scene", "caf\xe9"}});
+        } catch (const InputError& e) {
+          EXPECT_NE(std::string(e.what()).find("property 'scene' has a value that is not UTF-8"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      InputError);
+}
+
+// The writer refuses (InputError, not a crash) a frame that readers would refuse as above the
+// per-frame byte limit, naming the frame and the limit.
+TEST(TraceFormatTest, WriterRefusesFrameAboveByteLimit) {
+  const fs::path f = scratch("frame_limit.nbtrace");
+  TraceWriter w(f, {{"viewport", "8x8"}});
+  w.begin_frame(sample_frame_begin(0));
+  DrawRecord d;
+  d.clip_positions.assign(1500000, {0.0f, 0.0f, 0.5f, 1.0f});  // 24 MB a draw, flushed one by one (4 MiB batches)
+  std::string error;
+  try {
+    for (std::uint32_t i = 0; i < 3; ++i) {
+      d.index = i;
+      w.write(d);
+    }
+    w.end_frame({0, 3, 0.0});
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  EXPECT_TRUE(error.find("frame 0's records come to") != std::string::npos &&
+              error.find("per-frame limit of 67117056 bytes") != std::string::npos)
+      << "the third draw crosses 64 MiB + 128 bytes x 64 pixels: " << error;
+}
+
+// The per-frame limit holds the largest real frames with room to spare: a 2048x2048
+// occlusion-culling frame (two depth images, 11 N-buffer planes of max and of min, an ID buffer, a
+// stencil image, 20,000 draws of 1 KiB) and a 512x512 one.
+TEST(TraceFormatTest, FrameLimitHoldsReal2048Frames) {
+  for (const int side : {512, 2048}) {
+    Header h;
+    h.viewport = Viewport{side, side};
+    const std::uint64_t px = static_cast<std::uint64_t>(side) * static_cast<std::uint64_t>(side);
+    const std::uint64_t levels = side == 2048 ? 11 : 9;
+    const std::uint64_t frame = 2 * 4 * px + 2 * 4 * levels * px + 4 * px + px + 20000 * 1024;
+    EXPECT_GE(h.frame_byte_limit(), frame) << side << "x" << side << ": " << h.frame_byte_limit_rule();
+  }
+}
+
 }  // namespace
