@@ -11,6 +11,8 @@
 #include <iterator>
 #include <string_view>
 
+#include "pipeline/io/image_precheck.h"
+
 namespace nbsim::io::backend {
 namespace {
 
@@ -41,8 +43,15 @@ std::uintmax_t pfm_pixels_offset(const std::string& path) {
 }
 
 std::string read(const std::string& path, FloatImage& image) try {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) return fmt::format("cannot be read: {}", reason(OIIO::geterror(), "OpenImageIO reads no image format from it"));
+  // The format by its magic bytes and the declared sizes checked first (image_precheck.h says why);
+  // then only that format's reader opens the file.
+  const ImagePrecheck pre = precheck_depth_file(path, kMaxDepthSide, kMaxDepthPixels);
+  if (!pre.refusal.empty()) return pre.refusal;
+  auto in = OIIO::ImageInput::create(pre.format);
+  if (!in) return fmt::format("cannot be read: {}", reason(OIIO::geterror(), "OpenImageIO has no reader for it"));
+  OIIO::ImageSpec opened;
+  if (!in->open(path, opened))
+    return fmt::format("cannot be read: {}", reason(in->geterror(), "OpenImageIO cannot read its header"));
   const OIIO::ImageSpec& spec = in->spec();
   image.width = spec.width;
   image.height = spec.height;

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -206,6 +207,57 @@ TEST(NBufferCliTest, RefusesTruncatedPfm) {
   EXPECT_FALSE(has(r.err, "cannot be read: \n")) << "a refusal always says why: " << r.err;
   const fs::path whole = pfm_with("whole.pfm", "Pf\n4 4\n-1.0\n", 64);
   EXPECT_EQ(nbsim("nbuffer query --depth " + whole.string() + " --rect 0,0,1,1").status, 0) << "the complete file reads";
+}
+
+// fuzz_depth_image's first finding: a 402-byte PNG whose text chunk declares 1.8 GB. libpng
+// allocated and cleared the declared length before reading it (2 GB and a 15 s timeout); every
+// PNG chunk is now checked against the file's size before OpenImageIO opens it. The input is the
+// finding as the fuzzer kept it (its first byte picked the extension).
+// A fuzz finding kept in tests/fuzz/corpus/fuzz_depth_image/, written as the file it stood for.
+fs::path finding_file(const std::string& finding, const std::string& name) {
+  std::ifstream in(fs::path(NBSIM_SOURCE_DIR) / "tests/fuzz/corpus/fuzz_depth_image" / finding, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_GT(bytes.size(), 10u) << finding;
+  const fs::path f = scratch(name);
+  std::ofstream(f, std::ios::binary) << bytes.substr(1);
+  return f;
+}
+
+TEST(NBufferCliTest, RefusesPngChunkPastTheFileEnd) {
+  const fs::path f = finding_file("png_text_chunk_past_end", "chunk_past_end.png");
+  const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, f.string()) && has(r.err, "is a damaged PNG: chunk 5 ('tEXt') at byte 110 declares 1886545267 "
+                                                    "bytes of data, past the end of the 401-byte file"))
+      << r.err;
+  // A whole PNG still reads (16-bit grey, as `nbuffer build --preview` writes them).
+  const fs::path png = scratch("whole.png");
+  nbsim::io::write_preview(nbsim::DepthImage(4, 4, 0.5f), png, 0.0f, 1.0f);
+  EXPECT_EQ(nbsim("nbuffer query --depth " + png.string() + " --rect 0,0,1,1").status, 0);
+}
+
+// fuzz_depth_image's second finding: a 43-byte OpenEXR header whose string attribute declares
+// 1.8 GB (OpenEXR allocated it: out of memory). Before that fix, a file OpenImageIO did not
+// recognise by its extension was also offered to every reader it has (DICOM, video, raw, ...).
+TEST(NBufferCliTest, RefusesExrAttributePastTheFileEnd) {
+  const fs::path f = finding_file("exr_attribute_past_end", "attribute_past_end.exr");
+  CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "is a damaged OpenEXR file: attribute 'Exif:ImageHistory' at byte 33 declares 1833519362 bytes, "
+                         "past the end of the 42-byte file"))
+      << r.err;
+  // The same bytes named .png or .tif are still read as what they are.
+  const fs::path renamed = scratch("attribute_past_end.png");
+  fs::copy_file(f, renamed, fs::copy_options::overwrite_existing);
+  r = nbsim("nbuffer query --depth " + renamed.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "is a damaged OpenEXR file")) << r.err;
+  // A text file is none of the formats read.
+  const fs::path text = scratch("text.tif");
+  std::ofstream(text) << "P5 not really";
+  r = nbsim("nbuffer query --depth " + text.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "not a depth image format nbsim reads (OpenEXR, TIFF, PNG or PFM")) << r.err;
 }
 
 // The OpenImageIO backend is loaded only when an image is touched: without it, a query on the
