@@ -26,7 +26,8 @@ void install_report_handler();
 
 // An exception escaping a unit's thread (a damaged trace read mid-run, say) would reach SystemC
 // as an uncaught-exception error. Threads catch it and call thread_failed(), which keeps the first
-// one and stops the simulation; the driver calls rethrow_thread_failure() after sc_start returns.
+// one and stops the simulation; the driver calls rethrow_thread_failure() right after sc_start
+// returns, on the main thread (in sanitizer builds it also tells ASan that this is the main stack).
 void thread_failed(std::exception_ptr e);
 void rethrow_thread_failure();
 
