@@ -26,7 +26,8 @@
 // Points (process_points), Mesa 22.3:
 // - draw_pipe_clip.c clip_first_point picks clip_point unless draw->guard_band_points_lines_xy;
 //   that flag is guard_band_xy || (driver.bypass_clip_points_lines && rasterizer
-//   point_line_tri_clip) (draw_context.c draw_update_clip_flags). llvmpipe calls
+//   point_line_tri_clip) (draw_context.c draw_update_clip_flags; older trees call them
+//   guard_band_points_xy, bypass_clip_points and point_tri_clip). llvmpipe calls
 //   draw_set_driver_clipping(draw, false, false, false, true) (lp_context.c: clipping on, no guard
 //   band) and the state tracker sets point_line_tri_clip only for GLES 2 (st_atom_rasterizer.c),
 //   so desktop GL points are clipped by their centre: a point with any outcode bit (x, y, near,

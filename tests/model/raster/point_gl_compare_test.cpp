@@ -4,6 +4,8 @@
 // fragment tests) and the passed samples (the same with early_fragment_tests), the final depth
 // buffer, and per draw GL_SAMPLES_PASSED and the clipper's input and output primitives. Each case
 // is one draw of many points with gl_PointSize from the vertex shader on a prepared depth buffer.
+// UnitsReplayPointTraceExactly replays GL's draws through the SystemC units (`nbsim compare`), and
+// PointReplayInputTest feeds `nbsim compare` bad point draws.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <random>
 #include <string>
 #include <utility>
@@ -20,7 +23,10 @@
 #include "model/raster/raster_path.h"
 #include "tests/model/raster/point_coverage.h"
 #include "traces/capture/gl_program.h"
+#include "traces/format/writer.h"
 #include "traces/gl/context.h"
+#include "tests/common/run_nbsim.h"
+#include <nlohmann/json.hpp>
 
 namespace nbsim::raster {
 namespace {
@@ -54,6 +60,7 @@ struct Case {
   DepthFunc func = DepthFunc::Less;
   bool write = true;
   bool test = true;
+  bool depth_clamp = false;  // GL_DEPTH_CLAMP: no near/far clipping, fragment depth clamped to [0, 1]
   ClipControl clip_control = ClipControl::NegativeOneToOne;
   std::vector<float> depth;  // prepared depth buffer, y up
 };
@@ -103,6 +110,7 @@ class GlPoints {
     glDepthRange(0.0, 1.0);
     glClipControl(GL_LOWER_LEFT, c.clip_control == ClipControl::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
     glEnable(GL_PROGRAM_POINT_SIZE);
+    if (c.depth_clamp) glEnable(GL_DEPTH_CLAMP); else glDisable(GL_DEPTH_CLAMP);
     if (c.test) glEnable(GL_DEPTH_TEST); else glDisable(GL_DEPTH_TEST);
     glDepthFunc(gl_func(c.func));
     glDepthMask(c.write ? GL_TRUE : GL_FALSE);
@@ -333,6 +341,7 @@ Outcome compare(GlPoints& gl, const Case& c) {
   geometry::GeometryState gs;
   gs.clip = c.clip_control;
   gs.face.cull = geometry::CullFace::None;
+  gs.depth_clamp = c.depth_clamp;
   DepthState ds;
   ds.func = c.func;
   ds.write = c.write;
@@ -447,6 +456,17 @@ TEST_F(PointGlCompareTest, ReversedZMatchesGl) {
   compare(*gl_, reversed_z(DepthFunc::Gequal));
 }
 
+// Depth clamp: centres beyond near and far are kept and their fragments tested at 0 or 1.
+TEST_F(PointGlCompareTest, DepthClampKeepsPointsBeyondNearAndFar) {
+  Case c = centres_outside();
+  c.name = "depth clamp";
+  c.depth_clamp = true;
+  c.func = DepthFunc::Lequal;
+  for (std::size_t i = 0; i < c.depth.size(); i += 3) c.depth[i] = i % 2 ? 1.0f : 0.0f;  // equal to the clamped depths
+  const Outcome o = compare(*gl_, c);
+  EXPECT_GT(o.passed, 0u);
+}
+
 // With the depth test off every rasterized fragment passes.
 TEST_F(PointGlCompareTest, DepthTestOffMatchesGl) {
   const Outcome o = compare(*gl_, depth_test_off());
@@ -524,6 +544,101 @@ TEST_F(PointGlCompareTest, CentreJustOutsideDrawsNothing) {
   EXPECT_EQ(out.fragments, 0u);
   const Outcome in = compare(*gl_, single("centre inside", 0.0f, 64.0f, 64.0f));
   EXPECT_EQ(in.fragments, 32u * 64u) << "centre on the left border: the right half of the square";
+}
+
+// The SystemC model (geometry and raster units, `nbsim compare`) replays a trace of point draws
+// that GL drew one after another on one depth buffer: every draw's fragments and passed samples
+// equal GL's, and the final depth buffer GL's bit for bit.
+TEST_F(PointGlCompareTest, UnitsReplayPointTraceExactly) {
+  std::vector<Case> cases = {centres_edges_corners(), snap_ties(), random_subpixel(11, DepthFunc::Less, true),
+                             random_subpixel(12, DepthFunc::Greater, false), partly_offscreen(), centres_outside(),
+                             depth_test_off()};
+  const std::filesystem::path t = nbsim::testing::scratch_path("nbsim_points", "points.nbt");
+  std::uint64_t fragments = 0;
+  {
+    trace::TraceWriter w(t, {{"viewport", std::to_string(kW) + "x" + std::to_string(kH)}, {"depth_func", "LESS"},
+                             {"depth_clear", "1"}, {"frames", "1"}});
+    w.begin_frame(trace::FrameBegin{});
+    std::vector<float> depth(static_cast<std::size_t>(kW * kH), 1.0f);  // GL's buffer, draw after draw
+    std::uint32_t index = 0;
+    for (Case& c : cases) {
+      c.depth = depth;
+      const GlResult g = gl_->run(c);
+      depth = g.depth;
+      trace::DrawRecord d;
+      d.index = index++;
+      d.topology = trace::Topology::Points;
+      d.clip_positions = c.clip;
+      d.point_sizes = c.sizes;
+      d.state.func = static_cast<scene::DepthFunc>(c.func);
+      d.state.write = c.write;
+      d.state.test = c.test;
+      d.state.cull = scene::CullFace::None;
+      for (std::uint32_t v : g.fragments) d.gl.fragments += v;
+      d.gl.samples_passed = g.samples_passed;
+      d.gl.clip_prims_in = g.clip_in;
+      d.gl.clip_prims_out = g.clip_out;
+      fragments += d.gl.fragments;
+      w.write(d);
+    }
+    trace::DepthSnapshot fin;
+    fin.name = "final";
+    fin.width = kW;
+    fin.height = kH;
+    fin.texels = depth;
+    w.write(fin);
+    trace::FrameEnd e;
+    e.draws = index;
+    w.end_frame(e);
+    w.close();
+  }
+  const nbsim::testing::CliResult r = nbsim::testing::run_nbsim("compare " + t.string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["draws"], cases.size());
+  EXPECT_EQ(j["draws_exact"], cases.size()) << r.out;
+  EXPECT_EQ(j["fragments_model"], fragments);
+  EXPECT_EQ(j["fragments_gl"], fragments);
+  EXPECT_EQ(j["passed_model"], j["passed_gl"]);
+  EXPECT_EQ(j["depth_pixels_matching"], j["depth_pixels"]);
+  EXPECT_EQ(j["depth_max_abs_error"], 0.0) << "the final depth buffer is GL's bit for bit";
+  std::filesystem::remove(t);
+}
+
+// A point draw with a NaN point size or an infinite position in a trace is refused by `nbsim
+// compare` with exit 2 and a message naming the point, not a crash (no GL needed).
+TEST(PointReplayInputTest, NonFinitePointDrawsRefused) {
+  const auto trace_with = [](const std::string& name, std::vector<ClipPosition> clip, std::vector<float> sizes) {
+    const std::filesystem::path t = nbsim::testing::scratch_path("nbsim_points", name);
+    trace::TraceWriter w(t, {{"viewport", "16x8"}, {"depth_func", "LESS"}, {"depth_clear", "1"}, {"frames", "1"}});
+    w.begin_frame(trace::FrameBegin{});
+    trace::DrawRecord d;
+    d.topology = trace::Topology::Points;
+    d.clip_positions = std::move(clip);
+    d.point_sizes = std::move(sizes);
+    w.write(d);
+    trace::FrameEnd e;
+    e.draws = 1;
+    w.end_frame(e);
+    w.close();
+    return t;
+  };
+  struct Row {
+    const char* name;
+    std::vector<ClipPosition> clip;
+    std::vector<float> sizes;
+    const char* message;
+  } rows[] = {
+      {"nan_size.nbt", {{0, 0, 0, 1}, {0.5f, 0, 0, 1}}, {4.0f, NAN}, "point 1 of a point draw has a NaN or infinite point size"},
+      {"inf_position.nbt", {{INFINITY, 0, 0, 1}}, {4.0f}, "point 0 of a point draw has a NaN or infinite clip position"},
+  };
+  for (const Row& row : rows) {
+    const std::filesystem::path t = trace_with(row.name, row.clip, row.sizes);
+    const nbsim::testing::CliResult r = nbsim::testing::run_nbsim("compare " + t.string());
+    EXPECT_EQ(r.status, 2) << row.name << ": " << r.out << r.err;
+    EXPECT_TRUE(nbsim::testing::has(r.err, row.message)) << row.name << ": " << r.err;
+    std::filesystem::remove(t);
+  }
 }
 
 }  // namespace
