@@ -58,8 +58,10 @@ class PointSetup {
 
   // Sets up one point; `out` is filled only when the result is Accepted (four planes, front
   // facing, a constant depth plane). Offscreen: the square misses the render target.
-  // Unsupported: a non-finite or out-of-range window position (a w = 0 vertex), which llvmpipe
-  // cannot snap either. Counts into `counters.points` and the shared result counters.
+  // Unsupported: a non-finite or out-of-range window position (a w = 0 vertex at the origin,
+  // which has no outcode bit), which llvmpipe cannot snap either and for which GL draws nothing
+  // (PointGlCompareTest.ZeroWPointCountedButNotDrawn). Counts into `counters.points` and the
+  // shared result counters.
   SetupResult setup(const geometry::WindowPoint& point, SetupTriangle& out, SetupCounters& counters) const;
 
   const SetupConfig& config() const noexcept { return config_; }

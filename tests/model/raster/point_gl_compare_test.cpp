@@ -546,6 +546,19 @@ TEST_F(PointGlCompareTest, CentreJustOutsideDrawsNothing) {
   EXPECT_EQ(in.fragments, 32u * 64u) << "centre on the left border: the right half of the square";
 }
 
+// A w = 0 vertex at the origin has no outcode bit (every comparison is with 0), so GL's clipper
+// hands it to setup (GL_CLIPPING_OUTPUT_PRIMITIVES counts it), whose NaN window position draws
+// nothing; the model counts it alike and sets it up as Unsupported.
+TEST_F(PointGlCompareTest, ZeroWPointCountedButNotDrawn) {
+  Case c = single("w zero", 0, 0, 4.0f);
+  c.clip = {{0, 0, 0, 0}, {0, 0, 0.5f, 0}, {-0.0f, 0, 0, 0}};
+  c.sizes = {4.0f, 8.0f, 2.0f};
+  const GlResult g = gl_->run(c);
+  EXPECT_EQ(g.clip_in, 3u);
+  EXPECT_EQ(g.clip_out, 2u) << "GL: z > w drops the second, the others reach setup";
+  EXPECT_EQ(compare(*gl_, c).fragments, 0u) << "GL draws nothing for them";
+}
+
 // The SystemC model (geometry and raster units, `nbsim compare`) replays a trace of point draws
 // that GL drew one after another on one depth buffer: every draw's fragments and passed samples
 // equal GL's, and the final depth buffer GL's bit for bit.
