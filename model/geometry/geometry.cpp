@@ -294,4 +294,39 @@ void GeometryStage::emit_batch(std::span<const ClipPosition> batch, const Geomet
   }
 }
 
+void GeometryStage::process_points(std::span<const ClipPosition> clip_positions, std::span<const float> point_sizes,
+                                   const GeometryState& state, std::vector<WindowPoint>& out,
+                                   GeometryCounters& counters) const {
+  if (point_sizes.size() != clip_positions.size())
+    throw InputError("geometry: a point draw has " + std::to_string(clip_positions.size()) + " vertices but " +
+                     std::to_string(point_sizes.size()) + " point sizes (one per vertex expected)");
+  for (std::size_t i = 0; i < clip_positions.size(); ++i) {
+    const ClipPosition& p = clip_positions[i];
+    if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]) && std::isfinite(p[3])))
+      throw InputError("geometry: point " + std::to_string(i) + " of a point draw has a NaN or infinite clip position");
+    if (!std::isfinite(point_sizes[i]))
+      throw InputError("geometry: point " + std::to_string(i) + " of a point draw has a NaN or infinite point size");
+  }
+  // Batches as for triangles: the same vertex budget (3 * batch_triangles vertices); only the
+  // batch counters depend on it, every point is clipped on its own.
+  const std::size_t batch = 3 * static_cast<std::size_t>(config_.batch_triangles);
+  for (std::size_t first = 0; first < clip_positions.size(); first += batch) {
+    const std::size_t n = std::min(batch, clip_positions.size() - first);
+    counters.batches += 1;
+    counters.prims_in += n;
+    bool pipeline = false;
+    for (std::size_t i = first; i < first + n; ++i) {
+      const ClipPosition& p = clip_positions[i];
+      if (outcode(p, state.clip, state.depth_clamp) != 0) {  // draw_pipe_clip.c clip_point
+        pipeline = true;
+        counters.trivially_rejected += 1;
+        continue;
+      }
+      counters.prims_out += 1;
+      out.push_back(WindowPoint{to_window(p, state.clip), point_sizes[i]});
+    }
+    if (pipeline) counters.pipeline_batches += 1;
+  }
+}
+
 }  // namespace nbsim::geometry

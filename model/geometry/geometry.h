@@ -22,6 +22,25 @@
 //   culled; which rule 22.3.6 has is not verified, the traces only cull back faces.)
 // The counters map onto GL's: prims_in is GL_CLIPPING_INPUT_PRIMITIVES and prims_out is
 // GL_CLIPPING_OUTPUT_PRIMITIVES as llvmpipe counts it (each triangle that reaches its setup).
+//
+// Points (process_points), Mesa 22.3:
+// - draw_pipe_clip.c clip_first_point picks clip_point unless draw->guard_band_points_lines_xy;
+//   that flag is guard_band_xy || (driver.bypass_clip_points_lines && rasterizer
+//   point_line_tri_clip) (draw_context.c draw_update_clip_flags; older trees call them
+//   guard_band_points_xy, bypass_clip_points and point_tri_clip). llvmpipe calls
+//   draw_set_driver_clipping(draw, false, false, false, true) (lp_context.c: clipping on, no guard
+//   band) and the state tracker sets point_line_tri_clip only for GLES 2 (st_atom_rasterizer.c),
+//   so desktop GL points are clipped by their centre: a point with any outcode bit (x, y, near,
+//   far; the same generate_clipmask as triangles) is dropped whole, even when its square would
+//   overlap the viewport; a point with none goes to setup unchanged. Batches without outcodes
+//   skip the pipeline, which changes nothing for points.
+// - llvmpipe never turns points into triangles: it sets draw_wide_point_threshold(10000),
+//   draw_wide_point_sprites(false) and draw_enable_point_sprites(false) (lp_context.c), so
+//   draw_need_pipeline (draw_pipe_validate.c) never inserts draw_pipe_wide_point.c; the point
+//   reaches lp_setup_point.c as one vertex with its gl_PointSize (model/raster/point_setup.h).
+// - The window position is the same viewport transform as a triangle vertex's (to_window).
+// - GL_CLIPPING_INPUT_PRIMITIVES counts every point, GL_CLIPPING_OUTPUT_PRIMITIVES every point
+//   that reaches try_setup_point (it counts c_primitives before its own draw-region test).
 #pragma once
 
 #include <array>
@@ -82,6 +101,13 @@ class GeometryStage {
   // a trailing incomplete triangle is ignored, as GL does) and adds to `counters`.
   void process(std::span<const ClipPosition> clip_positions, const GeometryState& state,
                std::vector<WindowTriangle>& out, GeometryCounters& counters) const;
+
+  // Appends the points of one draw (one clip position and one gl_PointSize each) that survive
+  // centre clipping to `out` and adds to `counters` (prims_in: points, trivially_rejected: centres
+  // outside the clip volume, prims_out: points handed to setup). Throws InputError naming the
+  // point when the counts differ or a position or size is NaN or infinite.
+  void process_points(std::span<const ClipPosition> clip_positions, std::span<const float> point_sizes,
+                      const GeometryState& state, std::vector<WindowPoint>& out, GeometryCounters& counters) const;
 
   const GeometryConfig& config() const noexcept { return config_; }
 

@@ -1,5 +1,6 @@
-// Window-space triangles: the data the geometry stage (model/geometry) hands to triangle setup
-// (model/raster), with the face state setup needs to orient and cull them.
+// Window-space triangles and points: the data the geometry stage (model/geometry) hands to
+// triangle and point setup (model/raster), with the face state setup needs to orient and cull
+// triangles.
 // Conventions (model/common/depth.h): x, y in pixels with y up and pixel centres at +0.5, z is GL
 // window depth in [0, 1].
 #pragma once
@@ -21,6 +22,13 @@ struct WindowVertex {
 // provoking vertex, the polygon's first, comes last).
 struct WindowTriangle {
   std::array<WindowVertex, 3> v{};
+};
+
+// One point sprite that passed clipping: its vertex and gl_PointSize as the vertex shader wrote it
+// (finite; point setup clamps it to llvmpipe's range, model/raster/point_setup.h).
+struct WindowPoint {
+  WindowVertex v;
+  float size = 1.0f;  // pixels
 };
 
 // Which faces are dropped. Fixed values, GL's order, equal to scene::CullFace of trace files.

@@ -61,7 +61,10 @@ void GeometryUnit::serve() {
     batch->work = w;
     if (w->kind == cp::WorkKind::Draw) {
       const scene::DrawRecord& d = w->record();
-      stage_.process(d.clip_positions, state_of(d.state), batch->triangles, batch->counters);
+      if (d.topology == scene::Topology::Points)
+        stage_.process_points(d.clip_positions, d.point_sizes, state_of(d.state), batch->points, batch->counters);
+      else
+        stage_.process(d.clip_positions, state_of(d.state), batch->triangles, batch->counters);
       const GeometryCounters& k = batch->counters;
       prims_in_ += k.prims_in;
       prims_out_ += k.prims_out;

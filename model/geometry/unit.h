@@ -1,7 +1,8 @@
 // GeometryUnit: the SystemC wrapper of the geometry core (model/geometry/geometry.h): clipping
 // as Mesa's draw module does it, the viewport transform and the draw module's face cull, one draw
 // at a time: a draw occupies it for triangles / triangles_per_cycle cycles and leaves it
-// latency_cycles later (pipelined).
+// latency_cycles later (pipelined). A point-sprite draw counts its points as primitives (centre
+// clipping; the prims_* counters then count points).
 #pragma once
 
 #include <memory>
@@ -24,10 +25,12 @@ struct GeometryUnitConfig {
   static void describe(config::Schema& s, GeometryUnitConfig& c);
 };
 
-// Geometry -> raster: the window-space triangles of one piece of work (none for markers).
+// Geometry -> raster: the window-space triangles, or points for a point-sprite draw, of one piece
+// of work (none for markers).
 struct TriangleBatch {
   cp::WorkPtr work;
   std::vector<WindowTriangle> triangles;
+  std::vector<WindowPoint> points;
   GeometryCounters counters;
 };
 using TriangleBatchPtr = std::shared_ptr<const TriangleBatch>;

@@ -32,6 +32,7 @@ RasterPath::RasterPath(const RasterPathConfig& config, DepthImage& depth)
     : config_(config),
       geometry_(geometry_config(config)),
       setup_(SetupConfig{config.width_px, config.height_px}),
+      point_setup_(SetupConfig{config.width_px, config.height_px}),
       rasterizer_(config.width_px, config.height_px),
       depth_test_(depth, config.fused_interpolation) {
   if (depth.width != config.width_px || depth.height != config.height_px ||
@@ -48,6 +49,21 @@ DrawCounters RasterPath::draw(std::span<const geometry::ClipPosition> clip_posit
   SetupTriangle t;
   for (const geometry::WindowTriangle& w : triangles_) {
     if (setup_.setup(w, state.geometry.face, t, k.setup) != SetupResult::Accepted) continue;
+    rasterizer_.rasterize(t, k.tiles, [&](int x, int y, std::uint16_t mask) {
+      depth_test_.test_block(t.depth, x, y, mask, state.depth, k.depth);
+    });
+  }
+  return k;
+}
+
+DrawCounters RasterPath::draw_points(std::span<const geometry::ClipPosition> clip_positions,
+                                     std::span<const float> point_sizes, const DrawState& state) {
+  DrawCounters k;
+  points_.clear();
+  geometry_.process_points(clip_positions, point_sizes, state.geometry, points_, k.geometry);
+  SetupTriangle t;
+  for (const geometry::WindowPoint& p : points_) {
+    if (point_setup_.setup(p, t, k.setup) != SetupResult::Accepted) continue;
     rasterizer_.rasterize(t, k.tiles, [&](int x, int y, std::uint16_t mask) {
       depth_test_.test_block(t.depth, x, y, mask, state.depth, k.depth);
     });

@@ -1,5 +1,6 @@
 // RasterPath: one draw from clip space to depth-tested fragments through the plain C++ cores,
-// geometry (model/geometry) -> setup -> rasterizer -> early depth test (model/raster). It is what
+// geometry (model/geometry) -> setup -> rasterizer -> early depth test (model/raster); triangle
+// draws through triangle setup, point-sprite draws through point setup (point_setup.h). It is what
 // the SystemC units wrap one stage at a time, and what the counter comparison replays against GL.
 #pragma once
 
@@ -9,6 +10,7 @@
 #include "model/common/depth.h"
 #include "model/geometry/geometry.h"
 #include "model/raster/depth_test.h"
+#include "model/raster/point_setup.h"
 #include "model/raster/rasterizer.h"
 #include "model/raster/setup.h"
 
@@ -45,6 +47,10 @@ class RasterPath {
 
   // Runs one draw (three clip positions a triangle) and returns its counters.
   DrawCounters draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state);
+  // Runs one point-sprite draw (one clip position and one gl_PointSize a point). Throws
+  // InputError when the counts differ or a position or size is NaN or infinite.
+  DrawCounters draw_points(std::span<const geometry::ClipPosition> clip_positions, std::span<const float> point_sizes,
+                           const DrawState& state);
 
   const RasterPathConfig& config() const noexcept { return config_; }
   DepthImage& depth() noexcept { return depth_test_.buffer(); }
@@ -53,9 +59,11 @@ class RasterPath {
   RasterPathConfig config_;
   geometry::GeometryStage geometry_;
   TriangleSetup setup_;
+  PointSetup point_setup_;
   Rasterizer rasterizer_;
   EarlyDepthTest depth_test_;
   std::vector<geometry::WindowTriangle> triangles_;  // reused from draw to draw
+  std::vector<geometry::WindowPoint> points_;        // likewise
 };
 
 }  // namespace nbsim::raster

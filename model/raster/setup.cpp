@@ -93,6 +93,7 @@ float DepthPlane::at(int x, int y, bool fused) const noexcept {
 
 SetupCounters& SetupCounters::operator+=(const SetupCounters& o) {
   triangles += o.triangles;
+  points += o.points;
   zero_area += o.zero_area;
   unsupported += o.unsupported;
   culled += o.culled;

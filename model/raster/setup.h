@@ -95,6 +95,8 @@ enum class SetupResult : std::uint8_t {
 // Per-draw counters of setup (added to, never reset by the stage).
 struct SetupCounters {
   std::uint64_t triangles = 0;  // entering setup
+  std::uint64_t points = 0;     // point sprites entering point setup (point_setup.h); the result
+                                // counters below count points and triangles alike
   std::uint64_t zero_area = 0;
   std::uint64_t culled = 0;
   std::uint64_t offscreen = 0;

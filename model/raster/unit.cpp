@@ -18,6 +18,7 @@ RasterUnit::RasterUnit(const sc_core::sc_module_name& name, stats::Registry& reg
       config_(config),
       delay_("delay", 64),
       setup_(SetupConfig{width_px, height_px}),
+      point_setup_(SetupConfig{width_px, height_px}),
       rasterizer_(width_px, height_px),
       triangles_(stats().counter("triangles", "triangles", "triangles entering setup")),
       accepted_(stats().counter("accepted", "triangles", "triangles that produced coverage tests")),
@@ -67,6 +68,10 @@ void RasterUnit::serve() {
       for (const geometry::WindowTriangle& w : in_batch->triangles)
         if (setup_.setup(w, face, t, b->setup) == SetupResult::Accepted) walk(t);
     }
+    // Point sprites (a point draw has no triangles): their squares are walked like triangles; a
+    // primitive tester is not asked about them.
+    for (const geometry::WindowPoint& p : in_batch->points)
+      if (point_setup_.setup(p, t, b->setup) == SetupResult::Accepted) walk(t);
     triangles_ += b->setup.triangles;
     accepted_ += b->setup.accepted;
     blocks_ += b->blocks.size();
@@ -75,7 +80,7 @@ void RasterUnit::serve() {
     tiles_.add(1, b->tiles.tiles_partial);
     tiles_.add(2, b->tiles.tiles_full);
     label_with([&] { return cp::timeline_label(*b->work); });
-    work(sim::batch_cycles(b->setup.triangles, config_.setup_triangles_per_cycle, 0) +
+    work(sim::batch_cycles(b->setup.triangles + b->setup.points, config_.setup_triangles_per_cycle, 0) +
          sim::batch_cycles(b->blocks.size(), config_.blocks_per_cycle, 0));
     const bool stop = b->work->kind == cp::WorkKind::Stop;
     delay_.send(b, b->work->kind == cp::WorkKind::Draw ? static_cast<std::uint64_t>(config_.latency_cycles) : 0);

@@ -1,5 +1,5 @@
-// RasterUnit: the SystemC wrapper of triangle setup and the tile rasterizer (model/raster/setup.h,
-// rasterizer.h). A draw's triangles become 4x4 blocks of covered pixels with the depth plane they
+// RasterUnit: the SystemC wrapper of triangle and point setup and the tile rasterizer
+// (model/raster/setup.h, point_setup.h, rasterizer.h). A draw's triangles become 4x4 blocks of covered pixels with the depth plane they
 // belong to; the unit costs triangles / setup rate plus blocks / block rate cycles, pipelined.
 #pragma once
 
@@ -10,6 +10,7 @@
 #include "model/config/schema.h"
 #include "model/geometry/unit.h"
 #include "model/raster/primitive_tester.h"
+#include "model/raster/point_setup.h"
 #include "model/raster/rasterizer.h"
 #include "model/raster/setup.h"
 #include "model/sim/unit.h"
@@ -63,6 +64,7 @@ class RasterUnit : public sim::Unit {
   RasterUnitConfig config_;
   sim::DelayLine<BlockBatchPtr> delay_;
   TriangleSetup setup_;
+  PointSetup point_setup_;
   Rasterizer rasterizer_;
   PrimitiveTester* tester_ = nullptr;
   std::vector<SetupPrimitive> prims_;  // one draw's accepted triangles, when a tester tests them

@@ -61,7 +61,9 @@ class Collector : public depth::ResultSink {
     if (d.role == trace::DrawRole::Visible && r.depth.passed < d.gl.samples_passed) ++visible_draws_passed_below_gl;
     if (draws_.is_open())
       draws_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, d.index, d.object,
-                            trace::to_string(d.role), d.clip_positions.size() / 3, r.geometry.prims_out, d.gl.clip_prims_out,
+                            trace::to_string(d.role),
+                            d.topology == trace::Topology::Points ? d.clip_positions.size() : d.clip_positions.size() / 3,
+                            r.geometry.prims_out, d.gl.clip_prims_out,
                             r.depth.fragments, d.gl.fragments, r.depth.passed, d.gl.samples_passed, r.depth.depth_tests,
                             "none", 0, r.done_cycle);
   }

@@ -97,7 +97,9 @@ CompareSummary compare_trace(const std::filesystem::path& path, const CompareOpt
         continue;
       }
       const auto t0 = std::chrono::steady_clock::now();
-      const raster::DrawCounters k = path_core.draw(d.clip_positions, draw_state(d.state));
+      const raster::DrawCounters k = d.topology == trace::Topology::Points
+                                         ? path_core.draw_points(d.clip_positions, d.point_sizes, draw_state(d.state))
+                                         : path_core.draw(d.clip_positions, draw_state(d.state));
       s.model_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       s.totals += k;
       s.draws += 1;
