@@ -11,6 +11,7 @@
 #include "model/common/error.h"
 #include "traces/format/bytes.h"
 #include "traces/format/codec.h"
+#include "traces/format/particles_chunk.h"
 
 namespace nbsim::trace {
 
@@ -26,8 +27,12 @@ struct Registry {
   std::vector<ChunkSpec> specs;
 };
 
+// The chunk types of the techniques this build knows, registered before anything else so that
+// every reader decodes them (a technique's own test types register later, at run time).
+std::vector<ChunkSpec> built_in_chunks() { return {particles_chunk_spec()}; }
+
 Registry& registry() {
-  static Registry r;
+  static Registry r{{}, built_in_chunks()};
   return r;
 }
 
