@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -155,6 +156,54 @@ TEST(ParticlesTest, NoPoppingWithAnySizeOrConvention) {
         EXPECT_EQ(t.popping, 0u);
         fs::remove(file);
       }
+}
+
+// Every cull is justified by the recorded scene depth alone (a brute force over the sprite's pixels,
+// independent of the reference pass): nb and hiz cull a sprite only when every pixel it covers
+// (the pixel centres inside its square, widened by one near a tie, clipped to the viewport) holds
+// a depth nearer than the sprite's; center only when its centre pixel does.
+TEST(ParticlesTest, CullsAreJustifiedByTheDepthImage) {
+  for (const std::string& mode : std::vector<std::string>{"center", "nb", "hiz"})
+    for (bool reversed : {false, true}) {
+      SCOPED_TRACE(mode + (reversed ? " reversed" : ""));
+      CaptureOptions o = small(mode, "atten");
+      o.reversed_z = reversed;
+      const fs::path file = scratch("brute_" + mode);
+      capture(o, file.string());
+      trace::FrameReader frames(file);
+      std::uint64_t culled = 0;
+      while (auto f = frames.next()) {
+        const trace::DepthSnapshot* d = f->depth("scene");
+        ASSERT_NE(d, nullptr);
+        const Particles p = particles_of(*f);
+        auto hidden_behind = [&](float depth, float stored) { return reversed ? depth < stored : depth > stored; };
+        for (std::size_t i = 0; i < p.culled.size(); ++i) {
+          if (!p.culled[i]) continue;
+          ++culled;
+          if (mode == "center") {
+            const int cx = static_cast<int>(std::floor(p.x[i])), cy = static_cast<int>(std::floor(p.y[i]));
+            ASSERT_TRUE(cx >= 0 && cy >= 0 && cx < d->width && cy < d->height) << "particle " << i;
+            EXPECT_TRUE(hidden_behind(p.depth[i], d->texels[static_cast<std::size_t>(cy * d->width + cx)])) << "particle " << i;
+            continue;
+          }
+          int lo[2], hi[2];
+          const float centre[2] = {p.x[i], p.y[i]};
+          for (int k = 0; k < 2; ++k) {
+            const float a = centre[k] - 0.5f - 0.5f * p.size[i];
+            const bool tie = std::fabs(a - std::round(a)) < 1.0f / 64.0f;
+            lo[k] = static_cast<int>(tie ? std::round(a) : std::ceil(a));
+            hi[k] = lo[k] + static_cast<int>(p.size[i]) + (tie ? 1 : 0);
+          }
+          for (int y = std::max(lo[1], 0); y < std::min(hi[1], d->height); ++y)
+            for (int x = std::max(lo[0], 0); x < std::min(hi[0], d->width); ++x)
+              ASSERT_TRUE(hidden_behind(p.depth[i], d->texels[static_cast<std::size_t>(y * d->width + x)]))
+                  << "particle " << i << " culled but pixel (" << x << ", " << y << ") holds " << d->texels[static_cast<std::size_t>(y * d->width + x)]
+                  << ", the sprite is at " << p.depth[i];
+        }
+      }
+      EXPECT_GT(culled, 0u);
+      fs::remove(file);
+    }
 }
 
 // The centre test is the baseline that pops: its culls and its lookups (one a tested particle) are
