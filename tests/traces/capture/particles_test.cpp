@@ -220,6 +220,38 @@ TEST(ParticlesTest, CenterCullsAreRecorded) {
   fs::remove(file);
 }
 
+// The hard case of the paper: a centre hidden behind a building edge while a corner of the sprite
+// shows. The same frames (same seed, same particles, same scene depth: particles write no depth)
+// in center, nb and hiz: every particle the centre test pops is kept by nb and hiz.
+TEST(ParticlesTest, SilhouettesPopWithTheCentreOnly) {
+  auto frames_of = [](const std::string& mode) {
+    CaptureOptions o = small(mode, "24");
+    o.options.set("particles", "4000");
+    const fs::path file = scratch("silhouette_" + mode);
+    capture(o, file.string());
+    std::vector<Particles> out;
+    trace::FrameReader frames(file);
+    while (auto f = frames.next()) out.push_back(particles_of(*f));
+    fs::remove(file);
+    return out;
+  };
+  const auto centre = frames_of("center"), nb = frames_of("nb"), hiz = frames_of("hiz");
+  ASSERT_EQ(centre.size(), 2u);
+  ASSERT_EQ(nb.size(), 2u);
+  ASSERT_EQ(hiz.size(), 2u);
+  std::uint64_t popped = 0;
+  for (std::size_t f = 0; f < centre.size(); ++f) {
+    ASSERT_EQ(centre[f].samples, nb[f].samples) << "the same particles see the same depth in every mode";
+    for (std::size_t i = 0; i < centre[f].culled.size(); ++i)
+      if (centre[f].culled[i] && centre[f].samples[i] > 0) {
+        ++popped;
+        EXPECT_EQ(nb[f].culled[i], 0u) << "frame " << f << " particle " << i << ": popped by center, culled by nb";
+        EXPECT_EQ(hiz[f].culled[i], 0u) << "frame " << f << " particle " << i << ": popped by center, culled by hiz";
+      }
+  }
+  EXPECT_GT(popped, 0u) << "the centre test pops on this walk";
+}
+
 // A power-of-two sprite is one lookup at its lower-left pixel unless it sits on a pixel-centre tie
 // or the screen border; 24 px sprites take four.
 TEST(ParticlesTest, LookupsFollowTheCovering) {
