@@ -1,10 +1,43 @@
 // The particles technique's chunk description; see particles_chunk.h.
 #include "traces/format/particles_chunk.h"
 
+#include <fmt/format.h>
+
+#include <string>
+#include <type_traits>
+#include <variant>
+
 namespace nbsim::trace {
 
+namespace {
+
+// The rule of particles_chunk_spec(): what a reader refuses beyond the field types.
+std::string particles_rule(const TechniqueRecord& r) {
+  const std::uint64_t count = std::get<std::uint64_t>(r.fields.at(0).value);
+  for (const TechniqueField& f : r.fields) {
+    const std::size_t n = std::visit(
+        [](const auto& v) -> std::size_t {
+          if constexpr (requires { v.size(); } && !std::is_same_v<std::decay_t<decltype(v)>, std::string>) return v.size();
+          return 0;
+        },
+        f.value);
+    if (f.name != "count" && n != count)
+      return fmt::format("field '{}' has {} elements, but count is {} (one a particle)", f.name, n, count);
+  }
+  for (const TechniqueField& f : r.fields) {
+    if (f.name != "culled" && f.name != "lookups") continue;
+    const auto& v = std::get<std::vector<std::uint32_t>>(f.value);
+    const std::uint32_t limit = f.name == "culled" ? 1u : 4u;
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (v[i] > limit) return fmt::format("field '{}' of particle {} is {}, above {}", f.name, i, v[i], limit);
+  }
+  return {};
+}
+
+}  // namespace
+
 ChunkSpec particles_chunk_spec() {
-  return {kParticlesChunk,
+  ChunkSpec spec{kParticlesChunk,
           "particles",
           "ParticleCulling",
           {{"count", FieldKind::U32, "particles in the frame (every vector below has this many elements)"},
@@ -20,6 +53,8 @@ ChunkSpec particles_chunk_spec() {
            {"reference_samples", FieldKind::VecU32,
             "samples that passed the depth test in the reference pass (every particle drawn, same depth test, early "
             "fragment tests, a counter per particle); culled with reference_samples > 0 is popping"}}};
+  spec.rule = particles_rule;
+  return spec;
 }
 
 }  // namespace nbsim::trace

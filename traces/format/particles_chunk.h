@@ -16,6 +16,7 @@ inline constexpr std::uint32_t kParticlesChunk = fourcc("PRTC");
 
 // Its description: fields in this order (the vectors have `count` elements each, particle p's
 // values at index p; particles are numbered across the frame's particle draws in draw order).
+// Its rule: every vector has `count` elements, culled is 0 or 1, lookups at most 4.
 ChunkSpec particles_chunk_spec();
 
 }  // namespace nbsim::trace

@@ -87,6 +87,8 @@ std::vector<std::uint8_t> encode(const TechniqueRecord& record) {
   NBSIM_CHECK(record.fields.size() == spec->fields.size(),
               fmt::format("technique chunk {}: {} fields, its description has {}", spec->record, record.fields.size(),
                           spec->fields.size()));
+  NBSIM_CHECK(!spec->rule || spec->rule(record).empty(),
+              fmt::format("technique chunk {} breaks its rule: {}", spec->record, spec->rule ? spec->rule(record) : ""));
   bytes::Out o;
   for (std::size_t i = 0; i < spec->fields.size(); ++i) {
     const FieldSpec& fs = spec->fields[i];
@@ -135,6 +137,8 @@ TechniqueRecord decode_technique(std::uint32_t type, std::span<const std::uint8_
   }
   in.finish();
   r.decoded = true;
+  if (spec->rule)
+    if (const std::string broken = spec->rule(r); !broken.empty()) throw InputError(fmt::format("{}: {}", spec->record, broken));
   return r;
 }
 

@@ -7,6 +7,7 @@
 
 #include "model/common/error.h"
 #include "tests/traces/format/sample_trace.h"
+#include "traces/format/bytes.h"
 #include "traces/format/particles_chunk.h"
 
 namespace {
@@ -561,6 +562,30 @@ TEST(TraceCorruptionTest, ParticleChunk) {
   put_le32(hostile.payload, 4, 0xFFFFFFFFu);  // the draw vector's count
   e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(hostile).add(FrameEnd{0, 0, 0}).end(1).b);
   EXPECT_TRUE(has(e, "chunk 2 (PRTC)") && has(e, "4294967295")) << e;
+  // Intact framing, broken rule: a vector of another length than count, a flag or a lookup count
+  // out of range (payloads built by hand: the writer's encode() aborts on such records).
+  struct Broken {
+    std::vector<float> x;
+    std::vector<std::uint32_t> culled, lookups;
+    std::string message;
+  };
+  for (const Broken& b : {Broken{{1.0f, 2.0f}, {1, 0, 0}, {1, 4, 0}, "field 'x' has 2 elements, but count is 3"},
+                          Broken{{1.0f, 2.0f, 3.0f}, {0, 2, 0}, {1, 4, 0}, "field 'culled' of particle 1 is 2, above 1"},
+                          Broken{{1.0f, 2.0f, 3.0f}, {1, 0, 0}, {1, 5, 0}, "field 'lookups' of particle 1 is 5, above 4"}}) {
+    bytes::Out o;
+    o.u32(3);
+    o.counted_words(std::vector<std::uint32_t>{0, 0, 1});  // draw
+    o.counted_words(b.x);
+    for (int k = 0; k < 3; ++k) o.counted_words(std::vector<float>{1.0f, 2.0f, 3.0f});  // y, depth, size
+    o.counted_words(b.culled);
+    o.counted_words(b.lookups);
+    o.counted_words(std::vector<std::uint32_t>{0, 0, 0});  // reference_samples
+    TechniqueRecord broken;
+    broken.type = kParticlesChunk;
+    broken.payload = o.take();
+    e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(broken).add(FrameEnd{0, 0, 0}).end(1).b);
+    EXPECT_TRUE(has(e, "chunk 2 (PRTC)") && has(e, b.message)) << e;
+  }
 }
 
 // Draw batches: empty ones, counts past the payload, indices that do not continue across DRAW and
