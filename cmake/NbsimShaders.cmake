@@ -1,7 +1,7 @@
 # nbsim_embed_shaders(<target> <files...>): compiles the GLSL files of shaders/ into the target as
 # strings named after their path below shaders/ (nbsim::shaders::<folder>_<name>, e.g.
-# shaders/common/scene.vert -> common_scene_vert, shaders/occlusion/nbuffer_query.comp ->
-# occlusion_nbuffer_query_comp), so the binary runs from anywhere and two techniques' folders may
+# shaders/common/scene.vert -> common_scene_vert, shaders/particles/particles.vert ->
+# particles_particles_vert), so the binary runs from anywhere and two techniques' folders may
 # hold files of the same name. Editing a shader re-runs the configure step.
 function(nbsim_embed_shaders target)
   set(out ${CMAKE_CURRENT_BINARY_DIR}/nbsim_shaders.cpp)

@@ -50,6 +50,9 @@ enum class DrawRole : std::uint8_t {
   NBufferQuery = 4,   // bounds tested against the N-buffer (4 lookups each) in a shader
   Visible = 5,        // an object the technique found visible, drawn for the final image
   IdBuffer = 6,       // the ground-truth ID-buffer pass (every object in the frustum, nothing culled)
+  Scene = 7,          // a scene object drawn to fill the depth buffer, nothing culled (particles)
+  Particles = 8,      // point sprites, depth test on, depth write off, culled in the vertex stage (particles)
+  HiZBuild = 9,       // a full-screen pass building one level of a Hi-Z max/min mip pyramid (particles' hiz mode)
 };
 
 // The culling technique a frame ran (ARCHITECTURE.md Table 2 modes).

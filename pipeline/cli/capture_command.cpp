@@ -58,6 +58,7 @@ void add_plugin_options(CLI::App* cmd, Args& a, const std::vector<std::pair<cons
       value = spec.default_value;
       CLI::Option* opt = cmd->add_option("--" + spec.name, value, fmt::format("{} [{}]", spec.help, readers));
       opt->type_name(spec.kind == capture::OptionSpec::Kind::Integer ? fmt::format("INT in [{} - {}]", spec.min, spec.max)
+                     : spec.kind == capture::OptionSpec::Kind::Text  ? std::string("TEXT")
                                                                       : "{" + fmt::format("{}", fmt::join(spec.choices, ",")) + "}");
       opt->capture_default_str()->group(kind == "scene" ? "Scene options" : kind == "path" ? "Camera path options" : "Technique options");
       a.given[spec.name] = opt;
@@ -106,6 +107,11 @@ void add_capture_subcommand(CLI::App* cap, Action& action, const capture::Techni
                  static_cast<double>(s.bytes) / 1e6, static_cast<double>(s.bytes) / 1e3 / s.frames);
       fmt::print("  {} draws; objects rendered {}, visible by ground truth {}, visible but not rendered {}\n", s.draws,
                  s.objects_rendered, s.objects_visible, s.visible_not_rendered);
+      if (!s.technique_counts.empty()) {
+        std::string counts;
+        for (const auto& [name, value] : s.technique_counts) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", name, value);
+        fmt::print("  {} (summed over the frames)\n", counts);
+      }
       return s.visible_not_rendered == 0 ? 0 : 1;
     };
   });

@@ -37,11 +37,14 @@ Program occlusion_culling(const ProgramContext& c) {
   return p;
 }
 
-constexpr std::array<ProgramRow, 1> kPrograms = {{
+constexpr std::array<ProgramRow, 2> kPrograms = {{
     {"occlusion_culling",
      "occlusion culling of a scene's objects (cull.mode: trace replays the recorded draws; none, oq, oq_hier, nb, "
      "nb_hier, hiz_tile, hiz_pyramid cull every candidate again)",
      occlusion_culling},
+    // Captured (traces/capture/particles/), not modelled yet: its point sprites cannot be replayed as
+    // recorded draws either, so every replay is refused (the build is null).
+    {"particles", "point-sprite particles culled in the vertex stage (not modelled yet)", nullptr},
 }};
 
 constexpr std::array<StructureInstance, 2> kInstances = {{
@@ -51,7 +54,8 @@ constexpr std::array<StructureInstance, 2> kInstances = {{
 
 std::string technique_list() {
   std::string s;
-  for (const ProgramRow& r : kPrograms) s += (s.empty() ? "" : ", ") + std::string(r.technique);
+  for (const ProgramRow& r : kPrograms)
+    if (r.build) s += (s.empty() ? "" : ", ") + std::string(r.technique);
   return s;
 }
 
@@ -75,8 +79,14 @@ std::unique_ptr<query::Structure> ProgramContext::structure(std::string_view ins
 }
 
 Program build_program(std::string_view technique, const ProgramContext& context) {
-  for (const ProgramRow& r : kPrograms)
-    if (r.technique == technique) return r.build(context);
+  for (const ProgramRow& r : kPrograms) {
+    if (r.technique != technique) continue;
+    if (!r.build)
+      throw InputError(fmt::format("no model program for technique '{}' yet: its traces can be read (nbsim trace info, "
+                                   "dump) but not replayed (programs exist for: {})",
+                                   technique, technique_list()));
+    return r.build(context);
+  }
   if (context.config.cull.parsed_mode() != cull::CullMode::Trace)
     throw InputError(fmt::format(
         "cull.mode={} culls with occlusion culling's program, but the trace's technique is '{}' (programs exist for: "

@@ -52,7 +52,8 @@ struct ProgramRow {
   std::string_view technique;    // the trace header's "technique"
   std::string_view description;  // for --help and messages
   // The program this configuration asks for, or an empty Program to replay the recorded draws.
-  // Throws InputError for a configuration the technique cannot run.
+  // Throws InputError for a configuration the technique cannot run. Null: a technique the
+  // renderer captures but the model does not replay yet; build_program refuses its traces.
   Program (*build)(const ProgramContext& context);
 };
 

@@ -103,11 +103,17 @@ CaptureSummary capture(const CaptureOptions& o, const std::string& out_path, con
     for (const auto& d : fr.draws) writer.write(d);
     for (const auto& d : fr.depths) writer.write(d);
     for (const auto& l : fr.levels) writer.write(l);
+    for (const auto& r : fr.technique_records) writer.write(r);
     if (fr.truth) writer.write(*fr.truth);
     writer.end_frame(fr.end);
     sum.frames++;
     sum.gl_ms += fr.end.gl_ms;
     sum.draws += fr.draws.size();
+    for (const auto& [name, value] : cf.counts) {
+      auto it = std::find_if(sum.technique_counts.begin(), sum.technique_counts.end(), [&](const auto& c) { return c.first == name; });
+      if (it == sum.technique_counts.end()) it = sum.technique_counts.insert(it, {name, 0});
+      it->second += value;
+    }
     if (cf.rendered_objects && fr.truth) {
       const auto& rendered = *cf.rendered_objects;
       sum.objects_rendered += rendered.size();

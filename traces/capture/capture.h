@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "traces/capture/plugin.h"
 
@@ -34,6 +36,8 @@ struct CaptureSummary {
   std::uint64_t draws = 0;
   // For techniques that cull objects (zero otherwise).
   std::uint64_t objects_rendered = 0, objects_visible = 0, visible_not_rendered = 0;
+  // The technique's own counts (CapturedFrame::counts), summed over the frames, in first-seen order.
+  std::vector<std::pair<std::string, std::uint64_t>> technique_counts;
 };
 
 // Progress callback: frames done, frames total.

@@ -83,11 +83,13 @@ void DrawRecorder::bind() const {
 
 std::size_t DrawRecorder::begin_draw(scene::DrawRecord record, std::size_t captured_vertices, GLenum primitive) {
   const std::size_t slot = draws_.size();
-  const std::size_t bytes = captured_vertices * 16;  // one vec4 a vertex
+  const std::size_t floats = primitive == GL_POINTS ? 5 : 4;  // one vec4 a vertex (and a point size)
+  const std::size_t bytes = captured_vertices * floats * 4;
   reserve(slot + 1, tf_used_ + bytes);
   record.index = static_cast<std::uint32_t>(slot);
+  if (primitive == GL_POINTS) record.topology = scene::Topology::Points;
   draws_.push_back(std::move(record));
-  pending_.push_back({true, bytes > 0, tf_used_, bytes});
+  pending_.push_back({true, bytes > 0, tf_used_, bytes, floats});
   if (bytes > 0) {
     glBindBufferRange(GL_TRANSFORM_FEEDBACK_BUFFER, 0, tf_buffer_, static_cast<GLintptr>(tf_used_), static_cast<GLsizeiptr>(bytes));
     tf_used_ += bytes;
@@ -140,8 +142,10 @@ std::vector<scene::DrawRecord> DrawRecorder::collect() {
     glGetQueryObjectui64v(q_samples_[i], GL_QUERY_RESULT, &d.gl.samples_passed);
     glGetQueryObjectui64v(q_clip_in_[i], GL_QUERY_RESULT, &d.gl.clip_prims_in);
     glGetQueryObjectui64v(q_clip_out_[i], GL_QUERY_RESULT, &d.gl.clip_prims_out);
-    for (std::size_t b = p.tf_offset; b < p.tf_offset + p.tf_bytes; b += 16)
+    for (std::size_t b = p.tf_offset; b < p.tf_offset + p.tf_bytes; b += p.floats_per_vertex * 4) {
       d.clip_positions.push_back({tf[b / 4], tf[b / 4 + 1], tf[b / 4 + 2], tf[b / 4 + 3]});
+      if (p.floats_per_vertex == 5) d.point_sizes.push_back(tf[b / 4 + 4]);
+    }
   }
   std::vector<scene::DrawRecord> out = std::move(draws_);
   draws_.clear();

@@ -37,7 +37,9 @@ class DrawRecorder {
   // A recorded GL draw: record.index becomes its slot, its queries begin and, when
   // `captured_vertices` > 0, transform feedback of that many vertices of `primitive` (GL_TRIANGLES,
   // GL_POINTS, ...) begins. The caller sets its shader's draw_slot to the returned slot, issues the
-  // one draw and calls end_draw().
+  // one draw and calls end_draw(). GL_POINTS captures gl_Position and gl_PointSize (the program is
+  // linked with link_program(..., true, true)) into clip_positions and point_sizes, and sets the
+  // record's topology to Points.
   std::size_t begin_draw(scene::DrawRecord record, std::size_t captured_vertices, GLenum primitive = GL_TRIANGLES);
   void end_draw();
 
@@ -62,6 +64,7 @@ class DrawRecorder {
     bool gl_draw = false;
     bool capturing = false;
     std::size_t tf_offset = 0, tf_bytes = 0;
+    std::size_t floats_per_vertex = 4;  // gl_Position, then gl_PointSize for points
   };
   void reserve(std::size_t draw_count, std::size_t tf_bytes);
 

@@ -23,12 +23,12 @@ GLuint compile_shader(GLenum type, const std::string& source, const char* name) 
   return s;
 }
 
-GLuint link_program(std::initializer_list<GLuint> shaders, const char* name, bool capture_position) {
+GLuint link_program(std::initializer_list<GLuint> shaders, const char* name, bool capture_position, bool capture_point_size) {
   const GLuint p = glCreateProgram();
   for (GLuint s : shaders) glAttachShader(p, s);
   if (capture_position) {
-    const char* varyings[] = {"gl_Position"};
-    glTransformFeedbackVaryings(p, 1, varyings, GL_INTERLEAVED_ATTRIBS);
+    const char* varyings[] = {"gl_Position", "gl_PointSize"};
+    glTransformFeedbackVaryings(p, capture_point_size ? 2 : 1, varyings, GL_INTERLEAVED_ATTRIBS);
   }
   glLinkProgram(p);
   for (GLuint s : shaders) glDeleteShader(s);

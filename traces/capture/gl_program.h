@@ -17,8 +17,10 @@ namespace nbsim::capture {
 GLuint compile_shader(GLenum type, const std::string& source, const char* name);
 
 // Links the shaders into a program and deletes them. capture_position: record gl_Position with
-// transform feedback (interleaved, one vec4 a vertex). Throws std::runtime_error with GL's log.
-GLuint link_program(std::initializer_list<GLuint> shaders, const char* name, bool capture_position = false);
+// transform feedback (interleaved, one vec4 a vertex); capture_point_size: and gl_PointSize after
+// it (five floats a vertex, for GL_POINTS draws). Throws std::runtime_error with GL's log.
+GLuint link_program(std::initializer_list<GLuint> shaders, const char* name, bool capture_position = false,
+                    bool capture_point_size = false);
 
 // `source` with `defines` inserted after its #version line.
 std::string with_defines(const char* source, const std::string& defines);

@@ -35,6 +35,11 @@ std::string option_problem(const OptionSpec& spec, const std::string& value) {
         return fmt::format("--{} {} is out of range ({} to {})", spec.name, value, spec.min, spec.max);
       return {};
     }
+    case OptionSpec::Kind::Text:
+      if (value.empty() || value.size() > 4096 ||
+          std::any_of(value.begin(), value.end(), [](char c) { return static_cast<unsigned char>(c) <= ' '; }))
+        return fmt::format("--{} '{}' is not one word of at most 4096 characters", spec.name, value.substr(0, 120));
+      return {};
     case OptionSpec::Kind::Choice:
       if (std::find(spec.choices.begin(), spec.choices.end(), value) == spec.choices.end())
         return fmt::format("--{} '{}' is not one of {}", spec.name, value, joined(spec.choices));

@@ -16,7 +16,7 @@
 namespace nbsim::capture {
 
 struct OptionSpec {
-  enum class Kind : std::uint8_t { Integer, Choice };
+  enum class Kind : std::uint8_t { Integer, Choice, Text };  // Text: any word, checked by its reader
   std::string name;  // as on the command line without the dashes: "levels-every" is --levels-every
   std::string help;
   std::string default_value;

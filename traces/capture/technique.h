@@ -10,7 +10,9 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "model/scene/frame.h"
@@ -36,6 +38,9 @@ struct CapturedFrame {
   // For techniques that cull objects: every object they drew, sorted. The capture checks that
   // each object the ground truth sees is among them (a conservative technique culls none).
   std::optional<std::vector<std::uint32_t>> rendered_objects;
+  // Counts the technique reports for the frame by name (particles: culled, popping, ...), summed
+  // over the capture into CaptureSummary::technique_counts and printed by `nbsim capture`.
+  std::vector<std::pair<std::string, std::uint64_t>> counts;
 };
 
 class Technique {

@@ -1,6 +1,7 @@
 // The technique table (technique.h): one row per technique. A new technique is a folder of its
 // own (traces/capture/<name>/, shaders/<name>/) and one row here.
 #include "traces/capture/occlusion/occlusion_culling.h"
+#include "traces/capture/particles/particles.h"
 #include "traces/capture/technique.h"
 
 namespace nbsim::capture {
@@ -11,6 +12,11 @@ const std::vector<TechniqueRow>& technique_table() {
         "Occlusion culling with occlusion queries or the GLSL N-buffer, flat or over the BVH (N-buffer paper, 3.1 and 4.2)",
         occlusion_culling_options()},
        make_occlusion_culling},
+      {{"particles",
+        "Point-sprite particles culled in the vertex stage: none, centre lookup, partial N-buffer or Hi-Z, with a "
+        "reference pass for popping (N-buffer paper, 3.2 and 4.3)",
+        particles_options()},
+       make_particles},
   };
   return table;
 }

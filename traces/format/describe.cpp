@@ -289,6 +289,8 @@ std::string table_for(const Region& r) {
       std::string t = record_table(k.type, r.version);
       if (!t.empty()) return t;
     }
+  for (const ChunkSpec& spec : technique_chunks())  // a technique's chunk type, by its fourcc
+    if (chunk_type_name(spec.type) == r.type && r.version >= 2) return technique_table(spec);
   throw InputError(fmt::format("FORMAT.md: no record {} in format version {}", r.type, r.version));
 }
 

@@ -11,6 +11,7 @@
 #include "model/common/error.h"
 #include "traces/format/bytes.h"
 #include "traces/format/codec.h"
+#include "traces/format/particles_chunk.h"
 
 namespace nbsim::trace {
 
@@ -26,8 +27,12 @@ struct Registry {
   std::vector<ChunkSpec> specs;
 };
 
+// The chunk types of the techniques this build knows, registered before anything else so that
+// every reader decodes them (a technique's own test types register later, at run time).
+std::vector<ChunkSpec> built_in_chunks() { return {particles_chunk_spec()}; }
+
 Registry& registry() {
-  static Registry r;
+  static Registry r{{}, built_in_chunks()};
   return r;
 }
 
@@ -82,6 +87,8 @@ std::vector<std::uint8_t> encode(const TechniqueRecord& record) {
   NBSIM_CHECK(record.fields.size() == spec->fields.size(),
               fmt::format("technique chunk {}: {} fields, its description has {}", spec->record, record.fields.size(),
                           spec->fields.size()));
+  NBSIM_CHECK(!spec->rule || spec->rule(record).empty(),
+              fmt::format("technique chunk {} breaks its rule: {}", spec->record, spec->rule ? spec->rule(record) : ""));
   bytes::Out o;
   for (std::size_t i = 0; i < spec->fields.size(); ++i) {
     const FieldSpec& fs = spec->fields[i];
@@ -130,6 +137,8 @@ TechniqueRecord decode_technique(std::uint32_t type, std::span<const std::uint8_
   }
   in.finish();
   r.decoded = true;
+  if (spec->rule)
+    if (const std::string broken = spec->rule(r); !broken.empty()) throw InputError(fmt::format("{}: {}", spec->record, broken));
   return r;
 }
 

@@ -30,6 +30,10 @@ struct ChunkSpec {
   std::string technique;     // "particles"
   std::string record;        // "ParticleCulling"
   std::vector<FieldSpec> fields;
+  // A rule the decoded fields keep beyond their types (e.g. vectors of one length), or null: why a
+  // record breaks it, empty when it keeps it. The reader refuses a record that breaks it
+  // (InputError naming the chunk), the writer aborts on one.
+  std::string (*rule)(const TechniqueRecord& record) = nullptr;
 };
 
 // Registers a chunk type. A bad spec (a core or already registered type, an unprintable fourcc,

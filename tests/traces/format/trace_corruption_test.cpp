@@ -7,6 +7,8 @@
 
 #include "model/common/error.h"
 #include "tests/traces/format/sample_trace.h"
+#include "traces/format/bytes.h"
+#include "traces/format/particles_chunk.h"
 
 namespace {
 
@@ -312,7 +314,7 @@ TEST(TraceCorruptionTest, FieldValuesOutOfRange) {
     std::string message;
   };
   const Row rows[] = {
-      {ChunkType::Draw, [](Bytes& p) { p[4] = 7; }, "field 'role' is 7"},                       // DrawRole 0..6
+      {ChunkType::Draw, [](Bytes& p) { p[4] = 10; }, "field 'role' is 10"},                     // DrawRole 0..9
       {ChunkType::Draw, [](Bytes& p) { p[15] = 2; }, "field 'state.write' is 2, not 0 or 1"},   // bools are 0/1
       {ChunkType::Draw, [](Bytes& p) { p[14] = 8; }, "state.func"},                             // DepthFunc 0..7
       {ChunkType::Draw, [](Bytes& p) { p[13] = 32; }, "field 'level' is 32"},                  // levels below 32
@@ -326,7 +328,7 @@ TEST(TraceCorruptionTest, FieldValuesOutOfRange) {
       {ChunkType::Levels, [](Bytes& p) { p[19] = 2; }, "field 'op' is 2"},                      // FarOp 0..1
       {ChunkType::Levels, [](Bytes& p) { put_le32(p, 28, 33); }, "field 'levels' is 33"},       // at most 32 levels
       {ChunkType::Draw, [](Bytes& p) { p[80 + 48] = 2; }, "field 'topology' is 2"},            // Topology 0..1
-      {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 4] = 9; }, "field 'role' is 9"},               // each draw checked
+      {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 4] = 10; }, "field 'role' is 10"},              // each draw checked
       // The batch's first draw: 128 bytes of version 1 fields, topology, 3 point sizes, stencil.test,
       // stencil.front.func, ref, value_mask, write_mask, then stencil.front.fail at 4 + 159.
       {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 159] = 8; }, "field 'stencil.front.fail' is 8"},  // StencilOp 0..7
@@ -508,6 +510,82 @@ TEST(TraceCorruptionTest, TechniqueChunks) {
   t.add(P).add(sample_frame_begin(0)).chunk(static_cast<ChunkType>(0x01020304u), {1, 2}, false, kFlagTechnique);
   e = read_error(t.b);
   EXPECT_TRUE(has(e, "chunk 2 (0x01020304)") && has(e, "four printable characters")) << e;
+}
+
+// The particles technique's PRTC record (traces/format/particles_chunk.h) is decoded by every
+// reader; each flipped byte, a payload one byte short or long and a vector count past the payload
+// are refused naming the chunk.
+TEST(TraceCorruptionTest, ParticleChunk) {
+  TechniqueRecord r;
+  r.type = kParticlesChunk;
+  r.decoded = true;
+  r.fields = {{"count", std::uint64_t{3}},
+              {"draw", std::vector<std::uint32_t>{0, 0, 1}},
+              {"x", std::vector<float>{0.5f, -3.0f, 100.25f}},
+              {"y", std::vector<float>{1.5f, 2.0f, 95.0f}},
+              {"depth", std::vector<float>{0.25f, 1.0f, 0.999f}},
+              {"size", std::vector<float>{16.0f, 24.0f, 64.0f}},
+              {"culled", std::vector<std::uint32_t>{1, 0, 0}},
+              {"lookups", std::vector<std::uint32_t>{1, 4, 0}},
+              {"reference_samples", std::vector<std::uint32_t>{0, 17, 4096}}};
+  r.payload = encode(r);
+  const Properties P;
+  Builder t;
+  t.add(P).add(sample_frame_begin(0)).technique(r).add(FrameEnd{0, 0, 0}).end(1);
+  {
+    FrameReader frames(TraceReader(t.b, "t.nbtrace"));
+    const auto f = frames.next();
+    ASSERT_TRUE(f);
+    ASSERT_EQ(f->technique_records.size(), 1u);
+    expect_same(r, f->technique_records[0]);
+  }
+  const std::vector<std::size_t> offsets = chunk_offsets(t.b);
+  const std::size_t at = offsets[2];  // HEAD, FRAM, PRTC
+  for (std::size_t i = at; i < offsets[3]; ++i) {
+    Bytes b = t.b;
+    b[i] ^= 0x01;
+    const std::string e = read_error(b);
+    ASSERT_TRUE(has(e, "chunk 2 ")) << "byte " << i << " of PRTC flipped: " << e;
+  }
+  TechniqueRecord shorter = r;
+  shorter.decoded = false;
+  shorter.payload.pop_back();
+  std::string e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(shorter).add(FrameEnd{0, 0, 0}).end(1).b);
+  EXPECT_TRUE(has(e, "chunk 2 (PRTC)") && has(e, "decodes short")) << e;
+  TechniqueRecord longer = shorter;
+  longer.payload = r.payload;
+  longer.payload.push_back(0);
+  e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(longer).add(FrameEnd{0, 0, 0}).end(1).b);
+  EXPECT_TRUE(has(e, "chunk 2 (PRTC)") && has(e, "decodes long")) << e;
+  TechniqueRecord hostile = shorter;
+  hostile.payload = r.payload;
+  put_le32(hostile.payload, 4, 0xFFFFFFFFu);  // the draw vector's count
+  e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(hostile).add(FrameEnd{0, 0, 0}).end(1).b);
+  EXPECT_TRUE(has(e, "chunk 2 (PRTC)") && has(e, "4294967295")) << e;
+  // Intact framing, broken rule: a vector of another length than count, a flag or a lookup count
+  // out of range (payloads built by hand: the writer's encode() aborts on such records).
+  struct Broken {
+    std::vector<float> x;
+    std::vector<std::uint32_t> culled, lookups;
+    std::string message;
+  };
+  for (const Broken& b : {Broken{{1.0f, 2.0f}, {1, 0, 0}, {1, 4, 0}, "field 'x' has 2 elements, but count is 3"},
+                          Broken{{1.0f, 2.0f, 3.0f}, {0, 2, 0}, {1, 4, 0}, "field 'culled' of particle 1 is 2, above 1"},
+                          Broken{{1.0f, 2.0f, 3.0f}, {1, 0, 0}, {1, 5, 0}, "field 'lookups' of particle 1 is 5, above 4"}}) {
+    bytes::Out o;
+    o.u32(3);
+    o.counted_words(std::vector<std::uint32_t>{0, 0, 1});  // draw
+    o.counted_words(b.x);
+    for (int k = 0; k < 3; ++k) o.counted_words(std::vector<float>{1.0f, 2.0f, 3.0f});  // y, depth, size
+    o.counted_words(b.culled);
+    o.counted_words(b.lookups);
+    o.counted_words(std::vector<std::uint32_t>{0, 0, 0});  // reference_samples
+    TechniqueRecord broken;
+    broken.type = kParticlesChunk;
+    broken.payload = o.take();
+    e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(broken).add(FrameEnd{0, 0, 0}).end(1).b);
+    EXPECT_TRUE(has(e, "chunk 2 (PRTC)") && has(e, b.message)) << e;
+  }
 }
 
 // Draw batches: empty ones, counts past the payload, indices that do not continue across DRAW and

@@ -13,8 +13,8 @@
 
 #include "model/scene/visibility.h"
 #include "traces/capture/draw_recorder.h"
+#include "traces/capture/glsl_nbuffer.h"
 #include "traces/capture/ground_truth.h"
-#include "traces/capture/occlusion/glsl_nbuffer.h"
 #include "traces/capture/readback.h"
 #include "traces/capture/render_target.h"
 #include "traces/capture/scene_pass.h"

@@ -1,7 +1,10 @@
-// The GLSL N-buffer of the occlusion-culling technique (N-buffer paper, Fig. 2 and section 3.2):
-// built from a depth texture by one full-screen pass per level (shaders/occlusion/nbuffer_build.frag,
-// each pass a recorded draw), queried in batches by a compute shader (nbuffer_query.comp), read
-// back as the trace's level record. Levels are R32F; max under LESS, min under reversed Z.
+// The GLSL N-buffer the capture techniques share (N-buffer paper, Fig. 2 and section 3.2): built
+// from a depth texture by one full-screen pass per level (shaders/common/nbuffer_build.frag, each
+// pass a recorded draw), up to a level cap (the paper's partial build for particles: only the
+// levels the largest sprite needs); queried in batches of rectangles by a compute shader
+// (shaders/common/nbuffer_query.comp, occlusion culling's bounds tests) or sampled by a technique's
+// own shaders (texture()), read back as the trace's level record. Levels are R32F; max under LESS,
+// min under reversed Z.
 #pragma once
 
 #include <vector>
@@ -15,8 +18,9 @@ namespace nbsim::capture {
 
 class GlslNBuffer {
  public:
-  // Levels: nbuffer_level_count(width, height) (model/nbuffer/covering.h).
-  GlslNBuffer(int width, int height, FarOp op);
+  // Levels: nbuffer_level_count(width, height) (model/nbuffer/covering.h), or fewer: levels 0 ..
+  // max_level when max_level is below the last of them (a partial build).
+  GlslNBuffer(int width, int height, FarOp op, int max_level = 1 << 30);
   ~GlslNBuffer();
   GlslNBuffer(const GlslNBuffer&) = delete;
   GlslNBuffer& operator=(const GlslNBuffer&) = delete;
@@ -28,10 +32,13 @@ class GlslNBuffer {
   void build(GLuint depth_texture, DrawRecorder& recorder, const scene::DepthState& state);
 
   // One compute dispatch over the batch: sets each test's .visible (off-screen rectangles are
-  // never visible; bounds crossing the near plane always are).
+  // never visible; bounds crossing the near plane always are). Needs every level (no cap).
   void query(std::vector<scene::BoundsTest>& tests);
 
   scene::NBufferLevels read() const;
+
+  // The levels as a 2D array texture, one R32F layer a level (for a technique's own queries).
+  GLuint texture() const noexcept { return level_array_; }
 
  private:
   int width_ = 0, height_ = 0, levels_ = 1;

@@ -1,26 +1,27 @@
 // The GLSL N-buffer; see glsl_nbuffer.h.
-#include "traces/capture/occlusion/glsl_nbuffer.h"
+#include "traces/capture/glsl_nbuffer.h"
 
 #include <algorithm>
 #include <cstdint>
 #include <string>
 
+#include "model/common/error.h"
 #include "model/nbuffer/covering.h"
 #include "nbsim_shaders.h"
 #include "traces/capture/readback.h"
 
 namespace nbsim::capture {
 
-GlslNBuffer::GlslNBuffer(int width, int height, FarOp op)
-    : width_(width), height_(height), levels_(nbuffer_level_count(width, height)), op_(op) {
+GlslNBuffer::GlslNBuffer(int width, int height, FarOp op, int max_level)
+    : width_(width), height_(height), levels_(std::clamp(max_level + 1, 1, nbuffer_level_count(width, height))), op_(op) {
   const std::string far = op == FarOp::Min ? "#define FAR(a, b) min(a, b)\n#define FARTHER_THAN(a, b) ((a) < (b))\n"
                                            : "#define FAR(a, b) max(a, b)\n#define FARTHER_THAN(a, b) ((a) > (b))\n";
   build_prog_ = link_program({compile_shader(GL_VERTEX_SHADER, shaders::common_fullscreen_vert, "common/fullscreen.vert"),
-                              compile_shader(GL_FRAGMENT_SHADER, with_defines(shaders::occlusion_nbuffer_build_frag, far),
-                                             "occlusion/nbuffer_build.frag")},
+                              compile_shader(GL_FRAGMENT_SHADER, with_defines(shaders::common_nbuffer_build_frag, far),
+                                             "common/nbuffer_build.frag")},
                              "nbuffer_build");
-  query_prog_ = link_program({compile_shader(GL_COMPUTE_SHADER, with_defines(shaders::occlusion_nbuffer_query_comp, far),
-                                             "occlusion/nbuffer_query.comp")},
+  query_prog_ = link_program({compile_shader(GL_COMPUTE_SHADER, with_defines(shaders::common_nbuffer_query_comp, far),
+                                             "common/nbuffer_query.comp")},
                              "nbuffer_query");
   glCreateVertexArrays(1, &empty_vao_);
   glCreateBuffers(1, &query_ssbo_);
@@ -106,6 +107,8 @@ void GlslNBuffer::query(std::vector<scene::BoundsTest>& tests) {
     in.push_back(g);
   }
   if (in.empty()) return;
+  // A rectangle wider than the top level's squares would be answered from too small a square.
+  NBSIM_CHECK(levels_ == nbuffer_level_count(width_, height_), "GlslNBuffer::query() on a partial build");
   glDeleteBuffers(1, &query_ssbo_);
   glCreateBuffers(1, &query_ssbo_);
   glNamedBufferStorage(query_ssbo_, static_cast<GLsizeiptr>(in.size() * sizeof(Gpu)), in.data(), 0);

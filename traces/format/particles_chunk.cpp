@@ -1,0 +1,60 @@
+// The particles technique's chunk description; see particles_chunk.h.
+#include "traces/format/particles_chunk.h"
+
+#include <fmt/format.h>
+
+#include <string>
+#include <type_traits>
+#include <variant>
+
+namespace nbsim::trace {
+
+namespace {
+
+// The rule of particles_chunk_spec(): what a reader refuses beyond the field types.
+std::string particles_rule(const TechniqueRecord& r) {
+  const std::uint64_t count = std::get<std::uint64_t>(r.fields.at(0).value);
+  for (const TechniqueField& f : r.fields) {
+    const std::size_t n = std::visit(
+        [](const auto& v) -> std::size_t {
+          if constexpr (requires { v.size(); } && !std::is_same_v<std::decay_t<decltype(v)>, std::string>) return v.size();
+          return 0;
+        },
+        f.value);
+    if (f.name != "count" && n != count)
+      return fmt::format("field '{}' has {} elements, but count is {} (one a particle)", f.name, n, count);
+  }
+  for (const TechniqueField& f : r.fields) {
+    if (f.name != "culled" && f.name != "lookups") continue;
+    const auto& v = std::get<std::vector<std::uint32_t>>(f.value);
+    const std::uint32_t limit = f.name == "culled" ? 1u : 4u;
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (v[i] > limit) return fmt::format("field '{}' of particle {} is {}, above {}", f.name, i, v[i], limit);
+  }
+  return {};
+}
+
+}  // namespace
+
+ChunkSpec particles_chunk_spec() {
+  ChunkSpec spec{kParticlesChunk,
+          "particles",
+          "ParticleCulling",
+          {{"count", FieldKind::U32, "particles in the frame (every vector below has this many elements)"},
+           {"draw", FieldKind::VecU32, "the frame's draw (role particles) that drew the particle"},
+           {"x", FieldKind::VecF32, "sprite centre, window x, pixels (as the vertex shader computed it)"},
+           {"y", FieldKind::VecF32, "sprite centre, window y, pixels, y up"},
+           {"depth", FieldKind::VecF32, "window depth of the sprite (every fragment's), [0, 1]"},
+           {"size", FieldKind::VecF32, "sprite side, pixels (gl_PointSize)"},
+           {"culled", FieldKind::VecU32, "1: the vertex stage culled it (moved it outside the clip volume), 0: drawn"},
+           {"lookups", FieldKind::VecU32,
+            "depth texels the vertex-stage query read (0: not tested: mode none, off-screen, behind the eye, or larger "
+            "than the levels built)"},
+           {"reference_samples", FieldKind::VecU32,
+            "samples that passed the depth test in the reference pass (every particle drawn, same depth test, early "
+            "fragment tests, a counter per particle); culled with reference_samples > 0 is popping"}}};
+  spec.rule = particles_rule;
+  return spec;
+}
+
+}  // namespace nbsim::trace
