@@ -3,6 +3,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #if defined(__SANITIZE_ADDRESS__)
 #include <pthread.h>
@@ -29,11 +30,31 @@ std::exception_ptr& failure() {
   static std::exception_ptr first;
   return first;
 }
+
+// Every thread process below `o` that is still alive, except the caller.
+void collect_threads(sc_core::sc_object* o, std::vector<sc_core::sc_process_handle>& out) {
+  const sc_core::sc_process_handle h(o);
+  if (h.valid() && !h.terminated() && h != sc_core::sc_get_current_process_handle() &&
+      (h.proc_kind() == sc_core::SC_THREAD_PROC_ || h.proc_kind() == sc_core::SC_CTHREAD_PROC_))
+    out.push_back(h);
+  for (sc_core::sc_object* child : o->get_child_objects()) collect_threads(child, out);
+}
+
 }  // namespace
 
 void thread_failed(std::exception_ptr e) {
-  if (!failure()) failure() = e;
+  const bool first = !failure();
+  if (first) failure() = e;
   sc_core::sc_stop();
+  if (!first || !sc_core::sc_is_running()) return;
+  // The other units' threads wait in the middle of their work, holding batches and frames on their
+  // own stacks, and SystemC never unwinds a suspended thread when the simulation ends: kill them
+  // now, from this thread, so that their stacks unwind (sc_unwind_exception, which guard_thread
+  // passes through) and free what they hold instead of leaking it at exit.
+  std::vector<sc_core::sc_process_handle> alive;
+  for (sc_core::sc_object* top : sc_core::sc_get_top_level_objects()) collect_threads(top, alive);
+  for (auto& h : alive)
+    if (!h.terminated()) h.kill();
 }
 
 namespace {
