@@ -190,6 +190,43 @@ nlohmann::ordered_json cull_summary(const nlohmann::ordered_json& cull, const nl
   return j;
 }
 
+// The particles program's run totals (summary "particles"), from its statistics and its N-buffer's
+// when the run is done. Depth tests as ARCHITECTURE.md counts them: the queries' texels read, the
+// particle draws' fragments, and the partial build's texels; the scene's own depth tests apart.
+nlohmann::ordered_json particles_summary(const nlohmann::ordered_json& p, std::string_view mode, std::uint64_t cycles) {
+  const std::uint64_t frames = stat(p, "frames");
+  const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
+  const std::uint64_t query = stat(p, "lookups"), raster = stat(p, "particle_fragments"), build = stat(p, "build_texels");
+  const std::uint64_t total = query + raster + build;
+  nlohmann::ordered_json j;
+  j["mode"] = mode;
+  j["frames"] = frames;
+  for (const char* name : {"particles", "tested", "culled", "kept_too_large", "offscreen", "gl_culled"}) {
+    j[name] = stat(p, name);
+    j[std::string(name) + "_per_frame"] = per_frame(stat(p, name));
+  }
+  j["query_depth_tests"] = query;
+  j["query_depth_tests_per_frame"] = per_frame(query);
+  j["gl_lookups"] = stat(p, "gl_lookups");
+  j["raster_depth_tests"] = raster;
+  j["raster_depth_tests_per_frame"] = per_frame(raster);
+  j["raster_passed"] = stat(p, "particle_passed");
+  j["build_texels"] = build;
+  j["build_texels_per_frame"] = per_frame(build);
+  j["total_depth_tests"] = total;
+  j["total_depth_tests_per_frame"] = per_frame(total);
+  j["scene_depth_tests_per_frame"] = per_frame(stat(p, "scene_depth_tests"));
+  j["cycles"] = cycles;
+  j["cycles_per_frame"] = per_frame(cycles);
+  for (const char* name : {"decision_mismatches", "lookup_mismatches", "popping", "false_culls", "exactly_hidden",
+                           "visible_reference"})
+    j[name] = stat(p, name);
+  // Culled less than the exact sprite test would (the cost of the conservative test): exact - culled.
+  const std::uint64_t exact = stat(p, "exactly_hidden"), culled = stat(p, "culled") - stat(p, "false_culls");
+  j["culled_below_exact"] = exact > culled ? exact - culled : 0;
+  return j;
+}
+
 double rel(std::uint64_t a, std::uint64_t b) {
   if (b == 0) return a == 0 ? 0.0 : 1.0;
   return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
@@ -228,6 +265,7 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   j["cycles_per_host_second"] = host_seconds > 0 ? static_cast<double>(cycles) / host_seconds : 0.0;
   j["within_thresholds"] = within_thresholds();
   if (!cull.is_null()) j["cull"] = cull;
+  if (!particles.is_null()) j["particles"] = particles;
   return j;
 }
 
@@ -272,6 +310,7 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.zero_to_one = head.clip_control == trace::ClipControl::ZeroToOne;
   setup.scene = tr.scene();
   setup.fused_interpolation = o.config.depth.fused_interpolation;
+  setup.properties = tr.properties();
   Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head.technique, setup,
           o.out ? &*o.out : nullptr);
   std::optional<sim::Timeline> timeline;  // only when asked: units then report their busy spans
@@ -298,6 +337,15 @@ ReplaySummary replay(const ReplayOptions& o) {
     s.cull["structure_memory_bytes"] = bytes;  // N-buffer levels, tile Hi-Z or pyramid
     s.cull["nbuffer_memory_bytes"] =
         structure && structure->structure_kind() == query::Kind::NBuffer ? nlohmann::ordered_json(bytes) : nullptr;
+  }
+
+  if (s.stats.contains("gpu.particles")) {
+    std::string mode;
+    for (const auto& [k, v] : tr.properties())
+      if (k == "particle_mode") mode = v;
+    s.particles = particles_summary(s.stats["gpu.particles"], mode, sink.last_frame_cycle());
+    const auto& structures = gpu.program().structures;
+    s.particles["nbuffer_memory_bytes"] = structures.empty() ? 0 : structures.front()->storage_bytes();
   }
 
   if (o.out) {
