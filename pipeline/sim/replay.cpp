@@ -23,6 +23,10 @@ constexpr std::array<const char*, 11> kCullFrameCounts = {
     "bounds_tests",    "candidates",        "culled",            "candidates_not_visible",     "false_culls",
     "undrawable",      "primitive_tests",   "primitives_culled", "primitive_lookups",          "primitive_fragments_culled",
     "primitive_false_culls"};
+// The particles program's counters in run.json's per-frame values (differences at frame ends).
+constexpr std::array<const char*, 10> kParticlesFrameCounts = {
+    "particles", "culled", "kept_too_large", "lookups", "particle_fragments", "build_texels", "decision_mismatches",
+    "popping", "false_culls", "exactly_hidden"};
 
 // A statistic of a group's values (0 when the group has none of that name).
 std::uint64_t stat(const nlohmann::ordered_json& group, const char* name) {
@@ -101,6 +105,14 @@ class Collector : public depth::ResultSink {
       for (const char* name : kCullFrameCounts) pf[name] = delta(name);
       last_cull_ = now;
     }
+    if (const stats::Group* g = registry_.find("gpu.particles")) {
+      const nlohmann::ordered_json now = g->values();
+      const auto delta = [&](const char* name) { return stat(now, name) - stat(last_particles_, name); };
+      pf["query_depth_tests"] = delta("lookups");
+      pf["total_depth_tests"] = delta("lookups") + delta("particle_fragments") + delta("build_texels");
+      for (const char* name : kParticlesFrameCounts) pf[name] = delta(name);
+      last_particles_ = now;
+    }
     per_frame_.push_back(std::move(pf));
     last_cycle_ = cycle;
     for (const auto& d : w.frame->draws)
@@ -125,6 +137,7 @@ class Collector : public depth::ResultSink {
   const ReplayOptions& o_;
   const stats::Registry& registry_;
   nlohmann::ordered_json last_cull_ = nlohmann::ordered_json::object();  // gpu.cull at the last frame end
+  nlohmann::ordered_json last_particles_ = nlohmann::ordered_json::object();  // gpu.particles at the last frame end
   std::ofstream draws_, frames_;
   FrameTotals frame_;
   std::uint64_t last_cycle_ = 0;

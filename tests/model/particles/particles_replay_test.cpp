@@ -37,7 +37,7 @@ nlohmann::json replay(const fs::path& t) {
   const CliResult r = run_nbsim("replay " + t.string() + " --out " + dir.string());
   EXPECT_EQ(r.status, 0) << r.out << r.err;
   std::ifstream in(dir / "run.json");
-  return nlohmann::json::parse(in)["summary"];
+  return nlohmann::json::parse(in);
 }
 
 // `nbsim compare`: every draw exact (fragments and passed samples equal GL's).
@@ -58,6 +58,7 @@ struct Variant {
   const char* name;
   const char* args;
   bool conservative;  // nb, hiz: no popping, no false cull
+  bool all_kept = false;  // every on-screen sprite larger than the levels built
 };
 
 class ParticlesReplayTest : public ::testing::TestWithParam<Variant> {};
@@ -67,7 +68,8 @@ TEST_P(ParticlesReplayTest, ReplaysExactlyAndDecidesAsGl) {
   const Variant& v = GetParam();
   const fs::path t = capture(std::string(v.name) + ".nbt", v.args);
   expect_compare_exact(t);
-  const auto s = replay(t)["particles"];
+  const auto run = replay(t);
+  const auto s = run["summary"]["particles"];
   EXPECT_EQ(s["frames"], 3);
   EXPECT_EQ(s["particles"], 4500);
   EXPECT_EQ(s["culled"], s["gl_culled"]);
@@ -75,6 +77,15 @@ TEST_P(ParticlesReplayTest, ReplaysExactlyAndDecidesAsGl) {
   EXPECT_EQ(s["total_depth_tests"].get<std::uint64_t>(),
             s["query_depth_tests"].get<std::uint64_t>() + s["raster_depth_tests"].get<std::uint64_t>() +
                 s["build_texels"].get<std::uint64_t>());
+  std::uint64_t culled = 0, popping = 0;  // per frame: differences at frame ends
+  for (const auto& f : run["frames"]) culled += f["culled"].get<std::uint64_t>(), popping += f["popping"].get<std::uint64_t>();
+  EXPECT_EQ(culled, s["culled"].get<std::uint64_t>()) << "the frames' values add up to the run's";
+  EXPECT_EQ(popping, s["popping"].get<std::uint64_t>());
+  if (v.all_kept) {
+    EXPECT_EQ(s["culled"], 0) << v.name;
+    EXPECT_EQ(s["kept_too_large"], s["tested"].get<int>() + s["kept_too_large"].get<int>()) << "none tested";
+    EXPECT_GT(s["kept_too_large"].get<int>(), 0) << v.name;
+  }
   if (v.conservative) {
     EXPECT_GT(s["culled"].get<int>(), 0) << "the capture culls something";
     EXPECT_EQ(s["popping"], 0) << v.name << ": a conservative test never pops";
@@ -90,15 +101,17 @@ INSTANTIATE_TEST_SUITE_P(Modes, ParticlesReplayTest,
                                            Variant{"nb24", "--sprite 24 --mode nb", true},
                                            Variant{"nb_atten", "--sprite atten --mode nb", true},
                                            Variant{"hiz_atten", "--sprite atten --mode hiz", true},
-                                           Variant{"nb16_reversed", "--sprite 16 --mode nb --reversed-z", true}),
+                                           Variant{"nb16_reversed", "--sprite 16 --mode nb --reversed-z", true},
+                                           Variant{"hiz24_reversed", "--sprite 24 --mode hiz --reversed-z", true},
+                                           Variant{"nb16_cap3", "--sprite 16 --mode nb --level-cap 3", false, true}),
                          [](const auto& param_info) { return std::string(param_info.param.name); });
 
 // The paper's claim, checked: with 16 px sprites nb spends far fewer depth tests than none, and
 // center pops on the walk while nb does not.
 TEST(ParticlesCostTest, NBufferCheaperThanRasterizingAndCenterPops) {
-  const auto none = replay(capture("cost_none.nbt", "--sprite 16 --mode none"))["particles"];
-  const auto nb = replay(capture("cost_nb.nbt", "--sprite 16 --mode nb"))["particles"];
-  const auto center = replay(capture("cost_center.nbt", "--sprite 16 --mode center"))["particles"];
+  const auto none = replay(capture("cost_none.nbt", "--sprite 16 --mode none"))["summary"]["particles"];
+  const auto nb = replay(capture("cost_nb.nbt", "--sprite 16 --mode nb"))["summary"]["particles"];
+  const auto center = replay(capture("cost_center.nbt", "--sprite 16 --mode center"))["summary"]["particles"];
   EXPECT_EQ(none["culled"], 0);
   EXPECT_EQ(none["query_depth_tests"], 0);
   EXPECT_LT(nb["raster_depth_tests"].get<double>(), 0.5 * none["raster_depth_tests"].get<double>())
