@@ -122,6 +122,32 @@ TEST(ParticlesCostTest, NBufferCheaperThanRasterizingAndCenterPops) {
   EXPECT_EQ(nb["popping"], 0);
 }
 
+// The N-buffer unit's keys apply: every update policy decides as GL's shader (only the build cost
+// moves), u16 storage and a reduced resolution stay conservative, and cull.mode is refused.
+TEST(ParticlesCostTest, NBufferKeysApply) {
+  const fs::path t = capture("keys.nbt", "--sprite 16 --mode nb");
+  const auto replay_with = [&](const std::string& name, const std::string& set) {
+    const fs::path dir = scratch("keys_" + name);
+    const CliResult r = run_nbsim("replay " + t.string() + " --out " + dir.string() + " --set " + set);
+    EXPECT_EQ(r.status, 0) << set << ": " << r.out << r.err;
+    std::ifstream in(dir / "run.json");
+    return nlohmann::json::parse(in)["summary"]["particles"];
+  };
+  for (const char* policy : {"eager", "batched", "lazy"}) {
+    const auto s = replay_with(policy, std::string("nbuffer.update_policy=") + policy);
+    EXPECT_EQ(s["decision_mismatches"], 0) << policy;
+    EXPECT_GT(s["build_texels"].get<int>(), 0) << policy << ": the partial build is counted";
+  }
+  for (const char* set : {"nbuffer.format=u16", "nbuffer.resolution_divisor=2"}) {
+    const auto s = replay_with(set[8] == 'f' ? "u16" : "div2", set);
+    EXPECT_EQ(s["popping"], 0) << set;
+    EXPECT_EQ(s["false_culls"], 0) << set;
+  }
+  const CliResult refused = run_nbsim("compare " + t.string() + " --set cull.mode=nb");
+  EXPECT_EQ(refused.status, 2) << refused.out << refused.err;
+  EXPECT_TRUE(has(refused.err, "cull.mode=nb is occlusion culling's")) << refused.err;
+}
+
 // A PRTC record whose count does not match the particle draws' points: exit 2, the frame and the
 // count named, no run.json.
 TEST(ParticlesCostTest, DamagedRecordRefused) {
