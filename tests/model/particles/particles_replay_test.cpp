@@ -148,6 +148,36 @@ TEST(ParticlesCostTest, NBufferKeysApply) {
   EXPECT_TRUE(has(refused.err, "cull.mode=nb is occlusion culling's")) << refused.err;
 }
 
+// `nbsim particles`: one row per trace from its replay's /summary/particles, the paper's claim
+// beside none and nb for 16 px sprites; a trace of another technique is refused.
+TEST(ParticlesCostTest, TableCommand) {
+  const fs::path none = capture("table_none.nbt", "--sprite 16 --mode none");
+  const fs::path nb = capture("table_nb.nbt", "--sprite 16 --mode nb");
+  const fs::path dir = scratch("table_out");
+  const CliResult r = run_nbsim("particles " + none.string() + " " + nb.string() + " --json --out " + dir.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0]["mode"], "none");
+  EXPECT_EQ(rows[0]["paper_depth_tests_per_frame"].get<double>(), 256.0 * 1500.0);
+  EXPECT_EQ(rows[1]["mode"], "nb");
+  EXPECT_EQ(rows[1]["paper_depth_tests_per_frame"].get<double>(), 1500.0);
+  EXPECT_EQ(rows[1]["popping"], 0);
+  EXPECT_TRUE(fs::exists(dir / "particles.json"));
+  const CliResult text = run_nbsim("particles " + nb.string());
+  EXPECT_EQ(text.status, 0) << text.err;
+  EXPECT_TRUE(has(text.out, "256 N by rasterization, N with the N-buffer")) << text.out;
+  const fs::path other = scratch("other.nbt");
+  {
+    nbsim::trace::TraceWriter w(other, {{"viewport", "8x8"}, {"depth_func", "LESS"}, {"depth_clear", "1"},
+                                        {"technique", "occlusion_culling"}, {"frames", "0"}});
+    w.close();
+  }
+  const CliResult refused = run_nbsim("particles " + other.string());
+  EXPECT_EQ(refused.status, 2) << refused.out << refused.err;
+  EXPECT_TRUE(has(refused.err, "is not a particles trace")) << refused.err;
+}
+
 // A PRTC record whose count does not match the particle draws' points: exit 2, the frame and the
 // count named, no run.json.
 TEST(ParticlesCostTest, DamagedRecordRefused) {
