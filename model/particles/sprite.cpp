@@ -10,6 +10,7 @@
 
 #include "model/common/error.h"
 #include "model/common/names.h"
+#include "model/raster/point_setup.h"
 
 namespace nbsim::particles {
 
@@ -87,10 +88,22 @@ std::uint64_t hiz_build_texels(int width_px, int height_px, int top_level) noexc
   return n;
 }
 
-bool sprite_passes(const SpriteRect& r, float d, const DepthImage& depth, FarOp op) noexcept {
-  if (!r.on_screen) return false;
-  for (int y = r.clipped.y; y < r.clipped.y + r.clipped.h; ++y)
-    for (int x = r.clipped.x; x < r.clipped.x1(); ++x) {
+Rect drawn_rect(const Particle& p, int width_px, int height_px) noexcept {
+  const auto inside = [](float v, int side) { return v >= 0.0f && v <= static_cast<float>(side); };
+  if (!inside(p.x, width_px) || !inside(p.y, height_px) || !(p.depth >= 0.0f && p.depth <= 1.0f)) return {};
+  const std::int32_t w = raster::point_width_fixed(p.size);
+  // Pixel i is covered when x0 <= 256 i < x1: i from ceil(x0 / 256) to ceil(x1 / 256) - 1.
+  const auto first = [](std::int32_t f) { return static_cast<int>((static_cast<std::int64_t>(f) + 255) >> 8); };
+  const std::int32_t x0 = raster::snap_point_coordinate(p.x - 0.5f) - w / 2, y0 = raster::snap_point_coordinate(p.y - 0.5f) - w / 2;
+  const int px0 = std::max(first(x0), 0), py0 = std::max(first(y0), 0);
+  const int px1 = std::min(first(x0 + w), width_px), py1 = std::min(first(y0 + w), height_px);
+  if (px0 >= px1 || py0 >= py1) return {};
+  return Rect{px0, py0, px1 - px0, py1 - py0};
+}
+
+bool sprite_passes(const Rect& r, float d, const DepthImage& depth, FarOp op) noexcept {
+  for (int y = r.y; y < r.y + r.h; ++y)
+    for (int x = r.x; x < r.x1(); ++x) {
       const float z = depth.at(x, y);
       if (op == FarOp::Max ? d < z : d > z) return true;
     }

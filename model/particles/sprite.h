@@ -73,10 +73,17 @@ Decision hiz_test(const Particle& p, const SpriteRect& r, const HiZPyramid& pyra
 // Texels a partial Hi-Z build writes: levels 0..top_level of ceil(W / 2^k) x ceil(H / 2^k).
 std::uint64_t hiz_build_texels(int width_px, int height_px, int top_level) noexcept;
 
-// The exact sprite test: some pixel of the clipped rectangle passes the depth test against the
-// depth buffer (LESS under Max, GREATER under Min) at the sprite's depth. A sprite culled while this
+// The pixels GL's rasterizer covers for the sprite at the record's window position (llvmpipe's
+// point square, model/raster/point_setup.h: snapped corner, left/bottom fill rule), clipped to the
+// viewport; empty when GL draws nothing (the centre outside the viewport or the depth range: the
+// geometry stage clips points by their centre). Computed from the shader's window position, which
+// may differ from the geometry stage's by a rounding step.
+Rect drawn_rect(const Particle& p, int width_px, int height_px) noexcept;
+
+// The exact sprite test: some pixel of `r` (drawn_rect) passes the depth test against the depth
+// buffer (LESS under Max, GREATER under Min) at the sprite's depth. A sprite culled while this
 // holds is a false cull.
-bool sprite_passes(const SpriteRect& r, float d, const DepthImage& depth, FarOp op) noexcept;
+bool sprite_passes(const Rect& r, float d, const DepthImage& depth, FarOp op) noexcept;
 
 // A frame's particles, read from its PRTC record ("ParticleCulling") and checked against the
 // frame's particle draws: the count equals the points of the draws with role Particles, and every

@@ -185,8 +185,9 @@ void ParticlesUnit::decide(const FrameParticles& fp) {
     decision_mismatches_ += (d.culled ? 1u : 0u) != fp.culled[i] ? 1 : 0;
     lookup_mismatches_ += d.lookups != fp.lookups[i] ? 1 : 0;
     visible_reference_ += fp.reference_samples[i] > 0 ? 1 : 0;
-    const bool passes = sprite_passes(rects[i], p.depth, depth_buffer_, setup_.op);
-    exactly_hidden_ += rects[i].on_screen && !passes ? 1 : 0;
+    const Rect drawn = drawn_rect(p, setup_.width_px, setup_.height_px);
+    const bool passes = sprite_passes(drawn, p.depth, depth_buffer_, setup_.op);
+    exactly_hidden_ += !drawn.empty() && !passes ? 1 : 0;
     if (d.culled) {
       popping_ += fp.reference_samples[i] > 0 ? 1 : 0;
       false_culls_ += passes ? 1 : 0;

@@ -62,7 +62,10 @@ TEST(ParticlesCoreTest, CenterPopsWhereTheExactTestDoesNot) {
   const Decision d = center_test(p, r, depth, 1e-6f, FarOp::Max);
   EXPECT_TRUE(d.culled) << "the centre is hidden";
   EXPECT_EQ(d.lookups, 1u);
-  EXPECT_TRUE(sprite_passes(r, p.depth, depth, FarOp::Max)) << "a corner is visible: culling it pops";
+  const Rect drawn = drawn_rect(p, 32, 32);
+  EXPECT_EQ(drawn.x, 0);
+  EXPECT_EQ(drawn.w, 16) << "GL's square: 16 pixels";
+  EXPECT_TRUE(sprite_passes(drawn, p.depth, depth, FarOp::Max)) << "a corner is visible: culling it pops";
 }
 
 // hiz: at most 2x2 texels of the lowest level that holds the rectangle, kept above the top level.
@@ -78,6 +81,17 @@ TEST(ParticlesCoreTest, HiZLevelAndKeptWhenTooLarge) {
   EXPECT_FALSE(kept.culled) << "needs level 4, only 0..3 built";
   EXPECT_TRUE(kept.too_large);
   EXPECT_EQ(hiz_build_texels(64, 64, 2), 64u * 64u + 32u * 32u + 16u * 16u);
+}
+
+// GL's square: the left/bottom fill rule at a pixel-centre tie, the centre clipping.
+TEST(ParticlesCoreTest, DrawnRectangleAsLlvmpipe) {
+  const Rect tie = drawn_rect({10.5f, 20.5f, 0.5f, 16.0f}, 64, 48);  // edges through pixel centres 2 and 18
+  EXPECT_EQ(tie.x, 2) << "the left edge owns its pixel";
+  EXPECT_EQ(tie.w, 16) << "the right edge does not: 16, where the shader's rectangle widens to 17";
+  EXPECT_TRUE(drawn_rect({-0.5f, 20.0f, 0.5f, 16.0f}, 64, 48).empty()) << "centre outside: clipped, nothing drawn";
+  const Rect edge = drawn_rect({0.0f, 20.0f, 0.5f, 16.0f}, 64, 48);
+  EXPECT_EQ(edge.x, 0);
+  EXPECT_EQ(edge.w, 8) << "centre on the viewport edge: drawn, clipped to the viewport";
 }
 
 // nb tests a sprite only when its unclipped rectangle fits the levels built.

@@ -77,6 +77,8 @@ TEST_P(ParticlesReplayTest, ReplaysExactlyAndDecidesAsGl) {
   EXPECT_EQ(s["total_depth_tests"].get<std::uint64_t>(),
             s["query_depth_tests"].get<std::uint64_t>() + s["raster_depth_tests"].get<std::uint64_t>() +
                 s["build_texels"].get<std::uint64_t>());
+  EXPECT_EQ(s["false_culls"], s["popping"]) << "the exact sprite test (GL's square against the depth buffer) agrees with "
+                                               "GL's reference pass";
   std::uint64_t culled = 0, popping = 0;  // per frame: differences at frame ends
   for (const auto& f : run["frames"]) culled += f["culled"].get<std::uint64_t>(), popping += f["popping"].get<std::uint64_t>();
   EXPECT_EQ(culled, s["culled"].get<std::uint64_t>()) << "the frames' values add up to the run's";
