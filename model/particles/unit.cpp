@@ -52,6 +52,8 @@ ParticlesUnit::ParticlesUnit(const sc_core::sc_module_name& name, stats::Registr
                                    "culled by the model while some pixel of the sprite passes the depth test (exact sprite test)")),
       exactly_hidden_(stats().counter("exactly_hidden", "particles",
                                       "on-screen particles whose every pixel fails the depth test (what an exact test culls)")),
+      hidden_kept_(stats().counter("hidden_kept", "particles",
+                                   "of exactly_hidden, kept by the model (culled less than the exact sprite test would)")),
       visible_reference_(stats().counter("visible_reference", "particles",
                                          "particles with a passing sample in GL's reference pass")) {
   stats().formula("query_depth_tests", "tests", "depth tests of the vertex-stage queries (texels read)",
@@ -188,6 +190,7 @@ void ParticlesUnit::decide(const FrameParticles& fp) {
     const Rect drawn = drawn_rect(p, setup_.width_px, setup_.height_px);
     const bool passes = sprite_passes(drawn, p.depth, depth_buffer_, setup_.op);
     exactly_hidden_ += !drawn.empty() && !passes ? 1 : 0;
+    hidden_kept_ += !drawn.empty() && !passes && !d.culled ? 1 : 0;
     if (d.culled) {
       popping_ += fp.reference_samples[i] > 0 ? 1 : 0;
       false_culls_ += passes ? 1 : 0;

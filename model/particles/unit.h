@@ -79,7 +79,7 @@ class ParticlesUnit : public sim::Unit, public cp::FrameProgram, public depth::D
 
   stats::Counter &frames_, &particles_, &tested_, &culled_, &kept_too_large_, &offscreen_, &lookups_, &build_texels_,
       &particle_draws_, &particle_fragments_, &particle_passed_, &scene_depth_tests_, &decision_mismatches_,
-      &lookup_mismatches_, &gl_culled_, &gl_lookups_, &popping_, &false_culls_, &exactly_hidden_, &visible_reference_;
+      &lookup_mismatches_, &gl_culled_, &gl_lookups_, &popping_, &false_culls_, &exactly_hidden_, &hidden_kept_, &visible_reference_;
 
   std::vector<Rect> rects_;
   std::vector<float> nearest_;

@@ -88,6 +88,7 @@ TEST_P(ParticlesReplayTest, ReplaysExactlyAndDecidesAsGl) {
     EXPECT_EQ(s["kept_too_large"], s["tested"].get<int>() + s["kept_too_large"].get<int>()) << "none tested";
     EXPECT_GT(s["kept_too_large"].get<int>(), 0) << v.name;
   }
+  EXPECT_LE(s["culled_below_exact"].get<std::uint64_t>(), s["exactly_hidden"].get<std::uint64_t>());
   if (v.conservative) {
     EXPECT_GT(s["culled"].get<int>(), 0) << "the capture culls something";
     EXPECT_EQ(s["popping"], 0) << v.name << ": a conservative test never pops";
@@ -116,6 +117,9 @@ TEST(ParticlesCostTest, NBufferCheaperThanRasterizingAndCenterPops) {
   const auto center = replay(capture("cost_center.nbt", "--sprite 16 --mode center"))["summary"]["particles"];
   EXPECT_EQ(none["culled"], 0);
   EXPECT_EQ(none["query_depth_tests"], 0);
+  EXPECT_EQ(none["culled_below_exact"], none["exactly_hidden"]) << "none keeps every hidden sprite";
+  EXPECT_LE(100 * nb["culled_below_exact"].get<std::uint64_t>(), nb["exactly_hidden"].get<std::uint64_t>())
+      << "16 px sprites: one exact square each; only ties (a 17 px rectangle) and the margin keep a hidden one";
   EXPECT_LT(nb["raster_depth_tests"].get<double>(), 0.5 * none["raster_depth_tests"].get<double>())
       << "nb rasterizes only what it keeps";
   EXPECT_LT(nb["query_depth_tests"].get<double>(), 0.1 * none["raster_depth_tests"].get<double>())
