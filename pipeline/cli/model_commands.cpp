@@ -1,4 +1,4 @@
-// `nbsim replay`, `nbsim compare`, `nbsim table2` and `nbsim config`: the SystemC model from the
+// `nbsim replay`, `nbsim compare`, `nbsim table2`, `nbsim particles` and `nbsim config`: the SystemC model from the
 // command line. table2 runs one replay per row of the table the trace's technique declares
 // (pipeline/techniques/results.h; occlusion culling: one per culling mode), each in a child process
 // of this executable (SystemC allows one elaboration per process), and prints the paper's Table 2
@@ -314,6 +314,117 @@ void add_model_commands(CLI::App& app, Action& action) {
             if (const auto* r = row_named(table, list, n.row); r && (*r)[n.column] == n.value) fmt::print("{}\n", n.text);
         }
         return must_be_zero == 0 ? 0 : 1;
+      };
+    });
+  }
+  {
+    // One replay per particles trace (one capture per mode: GL's draws depend on it), in child
+    // processes, and a row each from its run.json's /summary/particles beside the paper's claim
+    // (16 px sprites: 256 N depth tests by rasterization, N with the N-buffer).
+    auto* cmd = app.add_subcommand("particles", "Replay particles traces (one per mode) and print the particles table");
+    auto traces = std::make_shared<std::vector<std::string>>();
+    auto out = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    auto jobs = std::make_shared<int>(2);
+    auto mo = std::make_shared<ModelOptions>();
+    cmd->add_option("TRACE", *traces, "Particles traces (nbsim capture particles), e.g. one per --mode")->required();
+    cmd->add_option("--out", *out, "Keep each replay's outputs in OUT/<trace name> and the table in OUT/particles.json");
+    cmd->add_flag("--json", *json, "Print a JSON list, one object per trace");
+    cmd->add_option("--jobs", *jobs, "Replays run at a time (one process each)")->check(CLI::Range(1, 16));
+    mo->add_options(cmd);
+    cmd->callback([&action, traces, out, json, jobs, mo] {
+      action = [traces, out, json, jobs, mo] {
+        pipeline::GpuConfig config;  // a bad config is refused here, before any child starts
+        nlohmann::ordered_json values;
+        mo->apply(config, values);
+        std::vector<std::string> sprites;
+        for (const std::string& t : *traces) {
+          if (!std::filesystem::exists(t)) throw InputError(fmt::format("trace '{}' does not exist", t));
+          const trace::TraceReader reader(t);
+          const std::string* technique = reader.property("technique");
+          if (!technique || *technique != "particles")
+            throw InputError(fmt::format("trace '{}' is not a particles trace (technique '{}')", t, technique ? *technique : ""));
+          const std::string* sprite = reader.property("sprite");
+          sprites.push_back(sprite ? *sprite : "");
+        }
+        std::filesystem::path dir;
+        const bool temporary = out->empty();
+        if (temporary) {
+          std::string tmpl = (std::filesystem::temp_directory_path() / "nbsim_particles_XXXXXX").string();
+          if (!mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary folder");
+          dir = tmpl;
+        } else {
+          dir = *out;
+        }
+        std::vector<explore::ChildJob> children;
+        for (std::size_t i = 0; i < traces->size(); ++i) {
+          const std::filesystem::path d = dir / fmt::format("{}_{}", i, std::filesystem::path((*traces)[i]).stem().string());
+          std::vector<std::string> args = {"replay", std::filesystem::absolute((*traces)[i]).string(), "--out", d.string()};
+          if (!mo->config_file.empty()) args.insert(args.end(), {"--config", mo->config_file});
+          for (const auto& s : mo->sets) args.insert(args.end(), {"--set", s});
+          children.push_back({std::move(args), d});
+        }
+        std::vector<nlohmann::ordered_json> rows(traces->size());
+        std::string failures;
+        explore::run_children(explore::self_executable(), children, *jobs, [&](std::size_t i, const explore::ChildOutcome& o) {
+          if (!o.ok) {
+            failures += fmt::format("{}: replay failed: {}\n", (*traces)[i], o.error);
+            return;
+          }
+          std::ifstream in(children[i].dir / "run.json");
+          const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+          const nlohmann::json* p = j.is_discarded() ? nullptr : techniques::at_pointer(j, "/summary/particles");
+          if (!p) {
+            failures += fmt::format("{}: its run.json has no /summary/particles\n", (*traces)[i]);
+            return;
+          }
+          nlohmann::ordered_json r;
+          r["trace"] = (*traces)[i];
+          r["mode"] = (*p)["mode"];
+          r["sprite"] = sprites[i];
+          const double n = (*p)["particles_per_frame"].get<double>();
+          r["particles_per_frame"] = n;
+          // The paper's claim for 16 px sprites: 256 N by rasterization (none), N with the N-buffer.
+          const std::string mode = (*p)["mode"].get<std::string>();
+          r["paper_depth_tests_per_frame"] = sprites[i] != "16" ? nlohmann::ordered_json(nullptr)
+                                             : mode == "none"   ? nlohmann::ordered_json(256.0 * n)
+                                             : mode == "nb"     ? nlohmann::ordered_json(n)
+                                                                : nlohmann::ordered_json(nullptr);
+          for (const char* k : {"culled_per_frame", "query_depth_tests_per_frame", "raster_depth_tests_per_frame",
+                                "build_texels_per_frame", "total_depth_tests_per_frame", "cycles_per_frame", "popping",
+                                "false_culls", "decision_mismatches", "kept_too_large"})
+            r[k] = (*p)[k];
+          rows[i] = std::move(r);
+        });
+        if (temporary) std::filesystem::remove_all(dir);
+        if (!failures.empty()) throw InputError(failures.substr(0, failures.size() - 1));
+        nlohmann::ordered_json list = nlohmann::ordered_json::array();
+        for (auto& r : rows) list.push_back(std::move(r));
+        if (!temporary) {
+          std::ofstream f(dir / "particles.json");
+          f << list.dump(2) << "\n";
+          if (!f) throw InputError(fmt::format("cannot write '{}'", (dir / "particles.json").string()));
+        }
+        if (*json) {
+          fmt::print("{}\n", list.dump());
+          return 0;
+        }
+        fmt::print("Particles: depth tests per frame (paper, 16 px sprites: 256 N by rasterization, N with the N-buffer)\n");
+        fmt::print("{:<7} {:>6} {:>9} {:>12} {:>9} {:>10} {:>10} {:>10} {:>10} {:>11} {:>8} {:>7} {:>10}\n", "mode", "sprite",
+                   "particles", "paper", "culled", "query", "raster", "build", "total", "cycles", "popping", "false",
+                   "mismatches");
+        for (const auto& r : list) {
+          const auto num = [&](const char* k) { return r[k].is_number() ? r[k].get<double>() : 0.0; };
+          fmt::print("{:<7} {:>6} {:>9.0f} {:>12} {:>9.0f} {:>10.0f} {:>10.0f} {:>10.0f} {:>10.0f} {:>11.0f} {:>8} {:>7} {:>10}\n",
+                     r["mode"].get<std::string>(), r["sprite"].get<std::string>(), num("particles_per_frame"),
+                     r["paper_depth_tests_per_frame"].is_number()
+                         ? fmt::format("{:.0f}", r["paper_depth_tests_per_frame"].get<double>())
+                         : std::string("-"),
+                     num("culled_per_frame"), num("query_depth_tests_per_frame"), num("raster_depth_tests_per_frame"),
+                     num("build_texels_per_frame"), num("total_depth_tests_per_frame"), num("cycles_per_frame"),
+                     r["popping"].dump(), r["false_culls"].dump(), r["decision_mismatches"].dump());
+        }
+        return 0;
       };
     });
   }

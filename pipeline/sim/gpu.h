@@ -23,6 +23,7 @@
 #include "model/depth/unit.h"
 #include "model/geometry/unit.h"
 #include "model/memory/memory.h"
+#include "model/particles/unit.h"
 #include "model/query/units.h"
 #include "model/raster/unit.h"
 #include "pipeline/sim/programs.h"
@@ -36,6 +37,7 @@ struct GpuConfig {
   depth::DepthUnitConfig depth;
   memory::ChannelConfig memory;
   cull::CullUnitConfig cull;
+  particles::ParticlesUnitConfig particles;
   // The query-structure instances (programs.h structure_instances()) by name, one config each
   // (keys "<name>.<field>"): "nbuffer" and "hiz" for occlusion culling's modes.
   std::map<std::string, nbuffer::NBufferUnitConfig, std::less<>> nbuffers;
@@ -46,7 +48,7 @@ struct GpuConfig {
   // item synchronises (the most detailed timing). Counts never depend on it; cycles do.
   int quantum_cycles = 0;
 
-  // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.",
+  // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.", "particles.",
   // "nbuffer.", "hiz.", "gpu.").
   static void describe(config::Schema& s, GpuConfig& c);
   // Throws InputError naming the key when a unit's value is out of its limits or inconsistent

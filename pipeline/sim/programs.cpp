@@ -37,19 +37,78 @@ Program occlusion_culling(const ProgramContext& c) {
   return p;
 }
 
+std::string_view property(const ProgramContext& c, std::string_view key) {
+  for (const auto& [k, v] : c.setup.properties)
+    if (k == key) return v;
+  throw InputError(fmt::format("the particles trace's header has no '{}' property", key));
+}
+
+// Point-sprite particles (the N-buffer paper, 3.2/4.3): the trace's particle_mode is the test; the
+// N-buffer instance "nbuffer" (mode nb) is built up to the capture's top level (levels_built - 1)
+// unless nbuffer.level_cap sets another; mode hiz reads the "hiz" instance's format and timing.
+Program particles(const ProgramContext& c) {
+  if (c.config.cull.parsed_mode() != cull::CullMode::Trace)
+    throw InputError(fmt::format("cull.mode={} is occlusion culling's; a particles trace culls with its own particle_mode "
+                                 "(leave cull.mode at trace)",
+                                 c.config.cull.mode));
+  c.config.cull.parsed_granularity();
+  particles::ParticlesSetup s;
+  s.width_px = c.setup.width_px;
+  s.height_px = c.setup.height_px;
+  s.op = c.setup.op;
+  s.depth_func = c.setup.depth_func;
+  const std::string mode(property(c, "particle_mode"));
+  const auto m = particles::parse_mode(mode);
+  if (!m) throw InputError(fmt::format("the particles trace's particle_mode '{}' is not one of none, center, nb, hiz", mode));
+  s.mode = *m;
+  const std::string levels(property(c, "levels_built")), margin(property(c, "cull_margin"));
+  try {
+    std::size_t used = 0;
+    const int built = std::stoi(levels, &used);
+    if (used != levels.size() || built < 0 || built > 31) throw std::invalid_argument("range");
+    s.top_level = built - 1;
+    s.margin = std::stof(margin, &used);
+    if (used != margin.size() || !(s.margin >= 0.0f) || s.margin > 0.01f) throw std::invalid_argument("range");
+  } catch (const std::exception&) {
+    throw InputError(fmt::format("the particles trace's levels_built '{}' or cull_margin '{}' is not valid", levels, margin));
+  }
+  Program p;
+  const HiZUnitConfig* hiz = nullptr;
+  if (s.mode == particles::Mode::NBuffer) {
+    nbuffer::NBufferUnitConfig nb = c.config.nbuffers.at("nbuffer");
+    if (nb.level_cap < 0) nb.level_cap = s.top_level;  // the partial build the capture made
+    s.top_level = nb.level_cap;
+    p.structures.push_back(std::make_unique<query::NBufferStructure>("nbuffer", c.registry, nb, c.setup.width_px,
+                                                                     c.setup.height_px, c.setup.op, &c.memory));
+  } else if (s.mode == particles::Mode::HiZ) {
+    hiz = &c.config.hiz.at("hiz");
+  }
+  auto unit = std::make_unique<particles::ParticlesUnit>("particles", c.registry, c.config.particles, s, c.depth_buffer,
+                                                         p.structures.empty() ? nullptr : p.structures.front().get(), hiz);
+  p.frames = unit.get();
+  p.depth_listener = unit.get();
+  p.unit = std::move(unit);
+  return p;
+}
+
 constexpr std::array<ProgramRow, 2> kPrograms = {{
     {"occlusion_culling",
      "occlusion culling of a scene's objects (cull.mode: trace replays the recorded draws; none, oq, oq_hier, nb, "
      "nb_hier, hiz_tile, hiz_pyramid cull every candidate again)",
      occlusion_culling},
-    // Captured (traces/capture/particles/), not modelled yet: its point sprites cannot be replayed as
-    // recorded draws either, so every replay is refused (the build is null).
-    {"particles", "point-sprite particles culled in the vertex stage (not modelled yet)", nullptr},
+    {"particles",
+     "point-sprite particles culled in the vertex stage (the trace's particle_mode: none, center, nb, hiz), each "
+     "decision made again by the model and compared with GL's; GL's particle draws rasterized",
+     particles},
 }};
 
 constexpr std::array<StructureInstance, 2> kInstances = {{
-    {"nbuffer", InstanceKind::NBuffer, "occlusion culling's N-buffer unit (cull.mode nb, nb_hier)"},
-    {"hiz", InstanceKind::HiZ, "occlusion culling's Hi-Z baselines (cull.mode hiz_tile, hiz_pyramid)"},
+    {"nbuffer", InstanceKind::NBuffer,
+     "occlusion culling's N-buffer unit (cull.mode nb, nb_hier); the particles' max N-buffer (particle_mode nb, level_cap -1: "
+     "the capture's levels)"},
+    {"hiz", InstanceKind::HiZ,
+     "occlusion culling's Hi-Z baselines (cull.mode hiz_tile, hiz_pyramid); the particles' Hi-Z pyramid format and timing "
+     "(particle_mode hiz)"},
 }};
 
 std::string technique_list() {

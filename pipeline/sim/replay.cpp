@@ -23,6 +23,10 @@ constexpr std::array<const char*, 11> kCullFrameCounts = {
     "bounds_tests",    "candidates",        "culled",            "candidates_not_visible",     "false_culls",
     "undrawable",      "primitive_tests",   "primitives_culled", "primitive_lookups",          "primitive_fragments_culled",
     "primitive_false_culls"};
+// The particles program's counters in run.json's per-frame values (differences at frame ends).
+constexpr std::array<const char*, 11> kParticlesFrameCounts = {
+    "particles", "culled", "kept_too_large", "lookups", "particle_fragments", "build_texels", "decision_mismatches",
+    "popping", "false_culls", "exactly_hidden", "hidden_kept"};
 
 // A statistic of a group's values (0 when the group has none of that name).
 std::uint64_t stat(const nlohmann::ordered_json& group, const char* name) {
@@ -101,6 +105,14 @@ class Collector : public depth::ResultSink {
       for (const char* name : kCullFrameCounts) pf[name] = delta(name);
       last_cull_ = now;
     }
+    if (const stats::Group* g = registry_.find("gpu.particles")) {
+      const nlohmann::ordered_json now = g->values();
+      const auto delta = [&](const char* name) { return stat(now, name) - stat(last_particles_, name); };
+      pf["query_depth_tests"] = delta("lookups");
+      pf["total_depth_tests"] = delta("lookups") + delta("particle_fragments") + delta("build_texels");
+      for (const char* name : kParticlesFrameCounts) pf[name] = delta(name);
+      last_particles_ = now;
+    }
     per_frame_.push_back(std::move(pf));
     last_cycle_ = cycle;
     for (const auto& d : w.frame->draws)
@@ -125,6 +137,7 @@ class Collector : public depth::ResultSink {
   const ReplayOptions& o_;
   const stats::Registry& registry_;
   nlohmann::ordered_json last_cull_ = nlohmann::ordered_json::object();  // gpu.cull at the last frame end
+  nlohmann::ordered_json last_particles_ = nlohmann::ordered_json::object();  // gpu.particles at the last frame end
   std::ofstream draws_, frames_;
   FrameTotals frame_;
   std::uint64_t last_cycle_ = 0;
@@ -190,6 +203,43 @@ nlohmann::ordered_json cull_summary(const nlohmann::ordered_json& cull, const nl
   return j;
 }
 
+// The particles program's run totals (summary "particles"), from its statistics and its N-buffer's
+// when the run is done. Depth tests as ARCHITECTURE.md counts them: the queries' texels read, the
+// particle draws' fragments, and the partial build's texels; the scene's own depth tests apart.
+nlohmann::ordered_json particles_summary(const nlohmann::ordered_json& p, std::string_view mode, std::uint64_t cycles) {
+  const std::uint64_t frames = stat(p, "frames");
+  const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
+  const std::uint64_t query = stat(p, "lookups"), raster = stat(p, "particle_fragments"), build = stat(p, "build_texels");
+  const std::uint64_t total = query + raster + build;
+  nlohmann::ordered_json j;
+  j["mode"] = mode;
+  j["frames"] = frames;
+  for (const char* name : {"particles", "tested", "culled", "kept_too_large", "offscreen", "gl_culled"}) {
+    j[name] = stat(p, name);
+    j[std::string(name) + "_per_frame"] = per_frame(stat(p, name));
+  }
+  j["query_depth_tests"] = query;
+  j["query_depth_tests_per_frame"] = per_frame(query);
+  j["gl_lookups"] = stat(p, "gl_lookups");
+  j["raster_depth_tests"] = raster;
+  j["raster_depth_tests_per_frame"] = per_frame(raster);
+  j["raster_passed"] = stat(p, "particle_passed");
+  j["build_texels"] = build;
+  j["build_texels_per_frame"] = per_frame(build);
+  j["total_depth_tests"] = total;
+  j["total_depth_tests_per_frame"] = per_frame(total);
+  j["scene_depth_tests_per_frame"] = per_frame(stat(p, "scene_depth_tests"));
+  j["cycles"] = cycles;
+  j["cycles_per_frame"] = per_frame(cycles);
+  for (const char* name : {"decision_mismatches", "lookup_mismatches", "popping", "false_culls", "exactly_hidden",
+                           "visible_reference"})
+    j[name] = stat(p, name);
+  // Culled less than the exact sprite test would (the cost of a conservative test): drawn sprites
+  // with no passing pixel that the model kept.
+  j["culled_below_exact"] = stat(p, "hidden_kept");
+  return j;
+}
+
 double rel(std::uint64_t a, std::uint64_t b) {
   if (b == 0) return a == 0 ? 0.0 : 1.0;
   return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
@@ -228,6 +278,7 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   j["cycles_per_host_second"] = host_seconds > 0 ? static_cast<double>(cycles) / host_seconds : 0.0;
   j["within_thresholds"] = within_thresholds();
   if (!cull.is_null()) j["cull"] = cull;
+  if (!particles.is_null()) j["particles"] = particles;
   return j;
 }
 
@@ -272,6 +323,7 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.zero_to_one = head.clip_control == trace::ClipControl::ZeroToOne;
   setup.scene = tr.scene();
   setup.fused_interpolation = o.config.depth.fused_interpolation;
+  setup.properties = tr.properties();
   Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head.technique, setup,
           o.out ? &*o.out : nullptr);
   std::optional<sim::Timeline> timeline;  // only when asked: units then report their busy spans
@@ -298,6 +350,15 @@ ReplaySummary replay(const ReplayOptions& o) {
     s.cull["structure_memory_bytes"] = bytes;  // N-buffer levels, tile Hi-Z or pyramid
     s.cull["nbuffer_memory_bytes"] =
         structure && structure->structure_kind() == query::Kind::NBuffer ? nlohmann::ordered_json(bytes) : nullptr;
+  }
+
+  if (s.stats.contains("gpu.particles")) {
+    std::string mode;
+    for (const auto& [k, v] : tr.properties())
+      if (k == "particle_mode") mode = v;
+    s.particles = particles_summary(s.stats["gpu.particles"], mode, sink.last_frame_cycle());
+    const auto& structures = gpu.program().structures;
+    s.particles["nbuffer_memory_bytes"] = structures.empty() ? 0 : structures.front()->storage_bytes();
   }
 
   if (o.out) {

@@ -44,6 +44,9 @@ struct ReplaySummary {
   // Culling modes (cull.mode other than trace): totals and per-frame averages of the cull stage,
   // Table 2's columns among them (see CullTotals in replay.cpp); null otherwise.
   nlohmann::ordered_json cull;
+  // Particles traces: totals and per-frame averages of the particles program (particles_summary in
+  // replay.cpp); null otherwise.
+  nlohmann::ordered_json particles;
 
   double fragment_error() const;  // |model - gl| / gl over all draws
   double passed_error() const;
