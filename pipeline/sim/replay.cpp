@@ -237,6 +237,11 @@ nlohmann::ordered_json particles_summary(const nlohmann::ordered_json& p, std::s
   // Culled less than the exact sprite test would (the cost of a conservative test): drawn sprites
   // with no passing pixel that the model kept.
   j["culled_below_exact"] = stat(p, "hidden_kept");
+  // As fractions of the sprites the exact test culls (exactly_hidden): the share it culled
+  // (culling_efficiency, 1 when no sprite was hidden) and the share it kept (culled_below_exact_fraction).
+  const std::uint64_t hidden = stat(p, "exactly_hidden"), kept = stat(p, "hidden_kept");
+  j["culling_efficiency"] = hidden ? static_cast<double>(hidden - kept) / static_cast<double>(hidden) : 1.0;
+  j["culled_below_exact_fraction"] = hidden ? static_cast<double>(kept) / static_cast<double>(hidden) : 0.0;
   return j;
 }
 

@@ -184,22 +184,75 @@ TEST(TechniqueResultsTest, ReferenceSettingParsesAgainstTheConfigSchema) {
   }
 }
 
-// Every declared source points at a value in a real run.json of the technique (the sample trace,
-// nb_hier), and so does every column of its table.
+// A real run.json of each declared technique: occlusion culling from the occlusion sample
+// (nb_hier), particles from a small fresh capture in mode nb. A row without one here fails.
+nlohmann::json real_run(const std::string& technique) {
+  std::string trace = kSample, sets;
+  if (technique == "occlusion_culling") {
+    sets = " --set cull.mode=nb_hier";
+  } else if (technique == "particles") {
+    trace = scratch("particles.nbt").string();
+    const CliResult c = run_nbsim("capture particles --scene city --path walk --size 96x64 --frames 2 --objects 600 "
+                                  "--particles 400 --sprite 16 --mode nb -o " + trace);
+    EXPECT_EQ(c.status, 0) << c.out << c.err;
+  } else {
+    ADD_FAILURE() << technique << ": no real run.json to check its row against (add its trace to real_run)";
+    return nlohmann::json();
+  }
+  const fs::path out = scratch("run_" + technique);
+  const CliResult r = run_nbsim("replay " + trace + " --out " + out.string() + sets);
+  EXPECT_EQ(r.status, 0) << r.err;
+  auto run = nlohmann::json::parse(std::ifstream(out / "run.json"));
+  EXPECT_EQ(run["trace_properties"]["technique"], technique) << trace;
+  return run;
+}
+
+// Every declared source of every row points at a value in a real run.json of its technique, and so
+// does every column of its table.
 TEST(TechniqueResultsTest, SourcesPointIntoARealRun) {
-  const auto* t = tq::find_technique_results("occlusion_culling");
+  for (const auto& t : tq::technique_results()) {
+    SCOPED_TRACE(t.technique);
+    const nlohmann::json run = real_run(t.technique);
+    if (run.is_null()) continue;
+    for (const auto& m : t.metrics) {
+      const nlohmann::json* v = tq::at_pointer(run, m.source);
+      ASSERT_NE(v, nullptr) << m.name << ": " << m.source << " is not in run.json";
+      EXPECT_TRUE(v->is_number()) << m.name << ": " << m.source << " is not a number (results.csv and the report read numbers)";
+    }
+    if (t.table) {
+      EXPECT_NE(tq::at_pointer(run, t.table->section), nullptr);
+      for (const auto& [name, pointer] : t.table->columns) EXPECT_NE(tq::at_pointer(run, pointer), nullptr) << name << ": " << pointer;
+    }
+    EXPECT_EQ(tq::at_pointer(run, "/summary/no_such_key"), nullptr);
+    EXPECT_EQ(tq::at_pointer(run, "not a pointer"), nullptr) << "a malformed pointer finds nothing";
+  }
+  ASSERT_NE(tq::find_technique_results("particles"), nullptr) << "particles declares its results";
+}
+
+// Particles in mode nb: conservative (no popping, no false cull), it culls, and its fractions
+// against the exact sprite test add up; must_be_zero marks popping and false_culls only.
+TEST(TechniqueResultsTest, ParticlesMetricsOfARealRun) {
+  const auto* t = tq::find_technique_results("particles");
   ASSERT_NE(t, nullptr);
-  const fs::path out = scratch("run");
-  const CliResult r = run_nbsim("replay " + kSample + " --out " + out.string() + " --set cull.mode=nb_hier");
-  ASSERT_EQ(r.status, 0) << r.err;
-  const auto run = nlohmann::json::parse(std::ifstream(out / "run.json"));
-  EXPECT_EQ(run["trace_properties"]["technique"], "occlusion_culling") << "the sample is an occlusion-culling trace";
-  for (const auto& m : t->metrics) EXPECT_NE(tq::at_pointer(run, m.source), nullptr) << m.name << ": " << m.source << " is not in run.json";
-  ASSERT_TRUE(t->table.has_value());
-  EXPECT_NE(tq::at_pointer(run, t->table->section), nullptr);
-  for (const auto& [name, pointer] : t->table->columns) EXPECT_NE(tq::at_pointer(run, pointer), nullptr) << name << ": " << pointer;
-  EXPECT_EQ(tq::at_pointer(run, "/summary/no_such_key"), nullptr);
-  EXPECT_EQ(tq::at_pointer(run, "not a pointer"), nullptr) << "a malformed pointer finds nothing";
+  std::set<std::string> zero;
+  for (const auto& m : t->metrics)
+    if (m.must_be_zero) zero.insert(m.name);
+  EXPECT_EQ(zero, (std::set<std::string>{"popping", "false_culls"}));
+  ASSERT_TRUE(t->reference.has_value());
+  EXPECT_EQ(t->reference->settings["nbuffer.level_cap"], -1) << "the reference builds the capture's levels";
+  EXPECT_TRUE(t->reference->skip_key.empty()) << "the mode is the trace's, not a config key: every point has a reference";
+  const nlohmann::json run = real_run("particles");
+  ASSERT_FALSE(run.is_null());
+  const auto value = [&](const char* name) { return tq::at_pointer(run, tq::find_metric(*t, name)->source)->get<double>(); };
+  EXPECT_EQ(value("popping"), 0.0) << "nb is conservative";
+  EXPECT_EQ(value("false_culls"), 0.0) << "nb is conservative";
+  EXPECT_GT(value("culled_per_frame"), 0.0) << "the walk hides sprites behind buildings";
+  EXPECT_GT(value("exactly_hidden"), 0.0);
+  EXPECT_DOUBLE_EQ(value("culling_efficiency") + value("culled_below_exact_fraction"), 1.0);
+  EXPECT_GT(value("culling_efficiency"), 0.0);
+  EXPECT_DOUBLE_EQ(value("total_depth_tests_per_frame"),
+                   value("query_depth_tests_per_frame") + value("raster_depth_tests_per_frame") + value("build_texels_per_frame"));
+  EXPECT_GT(value("nbuffer_memory_bytes"), 0.0);
 }
 
 // A trace whose technique declares no results, and one with no technique at all: explore runs them
