@@ -222,4 +222,27 @@ TEST(ParticlesCostTest, DamagedRecordRefused) {
   EXPECT_EQ(c.status, 2) << c.out << c.err;
 }
 
+// The committed sample (scripts/make_samples: 256x256, 16 frames, 10,000 sprites of 16 px, mode
+// nb): every draw exact, the model decides as GL's shader, conservative, and `nbsim particles` runs
+// on it with the paper's claim (N depth tests for N sprites) beside it.
+TEST(ParticlesSampleTest, SampleReplaysExactlyAndRunsTheTable) {
+  const fs::path t = fs::path(NBSIM_SAMPLES) / "particles_walk_256.nbt";
+  ASSERT_TRUE(fs::exists(t)) << t << " missing: run scripts/make_samples";
+  expect_compare_exact(t);
+  const CliResult r = run_nbsim("particles " + t.string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 1u);
+  const auto& row = rows[0];
+  EXPECT_EQ(row["mode"], "nb");
+  EXPECT_EQ(row["sprite"], "16");
+  EXPECT_EQ(row["particles_per_frame"].get<double>(), 10000.0);
+  EXPECT_EQ(row["paper_depth_tests_per_frame"].get<double>(), 10000.0) << "the paper: N depth tests with the N-buffer";
+  EXPECT_EQ(row["popping"], 0) << "nb never pops";
+  EXPECT_EQ(row["false_culls"], 0);
+  EXPECT_EQ(row["decision_mismatches"], 0);
+  EXPECT_GT(row["culled_per_frame"].get<double>(), 0.0) << "the walk hides sprites behind buildings";
+  EXPECT_LE(row["query_depth_tests_per_frame"].get<double>(), 4 * 10000.0) << "at most four lookups a sprite (one unless a tie widens it)";
+}
+
 }  // namespace
