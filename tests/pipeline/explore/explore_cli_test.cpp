@@ -307,4 +307,49 @@ TEST(ExploreCliTest, SampleSweepsAreValid) {
   EXPECT_GE(n, 8) << "the sample sweeps are missing";
 }
 
+// A particles sweep on the particles sample (mode nb): the technique's columns (pipeline/techniques/
+// results.cpp) are written, the reference (full-resolution float32 N-buffer at the capture's level
+// cap) is added, and the declared errors come out: a capped N-buffer below the sprites' level keeps
+// every sprite (the whole efficiency lost), a conservative one never pops.
+TEST(ExploreCliTest, ParticlesSweepWritesItsColumns) {
+  const std::string sample = (fs::path(NBSIM_SAMPLES) / "particles_walk_256.nbt").string();
+  ASSERT_TRUE(fs::exists(sample)) << sample << " missing: run scripts/make_samples";
+  const fs::path out = scratch("particles");
+  nlohmann::json sweep = {{"traces", {sample}}, {"set", {{"nbuffer.format", "u16"}}}, {"axes", nlohmann::json::object()}};
+  sweep["axes"]["nbuffer.level_cap"] = {3, -1};
+  const fs::path f = write_sweep("particles.json", sweep);
+  const CliResult r = run_nbsim("explore " + f.string() + " --jobs 2 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "3 points (1 of them references): 3 run, 0 resumed, 0 failed")) << r.out;
+  std::vector<std::string> header;
+  const auto rows = read_csv(out / "results.csv", &header);
+  ASSERT_EQ(rows.size(), 3u);
+  for (const char* col : {"query_depth_tests_per_frame", "raster_depth_tests_per_frame", "build_texels_per_frame",
+                          "total_depth_tests_per_frame", "popping", "false_culls", "culling_efficiency",
+                          "culled_below_exact_fraction", "culled_below_exact", "culled_per_frame", "nbuffer_memory_bytes",
+                          "particles_reference", "reference_culling_efficiency", "efficiency_lost", "culled_lost_per_frame"})
+    EXPECT_NE(std::find(header.begin(), header.end(), col), header.end()) << "results.csv lacks particles column " << col;
+  EXPECT_EQ(std::find(header.begin(), header.end(), "culling_reference"), header.end()) << "occlusion culling's, not in this sweep";
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "ok") << row.at("error");
+    EXPECT_EQ(row.at("popping"), "0") << "a conservative N-buffer never pops";
+    EXPECT_EQ(row.at("false_culls"), "0");
+    EXPECT_FALSE(row.at("efficiency_lost").empty());
+    EXPECT_NEAR(std::stod(row.at("culling_efficiency")) + std::stod(row.at("culled_below_exact_fraction")), 1.0, 1e-9);
+  }
+  const auto& capped = rows[0];  // level_cap 3: a 16 px sprite needs level 4
+  EXPECT_EQ(capped.at("nbuffer.level_cap"), "3");
+  EXPECT_EQ(std::stod(capped.at("culled_per_frame")), 0.0) << "every sprite too large for the levels built is kept";
+  EXPECT_EQ(std::stod(capped.at("culled_below_exact_fraction")), 1.0);
+  EXPECT_NEAR(std::stod(capped.at("efficiency_lost")), std::stod(capped.at("reference_culling_efficiency")), 1e-9);
+  EXPECT_GT(std::stod(rows[1].at("culled_per_frame")), 0.0);
+  EXPECT_EQ(rows[2].at("role"), "reference");
+  EXPECT_EQ(rows[2].at("nbuffer.format"), "f32");
+  EXPECT_EQ(std::stod(rows[2].at("efficiency_lost")), 0.0);
+  const auto tr = nlohmann::json::parse(std::ifstream(out / "technique_results.json"));
+  ASSERT_EQ(tr["techniques"].size(), 1u);
+  EXPECT_EQ(tr["techniques"][0]["technique"], "particles");
+  EXPECT_EQ(tr["techniques"][0]["headline_error"], "culled_below_exact_fraction");
+}
+
 }  // namespace
