@@ -3,8 +3,16 @@
 
 #include <unistd.h>
 
-#include <filesystem>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <filesystem>
+#include <string_view>
+
+#include "model/common/error.h"
+#include "model/common/names.h"
+#include "model/particles/sprite.h"
+#include "model/scene/frame.h"
 #include "pipeline/sim/replay.h"
 #include "traces/capture/capture.h"
 
@@ -14,22 +22,47 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
   capture::CaptureOptions c;
   if (std::sscanf(o.size.c_str(), "%dx%d", &c.width, &c.height) != 2) c.width = c.height = 512;
   c.frames = o.frames;
-  c.technique = "occlusion_culling";
+  c.technique = o.technique;
   c.scene = "city";
-  c.options = {{"mode", o.mode}, {"levels-every", "0"}};
+  const bool particles = o.technique == "particles";
+  std::string mode = o.mode;
+  if (particles) {
+    if (mode.empty()) mode = "nb";
+    if (!particles::parse_mode(mode))
+      throw InputError(fmt::format("--mode '{}' is not a particles mode ({})", mode, fmt::join(name_list(particles::kModeNames), ", ")));
+    c.options = {{"mode", mode}, {"levels-every", "0"}, {"particles", std::to_string(o.particles)}, {"sprite", o.sprite}};
+  } else if (o.technique == "occlusion_culling") {
+    if (mode.empty()) mode = "oq";
+    if (!parse_enum_name<scene::TestMode>(scene::kTestModeNames, mode))
+      throw InputError(fmt::format("--mode '{}' is not an occlusion_culling mode ({})", mode, fmt::join(name_list(scene::kTestModeNames), ", ")));
+    c.options = {{"mode", mode}, {"levels-every", "0"}};
+  } else {
+    throw InputError(fmt::format("--technique '{}' is not one of occlusion_culling, particles", o.technique));
+  }
   const auto file = std::filesystem::temp_directory_path() / ("nbsim_bench_" + std::to_string(::getpid()) + ".nbt");
   const capture::CaptureSummary cap = capture::capture(c, file.string());
 
   pipeline::ReplayOptions r;
   r.trace = file;
-  const pipeline::ReplaySummary s = pipeline::replay(r);
+  pipeline::ReplaySummary s;
+  try {
+    s = pipeline::replay(r);
+  } catch (...) {
+    std::filesystem::remove(file);
+    throw;
+  }
   std::filesystem::remove(file);
 
   nlohmann::ordered_json j;
   j["bench"] = "replay";
+  j["technique"] = o.technique;
   j["size"] = o.size;
   j["frames"] = s.frames;
-  j["mode"] = o.mode;
+  j["mode"] = mode;
+  if (particles) {
+    j["particles"] = o.particles;
+    j["sprite"] = o.sprite;
+  }
   j["draws"] = s.draws;
   j["gl_ms"] = cap.gl_ms;
   j["replay_ms"] = s.host_seconds * 1e3;
@@ -38,7 +71,9 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
   j["depth_tests_per_s"] = s.host_seconds > 0 ? static_cast<double>(s.depth_tests) / s.host_seconds : 0.0;
   j["cycles"] = s.cycles;
   j["cycles_per_s"] = s.host_seconds > 0 ? static_cast<double>(s.cycles) / s.host_seconds : 0.0;
+  j["draws_exact"] = s.draws_exact;
   j["within_thresholds"] = s.within_thresholds();
+  if (particles) j["particles_summary"] = s.particles;
   return j;
 }
 

@@ -1,6 +1,7 @@
 // `nbsim bench replay`: the simulator's own speed. Captures a walkthrough with llvmpipe (timing
 // the GL technique passes) and replays the same trace through the SystemC model in the same run,
-// so the ratio of the two compares like with like on this machine, now.
+// so the ratio of the two compares like with like on this machine, now. Techniques: occlusion
+// culling (the city walk) and particles (scene, partial N-buffer or Hi-Z build, culled sprites).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -10,13 +11,23 @@
 namespace nbsim::bench {
 
 struct ReplayBenchOptions {
+  std::string technique = "occlusion_culling";  // or "particles"
   std::string size = "512x512";
   int frames = 20;
-  std::string mode = "oq";  // the capture's test mode (oq draws every candidate's box: the most raster work)
+  // The capture's test mode: occlusion_culling's (default oq, which draws every candidate's box: the
+  // most raster work) or particles' particle_mode (default nb). Empty: the technique's default.
+  std::string mode;
+  int particles = 10000;      // particles only: --particles of the capture
+  std::string sprite = "16";  // particles only: 16, 24 or atten
 };
 
-// One JSON object: frames, gl_ms (llvmpipe, technique passes), replay_ms, ratio replay/gl,
-// depth tests and cycles per host second, and whether the comparison stayed within thresholds.
+// The technique names the bench accepts (the capture's plug-in names).
+inline constexpr const char* kReplayBenchTechniques[] = {"occlusion_culling", "particles"};
+
+// One JSON object: technique, frames, gl_ms (llvmpipe, technique passes), replay_ms, ratio replay/gl,
+// depth tests and cycles per host second, and whether the comparison stayed within thresholds;
+// for particles also the particle count, sprite and the replay's particles summary. Throws
+// InputError for an unknown technique or mode, or options the capture refuses.
 nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& options);
 
 }  // namespace nbsim::bench

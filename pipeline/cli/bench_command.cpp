@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -102,12 +103,24 @@ void add_bench_commands(CLI::App& app, Action& action) {
     auto ro = std::make_shared<bench::ReplayBenchOptions>();
     rep->add_option("--size", ro->size, "Viewport, WxH")->capture_default_str();
     rep->add_option("--frames", ro->frames, "Frames")->check(CLI::Range(1, 10000))->capture_default_str();
-    rep->add_option("--mode", ro->mode, "Capture test mode")->check(CLI::IsMember(name_list(scene::kTestModeNames)))->capture_default_str();
-    rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes), replay_ms (the SystemC model), ratio,\n"
-                "depth_tests_per_s and cycles_per_s of the model, measured in the same run.");
+    rep->add_option("--technique", ro->technique, "Technique captured and replayed")
+        ->check(CLI::IsMember(std::vector<std::string>(std::begin(bench::kReplayBenchTechniques), std::end(bench::kReplayBenchTechniques))))
+        ->capture_default_str();
+    rep->add_option("--mode", ro->mode,
+                    "Capture test mode: occlusion_culling's (oq, oq_hier, nb, nb_hier, none; default oq) or particles' "
+                    "(none, center, nb, hiz; default nb)");
+    rep->add_option("--particles", ro->particles, "Particles a frame (technique particles)")->capture_default_str();
+    rep->add_option("--sprite", ro->sprite, "Sprite size: 16, 24 or atten (technique particles)")->capture_default_str();
+    rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes; particles: scene, partial N-buffer or Hi-Z\n"
+                "build and the culled particle draws, not the reference pass), replay_ms (the SystemC model), ratio\n"
+                "replay/gl, depth_tests_per_s and cycles_per_s of the model, measured in the same run; for particles\n"
+                "also particles_summary (the replay's particles totals).");
     rep->callback([&action, ro] {
       action = [ro] {
         parse_size(ro->size, "--size");
+        if (ro->technique != "particles" && (ro->particles != bench::ReplayBenchOptions{}.particles ||
+                                             ro->sprite != bench::ReplayBenchOptions{}.sprite))
+          throw InputError("--particles and --sprite need --technique particles");
         fmt::print("{}\n", bench::run_replay_bench(*ro).dump());
         return 0;
       };

@@ -1,0 +1,62 @@
+// BenchReplayCliTest: `nbsim bench replay` from the outside, for the particles technique: one JSON
+// object with llvmpipe's time, the model's replay time and their ratio, measured in the same run
+// (the ratio is printed and recorded, never asserted: it depends on the machine), and bad
+// arguments refused with exit 2.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <string>
+
+#include "tests/common/run_nbsim.h"
+
+namespace nbsim {
+namespace {
+
+using testing::CliResult;
+using testing::has;
+using testing::run_nbsim;
+
+// A small particles capture replayed in the same run: the ratio is there and the replay is exact.
+TEST(BenchReplayCliTest, ParticlesRatioPrinted) {
+  const CliResult r = run_nbsim("bench replay --technique particles --size 128x96 --frames 2 --particles 2000 --sprite 24");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("bench"), "replay");
+  EXPECT_EQ(j.at("technique"), "particles");
+  EXPECT_EQ(j.at("mode"), "nb") << "the particles default mode";
+  EXPECT_EQ(j.at("frames"), 2);
+  EXPECT_EQ(j.at("particles"), 2000);
+  EXPECT_GT(j.at("gl_ms").get<double>(), 0.0) << "llvmpipe's technique passes are timed";
+  EXPECT_GT(j.at("replay_ms").get<double>(), 0.0);
+  EXPECT_GT(j.at("ratio").get<double>(), 0.0);
+  EXPECT_EQ(j.at("draws_exact"), j.at("draws")) << "every draw's fragments and passed samples equal GL's";
+  EXPECT_TRUE(j.at("within_thresholds").get<bool>());
+  ASSERT_TRUE(j.at("particles_summary").is_object()) << r.out;
+  const std::string ratio = std::to_string(j.at("ratio").get<double>());
+  ::testing::Test::RecordProperty("particles_replay_ratio", ratio);
+  std::printf("bench replay particles 128x96, 2 frames, 2000 particles: ratio %s (gl %.1f ms, replay %.1f ms)\n", ratio.c_str(),
+              j.at("gl_ms").get<double>(), j.at("replay_ms").get<double>());
+}
+
+// Bad arguments exit 2 with a message naming them.
+TEST(BenchReplayCliTest, BadArgumentsExitTwo) {
+  struct Case {
+    const char* args;
+    const char* message;
+  };
+  for (const Case& c : {Case{"--technique shadows", "--technique"},
+                        Case{"--technique particles --mode oq", "--mode 'oq' is not a particles mode"},
+                        Case{"--mode hiz", "--mode 'hiz' is not an occlusion_culling mode"},
+                        Case{"--particles 500", "--particles and --sprite need --technique particles"},
+                        Case{"--technique particles --particles 0", "--particles 0 is out of range"},
+                        Case{"--technique particles --sprite 32", "--sprite '32' is not one of 16, 24, atten"}}) {
+    const CliResult r = run_nbsim(std::string("bench replay --size 32x24 --frames 1 ") + c.args);
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
+    EXPECT_TRUE(has(r.err, c.message)) << c.args << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << c.args << " printed " << r.out;
+  }
+}
+
+}  // namespace
+}  // namespace nbsim
