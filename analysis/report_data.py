@@ -389,23 +389,31 @@ def particles_reading(rows):
             out.append(f"{pre}Popping (sprites culled while GL's reference pass shows them, over every frame): "
                        + ", ".join(f"{m} {by[m]['popping']:,.0f}" for m in pops)
                        + (f"; 0 in {_modes(clean)}" if clean else "") + ".")
+        elif len(clean) == 1:
+            out.append(f"{pre}Mode {clean[0]} neither pops nor culls a visible sprite.")
         elif clean:
             out.append(f"{pre}No mode pops or culls a visible sprite ({_modes(clean)}).")
         unsafe = [m for m, r in by.items() if r["false_culls"] > 0 and m != "center"]
         if unsafe:
             out.append(f"{pre}FALSE CULLS in {_modes(unsafe)}: a conservative test must have none.")
-        cheapest = min(by.values(), key=lambda r: r["total_depth_tests_per_frame"])
-        safe = [r for r in by.values() if r["popping"] == 0 and r["false_culls"] == 0 and r["mode"] != "none"]
-        s = (f"{pre}Fewest depth tests in total (queries + sprite fragments + N-buffer or Hi-Z build): "
-             f"{cheapest['mode']} ({cheapest['total_depth_tests_per_frame']:,.0f} a frame)")
-        if safe and cheapest not in safe:
-            best = min(safe, key=lambda r: r["total_depth_tests_per_frame"])
-            s += f"; of the culling modes that never pop, {best['mode']} ({best['total_depth_tests_per_frame']:,.0f})"
-        fastest = min(by.values(), key=lambda r: r["cycles_per_frame"])
-        out.append(s + f"; fewest cycles: {fastest['mode']} ({fastest['cycles_per_frame']:,.0f} a frame).")
+        if len(by) > 1:
+            cheapest = min(by.values(), key=lambda r: r["total_depth_tests_per_frame"])
+            safe = [r for r in by.values() if r["popping"] == 0 and r["false_culls"] == 0 and r["mode"] != "none"]
+            s = (f"{pre}Fewest depth tests in total (queries + sprite fragments + N-buffer or Hi-Z build): "
+                 f"{cheapest['mode']} ({cheapest['total_depth_tests_per_frame']:,.0f} a frame)")
+            if safe and cheapest not in safe:
+                best = min(safe, key=lambda r: r["total_depth_tests_per_frame"])
+                s += f"; of the culling modes that never pop, {best['mode']} ({best['total_depth_tests_per_frame']:,.0f})"
+            fastest = min(by.values(), key=lambda r: r["cycles_per_frame"])
+            out.append(s + f"; fewest cycles: {fastest['mode']} ({fastest['cycles_per_frame']:,.0f} a frame).")
         for m in ("nb", "hiz"):
             r = by.get(m)
-            if not r or not none or r["build_texels_per_frame"] <= 0:
+            if not r or r["build_texels_per_frame"] <= 0:
+                continue
+            if not none:
+                out.append(f"{pre}The build in {m} is {r['build_texels_per_frame']:,.0f} texels a frame, "
+                           f"{r['build_texels_per_frame'] / r['total_depth_tests_per_frame']:.0%} of its total depth "
+                           "tests (no none row here to weigh it against what culling saves).")
                 continue
             saved = none["raster_depth_tests_per_frame"] - r["raster_depth_tests_per_frame"]
             b = r["build_texels_per_frame"]

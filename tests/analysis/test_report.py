@@ -456,6 +456,14 @@ class ParticlesReading(unittest.TestCase):
         self.assertNotIn("times fewer", text)
         self.assertNotIn("Rasterizing every sprite", text)
 
+    def test_one_mode_alone(self):
+        # the demo's sample is nb alone: no comparison between modes, its build share still said
+        text = self.reading([particle_row("nb", query_depth_tests_per_frame=900.0, build_texels_per_frame=100000.0,
+                                          total_depth_tests_per_frame=200900.0)])
+        self.assertIn("Mode nb neither pops nor culls a visible sprite.", text)
+        self.assertNotIn("Fewest", text, "one mode is compared with nothing")
+        self.assertIn("The build in nb is 100,000 texels a frame, 50% of its total depth tests", text)
+
     def test_sprite_sizes_read_apart(self):
         # rows of two sprite sizes are read per size; the paper's claim only for 16 px
         text = self.reading([particle_row("nb", query_depth_tests_per_frame=900.0),
