@@ -415,7 +415,8 @@ class Report:
         ax.legend(fontsize=7, loc="upper left", ncols=2)
         img = self.save(fig, "particles.png")
         return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim particles TRACE... --out</code>: one replay per "
-                f"trace, each captured on Mesa in its own culling mode; traces {html.escape(traces)}). "
+                f"trace, each in the culling mode it was captured in on Mesa; traces {html.escape(traces)}; the run's "
+                "<code>--set</code> options are not recorded there). "
                 "The paper's claim (Décoret 2005, 3.2 and 4.3) is for 16 px sprites: rasterizing N sprites costs "
                 "256 N depth tests, the N-buffer N. Ours / paper compares nb's query depth tests and none's total "
                 "with it. Query: texels the culling test reads; raster: depth tests of GL's sprite fragments (its "
