@@ -10,6 +10,7 @@ marks). The inputs, and the nbsim commands that write them:
   DIR/table2/table2.json             nbsim table2 TRACE --out DIR/table2  (and DIR/table2/MODE/run.json)
   DIR/sweeps/NAME/results.csv        nbsim explore SWEEP.json --out DIR/sweeps/NAME  (and sweep.json, technique_results.json)
   DIR/results.csv                    nbsim explore SWEEP.json --out DIR  (DIR is then one sweep, named after it)
+  DIR/particles/particles.json       nbsim particles TRACE... --out DIR/particles  (or DIR/particles.json: --out DIR)
 The data side (reading, Pareto marks, labels, headline.md) is in report_data.py; plot helpers in
 report_plots.py. Every section whose inputs exist is rendered; the page names the inputs the others were missing.
 Exit 0 when at least one section rendered; 2 when DIR does not exist or holds nothing usable, or when
@@ -34,8 +35,9 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 import plot_coverage  # noqa: E402
 import table1  # noqa: E402
-from report_data import (FIDELITY_KNOBS, NUMERIC, BadInput, Missing, fmt, headline_sweep, headline_table2,  # noqa: E402
-                         kib_key, technique_results,
+from report_data import (FIDELITY_KNOBS, NUMERIC, BadInput, Missing, fmt, headline_particles,  # noqa: E402
+                         headline_sweep, headline_table2, kib_key, load_particles, particles_reading, particles_rows,
+                         technique_results,
                          load_json, mark_pareto, number, pct, read_csv, short_label, sorted_modes, table2_ratios,
                          trace_name)
 
@@ -50,6 +52,7 @@ class Report:
         self.inputs = []     # (relative path, section)
         self.versions = set()
         self.headline = []   # Markdown blocks for report/headline.md (what scripts/demo prints)
+        self.headline_last = []  # blocks printed after every other one (the particles table)
 
     def rel(self, p):
         return os.path.relpath(p, self.root)
@@ -343,6 +346,88 @@ class Report:
                             "total depth tests per frame. Read off: the gap between the occlusion-query modes "
                             "(blue) and the N-buffer modes (red) frame by frame, and which frames of the walk "
                             "cost the most."))
+
+    # ------------------------------------------------------------------------------ particles
+    def particles_path(self):
+        """DIR/particles/particles.json (the demo's layout) or DIR/particles.json (nbsim particles --out DIR)."""
+        for p in (self.root / "particles" / "particles.json", self.root / "particles.json"):
+            if p.is_file():
+                return p
+        return None
+
+    def particles(self):
+        path = self.particles_path()
+        if path is None:
+            raise Missing(["particles/particles.json"])
+        rows = particles_rows(load_particles(path))
+        self.used(path, "particles")
+        for r in rows:
+            r["trace_name"] = trace_name(str(r.get("trace", "?")))
+        cols = [("mode", "mode", None), ("sprite (px)", "sprite", None), ("trace", "trace_name", None),
+                ("sprites/frame", "particles_per_frame", None),
+                ("paper depth tests/frame", "paper_depth_tests_per_frame", None),
+                ("ours / paper", "ours_over_paper", lambda v: "-" if v is None else f"{v:.3g}"),
+                ("culled/frame", "culled_per_frame", None),
+                ("query depth tests/frame", "query_depth_tests_per_frame", None),
+                ("raster depth tests/frame", "raster_depth_tests_per_frame", None),
+                ("build texels/frame", "build_texels_per_frame", None),
+                ("total depth tests/frame", "total_depth_tests_per_frame", None),
+                ("cycles/frame", "cycles_per_frame", None), ("popping", "popping", None),
+                ("false culls", "false_culls", None), ("decisions unlike GL's", "decision_mismatches", None)]
+        tab = self.table("particles", cols, rows,
+                         row_class=lambda r: "bad" if r["popping"] or r["false_culls"] else "")
+        reading = particles_reading(rows)
+        traces = ", ".join(dict.fromkeys(r["trace_name"] for r in rows))
+        self.headline_last.append(headline_particles(traces, rows, reading))
+
+        # per mode: the paper's claim beside ours, split into queries, sprite fragments and build
+        fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
+        x = np.arange(len(rows))
+        wd = 0.38
+        paper = [r.get("paper_depth_tests_per_frame") or np.nan for r in rows]
+        ax.bar(x - wd / 2, paper, wd, label="paper's claim (16 px: 256 N none, N nb)", color="#999999", hatch="//",
+               edgecolor="white")
+        bottom = np.zeros(len(rows))
+        for key, label, colour in (("query_depth_tests_per_frame", "ours: queries", "#b2182b"),
+                                   ("raster_depth_tests_per_frame", "ours: sprite fragments", "#6fa8dc"),
+                                   ("build_texels_per_frame", "ours: N-buffer / Hi-Z build", "#fdb863")):
+            v = np.array([float(r[key]) for r in rows])
+            ax.bar(x + wd / 2, v, wd, bottom=bottom, label=label, color=colour)
+            bottom += v
+        for i, r in enumerate(rows):  # the queries and the paper's N are too small to see: their numbers
+            note = f"queries {r['query_depth_tests_per_frame']:,.0f}"
+            if r["popping"]:
+                note += f"\npops {r['popping']:,.0f}"
+            ax.annotate(note, (x[i] + wd / 2, bottom[i]), xytext=(0, 3), textcoords="offset points", ha="center",
+                        va="bottom", fontsize=7, color="#a00" if r["popping"] else "#222")
+            if not np.isnan(paper[i]):
+                ax.annotate(f"{paper[i]:,.0f}", (x[i] - wd / 2, paper[i]), xytext=(0, 3), textcoords="offset points",
+                            ha="center", va="bottom", fontsize=7, color="#555")
+        tallest = max([b for b in bottom] + [p for p in paper if not np.isnan(p)] + [1])
+        ax.set_ylim(0, tallest * 1.35)  # headroom: the legend sits above the bars
+        ax.yaxis.set_major_formatter(THOUSANDS)
+        ax.set_xticks(x, [f"{r['mode']}\n{r.get('sprite') or ''} px" if str(r.get("sprite", "")).isdigit()
+                          else f"{r['mode']}\n{r.get('sprite') or ''}" for r in rows])
+        ax.set_xlabel("vertex-stage culling mode")
+        ax.set_ylabel("depth tests per frame")
+        ax.set_title(f"Particles: depth tests per frame, paper vs nbsim ({traces})", fontsize=10)
+        ax.grid(axis="y", alpha=0.3)
+        ax.legend(fontsize=7, loc="upper left", ncols=2)
+        img = self.save(fig, "particles.png")
+        return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim particles TRACE... --out</code>: one replay per "
+                f"trace, each in the culling mode it was captured in on Mesa; traces {html.escape(traces)}; the run's "
+                "<code>--set</code> options are not recorded there). "
+                "The paper's claim (Décoret 2005, 3.2 and 4.3) is for 16 px sprites: rasterizing N sprites costs "
+                "256 N depth tests, the N-buffer N. Ours / paper compares nb's query depth tests and none's total "
+                "with it. Query: texels the culling test reads; raster: depth tests of GL's sprite fragments (its "
+                "draws replayed); build: N-buffer or Hi-Z texels written; total: their sum. Popping and false "
+                "culls are counted over every frame; rows with any are red (center pops by design).</p>" + tab +
+                "<p><b>What it shows</b> (computed from the table):</p><ul>" +
+                "".join(f"<li>{html.escape(s)}</li>" for s in reading) + "</ul>" +
+                self.figure(img, "Per mode: the paper's claim (grey, 16 px sprites only) and ours, stacked: the "
+                            "culling test's queries (red), the sprite fragments GL drew (blue) and the N-buffer or "
+                            "Hi-Z build (orange). Read off: how small the N-buffer's queries are against "
+                            "rasterizing every sprite, and whether the build eats what culling saves."))
 
     # ------------------------------------------------------------------------------ sweeps
     def sweep_dirs(self):
@@ -675,7 +760,7 @@ figcaption { color: #444; font-size: 90%; max-width: 900px; }
             h.append(body)
         h.append("</body></html>")
         (self.out / "index.html").write_text("\n".join(h) + "\n")
-        (self.out / "headline.md").write_text("\n\n".join(self.headline) + "\n")
+        (self.out / "headline.md").write_text("\n\n".join(self.headline + self.headline_last) + "\n")
 
 
 def main(argv):
@@ -698,6 +783,8 @@ def main(argv):
     rep.run("figure4", "Figure 4: covering tightness", rep.figure4, root / "figure4_map.csv")
     rep.run("table2", "Table 2: depth tests per frame in the walkthrough", rep.table2, root / "table2/table2.json")
     rep.run("walkthrough", "Depth tests per frame along the walkthrough", rep.walkthrough, root / "table2")
+    rep.run("particles", "Particles: depth tests per frame beside the paper's claim", rep.particles,
+            rep.particles_path() or root / "particles" / "particles.json")
     dirs = rep.sweep_dirs()
     if not dirs:
         rep.missing.append(("Sweeps (architecture exploration)", ["sweeps/NAME/results.csv"]))
@@ -712,7 +799,7 @@ def main(argv):
         except OSError:
             pass
         print(f"report: nothing usable in {a.dir}: looked for table1.jsonl, figure4_map.csv, table2/table2.json, "
-              "table2/MODE/run.json, sweeps/NAME/results.csv, results.csv", file=sys.stderr)
+              "table2/MODE/run.json, particles/particles.json, particles.json, sweeps/NAME/results.csv, results.csv", file=sys.stderr)
         return 2
     rep.write_html()
     print(f"report: wrote {rep.out / 'index.html'} ({rendered} sections"

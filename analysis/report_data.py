@@ -298,3 +298,148 @@ def headline_sweep(name, rows, traces, err_label, tech=LEGACY_TECHNIQUE):
     elif alike:
         lines.append("")
     return "\n".join(lines + alike)
+
+
+# ------------------------------------------------------------------------------------- particles
+
+PARTICLE_MODES = ["none", "center", "nb", "hiz"]
+# What a row of particles.json (nbsim particles --out) must hold for the report's table and reading.
+PARTICLE_NEED = ["mode", "particles_per_frame", "culled_per_frame", "query_depth_tests_per_frame",
+                 "raster_depth_tests_per_frame", "build_texels_per_frame", "total_depth_tests_per_frame",
+                 "cycles_per_frame", "popping", "false_culls"]
+# The paper's claim (Décoret 2005, 3.2 and 4.3) for 16 px sprites: rasterizing them costs 256 N depth
+# tests, the N-buffer N (one lookup each); nbsim particles writes it as paper_depth_tests_per_frame.
+PAPER_RASTER_PER_SPRITE = 256
+
+
+def load_particles(path):
+    """The rows of particles.json (a JSON list, one object per replayed trace), checked; BadInput otherwise."""
+    t = load_json(path)
+    if not isinstance(t, list) or not t:
+        raise BadInput(f"{path}: expected a non-empty JSON list of rows (nbsim particles --out)")
+    for i, r in enumerate(t):
+        if not isinstance(r, dict):
+            raise BadInput(f"{path}: rows[{i}] is not an object")
+        lacking = [k for k in PARTICLE_NEED if k not in r]
+        if lacking:
+            raise BadInput(f"{path}: rows[{i}] lacks {', '.join(lacking)}")
+        if not isinstance(r["mode"], str):
+            raise BadInput(f"{path}: rows[{i}].mode is not a string: {r['mode']!r}")
+        for k in PARTICLE_NEED[1:] + ["paper_depth_tests_per_frame", "decision_mismatches", "kept_too_large"]:
+            v = r.get(k)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
+                raise BadInput(f"{path}: rows[{i}].{k} is not a number: {v!r}")
+        if r["particles_per_frame"] <= 0:
+            raise BadInput(f"{path}: rows[{i}].particles_per_frame must be above 0, not {r['particles_per_frame']!r}")
+    return t
+
+
+def particles_rows(rows):
+    """The rows in mode order (none, center, nb, hiz, then others), each with ours_over_paper: the count the
+    paper's claim is about (nb: query depth tests; none: total, all rasterization) over the claim."""
+    out = []
+    for r in sorted(rows, key=lambda r: (str(r.get("sprite", "")),
+                                         PARTICLE_MODES.index(r["mode"]) if r["mode"] in PARTICLE_MODES else 99)):
+        rr = dict(r)
+        p = r.get("paper_depth_tests_per_frame")
+        ours = r["query_depth_tests_per_frame"] if r["mode"] == "nb" else r["total_depth_tests_per_frame"]
+        rr["ours_over_paper"] = ours / p if p else None
+        out.append(rr)
+    return out
+
+
+def _modes(names):
+    return ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
+
+
+def particles_reading(rows):
+    """What the particles table shows, as plain sentences computed from its rows (one group per sprite size)."""
+    groups = {}
+    for r in rows:
+        groups.setdefault(str(r.get("sprite", "")), []).append(r)
+    out = []
+    for sprite, g in groups.items():
+        pre = "" if len(groups) == 1 else f"[{sprite or '?'}{' px' if sprite.isdigit() else ''} sprites] "
+        by = {}
+        for r in g:
+            by.setdefault(r["mode"], r)  # the first row of a mode speaks for it
+        nb, none = by.get("nb"), by.get("none")
+        if nb:
+            n, q = nb["particles_per_frame"], nb["query_depth_tests_per_frame"]
+            claim = " (the paper's claim: N, one per sprite)" if nb.get("paper_depth_tests_per_frame") else ""
+            out.append(f"{pre}The N-buffer (nb) reads {q:,.0f} texels a frame for {n:,.0f} sprites, "
+                       f"{q / n:.2f} per sprite{claim}.")
+        if none:
+            n, t = none["particles_per_frame"], none["total_depth_tests_per_frame"]
+            paper = none.get("paper_depth_tests_per_frame")
+            out.append(f"{pre}Rasterizing every sprite (none) costs {t:,.0f} depth tests a frame, {t / n:,.0f} per sprite"
+                       + (f": {t / paper:.0%} of the paper's {PAPER_RASTER_PER_SPRITE} N (sprites wholly or partly "
+                          "off-screen have fewer fragments)" if paper else "") + ".")
+        if nb and none and nb["query_depth_tests_per_frame"] > 0:
+            ratio = none["total_depth_tests_per_frame"] / nb["query_depth_tests_per_frame"]
+            out.append(f"{pre}The N-buffer's queries are {ratio:,.0f} times fewer depth tests than rasterizing every "
+                       f"sprite (the paper: {PAPER_RASTER_PER_SPRITE} times for 16 px sprites).")
+        culls = [f"{m} {r['culled_per_frame']:,.0f} ({r['culled_per_frame'] / r['particles_per_frame']:.1%})"
+                 for m, r in by.items() if r["culled_per_frame"] > 0]
+        if culls:
+            out.append(f"{pre}Sprites culled a frame: {', '.join(culls)}.")
+        pops = [m for m, r in by.items() if r["popping"] > 0]
+        clean = [m for m, r in by.items() if r["popping"] == 0 and r["false_culls"] == 0]
+        if pops:
+            out.append(f"{pre}Popping (sprites culled while GL's reference pass shows them, over every frame): "
+                       + ", ".join(f"{m} {by[m]['popping']:,.0f}" for m in pops)
+                       + (f"; 0 in {_modes(clean)}" if clean else "") + ".")
+        elif len(clean) == 1:
+            out.append(f"{pre}Mode {clean[0]} neither pops nor culls a visible sprite.")
+        elif clean:
+            out.append(f"{pre}No mode pops or culls a visible sprite ({_modes(clean)}).")
+        unsafe = [m for m, r in by.items() if r["false_culls"] > 0 and m != "center"]
+        if unsafe:
+            out.append(f"{pre}FALSE CULLS in {_modes(unsafe)}: a conservative test must have none.")
+        if len(by) > 1:
+            cheapest = min(by.values(), key=lambda r: r["total_depth_tests_per_frame"])
+            safe = [r for r in by.values() if r["popping"] == 0 and r["false_culls"] == 0 and r["mode"] != "none"]
+            s = (f"{pre}Fewest depth tests in total (queries + sprite fragments + N-buffer or Hi-Z build): "
+                 f"{cheapest['mode']} ({cheapest['total_depth_tests_per_frame']:,.0f} a frame)")
+            if safe and cheapest not in safe:
+                best = min(safe, key=lambda r: r["total_depth_tests_per_frame"])
+                s += f"; of the culling modes that never pop, {best['mode']} ({best['total_depth_tests_per_frame']:,.0f})"
+            fastest = min(by.values(), key=lambda r: r["cycles_per_frame"])
+            out.append(s + f"; fewest cycles: {fastest['mode']} ({fastest['cycles_per_frame']:,.0f} a frame).")
+        for m in ("nb", "hiz"):
+            r = by.get(m)
+            if not r or r["build_texels_per_frame"] <= 0:
+                continue
+            if not none:
+                out.append(f"{pre}The build in {m} is {r['build_texels_per_frame']:,.0f} texels a frame, "
+                           f"{r['build_texels_per_frame'] / r['total_depth_tests_per_frame']:.0%} of its total depth "
+                           "tests (no none row here to weigh it against what culling saves).")
+                continue
+            saved = none["raster_depth_tests_per_frame"] - r["raster_depth_tests_per_frame"]
+            b = r["build_texels_per_frame"]
+            verdict = "more than" if b > saved else "less than"
+            out.append(f"{pre}The build in {m} ({b:,.0f} texels a frame, {b / r['total_depth_tests_per_frame']:.0%} of its "
+                       f"total) costs {verdict} its culling saves in sprite fragments ({saved:,.0f} against none): "
+                       f"its total is {r['total_depth_tests_per_frame'] / none['total_depth_tests_per_frame']:.2f} times "
+                       "none's.")
+        bad = [m for m, r in by.items() if (r.get("decision_mismatches") or 0) > 0]
+        if bad:
+            out.append(f"{pre}Decisions that differ from GL's recorded ones in {_modes(bad)}: the model's test is not "
+                       "the capture's.")
+    return out
+
+
+def headline_particles(label, rows, reading):
+    """The particles table beside the paper's claim and its reading, as Markdown."""
+    lines = [f"Particles ({label}): depth tests per frame beside the paper's claim (16 px sprites: "
+             f"{PAPER_RASTER_PER_SPRITE} N by rasterization, N with the N-buffer)",
+             "",
+             "| mode | sprite | paper | culled | query | raster | build | total | cycles | popping | false culls |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r['mode']} | {r.get('sprite') or '-'} | {cell(r, 'paper_depth_tests_per_frame', ',.0f')} | "
+                     f"{r['culled_per_frame']:,.0f} | {r['query_depth_tests_per_frame']:,.0f} | "
+                     f"{r['raster_depth_tests_per_frame']:,.0f} | {r['build_texels_per_frame']:,.0f} | "
+                     f"{r['total_depth_tests_per_frame']:,.0f} | {r['cycles_per_frame']:,.0f} | "
+                     f"{r['popping']:,.0f} | {r['false_culls']:,.0f} |")
+    return "\n".join(lines + [""] + [f"- {s}" for s in reading])

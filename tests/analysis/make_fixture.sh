@@ -1,7 +1,8 @@
 #!/bin/sh
 # Regenerates tests/analysis/fixture/, the input folder of analysis/report.py's tests, from real nbsim
 # outputs on the small samples (city_small_oq.nbt, and city_small_nb_reversed.nbt for a second trace
-# in two sweeps). Big files are trimmed to what the report reads. About a minute on 2 cores.
+# in two sweeps) and on four tiny particles captures. Big files are trimmed to what the report reads.
+# About a minute on 2 cores.
 # Usage: tests/analysis/make_fixture.sh [NBSIM]   (default: build/pipeline/nbsim; run from anywhere)
 set -eu
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -59,6 +60,16 @@ EOF
 sweep small pipeline/sweeps/small.json
 sweep nbuffer_resolution "$(small_traces pipeline/sweeps/nbuffer_resolution.json)"
 sweep fidelity "$(small_traces pipeline/sweeps/fidelity.json)"
+
+# Particles: four tiny captures (128x128, 4 frames, 2,000 sprites of 16 px), one per culling mode, and
+# the table nbsim particles writes (particles.json alone: the replays' folders are not read).
+mkdir -p "$out/particles"
+(cd "$tmp" && for m in none center nb hiz; do
+   "$nbsim" capture particles --size 128x128 --frames 4 --particles 2000 --sprite 16 --mode "$m" --levels-every 0 \
+     -o "particles_$m.nbt" >/dev/null
+ done &&
+ "$nbsim" particles particles_none.nbt particles_center.nbt particles_nb.nbt particles_hiz.nbt --out particles >/dev/null)
+cp "$tmp/particles/particles.json" "$out/particles/"
 
 du -sh "$out"
 echo "wrote $out"

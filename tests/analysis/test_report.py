@@ -137,6 +137,36 @@ class FixtureReport(unittest.TestCase):
         fidelity = text.split("Sweep fidelity:")[1].split("Sweep ")[0]
         self.assertIn("every point culls alike", fidelity)
         self.assertIn("largest |cycle error|", fidelity)
+        self.assertTrue(text.split("\n\n", 1)[0].startswith("Table 2"), "Table 2 comes first")
+        self.assertIn("Particles (particles_none, particles_center, particles_nb, particles_hiz)",
+                      text.split("Sweep fidelity:")[1], "the particles table is the last block (scripts/demo ends on it)")
+
+    def test_particles_section_per_mode_beside_the_paper(self):
+        # particles/particles.json: one row per mode beside the paper's 256 N and N, its CSV copy, and a
+        # reading whose numbers are the fixture's own
+        rows = {r["mode"]: r for r in json.loads((FIXTURE / "particles" / "particles.json").read_text())}
+        self.assertEqual(set(rows), {"none", "center", "nb", "hiz"}, "the fixture has one capture per mode")
+        self.assertIn("Particles: depth tests per frame beside the paper", self.html)
+        self.assertIn("particles/particles.json", self.html, "the page names its input")
+        with open(self.dir / "report" / "particles.csv") as f:
+            table = {r["mode"]: r for r in csv.DictReader(f)}
+        self.assertEqual(list(table), ["none", "center", "nb", "hiz"], "rows in mode order")
+        n = rows["nb"]["particles_per_frame"]
+        self.assertEqual(float(table["none"]["paper_depth_tests_per_frame"]), 256 * n, "none: the paper's 256 N")
+        self.assertEqual(float(table["nb"]["paper_depth_tests_per_frame"]), n, "nb: the paper's N")
+        self.assertAlmostEqual(float(table["nb"]["ours_over_paper"]), rows["nb"]["query_depth_tests_per_frame"] / n,
+                               msg="nb's ours / paper is its query depth tests over N")
+        for k in ["query_depth_tests_per_frame", "raster_depth_tests_per_frame", "build_texels_per_frame",
+                  "total_depth_tests_per_frame", "culled_per_frame", "popping", "false_culls", "cycles_per_frame"]:
+            for m, r in rows.items():
+                self.assertEqual(float(table[m][k]), float(r[k]), f"particles.csv {m}.{k} is not particles.json's")
+                self.assertIn(f">{report_data.fmt(r[k])}<", self.html, f"{m}.{k} is not in the page")
+        q, raster = rows["nb"]["query_depth_tests_per_frame"], rows["none"]["total_depth_tests_per_frame"]
+        self.assertIn(f"reads {q:,.0f} texels a frame for {n:,.0f} sprites, {q / n:.2f} per sprite", self.html)
+        self.assertIn(f"queries are {raster / q:,.0f} times fewer depth tests than rasterizing every sprite", self.html)
+        self.assertGreater(rows["center"]["popping"], 0, "the fixture's center capture pops")
+        self.assertIn(f"center {rows['center']['popping']:,.0f}; 0 in none, nb and hiz", self.html)
+        self.assertIn("particles.png", self.html)
 
 
 class Pareto(unittest.TestCase):
@@ -373,6 +403,78 @@ class TechniqueDeclarations(unittest.TestCase):
         self.assertNotIn("Traceback", err)
 
 
+def particle_row(mode, **kw):
+    """A particles.json row (nbsim particles --out) of 1,000 16 px sprites; kw overrides."""
+    r = {"trace": f"t_{mode}.nbt", "mode": mode, "sprite": "16", "particles_per_frame": 1000.0,
+         "paper_depth_tests_per_frame": {"none": 256000.0, "nb": 1000.0}.get(mode), "culled_per_frame": 0.0,
+         "query_depth_tests_per_frame": 0.0, "raster_depth_tests_per_frame": 100000.0, "build_texels_per_frame": 0.0,
+         "total_depth_tests_per_frame": 100000.0, "cycles_per_frame": 50000.0, "popping": 0, "false_culls": 0,
+         "decision_mismatches": 0, "kept_too_large": 0}
+    r.update(kw)
+    return r
+
+
+class ParticlesReading(unittest.TestCase):
+    """The particles section's reading follows the rows it is given, not fixed text."""
+
+    def reading(self, rows):
+        return " ".join(report_data.particles_reading(report_data.particles_rows(rows)))
+
+    def test_build_cheaper_than_the_culling_saves(self):
+        # nb culls half the fragments with a small build: its build costs less than it saves, and it is cheapest
+        nb = particle_row("nb", culled_per_frame=500.0, query_depth_tests_per_frame=1200.0,
+                          raster_depth_tests_per_frame=50000.0, build_texels_per_frame=10000.0,
+                          total_depth_tests_per_frame=61200.0)
+        text = self.reading([particle_row("none"), nb])
+        self.assertIn("1.20 per sprite", text)
+        self.assertIn("83 times fewer", text, "100,000 raster depth tests over 1,200 queries")
+        self.assertIn("The build in nb (10,000 texels a frame, 16% of its total) costs less than its culling saves",
+                      text)
+        self.assertIn("Fewest depth tests in total (queries + sprite fragments + N-buffer or Hi-Z build): nb", text)
+        self.assertIn("No mode pops or culls a visible sprite (none and nb)", text)
+
+    def test_build_dearer_than_the_culling_saves_and_popping_named(self):
+        # a big build, and center popping: both said, the cheapest non-popping culling mode named
+        nb = particle_row("nb", culled_per_frame=500.0, query_depth_tests_per_frame=1200.0,
+                          raster_depth_tests_per_frame=50000.0, build_texels_per_frame=90000.0,
+                          total_depth_tests_per_frame=141200.0)
+        center = particle_row("center", culled_per_frame=700.0, query_depth_tests_per_frame=1000.0,
+                              raster_depth_tests_per_frame=30000.0, total_depth_tests_per_frame=31000.0,
+                              popping=1234, false_culls=1234)
+        text = self.reading([nb, center, particle_row("none")])
+        self.assertIn("costs more than its culling saves", text)
+        self.assertIn("its total is 1.41 times none's", text)
+        self.assertIn("Popping (sprites culled while GL's reference pass shows them, over every frame): center 1,234; "
+                      "0 in none and nb", text)
+        self.assertIn(": center (31,000 a frame); of the culling modes that never pop, nb (141,200)", text)
+        self.assertNotIn("FALSE CULLS", text, "center's false culls are its popping, by design")
+
+    def test_false_culls_in_a_conservative_mode_and_no_none_row(self):
+        # nb alone with false culls: flagged; no comparison with rasterization without a none row
+        text = self.reading([particle_row("nb", query_depth_tests_per_frame=900.0, false_culls=3)])
+        self.assertIn("FALSE CULLS in nb", text)
+        self.assertNotIn("times fewer", text)
+        self.assertNotIn("Rasterizing every sprite", text)
+
+    def test_one_mode_alone(self):
+        # the demo's sample is nb alone: no comparison between modes, its build share still said
+        text = self.reading([particle_row("nb", query_depth_tests_per_frame=900.0, build_texels_per_frame=100000.0,
+                                          total_depth_tests_per_frame=200900.0)])
+        self.assertIn("Mode nb neither pops nor culls a visible sprite.", text)
+        self.assertNotIn("Fewest", text, "one mode is compared with nothing")
+        self.assertIn("The build in nb is 100,000 texels a frame, 50% of its total depth tests", text)
+
+    def test_sprite_sizes_read_apart(self):
+        # rows of two sprite sizes are read per size; the paper's claim only for 16 px
+        text = self.reading([particle_row("nb", query_depth_tests_per_frame=900.0),
+                             particle_row("nb", sprite="atten", paper_depth_tests_per_frame=None,
+                                          query_depth_tests_per_frame=700.0)])
+        self.assertIn("[16 px sprites] The N-buffer (nb) reads 900 texels a frame for 1,000 sprites, 0.90 per sprite "
+                      "(the paper's claim", text)
+        self.assertIn("[atten sprites] The N-buffer (nb) reads 700 texels a frame for 1,000 sprites, 0.70 per "
+                      "sprite.", text)
+
+
 class MissingAndBroken(unittest.TestCase):
     """Missing inputs are named in the page; malformed ones exit 2 naming the file, without a traceback."""
 
@@ -390,7 +492,7 @@ class MissingAndBroken(unittest.TestCase):
         self.assertEqual(rc, 0, err)
         html = (self.dir / "report" / "index.html").read_text()
         self.assertIn("Table 1: N-buffer build cost", html)
-        for missing in ["figure4_map.csv", "table2/table2.json", "sweeps/NAME/results.csv"]:
+        for missing in ["figure4_map.csv", "table2/table2.json", "sweeps/NAME/results.csv", "particles/particles.json"]:
             self.assertIn(missing, html, f"the page does not say {missing} is missing")
         self.assertIn("missing inputs", out)
 
@@ -460,6 +562,23 @@ class MissingAndBroken(unittest.TestCase):
         rc, _, err = run_report(self.dir)
         self.assertBroken(rc, err, "table1.jsonl")
         self.assertIn("figure4_map.csv", err)
+
+    def test_particles_json_of_nbsim_particles_out_dir(self):
+        # DIR/particles.json (nbsim particles --out DIR) renders alone; a malformed one exits 2 naming the file
+        (self.dir / "particles.json").write_text(json.dumps([particle_row("none"), particle_row("nb")]))
+        rc, out, err = run_report(self.dir)
+        self.assertEqual(rc, 0, err)
+        self.assertIn("1 sections", out)
+        self.assertIn("Particles (t_none, t_nb)", (self.dir / "report" / "headline.md").read_text())
+        for bad, says in [("[]", "non-empty JSON list"), ('{"rows": []}', "non-empty JSON list"),
+                          (json.dumps([{"mode": "nb"}]), "lacks particles_per_frame"),
+                          (json.dumps([particle_row("nb", popping="many")]), "rows[0].popping is not a number"),
+                          (json.dumps([particle_row("nb", particles_per_frame=0)]), "particles_per_frame must be above 0"),
+                          ("[{", "broken JSON")]:
+            (self.dir / "particles.json").write_text(bad)
+            rc, _, err = run_report(self.dir)
+            self.assertBroken(rc, err, "particles.json")
+            self.assertIn(says, err, bad)
 
     def test_help(self):
         # --help works and describes the inputs
