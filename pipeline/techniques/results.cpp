@@ -7,6 +7,28 @@ namespace nbsim::techniques {
 
 namespace {
 
+Metric metric(const char* name, const char* unit, const char* description, MetricKind kind, std::string source) {
+  Metric m;
+  m.name = name;
+  m.unit = unit;
+  m.description = description;
+  m.kind = kind;
+  m.source = std::move(source);
+  return m;
+}
+
+// The labels of a technique whose headline cost is total depth tests per frame and whose memory
+// cost is the N-buffer's (occlusion culling, particles).
+void depth_test_and_nbuffer_labels(ReportLabels& l) {
+  l.cost_axis = "total depth tests per frame";
+  l.cost_column = "total depth tests/frame";
+  l.cost_pareto = "pareto_depth_tests";
+  l.cost_short = "tests";
+  l.memory_axis = "N-buffer memory (KiB)";
+  l.memory_pareto = "pareto_memory";
+  l.memory_short = "memory";
+}
+
 // Occlusion culling (Décoret 2005, 4.2; ARCHITECTURE.md "Shared definitions"): depth tests per
 // frame against culling efficiency, with false culls as the correctness count (must be 0).
 TechniqueResults occlusion_culling() {
@@ -15,15 +37,6 @@ TechniqueResults occlusion_culling() {
   t.description = "Object (or primitive) culling by depth queries: occlusion queries, N-buffer, Hi-Z";
   const auto cull = [](const char* key) { return std::string("/summary/cull/") + key; };
   using K = MetricKind;
-  const auto metric = [](const char* name, const char* unit, const char* description, MetricKind kind, std::string source) {
-    Metric m;
-    m.name = name;
-    m.unit = unit;
-    m.description = description;
-    m.kind = kind;
-    m.source = std::move(source);
-    return m;
-  };
   Metric false_culls = metric("false_culls", "objects",
                               "objects culled while visible in the ground truth (ID buffer); 0 for a conservative query", K::Error,
                               cull("false_culls"));
@@ -126,13 +139,7 @@ TechniqueResults occlusion_culling() {
   l.fallback_axis = "hidden objects not culled (%, = 1 - culling efficiency)";
   l.fallback_text = "hidden objects left unculled, 1 - culling efficiency (no efficiency_lost column)";
   l.fallback_column = "not culled (%)";
-  l.cost_axis = "total depth tests per frame";
-  l.cost_column = "total depth tests/frame";
-  l.cost_pareto = "pareto_depth_tests";
-  l.cost_short = "tests";
-  l.memory_axis = "N-buffer memory (KiB)";
-  l.memory_pareto = "pareto_memory";
-  l.memory_short = "memory";
+  depth_test_and_nbuffer_labels(l);
   l.quality_column = "culling efficiency";
   l.must_be_zero = "false culls";
   l.alike = "culls alike";
@@ -153,15 +160,6 @@ TechniqueResults particles() {
   t.description = "Point-sprite particles culled in the vertex stage: none, centre lookup, N-buffer, Hi-Z";
   const auto prt = [](const char* key) { return std::string("/summary/particles/") + key; };
   using K = MetricKind;
-  const auto metric = [](const char* name, const char* unit, const char* description, MetricKind kind, std::string source) {
-    Metric m;
-    m.name = name;
-    m.unit = unit;
-    m.description = description;
-    m.kind = kind;
-    m.source = std::move(source);
-    return m;
-  };
   Metric popping = metric("popping", "particles",
                           "sprites culled while GL's reference pass shows a passing sample, over every frame; 0 for nb and hiz "
                           "(center pops by design)",
@@ -240,13 +238,7 @@ TechniqueResults particles() {
   l.fallback_axis = "hidden sprites not culled (%, = 1 - culling efficiency)";
   l.fallback_text = "hidden sprites left unculled, 1 - culling efficiency (no culled_below_exact_fraction column)";
   l.fallback_column = "not culled (%)";
-  l.cost_axis = "total depth tests per frame";
-  l.cost_column = "total depth tests/frame";
-  l.cost_pareto = "pareto_depth_tests";
-  l.cost_short = "tests";
-  l.memory_axis = "N-buffer memory (KiB)";
-  l.memory_pareto = "pareto_memory";
-  l.memory_short = "memory";
+  depth_test_and_nbuffer_labels(l);
   l.quality_column = "sprite culling efficiency";
   l.must_be_zero = "popped sprites";
   l.alike = "culls alike";
