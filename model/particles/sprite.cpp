@@ -19,6 +19,17 @@ std::string_view to_string(Mode m) noexcept { return enum_name(kModeNames, m); }
 
 int floor_log2(int v) noexcept { return v <= 1 ? 0 : std::bit_width(static_cast<unsigned>(v)) - 1; }
 
+int top_level_needed(Mode m, int largest_side_px, int level_cap) noexcept {
+  const int side = std::max(largest_side_px, 1);
+  switch (m) {
+    case Mode::NBuffer: return std::min(floor_log2(side + 1), level_cap);
+    case Mode::HiZ: return std::min(side <= 1 ? 0 : static_cast<int>(std::bit_width(static_cast<unsigned>(side - 1))), level_cap);
+    case Mode::None:
+    case Mode::Center: break;
+  }
+  return -1;
+}
+
 SpriteRect sprite_rect(const Particle& p, int width_px, int height_px) {
   SpriteRect r;
   // const vec2 a = win - 0.5 - 0.5 * size; (0.5 * size is exact: sizes are whole pixels)

@@ -54,6 +54,15 @@ inline float query_nearest(float d, float margin, FarOp op) noexcept { return op
 
 int floor_log2(int v) noexcept;  // v >= 1
 
+// The largest distance-attenuated sprite side (--sprite atten: 1 to 64 px), fixed by the capture.
+inline constexpr float kMaxAttenuatedPx = 64.0f;
+// The highest level mode m builds for sprites of at most `largest_side_px` pixels (one more near a
+// pixel-centre tie: the shader's rectangle), capped at level_cap: nb floor_log2(side + 1) (one
+// lookup per power of two), hiz ceil_log2(side) (a 2x2 texel footprint); -1 for none and center,
+// which build nothing. The capture builds exactly these levels, and a replay in another mode than
+// the capture's (particles.mode) builds them from the trace's sprite and level_cap properties.
+int top_level_needed(Mode m, int largest_side_px, int level_cap) noexcept;
+
 // One particle's test, as decided by the model.
 struct Decision {
   bool culled = false;

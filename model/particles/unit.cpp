@@ -15,6 +15,10 @@ void ParticlesUnitConfig::describe(config::Schema& s, ParticlesUnitConfig& c) {
   s.add("particles.latency_cycles", c.latency_cycles, "cycles", "latency of a frame's batch of vertex-stage tests", 0, 100000);
   s.add("particles.center_lookups_per_cycle", c.center_lookups_per_cycle, "texels/cycle",
         "mode center: depth-buffer texels the vertex stage reads a cycle", 0.01, 1024.0);
+  s.add("particles.mode", c.mode,
+        "the vertex-stage test: trace (the capture's particle_mode) or none, center, nb, hiz (a capture replayed as that "
+        "mode would have run; exact on a none capture, which draws every sprite)",
+        {"trace", "none", "center", "nb", "hiz"});
 }
 
 ParticlesUnit::ParticlesUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ParticlesUnitConfig& config,
@@ -55,7 +59,12 @@ ParticlesUnit::ParticlesUnit(const sc_core::sc_module_name& name, stats::Registr
       hidden_kept_(stats().counter("hidden_kept", "particles",
                                    "of exactly_hidden, kept by the model (culled less than the exact sprite test would)")),
       visible_reference_(stats().counter("visible_reference", "particles",
-                                         "particles with a passing sample in GL's reference pass")) {
+                                         "particles with a passing sample in GL's reference pass")),
+      dropped_(stats().counter("dropped", "particles", "particles GL drew that the model culled: left out of its draws")),
+      redrawn_(stats().counter("redrawn", "particles",
+                               "particles GL culled that the model kept: drawn at the record's window position")),
+      own_draws_(stats().counter("own_draws", "draws",
+                                 "particle draws issued as the model's own because a decision differs from GL's")) {
   stats().formula("query_depth_tests", "tests", "depth tests of the vertex-stage queries (texels read)",
                   [this] { return static_cast<double>(lookups_.value()); });
   stats().formula("total_depth_tests", "tests",
@@ -113,7 +122,8 @@ void ParticlesUnit::draw_finished(const cp::Work& w, const depth::DrawResult& r)
 
 void ParticlesUnit::decide(const FrameParticles& fp) {
   const std::size_t n = fp.particles.size();
-  std::vector<Decision> decisions(n);
+  decisions_.assign(n, Decision{});
+  std::vector<Decision>& decisions = decisions_;
   std::vector<SpriteRect> rects(n);
   for (std::size_t i = 0; i < n; ++i) rects[i] = sprite_rect(fp.particles[i], setup_.width_px, setup_.height_px);
 
@@ -198,6 +208,52 @@ void ParticlesUnit::decide(const FrameParticles& fp) {
   }
 }
 
+void ParticlesUnit::issue_particle_draw(const std::shared_ptr<const scene::Frame>& f, std::uint32_t draw,
+                                        const FrameParticles& fp, std::size_t first, cp::CommandProcessor& cp) {
+  const scene::DrawRecord& d = f->draws[draw];
+  const std::size_t n = d.clip_positions.size();
+  bool same = true;
+  for (std::size_t k = 0; k < n && same; ++k) same = decisions_[first + k].culled == (fp.culled[first + k] != 0);
+  auto w = std::make_shared<cp::Work>();
+  w->frame = f;
+  w->draw = draw;
+  if (!same) {
+    auto own = std::make_shared<scene::DrawRecord>();
+    own->index = d.index;
+    own->role = d.role;
+    own->object = d.object;
+    own->state = d.state;
+    own->stencil = d.stencil;
+    own->topology = d.topology;
+    own->discards = d.discards;
+    own->writes_depth = d.writes_depth;
+    const float half_w = 0.5f * static_cast<float>(setup_.width_px), half_h = 0.5f * static_cast<float>(setup_.height_px);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t p = first + k;
+      const bool gl_culled = fp.culled[p] != 0;
+      if (decisions_[p].culled) {
+        dropped_ += gl_culled ? 0 : 1;
+        continue;
+      }
+      if (!gl_culled) {
+        own->clip_positions.push_back(d.clip_positions[k]);
+        own->point_sizes.push_back(k < d.point_sizes.size() ? d.point_sizes[k] : fp.particles[p].size);
+        continue;
+      }
+      // Kept by the model, culled by GL: back from the record's window position to clip space (w = 1).
+      const Particle& q = fp.particles[p];
+      const float z = d.state.clip == scene::ClipControl::ZeroToOne ? q.depth : 2.0f * q.depth - 1.0f;
+      own->clip_positions.push_back({(q.x - half_w) / half_w, (q.y - half_h) / half_h, z, 1.0f});
+      own->point_sizes.push_back(q.size);
+      ++redrawn_;
+    }
+    ++own_draws_;
+    if (own->clip_positions.empty()) return;  // every particle of the draw culled: nothing to draw
+    w->own = std::move(own);
+  }
+  issue(cp, std::move(w));
+}
+
 void ParticlesUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) {
   ++frames_begun_;
   const FrameParticles fp = read_particles(*f);  // refuses a damaged record before anything is issued
@@ -223,11 +279,18 @@ void ParticlesUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::
   decide(fp);
   ++frames_;
 
-  // 4. GL's particle draws as recorded (and any other draw with geometry), in order.
+  // 4. The particle draws as the model decided (GL's where the decisions agree), and any other
+  // draw with geometry, in order.
+  std::size_t first = 0;  // the draw's first particle
   for (std::size_t i = 0; i < f->draws.size(); ++i) {
     const scene::DrawRecord& d = f->draws[i];
+    if (d.role == scene::DrawRole::Particles) {
+      ++particle_draws_;
+      issue_particle_draw(f, static_cast<std::uint32_t>(i), fp, first, cp);
+      first += d.clip_positions.size();
+      continue;
+    }
     if (d.role == scene::DrawRole::Scene || d.clip_positions.empty()) continue;
-    particle_draws_ += d.role == scene::DrawRole::Particles ? 1 : 0;
     auto w = std::make_shared<cp::Work>();
     w->frame = f;
     w->draw = static_cast<std::uint32_t>(i);

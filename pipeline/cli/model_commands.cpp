@@ -166,7 +166,7 @@ void add_model_commands(CLI::App& app, Action& action) {
         bar.finish();
         fmt::print("replayed {} frames, {} draws: {} cycles ({:.0f} per frame), {} depth tests, {:.2f} s host "
                    "({:.1f} M depth tests/s); wrote {}/run.json, frames.csv, draws.csv, culls.csv\n",
-                   s.frames, s.draws, s.cycles, s.frames ? static_cast<double>(s.cycles) / static_cast<double>(s.frames) : 0.0,
+                   s.frames, s.draws + s.own_draws, s.cycles, s.frames ? static_cast<double>(s.cycles) / static_cast<double>(s.frames) : 0.0,
                    s.depth_tests, s.host_seconds, s.host_seconds > 0 ? static_cast<double>(s.depth_tests) / s.host_seconds / 1e6 : 0.0,
                    *out);
         if (o.timeline)
@@ -198,6 +198,8 @@ void add_model_commands(CLI::App& app, Action& action) {
         } else {
           fmt::print("{} frames, {} draws replayed ({} GLSL passes and lookups not replayed)\n", s.frames, s.draws,
                      s.passes_not_replayed);
+          if (s.own_draws)
+            fmt::print("  own draws          {} (the program's own, not GL's: not compared with GL's counters)\n", s.own_draws);
           fmt::print("  draws exact        {} of {} ({:.3f}%)\n", s.draws_exact, s.draws,
                      s.draws ? 100.0 * static_cast<double>(s.draws_exact) / static_cast<double>(s.draws) : 100.0);
           fmt::print("  fragments          model {} GL {} (error {:.4f}%)\n", s.fragments_model, s.fragments_gl, 100 * s.fragment_error());
@@ -321,7 +323,9 @@ void add_model_commands(CLI::App& app, Action& action) {
     // One replay per particles trace (one capture per mode: GL's draws depend on it), in child
     // processes, and a row each from its run.json's /summary/particles beside the paper's claim
     // (16 px sprites: 256 N depth tests by rasterization, N with the N-buffer).
-    auto* cmd = app.add_subcommand("particles", "Replay particles traces (one per mode) and print the particles table");
+    auto* cmd = app.add_subcommand(
+        "particles",
+        "Replay particles traces (one per mode, or one `none` capture with --set particles.mode=M) and print the particles table");
     auto traces = std::make_shared<std::vector<std::string>>();
     auto out = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);
@@ -381,6 +385,7 @@ void add_model_commands(CLI::App& app, Action& action) {
           nlohmann::ordered_json r;
           r["trace"] = (*traces)[i];
           r["mode"] = (*p)["mode"];
+          r["capture_mode"] = p->contains("capture_mode") ? (*p)["capture_mode"] : (*p)["mode"];
           r["sprite"] = sprites[i];
           const double n = (*p)["particles_per_frame"].get<double>();
           r["particles_per_frame"] = n;
@@ -392,7 +397,7 @@ void add_model_commands(CLI::App& app, Action& action) {
                                                                 : nlohmann::ordered_json(nullptr);
           for (const char* k : {"culled_per_frame", "query_depth_tests_per_frame", "raster_depth_tests_per_frame",
                                 "build_texels_per_frame", "total_depth_tests_per_frame", "cycles_per_frame", "popping",
-                                "false_culls", "decision_mismatches", "kept_too_large"})
+                                "false_culls", "decision_mismatches", "kept_too_large", "redrawn"})
             r[k] = (*p)[k];
           rows[i] = std::move(r);
         });
@@ -410,13 +415,16 @@ void add_model_commands(CLI::App& app, Action& action) {
           return 0;
         }
         fmt::print("Particles: depth tests per frame (paper, 16 px sprites: 256 N by rasterization, N with the N-buffer)\n");
-        fmt::print("{:<7} {:>6} {:>9} {:>12} {:>9} {:>10} {:>10} {:>10} {:>10} {:>11} {:>8} {:>7} {:>10}\n", "mode", "sprite",
-                   "particles", "paper", "culled", "query", "raster", "build", "total", "cycles", "popping", "false",
-                   "mismatches");
+        // mismatches: decisions unlike GL's (0 in the capture's own mode; a replay in another mode
+        // differs by design); capture: the mode the trace was captured in.
+        fmt::print("{:<7} {:<7} {:>6} {:>9} {:>12} {:>9} {:>10} {:>10} {:>10} {:>10} {:>11} {:>8} {:>7} {:>10}\n", "mode",
+                   "capture", "sprite", "particles", "paper", "culled", "query", "raster", "build", "total", "cycles",
+                   "popping", "false", "mismatches");
         for (const auto& r : list) {
           const auto num = [&](const char* k) { return r[k].is_number() ? r[k].get<double>() : 0.0; };
-          fmt::print("{:<7} {:>6} {:>9.0f} {:>12} {:>9.0f} {:>10.0f} {:>10.0f} {:>10.0f} {:>10.0f} {:>11.0f} {:>8} {:>7} {:>10}\n",
-                     r["mode"].get<std::string>(), r["sprite"].get<std::string>(), num("particles_per_frame"),
+          fmt::print("{:<7} {:<7} {:>6} {:>9.0f} {:>12} {:>9.0f} {:>10.0f} {:>10.0f} {:>10.0f} {:>10.0f} {:>11.0f} {:>8} {:>7} {:>10}\n",
+                     r["mode"].get<std::string>(), r["capture_mode"].get<std::string>(), r["sprite"].get<std::string>(),
+                     num("particles_per_frame"),
                      r["paper_depth_tests_per_frame"].is_number()
                          ? fmt::format("{:.0f}", r["paper_depth_tests_per_frame"].get<double>())
                          : std::string("-"),

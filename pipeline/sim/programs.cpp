@@ -72,6 +72,25 @@ Program particles(const ProgramContext& c) {
   } catch (const std::exception&) {
     throw InputError(fmt::format("the particles trace's levels_built '{}' or cull_margin '{}' is not valid", levels, margin));
   }
+  if (c.config.particles.mode != "trace") {
+    // Another test than the capture's: the levels it builds follow from the capture's sprite sizes
+    // and level cap, as the capture computes them for that mode.
+    const auto other = particles::parse_mode(c.config.particles.mode);
+    if (!other) throw InputError(fmt::format("particles.mode '{}' is not one of trace, none, center, nb, hiz", c.config.particles.mode));
+    const std::string sprite(property(c, "sprite")), cap(property(c, "level_cap"));
+    int largest = 0, level_cap = 0;
+    try {
+      std::size_t used = 0;
+      largest = sprite == "atten" ? static_cast<int>(particles::kMaxAttenuatedPx) : std::stoi(sprite, &used);
+      if (sprite != "atten" && (used != sprite.size() || largest < 1 || largest > 4096)) throw std::invalid_argument("range");
+      level_cap = std::stoi(cap, &used);
+      if (used != cap.size() || level_cap < 0 || level_cap > 31) throw std::invalid_argument("range");
+    } catch (const std::exception&) {
+      throw InputError(fmt::format("the particles trace's sprite '{}' or level_cap '{}' is not valid", sprite, cap));
+    }
+    if (*other != s.mode) s.top_level = particles::top_level_needed(*other, largest, level_cap);
+    s.mode = *other;
+  }
   Program p;
   const HiZUnitConfig* hiz = nullptr;
   if (s.mode == particles::Mode::NBuffer) {

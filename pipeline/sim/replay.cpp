@@ -51,18 +51,24 @@ class Collector : public depth::ResultSink {
 
   void draw_done(const cp::Work& w, const depth::DrawResult& r) override {
     const trace::DrawRecord& d = w.record();
-    ++s_.draws;
     ++frame_.draws;
-    s_.fragments_model += r.depth.fragments;
-    s_.fragments_gl += d.gl.fragments;
-    s_.passed_model += r.depth.passed;
-    s_.passed_gl += d.gl.samples_passed;
     s_.depth_tests += r.depth.depth_tests;
-    frame_.fragments_model += r.depth.fragments, frame_.fragments_gl += d.gl.fragments;
-    frame_.passed_model += r.depth.passed, frame_.passed_gl += d.gl.samples_passed;
     frame_.depth_tests += r.depth.depth_tests;
-    if (r.depth.fragments == d.gl.fragments && r.depth.passed == d.gl.samples_passed) ++s_.draws_exact;
-    if (d.role == trace::DrawRole::Visible && r.depth.passed < d.gl.samples_passed) ++visible_draws_passed_below_gl;
+    if (w.own) {
+      // A draw the program made itself (its own query boxes, particle draws it decided otherwise):
+      // GL drew nothing like it, so it is counted apart from the comparison with GL's counters.
+      ++s_.own_draws;
+    } else {
+      ++s_.draws;
+      s_.fragments_model += r.depth.fragments;
+      s_.fragments_gl += d.gl.fragments;
+      s_.passed_model += r.depth.passed;
+      s_.passed_gl += d.gl.samples_passed;
+      frame_.fragments_model += r.depth.fragments, frame_.fragments_gl += d.gl.fragments;
+      frame_.passed_model += r.depth.passed, frame_.passed_gl += d.gl.samples_passed;
+      if (r.depth.fragments == d.gl.fragments && r.depth.passed == d.gl.samples_passed) ++s_.draws_exact;
+      if (d.role == trace::DrawRole::Visible && r.depth.passed < d.gl.samples_passed) ++visible_draws_passed_below_gl;
+    }
     if (draws_.is_open())
       draws_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", w.frame->begin.frame, d.index, d.object,
                             trace::to_string(d.role),
@@ -232,7 +238,7 @@ nlohmann::ordered_json particles_summary(const nlohmann::ordered_json& p, std::s
   j["cycles"] = cycles;
   j["cycles_per_frame"] = per_frame(cycles);
   for (const char* name : {"decision_mismatches", "lookup_mismatches", "popping", "false_culls", "exactly_hidden",
-                           "visible_reference"})
+                           "visible_reference", "dropped", "redrawn", "own_draws"})
     j[name] = stat(p, name);
   // Culled less than the exact sprite test would (the cost of a conservative test): drawn sprites
   // with no passing pixel that the model kept.
@@ -266,6 +272,7 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   j["frames"] = frames;
   j["draws"] = draws;
   j["draws_exact"] = draws_exact;
+  if (own_draws) j["own_draws"] = own_draws;
   j["passes_not_replayed"] = passes_not_replayed;
   j["fragments_model"] = fragments_model;
   j["fragments_gl"] = fragments_gl;
@@ -358,10 +365,12 @@ ReplaySummary replay(const ReplayOptions& o) {
   }
 
   if (s.stats.contains("gpu.particles")) {
-    std::string mode;
+    std::string capture_mode;
     for (const auto& [k, v] : tr.properties())
-      if (k == "particle_mode") mode = v;
+      if (k == "particle_mode") capture_mode = v;
+    const std::string& mode = o.config.particles.mode == "trace" ? capture_mode : o.config.particles.mode;
     s.particles = particles_summary(s.stats["gpu.particles"], mode, sink.last_frame_cycle());
+    s.particles["capture_mode"] = capture_mode;
     const auto& structures = gpu.program().structures;
     s.particles["nbuffer_memory_bytes"] = structures.empty() ? 0 : structures.front()->storage_bytes();
   }

@@ -29,8 +29,12 @@ struct ReplayOptions {
 
 struct ReplaySummary {
   std::uint64_t frames = 0;
-  std::uint64_t draws = 0;        // draws with geometry, replayed
+  std::uint64_t draws = 0;        // GL's draws with geometry, replayed (compared with GL's counters)
   std::uint64_t draws_exact = 0;  // fragments and passed samples equal to GL's
+  // Draws a frame program made itself (occlusion culling's query boxes in a culling mode, particle
+  // draws decided otherwise than GL): replayed and timed, their depth tests counted, but not
+  // compared with GL's counters (GL drew nothing like them). In run.json when non-zero.
+  std::uint64_t own_draws = 0;
   std::uint64_t passes_not_replayed = 0;  // GLSL N-buffer passes and lookups (no geometry)
   std::uint64_t fragments_model = 0, fragments_gl = 0;
   std::uint64_t passed_model = 0, passed_gl = 0;

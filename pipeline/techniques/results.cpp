@@ -149,11 +149,12 @@ TechniqueResults occlusion_culling() {
 // Particles (Décoret 2005, 3.2/4.3; ARCHITECTURE.md "Definitions for the other techniques"): the
 // depth tests of the vertex-stage queries, the sprites' rasterization and the partial build per
 // frame, against the sprites culled less than the exact sprite test would. The test is the trace's
-// particle_mode (none, center, nb, hiz: one capture each), so a sweep varies the query structure
-// (nbuffer.*, hiz.*) on a trace. Popping and false culls must be 0 for the conservative modes nb
+// particle_mode (none, center, nb, hiz: one capture each) unless particles.mode names another, so
+// a sweep varies the query structure (nbuffer.*, hiz.*) and the mode (exactly on a none capture). Popping and false culls must be 0 for the conservative modes nb
 // and hiz; center pops by design (the paper's rejected baseline), and its points are flagged as
 // breaking that rule, which is what the comparison shows, not a defect of the run. No TableSpec:
-// the mode is not a config key, so `nbsim particles` prints the per-mode table from one trace each.
+// `nbsim particles` prints the per-mode table (one trace each, or one none capture with --set
+// particles.mode).
 TechniqueResults particles() {
   TechniqueResults t;
   t.technique = "particles";

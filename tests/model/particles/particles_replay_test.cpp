@@ -128,17 +128,52 @@ TEST(ParticlesCostTest, NBufferCheaperThanRasterizingAndCenterPops) {
   EXPECT_EQ(nb["popping"], 0);
 }
 
+nlohmann::json replay_set(const fs::path& t, const std::string& name, const std::string& set) {
+  const fs::path dir = scratch(name);
+  const CliResult r = run_nbsim("replay " + t.string() + " --out " + dir.string() + " --set " + set);
+  EXPECT_EQ(r.status, 0) << set << ": " << r.out << r.err;
+  std::ifstream in(dir / "run.json");
+  return nlohmann::json::parse(in)["summary"]["particles"];
+}
+
+// particles.mode: a `none` capture (every sprite drawn at its own clip position) replayed as
+// center, nb and hiz decides, culls and rasterizes exactly as the replay of that mode's own
+// capture of the same walk (GL's draws there); the other way, a capture replayed as none draws the
+// sprites GL culled again from their window positions and rasterizes what the none capture drew.
+TEST(ParticlesModeTest, NoneCaptureReplaysAsEveryMode) {
+  for (const char* sprite : {"16", "atten"}) {
+    const std::string s(sprite);
+    const fs::path none = capture("mode_none_" + s + ".nbt", "--sprite " + s + " --mode none");
+    const auto base = replay(none)["summary"]["particles"];
+    for (const char* mode : {"center", "nb", "hiz"}) {
+      const std::string m(mode);
+      const fs::path own = capture("mode_" + m + "_" + s + ".nbt", "--sprite " + s + " --mode " + m);
+      const auto want = replay(own)["summary"]["particles"];
+      const auto got = replay_set(none, "mode_" + m + "_" + s + "_as", "particles.mode=" + m);
+      EXPECT_EQ(got["mode"], m);
+      EXPECT_EQ(got["capture_mode"], "none");
+      for (const char* k : {"culled", "tested", "kept_too_large", "query_depth_tests", "raster_depth_tests", "raster_passed",
+                            "popping", "false_culls", "exactly_hidden"})
+        EXPECT_EQ(got[k], want[k]) << m << " " << s << ": " << k;
+      EXPECT_EQ(got["redrawn"], 0) << "a none capture holds every sprite's own clip position";
+      EXPECT_EQ(got["dropped"], got["culled"]) << "what the model culls is left out of GL's draws";
+      EXPECT_EQ(want["own_draws"], 0) << "in its own mode the model issues GL's draws";
+      const auto back = replay_set(own, "mode_" + m + "_" + s + "_as_none", "particles.mode=none");
+      EXPECT_EQ(back["culled"], 0);
+      EXPECT_EQ(back["redrawn"], want["culled"]);
+      EXPECT_EQ(back["raster_depth_tests"], base["raster_depth_tests"]) << m << " " << s << " replayed as none";
+    }
+  }
+  const CliResult bad = run_nbsim("compare " + scratch("mode_none_16.nbt").string() + " --set particles.mode=zbuffer");
+  EXPECT_EQ(bad.status, 2) << bad.out << bad.err;
+  EXPECT_TRUE(has(bad.err, "particles.mode")) << bad.err;
+}
+
 // The N-buffer unit's keys apply: every update policy decides as GL's shader (only the build cost
 // moves), u16 storage and a reduced resolution stay conservative, and cull.mode is refused.
 TEST(ParticlesCostTest, NBufferKeysApply) {
   const fs::path t = capture("keys.nbt", "--sprite 16 --mode nb");
-  const auto replay_with = [&](const std::string& name, const std::string& set) {
-    const fs::path dir = scratch("keys_" + name);
-    const CliResult r = run_nbsim("replay " + t.string() + " --out " + dir.string() + " --set " + set);
-    EXPECT_EQ(r.status, 0) << set << ": " << r.out << r.err;
-    std::ifstream in(dir / "run.json");
-    return nlohmann::json::parse(in)["summary"]["particles"];
-  };
+  const auto replay_with = [&](const std::string& name, const std::string& set) { return replay_set(t, "keys_" + name, set); };
   for (const char* policy : {"eager", "batched", "lazy"}) {
     const auto s = replay_with(policy, std::string("nbuffer.update_policy=") + policy);
     EXPECT_EQ(s["decision_mismatches"], 0) << policy;

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "model/common/error.h"
+#include "model/particles/sprite.h"
 #include "model/scene/visibility.h"
 #include "nbsim_shaders.h"
 #include "traces/capture/draw_recorder.h"
@@ -38,7 +39,8 @@ using scene::DrawRole;
 constexpr float kMargin = 1e-6f;
 // Attenuated sprites: a particle 0.6 m across (tunable), sides rounded to whole pixels in [1, 64].
 constexpr double kParticleWidthM = 0.6;
-constexpr float kMinAttenuatedPx = 1.0f, kMaxAttenuatedPx = 64.0f;
+constexpr float kMinAttenuatedPx = 1.0f;
+using particles::kMaxAttenuatedPx;
 // Emitters of --emitters auto (tunable).
 constexpr int kAutoEmitters = 12;
 // Bounds of --particles: a frame's records must stay within the format's per-frame limit (64 MiB +
@@ -46,8 +48,8 @@ constexpr int kAutoEmitters = 12;
 // in its draw's clip position and point size), so 500,000 take 26 MB.
 constexpr std::int64_t kMaxParticles = 500000;
 
-enum class Mode : std::uint8_t { None = 0, Center = 1, NBuffer = 2, HiZ = 3 };
-constexpr std::array<const char*, 4> kModeNames = {"none", "center", "nb", "hiz"};
+using particles::Mode;  // the model's: the trace's particle_mode names are kModeNames
+using particles::kModeNames;
 constexpr std::array<const char*, 4> kModeDefines = {"MODE_NONE", "MODE_CENTER", "MODE_NB", "MODE_HIZ"};
 
 const OptionSpec& particles_option() {
@@ -124,16 +126,6 @@ std::vector<std::pair<double, double>> parse_emitters(const std::string& text) {
   return out;
 }
 
-int floor_log2(int v) {
-  int n = 0;
-  while ((2 << n) <= v) ++n;
-  return n;
-}
-int ceil_log2(int v) {
-  int n = 0;
-  while ((1 << n) < v) ++n;
-  return n;
-}
 
 class Particles final : public Technique {
  public:
@@ -143,7 +135,7 @@ class Particles final : public Technique {
   Particles& operator=(const Particles&) = delete;
 
   trace::Properties variant_properties() const override {
-    return {{"particle_mode", kModeNames[static_cast<std::size_t>(mode_)]}, {"sprite", sprite_}};
+    return {{"particle_mode", std::string(kModeNames[static_cast<std::size_t>(mode_)])}, {"sprite", sprite_}};
   }
   trace::Properties setting_properties() const override {
     return {{"particles", std::to_string(count_)},
@@ -199,13 +191,14 @@ Particles::Particles(const TechniqueSetup& s)
                                        : emitters_at(s.scene.site, parse_emitters(emitters_text_), count_);
   if (reversed_) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   const FarOp op = reversed_ ? FarOp::Min : FarOp::Max;
-  // The largest sprite's pixel rectangle (one more near a pixel-centre tie) gives the level it needs.
-  const int largest = (sprite_ == "atten" ? static_cast<int>(kMaxAttenuatedPx) : std::stoi(sprite_)) + 1;
+  // The largest sprite's pixel rectangle gives the level it needs (the model computes it alike).
+  const int largest = sprite_ == "atten" ? static_cast<int>(particles::kMaxAttenuatedPx) : std::stoi(sprite_);
   if (mode_ == Mode::NBuffer) {
-    nbuffer_ = std::make_unique<GlslNBuffer>(width_, height_, op, std::min(floor_log2(largest), level_cap_));
+    nbuffer_ = std::make_unique<GlslNBuffer>(width_, height_, op,
+                                             particles::top_level_needed(Mode::NBuffer, largest, level_cap_));
     levels_built_ = nbuffer_->levels();
   } else if (mode_ == Mode::HiZ) {
-    hiz_ = std::make_unique<GlslHiZ>(width_, height_, op, std::min(ceil_log2(largest - 1), level_cap_));
+    hiz_ = std::make_unique<GlslHiZ>(width_, height_, op, particles::top_level_needed(Mode::HiZ, largest, level_cap_));
     levels_built_ = hiz_->levels();
   }
 
