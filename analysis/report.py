@@ -414,9 +414,16 @@ class Report:
         ax.grid(axis="y", alpha=0.3)
         ax.legend(fontsize=7, loc="upper left", ncols=2)
         img = self.save(fig, "particles.png")
+        settings = sorted({s for r in rows for s in (r.get("settings") or [])})
+        other_mode = [f"{r['trace_name']} captured in {r['capture_mode']}" for r in rows
+                      if r.get("capture_mode") and r["capture_mode"] != r["mode"]]
+        setting_text = ("settings: <code>" + html.escape(" ".join(f"--set {s}" if not s.startswith("--") else s
+                                                                   for s in settings)) + "</code>") if settings else \
+            ("the model's default settings" if all("settings" in r for r in rows) else "their settings are not recorded there")
+        mode_text = ("each in the culling mode it was captured in on Mesa" if not other_mode else
+                     "in the mode of the row (particles.mode; " + html.escape(", ".join(other_mode)) + ")")
         return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim particles TRACE... --out</code>: one replay per "
-                f"trace, each in the culling mode it was captured in on Mesa; traces {html.escape(traces)}; the run's "
-                "<code>--set</code> options are not recorded there). "
+                f"trace, {mode_text}; traces {html.escape(traces)}; {setting_text}). "
                 "The paper's claim (Décoret 2005, 3.2 and 4.3) is for 16 px sprites: rasterizing N sprites costs "
                 "256 N depth tests, the N-buffer N. Ours / paper compares nb's query depth tests and none's total "
                 "with it. Query: texels the culling test reads; raster: depth tests of GL's sprite fragments (its "

@@ -387,6 +387,11 @@ void add_model_commands(CLI::App& app, Action& action) {
           r["mode"] = (*p)["mode"];
           r["capture_mode"] = p->contains("capture_mode") ? (*p)["capture_mode"] : (*p)["mode"];
           r["sprite"] = sprites[i];
+          // The run's settings, so that a table read later says what it was made with.
+          nlohmann::ordered_json settings = nlohmann::ordered_json::array();
+          if (!mo->config_file.empty()) settings.push_back("--config " + mo->config_file);
+          for (const auto& s : mo->sets) settings.push_back(s);
+          r["settings"] = std::move(settings);
           const double n = (*p)["particles_per_frame"].get<double>();
           r["particles_per_frame"] = n;
           // The paper's claim for 16 px sprites: 256 N by rasterization (none), N with the N-buffer.

@@ -570,6 +570,17 @@ class MissingAndBroken(unittest.TestCase):
         self.assertEqual(rc, 0, err)
         self.assertIn("1 sections", out)
         self.assertIn("Particles (t_none, t_nb)", (self.dir / "report" / "headline.md").read_text())
+        html_text = (self.dir / "report" / "index.html").read_text()
+        self.assertIn("their settings are not recorded there", html_text, "a particles.json without settings says so")
+        # rows with their settings and a replay in another mode than the capture's say both
+        (self.dir / "particles.json").write_text(json.dumps([
+            particle_row("none", settings=[]),
+            particle_row("nb", trace="t_none.nbt", capture_mode="none", settings=["particles.mode=nb", "nbuffer.format=u16"])]))
+        rc, out, err = run_report(self.dir)
+        self.assertEqual(rc, 0, err)
+        html_text = (self.dir / "report" / "index.html").read_text()
+        self.assertIn("--set nbuffer.format=u16 --set particles.mode=nb", html_text)
+        self.assertIn("t_none captured in none", html_text)
         for bad, says in [("[]", "non-empty JSON list"), ('{"rows": []}', "non-empty JSON list"),
                           (json.dumps([{"mode": "nb"}]), "lacks particles_per_frame"),
                           (json.dumps([particle_row("nb", popping="many")]), "rows[0].popping is not a number"),

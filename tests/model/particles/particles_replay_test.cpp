@@ -205,6 +205,16 @@ TEST(ParticlesCostTest, TableCommand) {
   EXPECT_EQ(rows[1]["paper_depth_tests_per_frame"].get<double>(), 1500.0);
   EXPECT_EQ(rows[1]["popping"], 0);
   EXPECT_TRUE(fs::exists(dir / "particles.json"));
+  EXPECT_EQ(rows[0]["settings"], nlohmann::json::array()) << "the run's --set options are recorded (none here)";
+  EXPECT_EQ(rows[0]["capture_mode"], "none");
+  // --set options land in every row; particles.mode replays the none capture as nb
+  const CliResult as_nb = run_nbsim("particles " + none.string() + " --json --set particles.mode=nb");
+  ASSERT_EQ(as_nb.status, 0) << as_nb.out << as_nb.err;
+  const auto nb_rows = nlohmann::json::parse(as_nb.out);
+  EXPECT_EQ(nb_rows[0]["mode"], "nb");
+  EXPECT_EQ(nb_rows[0]["capture_mode"], "none");
+  EXPECT_EQ(nb_rows[0]["settings"], nlohmann::json::array({"particles.mode=nb"}));
+  EXPECT_EQ(nb_rows[0]["paper_depth_tests_per_frame"].get<double>(), 1500.0) << "the paper's claim follows the mode replayed";
   const CliResult text = run_nbsim("particles " + nb.string());
   EXPECT_EQ(text.status, 0) << text.err;
   EXPECT_TRUE(has(text.out, "256 N by rasterization, N with the N-buffer")) << text.out;
