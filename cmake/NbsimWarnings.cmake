@@ -3,6 +3,9 @@ function(nbsim_target_defaults target)
   target_compile_features(${target} PUBLIC cxx_std_20)
   set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion)
+  # a * b + c stays two roundings everywhere, even on -march builds with FMA hardware: Mesa's C and
+  # JIT code round these products separately (the model's fused interpolation calls std::fma itself).
+  target_compile_options(${target} PUBLIC -ffp-contract=off)
   if(NBSIM_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()

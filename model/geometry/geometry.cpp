@@ -8,10 +8,10 @@
 
 // Keep the compiler from fusing a * b + c into one FMA even when a build targets FMA hardware
 // (-march): Mesa's C and JIT code round these products separately.
+// GCC: -ffp-contract=off on every target (cmake/NbsimWarnings.cmake), not a `#pragma GCC optimize`,
+// which would keep GCC from inlining std::min, std::max and friends into this file's functions.
 #if defined(__clang__)
 #pragma clang fp contract(off)
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off")
 #endif
 
 #include <algorithm>

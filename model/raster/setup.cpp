@@ -6,10 +6,10 @@
 
 // Keep the compiler from fusing a * b + c into one FMA even when a build targets FMA hardware
 // (-march): Mesa's C and JIT code round these products separately.
+// GCC: -ffp-contract=off on every target (cmake/NbsimWarnings.cmake), not a `#pragma GCC optimize`,
+// which would keep GCC from inlining std::min, std::max and friends into this file's functions.
 #if defined(__clang__)
 #pragma clang fp contract(off)
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off")
 #endif
 
 #include <algorithm>
@@ -76,20 +76,6 @@ DepthPlane depth_plane(const geometry::WindowVertex& v0, const geometry::WindowV
 
 }  // namespace
 
-float DepthPlane::raw_at(int x, int y, bool fused) const noexcept {
-  const float fx = static_cast<float>(x), fy = static_cast<float>(y);
-  if (fused) return std::fma(dzdy, fy, std::fma(dzdx, fx, a0));
-  const float ax = dzdx * fx;
-  const float a = a0 + ax;
-  const float ay = dzdy * fy;
-  return a + ay;
-}
-
-float DepthPlane::at(int x, int y, bool fused) const noexcept {
-  // Plus the (zero) polygon offset llvmpipe adds, then lp_build_clamp(z, 0, 1).
-  const float z = raw_at(x, y, fused) + 0.0f;
-  return std::min(std::max(z, 0.0f), 1.0f);
-}
 
 SetupCounters& SetupCounters::operator+=(const SetupCounters& o) {
   triangles += o.triangles;

@@ -23,7 +23,9 @@
 //   hosts), then clamped to [0, 1] (lp_state_fs.c lp_build_depth_clamp).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "model/geometry/primitive.h"
@@ -67,9 +69,22 @@ struct DepthPlane {
   float dzdy = 0.0f;
   // z before the [0, 1] clamp: fmuladd(dzdy, y, fmuladd(dzdx, x, a0)), with one rounding each
   // (fused) or two (unfused, for hosts without FMA).
-  float raw_at(int x, int y, bool fused = true) const noexcept;
-  // The depth the fragment is tested and written with.
-  float at(int x, int y, bool fused = true) const noexcept;
+  // (Inline: the depth test calls it per fragment. Every target compiles with -ffp-contract=off,
+  // so the unfused sum keeps its two roundings wherever it is inlined.)
+  float raw_at(int x, int y, bool fused = true) const noexcept {
+    const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+    if (fused) return std::fma(dzdy, fy, std::fma(dzdx, fx, a0));
+    const float ax = dzdx * fx;
+    const float a = a0 + ax;
+    const float ay = dzdy * fy;
+    return a + ay;
+  }
+  // The depth the fragment is tested and written with: plus the (zero) polygon offset llvmpipe
+  // adds, then lp_build_clamp(z, 0, 1).
+  float at(int x, int y, bool fused = true) const noexcept {
+    const float z = raw_at(x, y, fused) + 0.0f;
+    return std::min(std::max(z, 0.0f), 1.0f);
+  }
 };
 
 constexpr int kMaxPlanes = 7;  // three edges and at most four scissor planes
