@@ -67,6 +67,8 @@ class Gpu : public sc_core::sc_module {
 
   const memory::Channel& memory() const noexcept { return memory_; }
   const Program& program() const noexcept { return program_; }
+  // The depth unit: its depth and stencil buffers as the last work item left them.
+  const depth::DepthUnit& depth() const noexcept { return depth_; }
 
  private:
   memory::Channel memory_;
