@@ -554,6 +554,28 @@ TEST_F(StencilGlCompareTest, UnitsReplayStencilTraceExactly) {
   EXPECT_EQ(j["stencil_pixels_matching"], kPixels) << res.out;
   EXPECT_GT(j["stencil_tests"].get<std::uint64_t>(), 10000u);
   EXPECT_EQ(j["depth_max_abs_error"], 0.0) << "the final depth buffer is GL's bit for bit";
+  // `nbsim replay`'s statistics: the stencil counters and the stencil plane's memory traffic.
+  {
+    const std::filesystem::path out = nbsim::testing::scratch_path("nbsim_stencil", "run");
+    const nbsim::testing::CliResult rep = nbsim::testing::run_nbsim("replay " + t.string() + " --out " + out.string());
+    ASSERT_EQ(rep.status, 0) << rep.out << rep.err;
+    std::ifstream in(out / "run.json");
+    const auto run = nlohmann::json::parse(in);
+    const auto& depth = run["stats"]["gpu.depth"];
+    std::uint64_t stencil_draws = 0;
+    for (const Draw& d : c.draws) stencil_draws += d.stencil.test ? 1 : 0;
+    EXPECT_EQ(depth["stencil_draws"], stencil_draws);
+    EXPECT_EQ(depth["stencil_draws_unmodelled"], 0) << "no draw discards or writes depth";
+    EXPECT_EQ(depth["stencil_tests"], j["stencil_tests"]);
+    EXPECT_GT(depth["stencil_changed"].get<std::uint64_t>(), 0u);
+    EXPECT_LE(depth["stencil_changed"].get<std::uint64_t>(), depth["stencil_written"].get<std::uint64_t>());
+    EXPECT_GT(depth["stencil_read_bytes"].get<std::uint64_t>(), 0u) << "stencil tiles are read through the cache";
+    EXPECT_EQ(run["stats"]["gpu.memory"]["bytes_stencil"],
+              depth["stencil_read_bytes"].get<std::uint64_t>() + depth["stencil_write_bytes"].get<std::uint64_t>())
+        << "the memory channel's stencil client moved the stencil plane's bytes";
+    EXPECT_EQ(run["frames"][0]["stencil_pixels_matching"], kPixels);
+    std::filesystem::remove_all(out);
+  }
   // A stencil image one pixel off is reported, and the run leaves the thresholds (exit 1).
   {
     std::vector<std::uint8_t> wrong = g.stencil;
