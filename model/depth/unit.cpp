@@ -128,7 +128,7 @@ void DepthUnit::serve() {
     label_with([&] { return cp::timeline_label(w); });  // names the clear's or the draw's span
     switch (w.kind) {
       case cp::WorkKind::FrameBegin:
-        std::fill(buffer_.texels.begin(), buffer_.texels.end(), w.clear_depth);
+        std::fill(buffer_.texels.begin(), buffer_.texels.end(), raster::stored_depth(test_.depth_format(), w.clear_depth));
         cache_.invalidate();  // a fast clear: cached tiles are dropped, not written back
         std::fill(stencil_.texels.begin(), stencil_.texels.end(), std::uint8_t{0});  // GL's default glClearStencil(0)
         stencil_cache_.invalidate();

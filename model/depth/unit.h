@@ -80,6 +80,8 @@ class DepthUnit : public sim::Unit {
 
   const DepthImage& buffer() const noexcept { return buffer_; }
   const raster::StencilImage& stencil() const noexcept { return stencil_; }
+  // The depth buffer's format (the trace's depth_format; Float32 unless set); call before the run.
+  void set_depth_format(raster::DepthFormat format) noexcept { test_.set_depth_format(format); }
   void set_listener(DepthListener* l) noexcept { listener_ = l; }
 
  private:

@@ -50,7 +50,7 @@ RasterPath::RasterPath(const RasterPathConfig& config, DepthImage& depth, Stenci
       point_setup_(SetupConfig{config.width_px, config.height_px}),
       rasterizer_(config.width_px, config.height_px),
       own_stencil_(stencil ? nullptr : std::make_unique<StencilImage>(check_size(config, depth).width, depth.height, 0)),
-      test_(check_size(config, depth), stencil ? *stencil : *own_stencil_, config.fused_interpolation) {}
+      test_(check_size(config, depth), stencil ? *stencil : *own_stencil_, config.fused_interpolation, config.depth_format) {}
 
 DrawCounters RasterPath::draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state) {
   DrawCounters k;

@@ -24,6 +24,7 @@ struct RasterPathConfig {
   int batch_triangles = 85;         // geometry::GeometryConfig::batch_triangles
   bool fused_viewport = true;       // geometry::GeometryConfig::fused_viewport
   bool fused_interpolation = true;  // EarlyDepthTest: depth plane evaluated with FMA
+  DepthFormat depth_format = DepthFormat::Float32;  // Unorm24: the buffer holds llvmpipe's 24-bit depths
 };
 
 // The GL state of one draw that the path reads.

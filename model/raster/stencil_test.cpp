@@ -56,8 +56,8 @@ StencilCounters& StencilCounters::operator+=(const StencilCounters& o) {
   return *this;
 }
 
-DepthStencilTest::DepthStencilTest(DepthImage& depth, StencilImage& stencil, bool fused_interpolation)
-    : depth_test_(depth, fused_interpolation), stencil_(&stencil) {
+DepthStencilTest::DepthStencilTest(DepthImage& depth, StencilImage& stencil, bool fused_interpolation, DepthFormat format)
+    : depth_test_(depth, fused_interpolation, format), stencil_(&stencil) {
   if (stencil.width != depth.width || stencil.height != depth.height ||
       stencil.texels.size() != static_cast<std::size_t>(depth.width) * static_cast<std::size_t>(depth.height))
     throw InputError("stencil test: stencil buffer " + std::to_string(stencil.width) + "x" + std::to_string(stencil.height) +
@@ -99,7 +99,7 @@ void DepthStencilTest::test_block(const DepthPlane& plane, bool front_facing, in
     ++sk.passed;
     if (ds.test) {
       ++dk.depth_tests;
-      const float z = plane.at(px, py, fused);
+      const float z = stored_depth(depth_test_.format(), plane.at(px, py, fused));
       if (!depth_passes(ds.func, z, depth.texels[at])) {
         ++sk.depth_failed;
         store(s, f.depth_fail);

@@ -135,7 +135,8 @@ class DepthStencilTest {
  public:
   // Tests against and writes to `depth` and `stencil`, which must have the same size and outlive
   // the unit. Throws InputError when the sizes differ.
-  DepthStencilTest(DepthImage& depth, StencilImage& stencil, bool fused_interpolation = true);
+  DepthStencilTest(DepthImage& depth, StencilImage& stencil, bool fused_interpolation = true,
+                   DepthFormat format = DepthFormat::Float32);
 
   // Tests the pixels of `mask` in the 4x4 block at (x, y) (bit i + 4 j is pixel (x + i, y + j),
   // inside the buffers) of a primitive facing `front_facing`. With stencil.test false this is
@@ -146,6 +147,8 @@ class DepthStencilTest {
   DepthImage& depth() noexcept { return depth_test_.buffer(); }
   StencilImage& stencil() noexcept { return *stencil_; }
   bool fused_interpolation() const noexcept { return depth_test_.fused_interpolation(); }
+  DepthFormat depth_format() const noexcept { return depth_test_.format(); }
+  void set_depth_format(DepthFormat format) noexcept { depth_test_.set_format(format); }
 
  private:
   EarlyDepthTest depth_test_;

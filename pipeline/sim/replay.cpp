@@ -368,6 +368,15 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.properties = tr.properties();
   Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head.technique, setup,
           o.out ? &*o.out : nullptr);
+  for (const auto& [k, v] : tr.properties()) {  // DEPTH24_STENCIL8 captures compare 24-bit depths
+    if (k != "depth_format") continue;
+    const std::optional<raster::DepthFormat> f = raster::parse_depth_format(v);
+    if (!f)
+      throw InputError(fmt::format("{}: the header's depth_format '{}' is not one the model replays (DEPTH_COMPONENT32F, "
+                                   "DEPTH32F_STENCIL8, DEPTH24_STENCIL8, DEPTH_COMPONENT24)",
+                                   o.trace.string(), v));
+    gpu.set_depth_format(*f);
+  }
   std::optional<sim::Timeline> timeline;  // only when asked: units then report their busy spans
   if (o.timeline || o.vcd) {
     sim::TimelineOptions to;

@@ -8,12 +8,14 @@
 // - DEPTH32F_STENCIL8: random triangles, and the shadow-volume z-fail setup (depth LESS, no depth
 //   writes, no culling, back faces INCR_WRAP and front faces DECR_WRAP on depth fail) over closed
 //   boxes in perspective, some through the near plane, then a pass counting stencil == 0.
-// - DEPTH24_STENCIL8: the model's depth buffer is float (D24's 24-bit quantization is not
-//   modelled), so the draws there are constant-depth triangles at depths halfway between the
-//   prepared depths' grid: every depth comparison has the same outcome in float and in 24 bits.
-// UnitsReplayStencilTraceExactly writes GL's z-fail draws (from a cleared buffer) to a trace with
-// the final "stencil" image and checks `nbsim compare` (the SystemC depth unit) against it, and
-// StencilReplayInputTest feeds `nbsim compare` a trace with an out-of-range stencil op.
+// - DEPTH24_STENCIL8 (the shadows capture's format): the same random draws and z-fail volumes,
+//   the model storing llvmpipe's 24-bit depths (DepthFormat::Unorm24); GL's 24-bit depth buffer
+//   must equal the model's too.
+// UnitsReplayStencilTraceExactly writes GL's z-fail draws (from a cleared DEPTH24_STENCIL8 buffer)
+// to a trace with the final "stencil" image and checks `nbsim compare` (the SystemC depth unit)
+// against it, and
+// StencilReplayInputTest feeds `nbsim compare` a trace with an out-of-range stencil op and one
+// with a depth format the model does not replay.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -84,7 +86,8 @@ struct Case {
 
 struct GlResult {
   std::vector<std::uint64_t> samples_passed, fragments;
-  std::vector<float> depth;  // D32FS8 only
+  std::vector<float> depth;            // D32FS8
+  std::vector<std::uint32_t> depth24;  // D24S8: the 24-bit values
   std::vector<std::uint8_t> stencil;
   GLenum gl_error = GL_NO_ERROR;
 };
@@ -215,7 +218,11 @@ class GlStencil {
     } else {
       std::vector<std::uint32_t> t(kPixels);
       glGetTextureImage(tex_[f], 0, GL_DEPTH_STENCIL, GL_UNSIGNED_INT_24_8, static_cast<GLsizei>(t.size() * 4), t.data());
-      for (std::size_t i = 0; i < kPixels; ++i) r.stencil[i] = static_cast<std::uint8_t>(t[i] & 0xFF);
+      r.depth24.resize(kPixels);
+      for (std::size_t i = 0; i < kPixels; ++i) {
+        r.stencil[i] = static_cast<std::uint8_t>(t[i] & 0xFF);
+        r.depth24[i] = t[i] >> 8;
+      }
     }
   }
   GLuint plain_ = 0, count_ = 0, vao_ = 0, vbo_ = 0, counts_ = 0;
@@ -242,26 +249,22 @@ scene::StencilFace random_face(Rng& r) {
 }
 
 // A draw of 1 to 4 random triangles with random depth and stencil state, a quarter of them with
-// ZERO_TO_ONE clip control. `flat`: w = 1 and one depth per triangle, halfway between the 1/64
-// grid (the D24S8 cases), clip control NEGATIVE_ONE_TO_ONE.
-Draw random_draw(Rng& r, bool flat) {
+// ZERO_TO_ONE clip control.
+Draw random_draw(Rng& r) {
   Draw d;
   const unsigned n = 1 + r.below(4);
-  for (unsigned t = 0; t < n; ++t) {
-    const float flat_z = 2.0f * ((static_cast<float>(r.below(64)) + 0.5f) / 64.0f) - 1.0f;
-    for (int v = 0; v < 3; ++v) {
-      const float w = flat ? 1.0f : r.range(0.5f, 2.0f);
-      const float z = flat ? flat_z : r.range(-1.3f, 1.3f) * w;  // some vertices beyond near or far
-      d.clip.push_back({r.range(-1.4f, 1.4f) * w, r.range(-1.4f, 1.4f) * w, z, w});
-    }
+  for (unsigned t = 0; t < 3 * n; ++t) {
+    const float w = r.range(0.5f, 2.0f);
+    const float z = r.range(-1.3f, 1.3f) * w;  // some vertices beyond near or far
+    d.clip.push_back({r.range(-1.4f, 1.4f) * w, r.range(-1.4f, 1.4f) * w, z, w});
   }
   d.depth.test = r.below(8) != 0;
   d.depth.func = static_cast<scene::DepthFunc>(r.below(8));
   d.depth.write = r.below(3) != 0;
   d.depth.cull = r.below(4) == 0 ? static_cast<scene::CullFace>(1 + r.below(2)) : scene::CullFace::None;
   d.depth.front_ccw = r.below(2) == 0;
-  d.depth.depth_clamp = !flat && r.below(3) == 0;
-  if (!flat && r.below(4) == 0) d.depth.clip = scene::ClipControl::ZeroToOne;
+  d.depth.depth_clamp = r.below(3) == 0;
+  if (r.below(4) == 0) d.depth.clip = scene::ClipControl::ZeroToOne;
   d.stencil.test = r.below(10) != 0;
   d.stencil.front = random_face(r);
   d.stencil.back = r.below(4) == 0 ? d.stencil.front : random_face(r);
@@ -279,7 +282,7 @@ Case random_case(const std::string& name, unsigned seed, Format format, int draw
     c.depth[i] = static_cast<float>(r.below(65)) / 64.0f;
     c.stencil[i] = small_stencil(r);
   }
-  for (int k = 0; k < draws; ++k) c.draws.push_back(random_draw(r, format == Format::D24S8));
+  for (int k = 0; k < draws; ++k) c.draws.push_back(random_draw(r));
   return c;
 }
 
@@ -342,9 +345,10 @@ std::vector<Draw> zfail_draws(Rng& r, int boxes) {
   return draws;
 }
 
-Case zfail_case(unsigned seed) {
+Case zfail_case(unsigned seed, Format format = Format::D32FS8) {
   Case c;
-  c.name = "shadow-volume z-fail";
+  c.name = format == Format::D24S8 ? "shadow-volume z-fail, D24_S8" : "shadow-volume z-fail";
+  c.format = format;
   Rng r(seed);
   c.depth.resize(kPixels);
   c.stencil.assign(kPixels, 0);
@@ -396,6 +400,10 @@ ModelResult run_model(const Case& c) {
   RasterPathConfig cfg;
   cfg.width_px = kW;
   cfg.height_px = kH;
+  if (c.format == Format::D24S8) {  // the buffer holds the 24-bit values GL was given
+    cfg.depth_format = DepthFormat::Unorm24;
+    for (float& d : m.depth.texels) d = from_unorm24(to_d24(d));
+  }
   RasterPath path(cfg, m.depth, m.stencil);
   for (const Draw& d : c.draws) m.draws.push_back(path.draw(d.clip, model_state(d)));
   return m;
@@ -433,6 +441,9 @@ Outcome compare(GlStencil& gl, const Case& c) {
       if (c.format == Format::D32FS8 &&
           std::bit_cast<std::uint32_t>(g.depth[i]) != std::bit_cast<std::uint32_t>(m.depth.texels[i]) && bad_depth++ < 5)
         ADD_FAILURE() << "pixel (" << x << ", " << y << "): GL depth " << g.depth[i] << ", model " << m.depth.texels[i];
+      if (c.format == Format::D24S8 && g.depth24[i] != to_d24(m.depth.texels[i]) && bad_depth++ < 5)
+        ADD_FAILURE() << "pixel (" << x << ", " << y << "): GL 24-bit depth " << g.depth24[i] << ", model "
+                      << to_d24(m.depth.texels[i]);
     }
   EXPECT_EQ(bad_stencil, 0) << "stencil pixels not identical to GL's";
   EXPECT_EQ(bad_depth, 0) << "depth pixels not bit-identical to GL's";
@@ -459,7 +470,7 @@ TEST_F(StencilGlCompareTest, RandomStateLateTestsMatchGl) {
   EXPECT_GT(o.changed, 5000u);
 }
 
-// Constant-depth triangles on DEPTH24_STENCIL8 (depth outcomes independent of D24 rounding).
+// The same on DEPTH24_STENCIL8: the model compares and stores llvmpipe's 24-bit depths.
 TEST_F(StencilGlCompareTest, RandomStateD24S8MatchesGl) {
   const Outcome o = compare(*gl_, random_case("random D24_S8", 3, Format::D24S8, 250));
   EXPECT_GT(o.changed, 10000u);
@@ -483,8 +494,9 @@ TEST_F(StencilGlCompareTest, ZFailShadowVolumesMatchGl) {
 // the frame's "stencil" image.
 void write_trace(const std::filesystem::path& file, const Case& c, const GlResult& g, const std::vector<std::uint8_t>& stencil,
                  bool with_depth) {
-  trace::TraceWriter w(file, {{"viewport", std::to_string(kW) + "x" + std::to_string(kH)}, {"depth_func", "LESS"},
-                              {"depth_clear", "1"}, {"frames", "1"}});
+  trace::TraceWriter w(file, {{"viewport", std::to_string(kW) + "x" + std::to_string(kH)},
+                              {"depth_format", c.format == Format::D24S8 ? "DEPTH24_STENCIL8" : "DEPTH32F_STENCIL8"},
+                              {"depth_func", "LESS"}, {"depth_clear", "1"}, {"frames", "1"}});
   w.begin_frame(trace::FrameBegin{});
   for (std::size_t i = 0; i < c.draws.size(); ++i) {
     trace::DrawRecord d;
@@ -502,6 +514,8 @@ void write_trace(const std::filesystem::path& file, const Case& c, const GlResul
     fin.width = kW;
     fin.height = kH;
     fin.texels = g.depth;
+    if (c.format == Format::D24S8)
+      for (const std::uint32_t q : g.depth24) fin.texels.push_back(from_unorm24(q));
     w.write(fin);
   }
   trace::StencilSnapshot st;
@@ -516,6 +530,12 @@ void write_trace(const std::filesystem::path& file, const Case& c, const GlResul
   w.close();
 }
 
+// z-fail on DEPTH24_STENCIL8, the shadows capture's format.
+TEST_F(StencilGlCompareTest, ZFailShadowVolumesD24S8MatchGl) {
+  const Outcome o = compare(*gl_, zfail_case(7, Format::D24S8));
+  EXPECT_GT(o.changed, 10000u);
+}
+
 // z-fail with glFrontFace(GL_CW): the volumes' stencil counts wrap below zero.
 TEST_F(StencilGlCompareTest, ZFailClockwiseFrontMatchesGl) {
   const Outcome o = compare(*gl_, zfail_cw_case(6));
@@ -523,24 +543,25 @@ TEST_F(StencilGlCompareTest, ZFailClockwiseFrontMatchesGl) {
 }
 
 // The SystemC model (depth unit, `nbsim compare`) replays a trace of z-fail shadow volumes that
-// GL drew from a cleared buffer (depth 1, stencil 0) after receiver draws: every draw exact and
+// GL drew into DEPTH24_STENCIL8 from a cleared buffer (depth 1, stencil 0) after receiver draws: every draw exact and
 // the final stencil buffer equal to the trace's "stencil" image.
 TEST_F(StencilGlCompareTest, UnitsReplayStencilTraceExactly) {
   Case c;
   c.name = "trace";
+  c.format = Format::D24S8;
   c.count_fragments = true;
   c.depth.assign(kPixels, 1.0f);
   c.stencil.assign(kPixels, 0);
   Rng r(5);
   for (int k = 0; k < 30; ++k) {  // receivers: random triangles writing depth, no stencil test
-    Draw d = random_draw(r, false);
+    Draw d = random_draw(r);
     d.depth = scene::DepthState{};
     d.depth.cull = scene::CullFace::None;
     d.stencil.test = false;
     c.draws.push_back(d);
   }
   for (Draw& d : zfail_draws(r, 40)) c.draws.push_back(d);
-  for (int k = 0; k < 20; ++k) c.draws.push_back(random_draw(r, false));  // and random stencil state
+  for (int k = 0; k < 20; ++k) c.draws.push_back(random_draw(r));  // and random stencil state
   const GlResult g = gl_->run(c);
   ASSERT_EQ(g.gl_error, static_cast<GLenum>(GL_NO_ERROR));
   const std::filesystem::path t = nbsim::testing::scratch_path("nbsim_stencil", "stencil.nbt");
@@ -623,6 +644,23 @@ TEST(StencilReplayInputTest, OutOfRangeStencilOpRefused) {
   const nbsim::testing::CliResult r = nbsim::testing::run_nbsim("compare " + t.string());
   EXPECT_EQ(r.status, 2) << r.out << r.err;
   EXPECT_TRUE(nbsim::testing::has(r.err, "field 'stencil.back.fail' is 9")) << r.err;
+  std::filesystem::remove(t);
+}
+
+// A depth_format the model does not replay is refused with exit 2 naming it, before any draw.
+TEST(StencilReplayInputTest, UnknownDepthFormatRefused) {
+  const std::filesystem::path t = nbsim::testing::scratch_path("nbsim_stencil", "d16.nbt");
+  {
+    trace::TraceWriter w(t, {{"viewport", "16x8"}, {"depth_format", "DEPTH_COMPONENT16"}, {"depth_func", "LESS"},
+                             {"depth_clear", "1"}, {"frames", "1"}});
+    w.begin_frame(trace::FrameBegin{});
+    trace::FrameEnd e;
+    w.end_frame(e);
+    w.close();
+  }
+  const nbsim::testing::CliResult r = nbsim::testing::run_nbsim("compare " + t.string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(nbsim::testing::has(r.err, "depth_format 'DEPTH_COMPONENT16' is not one the model replays")) << r.err;
   std::filesystem::remove(t);
 }
 

@@ -72,6 +72,9 @@ CompareSummary compare_trace(const std::filesystem::path& path, const CompareOpt
   config.batch_triangles = options.batch_triangles;
   config.fused_viewport = options.fused_viewport;
   config.fused_interpolation = options.fused_interpolation;
+  for (const auto& [k, v] : frames.trace().properties())
+    if (k == "depth_format")
+      if (const auto f = raster::parse_depth_format(v)) config.depth_format = *f;
   DepthImage depth(width, height, clear);
   raster::StencilImage stencil(width, height, 0);
   raster::RasterPath path_core(config, depth, stencil);
