@@ -15,7 +15,7 @@
 // to a trace with the final "stencil" image and checks `nbsim compare` (the SystemC depth unit)
 // against it, and
 // StencilReplayInputTest feeds `nbsim compare` a trace with an out-of-range stencil op and one
-// with a depth format the model does not replay.
+// with a depth format the model does not replay, and counts discarding stencil draws.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -661,6 +661,40 @@ TEST(StencilReplayInputTest, UnknownDepthFormatRefused) {
   const nbsim::testing::CliResult r = nbsim::testing::run_nbsim("compare " + t.string());
   EXPECT_EQ(r.status, 2) << r.out << r.err;
   EXPECT_TRUE(nbsim::testing::has(r.err, "depth_format 'DEPTH_COMPONENT16' is not one the model replays")) << r.err;
+  std::filesystem::remove(t);
+}
+
+// A stencil draw whose fragment shader may discard or writes depth is replayed as if it kept
+// every fragment at its interpolated depth, and counted as such (no GL needed).
+TEST(StencilReplayInputTest, DiscardingStencilDrawsAreCounted) {
+  const std::filesystem::path t = nbsim::testing::scratch_path("nbsim_stencil", "discard.nbt");
+  {
+    trace::TraceWriter w(t, {{"viewport", "16x8"}, {"depth_func", "LESS"}, {"depth_clear", "1"}, {"frames", "1"}});
+    w.begin_frame(trace::FrameBegin{});
+    trace::DrawRecord d;
+    d.clip_positions = {{-1, -1, 0, 1}, {1, -1, 0, 1}, {-1, 1, 0, 1}};
+    d.stencil.test = true;
+    d.stencil.front.pass = d.stencil.back.pass = scene::StencilOp::IncrWrap;
+    for (const auto& [discards, writes_depth] : {std::pair{true, false}, std::pair{false, true}, std::pair{false, false}}) {
+      d.discards = discards;
+      d.writes_depth = writes_depth;
+      w.write(d);
+      ++d.index;
+    }
+    trace::FrameEnd e;
+    e.draws = d.index;
+    w.end_frame(e);
+    w.close();
+  }
+  const std::filesystem::path out = nbsim::testing::scratch_path("nbsim_stencil", "discard_run");
+  const nbsim::testing::CliResult r = nbsim::testing::run_nbsim("replay " + t.string() + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  std::ifstream in(out / "run.json");
+  const auto run = nlohmann::json::parse(in);
+  EXPECT_EQ(run["stats"]["gpu.depth"]["stencil_draws"], 3);
+  EXPECT_EQ(run["stats"]["gpu.depth"]["stencil_draws_unmodelled"], 2) << "the discarding and the depth-writing draw";
+  EXPECT_EQ(run["stats"]["gpu.depth"]["stencil_tests"], run["stats"]["gpu.depth"]["fragments"]);
+  std::filesystem::remove_all(out);
   std::filesystem::remove(t);
 }
 
