@@ -1,16 +1,22 @@
-// DepthUnit: the early depth test (model/raster/depth_test.h) behind a depth cache and the shared
-// memory channel (model/memory/memory.h). The depth buffer is stored in 8x8-pixel tiles, one cache
-// line each. It is the last unit of the replay pipeline: it reports each draw's counters, the
-// frame's depth snapshots and the end of each frame to a ResultSink.
+// DepthUnit: the stencil test and the early depth test (model/raster/stencil_test.h, depth_test.h)
+// behind a depth cache, a stencil cache and the shared memory channel (model/memory/memory.h). The
+// depth buffer is stored in 8x8-pixel tiles of 32-bit depth, one 256-byte cache line each; the
+// 8-bit stencil buffer is a separate plane of 8x8-pixel tiles, one 64-byte line each, read and
+// written only by draws with the stencil test on. Both are cleared at each frame's start (depth
+// to the trace's clear value, stencil to 0, GL's default glClearStencil). It is the last unit of
+// the replay pipeline: it reports each draw's counters, the frame's depth snapshots, the stencil
+// buffer at each frame's end and the end of each frame to a ResultSink.
 #pragma once
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "model/config/schema.h"
 #include "model/common/rect.h"
 #include "model/memory/memory.h"
 #include "model/raster/depth_test.h"
+#include "model/raster/stencil_test.h"
 #include "model/raster/unit.h"
 #include "model/sim/unit.h"
 
@@ -21,6 +27,7 @@ struct DepthUnitConfig {
   int latency_cycles = 10;        // tunable
   int clear_cycles = 64;          // a fast clear of the whole buffer; tunable
   memory::CacheConfig cache{32 * 1024, 256, 4};  // 256-byte lines = 8x8 pixels of 32-bit depth
+  memory::CacheConfig stencil_cache{8 * 1024, 64, 4};  // 64-byte lines = 8x8 pixels of 8-bit stencil
   bool fused_interpolation = true;  // depth plane evaluated with FMA, as llvmpipe on FMA hosts; fidelity knob
 
   static void describe(config::Schema& s, DepthUnitConfig& c);
@@ -32,8 +39,10 @@ struct DrawResult {
   raster::SetupCounters setup;
   raster::TileCounters tiles;
   raster::DepthCounters depth;
+  raster::StencilCounters stencil;  // zero unless the draw has the stencil test on
   std::uint64_t cache_misses = 0;
-  std::uint64_t memory_bytes = 0;
+  std::uint64_t memory_bytes = 0;          // depth tiles read and written back
+  std::uint64_t stencil_memory_bytes = 0;  // stencil tiles read and written back
   std::uint64_t done_cycle = 0;  // when the depth unit finished the draw
 };
 
@@ -42,6 +51,11 @@ class ResultSink {
   virtual ~ResultSink() = default;
   virtual void draw_done(const cp::Work& work, const DrawResult& result) = 0;
   virtual void snapshot(const cp::Work& work, const DepthImage& depth) = 0;
+  // The stencil buffer at the frame's end, just before frame_done (all zero when no draw of the
+  // frame had the stencil test on).
+  virtual void stencil_at_frame_end(const cp::Work& work, const raster::StencilImage& stencil) {
+    (void)work, (void)stencil;
+  }
   virtual void frame_done(const cp::Work& work, std::uint64_t cycle) = 0;
   virtual void stopped(std::uint64_t cycle) = 0;
 };
@@ -65,6 +79,9 @@ class DepthUnit : public sim::Unit {
             int height_px, memory::Channel& memory, ResultSink& sink);
 
   const DepthImage& buffer() const noexcept { return buffer_; }
+  const raster::StencilImage& stencil() const noexcept { return stencil_; }
+  // The depth buffer's format (the trace's depth_format; Float32 unless set); call before the run.
+  void set_depth_format(raster::DepthFormat format) noexcept { test_.set_depth_format(format); }
   void set_listener(DepthListener* l) noexcept { listener_ = l; }
 
  private:
@@ -76,12 +93,16 @@ class DepthUnit : public sim::Unit {
   DepthUnitConfig config_;
   int width_, height_, tiles_x_;
   DepthImage buffer_;
-  raster::EarlyDepthTest test_;
-  memory::Cache cache_;
+  raster::StencilImage stencil_;
+  raster::DepthStencilTest test_;
+  memory::Cache cache_, stencil_cache_;
   memory::Channel& memory_;
-  int client_;
+  int client_, stencil_client_;
   ResultSink& sink_;
   stats::Counter &fragments_, &tests_, &passed_, &written_, &hits_, &misses_, &writebacks_, &stall_, &clears_;
+  stats::Counter &stencil_draws_, &stencil_unmodelled_, &stencil_hits_, &stencil_misses_, &stencil_writebacks_,
+      &stencil_read_bytes_, &stencil_write_bytes_;
+  std::vector<stats::Counter*> stencil_counts_;  // one per raster::StencilCounters field (unit.cpp's table)
 };
 
 }  // namespace nbsim::depth

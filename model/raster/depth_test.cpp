@@ -2,6 +2,7 @@
 #include "model/raster/depth_test.h"
 
 #include <bit>
+#include <cmath>
 
 namespace nbsim::raster {
 
@@ -9,12 +10,12 @@ namespace {
 
 template <DepthFunc F>
 void run_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint16_t mask, bool write, bool fused,
-               DepthCounters& k) {
+               DepthFormat format, DepthCounters& k) {
   std::uint64_t passed = 0, written = 0;
   for (unsigned m = mask; m != 0; m &= m - 1) {
     const int i = std::countr_zero(m);
     const int px = x + (i & 3), py = y + (i >> 2);
-    const float z = plane.at(px, py, fused);
+    const float z = stored_depth(format, plane.at(px, py, fused));
     float& stored =
         img.texels[static_cast<std::size_t>(py) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(px)];
     if (depth_passes(F, z, stored)) {
@@ -31,6 +32,21 @@ void run_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint
 
 }  // namespace
 
+std::optional<DepthFormat> parse_depth_format(std::string_view n) noexcept {
+  if (n == "DEPTH_COMPONENT32F" || n == "DEPTH32F_STENCIL8") return DepthFormat::Float32;
+  if (n == "DEPTH24_STENCIL8" || n == "DEPTH_COMPONENT24") return DepthFormat::Unorm24;
+  return std::nullopt;
+}
+
+std::uint32_t to_unorm24(float z) noexcept {
+  const float p = z * 16777215.0f;  // one float rounding, as the JIT's fmul
+  if (!(p > 0.0f)) return 0;        // 0, negative zero and NaN
+  if (p >= 16777215.0f) return 16777215u;
+  return static_cast<std::uint32_t>(std::nearbyint(p));  // round to nearest, ties to even (cvtps2dq)
+}
+
+float from_unorm24(std::uint32_t q) noexcept { return static_cast<float>(static_cast<double>(q) / 16777215.0); }
+
 DepthCounters& DepthCounters::operator+=(const DepthCounters& o) {
   fragments += o.fragments;
   depth_tests += o.depth_tests;
@@ -40,8 +56,8 @@ DepthCounters& DepthCounters::operator+=(const DepthCounters& o) {
   return *this;
 }
 
-EarlyDepthTest::EarlyDepthTest(DepthImage& buffer, bool fused_interpolation)
-    : buffer_(&buffer), fused_(fused_interpolation) {}
+EarlyDepthTest::EarlyDepthTest(DepthImage& buffer, bool fused_interpolation, DepthFormat format)
+    : buffer_(&buffer), fused_(fused_interpolation), format_(format) {}
 
 void EarlyDepthTest::test_block(const DepthPlane& plane, int x, int y, std::uint16_t mask, const DepthState& state,
                                 DepthCounters& k) {
@@ -57,14 +73,14 @@ void EarlyDepthTest::test_block(const DepthPlane& plane, int x, int y, std::uint
   DepthImage& img = *buffer_;
   const bool w = state.write;
   switch (state.func) {
-    case DepthFunc::Never: run_block<DepthFunc::Never>(img, plane, x, y, mask, w, fused_, k); break;
-    case DepthFunc::Less: run_block<DepthFunc::Less>(img, plane, x, y, mask, w, fused_, k); break;
-    case DepthFunc::Equal: run_block<DepthFunc::Equal>(img, plane, x, y, mask, w, fused_, k); break;
-    case DepthFunc::Lequal: run_block<DepthFunc::Lequal>(img, plane, x, y, mask, w, fused_, k); break;
-    case DepthFunc::Greater: run_block<DepthFunc::Greater>(img, plane, x, y, mask, w, fused_, k); break;
-    case DepthFunc::NotEqual: run_block<DepthFunc::NotEqual>(img, plane, x, y, mask, w, fused_, k); break;
-    case DepthFunc::Gequal: run_block<DepthFunc::Gequal>(img, plane, x, y, mask, w, fused_, k); break;
-    case DepthFunc::Always: run_block<DepthFunc::Always>(img, plane, x, y, mask, w, fused_, k); break;
+    case DepthFunc::Never: run_block<DepthFunc::Never>(img, plane, x, y, mask, w, fused_, format_, k); break;
+    case DepthFunc::Less: run_block<DepthFunc::Less>(img, plane, x, y, mask, w, fused_, format_, k); break;
+    case DepthFunc::Equal: run_block<DepthFunc::Equal>(img, plane, x, y, mask, w, fused_, format_, k); break;
+    case DepthFunc::Lequal: run_block<DepthFunc::Lequal>(img, plane, x, y, mask, w, fused_, format_, k); break;
+    case DepthFunc::Greater: run_block<DepthFunc::Greater>(img, plane, x, y, mask, w, fused_, format_, k); break;
+    case DepthFunc::NotEqual: run_block<DepthFunc::NotEqual>(img, plane, x, y, mask, w, fused_, format_, k); break;
+    case DepthFunc::Gequal: run_block<DepthFunc::Gequal>(img, plane, x, y, mask, w, fused_, format_, k); break;
+    case DepthFunc::Always: run_block<DepthFunc::Always>(img, plane, x, y, mask, w, fused_, format_, k); break;
   }
 }
 

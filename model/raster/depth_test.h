@@ -6,9 +6,14 @@
 // Comparisons are IEEE float comparisons of fragment against stored depth, ordered except
 // NotEqual (which passes NaN), as lp_bld_depth.c builds them. With the test disabled every
 // fragment passes and nothing is written (GL: depth writes need the test enabled).
+// A 24-bit unorm buffer (DEPTH24_STENCIL8, DEPTH_COMPONENT24) is kept as floats too: a fragment's
+// depth becomes llvmpipe's 24-bit value first, and the buffer holds that value's float image
+// (from_unorm24), which is one-to-one and monotonic, so float comparisons are GL's integer ones.
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string_view>
 
 #include "model/common/depth.h"
 #include "model/raster/setup.h"
@@ -42,6 +47,25 @@ constexpr bool depth_passes(DepthFunc func, float fragment, float stored) noexce
   return false;
 }
 
+// The depth buffer's format, from the trace header's depth_format. Fixed values.
+enum class DepthFormat : std::uint8_t { Float32 = 0, Unorm24 = 1 };
+
+// "DEPTH_COMPONENT32F" and "DEPTH32F_STENCIL8" are Float32, "DEPTH24_STENCIL8" and
+// "DEPTH_COMPONENT24" Unorm24; anything else nullopt.
+std::optional<DepthFormat> parse_depth_format(std::string_view gl_name) noexcept;
+
+// llvmpipe's 24-bit value of a fragment depth in [0, 1] (lp_bld_conv.c
+// lp_build_clamped_float_to_unsigned_norm, width 24 = float mantissa + 1): the product
+// z * 16777215 rounded to float, then to the nearest integer, ties to even. NaN gives 0.
+std::uint32_t to_unorm24(float z) noexcept;
+// The float the buffer holds for a 24-bit value: q / (2^24 - 1) rounded to float (adjacent values
+// stay apart: their distance is above one float ulp in [0, 1]).
+float from_unorm24(std::uint32_t q) noexcept;
+// A fragment depth as a buffer of `format` stores it.
+inline float stored_depth(DepthFormat format, float z) noexcept {
+  return format == DepthFormat::Unorm24 ? from_unorm24(to_unorm24(z)) : z;
+}
+
 struct DepthState {
   DepthFunc func = DepthFunc::Less;
   bool test = true;   // GL_DEPTH_TEST
@@ -62,7 +86,8 @@ class EarlyDepthTest {
  public:
   // The unit tests against and writes to `buffer`, which must outlive it. `fused_interpolation`
   // evaluates the depth plane with FMA as llvmpipe does on FMA hosts (setup.h).
-  explicit EarlyDepthTest(DepthImage& buffer, bool fused_interpolation = true);
+  // `format` Unorm24 stores and compares llvmpipe's 24-bit depths (stored_depth).
+  explicit EarlyDepthTest(DepthImage& buffer, bool fused_interpolation = true, DepthFormat format = DepthFormat::Float32);
 
   // Tests the pixels of `mask` in the 4x4 block at (x, y) (bit i + 4 j is pixel (x + i, y + j);
   // they must lie inside the buffer).
@@ -71,10 +96,13 @@ class EarlyDepthTest {
 
   DepthImage& buffer() noexcept { return *buffer_; }
   bool fused_interpolation() const noexcept { return fused_; }
+  DepthFormat format() const noexcept { return format_; }
+  void set_format(DepthFormat format) noexcept { format_ = format; }
 
  private:
   DepthImage* buffer_;
   bool fused_;
+  DepthFormat format_;
 };
 
 }  // namespace nbsim::raster

@@ -1,9 +1,10 @@
 // RasterPath: one draw from clip space to depth-tested fragments through the plain C++ cores,
-// geometry (model/geometry) -> setup -> rasterizer -> early depth test (model/raster); triangle
+// geometry (model/geometry) -> setup -> rasterizer -> stencil and early depth test (model/raster); triangle
 // draws through triangle setup, point-sprite draws through point setup (point_setup.h). It is what
 // the SystemC units wrap one stage at a time, and what the counter comparison replays against GL.
 #pragma once
 
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "model/raster/point_setup.h"
 #include "model/raster/rasterizer.h"
 #include "model/raster/setup.h"
+#include "model/raster/stencil_test.h"
 
 namespace nbsim::raster {
 
@@ -22,12 +24,14 @@ struct RasterPathConfig {
   int batch_triangles = 85;         // geometry::GeometryConfig::batch_triangles
   bool fused_viewport = true;       // geometry::GeometryConfig::fused_viewport
   bool fused_interpolation = true;  // EarlyDepthTest: depth plane evaluated with FMA
+  DepthFormat depth_format = DepthFormat::Float32;  // Unorm24: the buffer holds llvmpipe's 24-bit depths
 };
 
 // The GL state of one draw that the path reads.
 struct DrawState {
   geometry::GeometryState geometry;
   DepthState depth;
+  StencilState stencil;  // test off: the stencil buffer is not touched
 };
 
 // Everything counted for one draw (or summed over many).
@@ -36,14 +40,17 @@ struct DrawCounters {
   SetupCounters setup;
   TileCounters tiles;
   DepthCounters depth;
+  StencilCounters stencil;
   DrawCounters& operator+=(const DrawCounters& o);
 };
 
 class RasterPath {
  public:
   // `depth` is the depth buffer the draws test and write; it must be width x height and outlive
-  // the path. Throws InputError for a bad size.
+  // the path. Throws InputError for a bad size. The path owns a stencil buffer cleared to 0.
   RasterPath(const RasterPathConfig& config, DepthImage& depth);
+  // The same with the caller's stencil buffer (width x height, outliving the path).
+  RasterPath(const RasterPathConfig& config, DepthImage& depth, StencilImage& stencil);
 
   // Runs one draw (three clip positions a triangle) and returns its counters.
   DrawCounters draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state);
@@ -53,15 +60,18 @@ class RasterPath {
                            const DrawState& state);
 
   const RasterPathConfig& config() const noexcept { return config_; }
-  DepthImage& depth() noexcept { return depth_test_.buffer(); }
+  DepthImage& depth() noexcept { return test_.depth(); }
+  StencilImage& stencil() noexcept { return test_.stencil(); }
 
  private:
+  RasterPath(const RasterPathConfig& config, DepthImage& depth, StencilImage* stencil);
   RasterPathConfig config_;
   geometry::GeometryStage geometry_;
   TriangleSetup setup_;
   PointSetup point_setup_;
   Rasterizer rasterizer_;
-  EarlyDepthTest depth_test_;
+  std::unique_ptr<StencilImage> own_stencil_;  // when the caller gave none
+  DepthStencilTest test_;
   std::vector<geometry::WindowTriangle> triangles_;  // reused from draw to draw
   std::vector<geometry::WindowPoint> points_;        // likewise
 };

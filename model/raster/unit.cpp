@@ -48,6 +48,7 @@ void RasterUnit::serve() {
     const auto walk = [&](const SetupTriangle& s) {
       const auto plane = static_cast<std::uint32_t>(b->planes.size());
       b->planes.push_back(s.depth);
+      b->front_facing.push_back(s.front_facing ? 1 : 0);
       rasterizer_.rasterize(s, b->tiles, [&](int x, int y, std::uint16_t mask) {
         b->blocks.push_back({x, y, mask, plane});
         pixels += static_cast<std::uint64_t>(std::popcount(mask));

@@ -39,6 +39,7 @@ struct BlockBatch {
   SetupCounters setup;
   TileCounters tiles;
   std::vector<DepthPlane> planes;
+  std::vector<std::uint8_t> front_facing;  // per plane: 1 when its primitive is front-facing (the stencil face)
   std::vector<Block> blocks;
 };
 using BlockBatchPtr = std::shared_ptr<const BlockBatch>;

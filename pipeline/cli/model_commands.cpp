@@ -186,7 +186,8 @@ void add_model_commands(CLI::App& app, Action& action) {
     cmd->add_flag("--json", *json, "Print one JSON summary object");
     mo->add_options(cmd);
     cmd->footer("Exit 0 only within the thresholds: total fragment and passed-sample error at most 0.01%, at least 99%\n"
-                "of draws exact, at least 99.99% of depth pixels within 1e-6 of GL's snapshots; exit 1 otherwise.");
+                "of draws exact, at least 99.99% of depth pixels within 1e-6 of GL's snapshots, every stencil pixel equal to a\n"
+                "frame's 'stencil' image when it has one; exit 1 otherwise.");
     cmd->callback([&action, trace, json, mo] {
       action = [trace, json, mo] {
         pipeline::ReplayOptions o;
@@ -206,6 +207,17 @@ void add_model_commands(CLI::App& app, Action& action) {
           fmt::print("  passed samples     model {} GL {} (error {:.4f}%)\n", s.passed_model, s.passed_gl, 100 * s.passed_error());
           fmt::print("  depth pixels       {} of {} within 1e-6 (max error {:.3g})\n", s.depth_pixels_matching, s.depth_pixels,
                      s.depth_max_abs_error);
+          if (s.stencil_pixels) {
+            fmt::print("  stencil pixels     {} of {} equal to GL's '{}' images ({} stencil tests)\n", s.stencil_pixels_matching,
+                       s.stencil_pixels, pipeline::kStencilSnapshotName, s.stencil_tests);
+            for (const pipeline::StencilMismatch& m : s.stencil_mismatches)
+              fmt::print("    frame {} pixel ({}, {}): model {} GL {}\n", m.frame, m.x, m.y, m.model, m.gl);
+            if (s.stencil_pixels - s.stencil_pixels_matching > s.stencil_mismatches.size())
+              fmt::print("    ... {} more\n", s.stencil_pixels - s.stencil_pixels_matching - s.stencil_mismatches.size());
+          } else if (s.stencil_tests) {
+            fmt::print("  stencil tests      {} (no '{}' stencil image in the trace to compare with)\n", s.stencil_tests,
+                       pipeline::kStencilSnapshotName);
+          }
           fmt::print("  {}\n", s.within_thresholds() ? "within the thresholds" : "OUTSIDE the thresholds");
         }
         return s.within_thresholds() ? 0 : 1;

@@ -67,6 +67,10 @@ class Gpu : public sc_core::sc_module {
 
   const memory::Channel& memory() const noexcept { return memory_; }
   const Program& program() const noexcept { return program_; }
+  // The depth unit: its depth and stencil buffers as the last work item left them.
+  const depth::DepthUnit& depth() const noexcept { return depth_; }
+  // The depth buffer's format (the trace header's depth_format); before sc_start.
+  void set_depth_format(raster::DepthFormat format) noexcept { depth_.set_depth_format(format); }
 
  private:
   memory::Channel memory_;

@@ -29,6 +29,7 @@ struct ProgramContext {
   const GpuConfig& config;
   const cull::CullSetup& setup;    // the trace as the programs see it: viewport, depth convention, scene
   const DepthImage& depth_buffer;  // the depth unit's
+  const raster::StencilImage& stencil_buffer;  // the depth unit's (8-bit, y up; cleared to 0 at each frame's start)
   memory::Channel& memory;
   const std::filesystem::path* out = nullptr;  // the run's output folder, for a program's own logs (null: none)
 

@@ -93,6 +93,28 @@ class Collector : public depth::ResultSink {
     s_.depth_pixels += depth.texels.size();
   }
 
+  void stencil_at_frame_end(const cp::Work& w, const raster::StencilImage& stencil) override {
+    const trace::StencilSnapshot* gl = w.frame->stencil(kStencilSnapshotName);
+    if (!gl) return;  // GL did not record the frame's stencil buffer
+    if (gl->width != stencil.width || gl->height != stencil.height)
+      throw InputError(fmt::format("frame {}: GL's '{}' stencil image is {}x{}, the viewport {}x{}", w.frame->begin.frame,
+                                   kStencilSnapshotName, gl->width, gl->height, stencil.width, stencil.height));
+    std::uint64_t matching = 0;
+    for (std::size_t i = 0; i < stencil.texels.size(); ++i) {
+      if (stencil.texels[i] == gl->texels[i]) {
+        ++matching;
+      } else if (s_.stencil_mismatches.size() < ReplaySummary::kMaxStencilMismatches) {
+        const int x = static_cast<int>(i % static_cast<std::size_t>(stencil.width));
+        const int y = static_cast<int>(i / static_cast<std::size_t>(stencil.width));
+        s_.stencil_mismatches.push_back({w.frame->begin.frame, x, y, stencil.texels[i], gl->texels[i]});
+      }
+    }
+    s_.stencil_pixels += stencil.texels.size();
+    s_.stencil_pixels_matching += matching;
+    frame_.stencil_pixels = stencil.texels.size();
+    frame_.stencil_matching = matching;
+  }
+
   void frame_done(const cp::Work& w, std::uint64_t cycle) override {
     ++s_.frames;
     s_.depth_pixels_matching += frame_.depth_matching;
@@ -102,6 +124,10 @@ class Collector : public depth::ResultSink {
                              frame_.depth_matching, frame_.depth_pixels, cycle, cycle - last_cycle_);
     nlohmann::ordered_json pf = {{"frame", w.frame->begin.frame}, {"draws", frame_.draws}, {"depth_tests", frame_.depth_tests},
                                  {"cycles", cycle - last_cycle_}};
+    if (frame_.stencil_pixels) {
+      pf["stencil_pixels"] = frame_.stencil_pixels;
+      pf["stencil_pixels_matching"] = frame_.stencil_matching;
+    }
     if (const stats::Group* g = registry_.find("gpu.cull")) {
       const nlohmann::ordered_json now = g->values();
       const auto delta = [&](const char* name) { return stat(now, name) - stat(last_cull_, name); };
@@ -138,6 +164,7 @@ class Collector : public depth::ResultSink {
   struct FrameTotals {
     std::uint64_t draws = 0, fragments_model = 0, fragments_gl = 0, passed_model = 0, passed_gl = 0, depth_tests = 0;
     std::uint64_t depth_matching = 0, depth_pixels = 0;
+    std::uint64_t stencil_matching = 0, stencil_pixels = 0;
   };
   ReplaySummary& s_;
   const ReplayOptions& o_;
@@ -264,7 +291,8 @@ double ReplaySummary::passed_error() const { return rel(passed_model, passed_gl)
 bool ReplaySummary::within_thresholds() const {
   const bool draws_ok = draws == 0 || static_cast<double>(draws_exact) >= 0.99 * static_cast<double>(draws);
   const bool depth_ok = depth_pixels == 0 || static_cast<double>(depth_pixels_matching) >= 0.9999 * static_cast<double>(depth_pixels);
-  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok;
+  const bool stencil_ok = stencil_pixels_matching == stencil_pixels;
+  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok && stencil_ok;
 }
 
 nlohmann::ordered_json ReplaySummary::to_json() const {
@@ -284,6 +312,15 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   j["depth_pixels"] = depth_pixels;
   j["depth_pixels_matching"] = depth_pixels_matching;
   j["depth_max_abs_error"] = depth_max_abs_error;
+  if (stencil_tests || stencil_pixels) {
+    j["stencil_tests"] = stencil_tests;
+    j["stencil_pixels"] = stencil_pixels;
+    j["stencil_pixels_matching"] = stencil_pixels_matching;
+    nlohmann::ordered_json m = nlohmann::ordered_json::array();
+    for (const StencilMismatch& p : stencil_mismatches)
+      m.push_back({{"frame", p.frame}, {"x", p.x}, {"y", p.y}, {"model", p.model}, {"gl", p.gl}});
+    j["stencil_mismatches"] = m;
+  }
   j["cycles"] = cycles;
   j["host_seconds"] = host_seconds;
   j["depth_tests_per_host_second"] = host_seconds > 0 ? static_cast<double>(depth_tests) / host_seconds : 0.0;
@@ -338,6 +375,15 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.properties = tr.properties();
   Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head.technique, setup,
           o.out ? &*o.out : nullptr);
+  for (const auto& [k, v] : tr.properties()) {  // DEPTH24_STENCIL8 captures compare 24-bit depths
+    if (k != "depth_format") continue;
+    const std::optional<raster::DepthFormat> f = raster::parse_depth_format(v);
+    if (!f)
+      throw InputError(fmt::format("{}: the header's depth_format '{}' is not one the model replays (DEPTH_COMPONENT32F, "
+                                   "DEPTH32F_STENCIL8, DEPTH24_STENCIL8, DEPTH_COMPONENT24)",
+                                   o.trace.string(), v));
+    gpu.set_depth_format(*f);
+  }
   std::optional<sim::Timeline> timeline;  // only when asked: units then report their busy spans
   if (o.timeline || o.vcd) {
     sim::TimelineOptions to;
@@ -353,6 +399,7 @@ ReplaySummary replay(const ReplayOptions& o) {
   sim::rethrow_thread_failure();  // a damaged trace read mid-run, as an InputError
   s.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.stats = registry.values();
+  s.stencil_tests = stat(s.stats["gpu.depth"], "stencil_tests");
   if (s.stats.contains("gpu.cull")) {
     s.cull = cull_summary(s.stats["gpu.cull"], s.stats["gpu.depth"], o.config.cull, sink.last_frame_cycle(),
                           sink.visible_draws_passed_below_gl);

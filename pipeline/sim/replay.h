@@ -1,6 +1,7 @@
 // Replay of a trace through the SystemC model (pipeline/sim/gpu.h), with the counter comparison
 // against what GL recorded: per draw, rasterized fragments and passed samples; per frame, the
-// depth buffer at GL's snapshots. Writes run.json, frames.csv and draws.csv when given a folder.
+// depth buffer at GL's snapshots and, when the frame recorded a stencil image named "stencil"
+// (kStencilSnapshotName), the stencil buffer at the frame's end. Writes run.json, frames.csv and draws.csv when given a folder.
 #pragma once
 
 #include <cstdint>
@@ -27,6 +28,17 @@ struct ReplayOptions {
   std::function<void(std::uint64_t frames_done, std::uint64_t frames_total)> progress;
 };
 
+// The frame's stencil image that `nbsim compare` compares with the model's stencil buffer at the
+// frame's end.
+inline constexpr const char* kStencilSnapshotName = "stencil";
+
+// One stencil pixel that differs from GL's (the first few of a run are kept).
+struct StencilMismatch {
+  std::uint32_t frame = 0;
+  int x = 0, y = 0;  // y up
+  unsigned model = 0, gl = 0;
+};
+
 struct ReplaySummary {
   std::uint64_t frames = 0;
   std::uint64_t draws = 0;        // GL's draws with geometry, replayed (compared with GL's counters)
@@ -41,6 +53,12 @@ struct ReplaySummary {
   std::uint64_t depth_tests = 0;
   std::uint64_t depth_pixels = 0, depth_pixels_matching = 0;
   double depth_max_abs_error = 0.0;
+  // Stencil: the depth unit's stencil tests, and the stencil buffer against GL's "stencil" images
+  // (zero when the trace has none); the first kMaxStencilMismatches differing pixels.
+  std::uint64_t stencil_tests = 0;
+  std::uint64_t stencil_pixels = 0, stencil_pixels_matching = 0;
+  static constexpr std::size_t kMaxStencilMismatches = 10;
+  std::vector<StencilMismatch> stencil_mismatches;
   std::uint64_t cycles = 0;
   double host_seconds = 0.0;
   std::uint64_t timeline_events = 0, timeline_dropped = 0;  // spans written to / left out of the timeline
@@ -55,8 +73,10 @@ struct ReplaySummary {
   double fragment_error() const;  // |model - gl| / gl over all draws
   double passed_error() const;
   // Issue 4's thresholds: total fragment and passed-sample error at most 0.01%, at least 99% of
-  // draws exact, at least 99.99% of depth pixels within the tolerance.
+  // draws exact, at least 99.99% of depth pixels within the tolerance; and every stencil pixel
+  // equal to GL's (the stencil buffer is bit-exact or wrong).
   bool within_thresholds() const;
+  // The stencil fields appear only for traces that have stencil draws or stencil images.
   nlohmann::ordered_json to_json() const;
 };
 

@@ -1,5 +1,5 @@
 // DepthTestTest: the early depth test (model/raster/depth_test.h): the depth functions, the depth
-// plane's interpolation and clamp, a disabled test.
+// plane's interpolation and clamp, a disabled test, the 24-bit depth format.
 #include "model/raster/depth_test.h"
 
 #include <gtest/gtest.h>
@@ -76,6 +76,52 @@ TEST(DepthTestTest, DisabledTestPassesWithoutWriting) {
   EXPECT_EQ(k.depth_tests, 0u) << "no comparison when the test is off";
   EXPECT_EQ(k.written, 0u);
   EXPECT_EQ(img.at(0, 0), 0.25f);
+}
+
+// llvmpipe's 24-bit depth: the product rounded to float, then ties to even; ends and NaN fixed.
+TEST(DepthTestTest, Unorm24Conversion) {
+  struct Row {
+    float z;
+    std::uint32_t q;
+    const char* why;
+  };
+  const Row rows[] = {
+      {0.0f, 0u, "zero"},
+      {1.0f, 16777215u, "one"},
+      {0.5f, 8388608u, "0.5 * (2^24 - 1) = 8388607.5, a tie: to even"},
+      {1.5f / 16777215.0f, 2u, "1.5 rounds to even 2"},
+      {2.5f / 16777215.0f, 2u, "2.5 rounds to even 2"},
+      {-0.25f, 0u, "negative clamps to 0"},
+      {2.0f, 16777215u, "above one clamps"},
+      {NAN, 0u, "NaN is 0"},
+  };
+  for (const Row& r : rows) EXPECT_EQ(to_unorm24(r.z), r.q) << r.why;
+}
+
+// The float image of every 24-bit value is strictly increasing (so float comparisons are the
+// integer ones) and converts back to the same value.
+TEST(DepthTestTest, Unorm24FloatsAreOneToOne) {
+  float last = -1.0f;
+  std::uint32_t bad_order = 0, bad_back = 0;
+  for (std::uint32_t q = 0; q <= 16777215u; ++q) {
+    const float f = from_unorm24(q);
+    bad_order += f > last ? 0 : 1;
+    bad_back += to_unorm24(f) == q ? 0 : 1;
+    last = f;
+  }
+  EXPECT_EQ(bad_order, 0u) << "from_unorm24 must be strictly increasing";
+  EXPECT_EQ(bad_back, 0u) << "to_unorm24(from_unorm24(q)) must be q";
+  EXPECT_EQ(from_unorm24(16777215u), 1.0f);
+  EXPECT_EQ(stored_depth(DepthFormat::Float32, 0.3f), 0.3f) << "Float32 stores the fragment depth";
+}
+
+// The trace header's depth_format names.
+TEST(DepthTestTest, DepthFormatNames) {
+  EXPECT_EQ(parse_depth_format("DEPTH_COMPONENT32F"), DepthFormat::Float32);
+  EXPECT_EQ(parse_depth_format("DEPTH32F_STENCIL8"), DepthFormat::Float32);
+  EXPECT_EQ(parse_depth_format("DEPTH24_STENCIL8"), DepthFormat::Unorm24);
+  EXPECT_EQ(parse_depth_format("DEPTH_COMPONENT24"), DepthFormat::Unorm24);
+  EXPECT_FALSE(parse_depth_format("DEPTH_COMPONENT16").has_value());
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "tests/model/raster/point_coverage.h"
 #include "traces/capture/gl_program.h"
 #include "traces/format/writer.h"
+#include "tests/model/raster/gl_suite.h"
 #include "traces/gl/context.h"
 #include "tests/common/run_nbsim.h"
 #include <nlohmann/json.hpp>
@@ -178,15 +179,6 @@ class GlPoints {
 };
 
 // ---- cases ------------------------------------------------------------------------------------
-
-// Deterministic floats in [0, 1) from a fixed-seed engine (its output is specified by the standard).
-struct Rng {
-  std::mt19937 e;
-  explicit Rng(unsigned seed) : e(seed) {}
-  float unit() { return static_cast<float>(e() >> 8) * (1.0f / 16777216.0f); }
-  float range(float a, float b) { return a + (b - a) * unit(); }
-  unsigned below(unsigned n) { return static_cast<unsigned>(e() % n); }
-};
 
 const std::vector<float> kSizes = {1, 1.5f, 2, 3, 7.5f, 16, 24, 33, 64, 100, 255, 300, 0.5f, 1.001953125f};
 
@@ -393,22 +385,7 @@ Outcome compare(GlPoints& gl, const Case& c) {
   return o;
 }
 
-class PointGlCompareTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    context_ = new gl::Context();
-    gl_ = new GlPoints();
-  }
-  static void TearDownTestSuite() {
-    delete gl_;
-    delete context_;
-  }
-  void SetUp() override { ASSERT_TRUE(gl_->complete()) << "depth-only FBO must be complete"; }
-  static gl::Context* context_;
-  static GlPoints* gl_;
-};
-gl::Context* PointGlCompareTest::context_ = nullptr;
-GlPoints* PointGlCompareTest::gl_ = nullptr;
+using PointGlCompareTest = testing::GlSuite<GlPoints>;
 
 // Every size from 0.5 to 300 at pixel centres, edges and corners (fill-rule ties on both axes).
 TEST_F(PointGlCompareTest, CentresEdgesAndCornersMatchGl) {

@@ -55,7 +55,8 @@ bool CompareSummary::within_thresholds() const {
   };
   return draws > 0 && static_cast<double>(draws_exact) >= 0.99 * static_cast<double>(draws) &&
          rel(fragments_model, fragments_gl) <= 1e-4 && rel(passed_model, passed_gl) <= 1e-4 &&
-         static_cast<double>(depth_pixels_matching) >= 0.9999 * static_cast<double>(depth_pixels);
+         static_cast<double>(depth_pixels_matching) >= 0.9999 * static_cast<double>(depth_pixels) &&
+         stencil_pixels_matching == stencil_pixels;
 }
 
 CompareSummary compare_trace(const std::filesystem::path& path, const CompareOptions& options) {
@@ -71,14 +72,19 @@ CompareSummary compare_trace(const std::filesystem::path& path, const CompareOpt
   config.batch_triangles = options.batch_triangles;
   config.fused_viewport = options.fused_viewport;
   config.fused_interpolation = options.fused_interpolation;
+  for (const auto& [k, v] : frames.trace().properties())
+    if (k == "depth_format")
+      if (const auto f = raster::parse_depth_format(v)) config.depth_format = *f;
   DepthImage depth(width, height, clear);
-  raster::RasterPath path_core(config, depth);
+  raster::StencilImage stencil(width, height, 0);
+  raster::RasterPath path_core(config, depth, stencil);
 
   CompareSummary s;
   const std::uint64_t full_screen = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
   while (auto f = frames.next()) {
     s.frames += 1;
     std::fill(depth.texels.begin(), depth.texels.end(), clear);
+    std::fill(stencil.texels.begin(), stencil.texels.end(), std::uint8_t{0});  // glClearStencil(0)
     std::size_t occluders_end = 0;
     for (std::size_t i = 0; i < f->draws.size(); ++i)
       if (f->draws[i].role == trace::DrawRole::Occluder) occluders_end = i + 1;
@@ -97,9 +103,11 @@ CompareSummary compare_trace(const std::filesystem::path& path, const CompareOpt
         continue;
       }
       const auto t0 = std::chrono::steady_clock::now();
+      raster::DrawState state = draw_state(d.state);
+      if (d.stencil.test) state.stencil = raster::stencil_state(d.stencil);
       const raster::DrawCounters k = d.topology == trace::Topology::Points
-                                         ? path_core.draw_points(d.clip_positions, d.point_sizes, draw_state(d.state))
-                                         : path_core.draw(d.clip_positions, draw_state(d.state));
+                                         ? path_core.draw_points(d.clip_positions, d.point_sizes, state)
+                                         : path_core.draw(d.clip_positions, state);
       s.model_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       s.totals += k;
       s.draws += 1;
@@ -136,6 +144,10 @@ CompareSummary compare_trace(const std::filesystem::path& path, const CompareOpt
     }
     if (const trace::DepthSnapshot* fin = f->depth(trace::DepthWhich::Final))
       compare_depth(depth, *fin, options.depth_tolerance, s);
+    if (const trace::StencilSnapshot* gl = f->stencil("stencil"); gl && gl->texels.size() == stencil.texels.size()) {
+      s.stencil_pixels += gl->texels.size();
+      for (std::size_t i = 0; i < gl->texels.size(); ++i) s.stencil_pixels_matching += gl->texels[i] == stencil.texels[i] ? 1 : 0;
+    }
   }
   return s;
 }
@@ -155,7 +167,8 @@ std::string to_json(const CompareSummary& s) {
     << ",\"depth_snapshots\":" << s.depth_snapshots << ",\"depth_pixels\":" << s.depth_pixels
     << ",\"depth_pixels_matching\":" << s.depth_pixels_matching
     << ",\"depth_pixels_identical\":" << s.depth_pixels_identical
-    << ",\"depth_max_abs_error\":" << s.depth_max_abs_error
+    << ",\"depth_max_abs_error\":" << s.depth_max_abs_error << ",\"stencil_pixels\":" << s.stencil_pixels
+    << ",\"stencil_pixels_matching\":" << s.stencil_pixels_matching
     << ",\"within_thresholds\":" << (s.within_thresholds() ? "true" : "false")
     << ",\"model_seconds\":" << s.model_seconds << ",\"model_fragments_per_second\":"
     << (s.model_seconds > 0 ? static_cast<double>(t.depth.fragments) / s.model_seconds : 0.0)

@@ -49,6 +49,8 @@ struct CompareSummary {
   std::uint64_t depth_pixels = 0;
   std::uint64_t depth_pixels_matching = 0;   // within depth_tolerance
   std::uint64_t depth_pixels_identical = 0;  // bit for bit
+  std::uint64_t stencil_pixels = 0;           // pixels of the frames' "stencil" images
+  std::uint64_t stencil_pixels_matching = 0;  // equal to the stencil buffer at the frame's end
   double depth_max_abs_error = 0.0;
   raster::DrawCounters totals;  // the model's counters summed over the draws with geometry
   double model_seconds = 0.0;   // host time spent in RasterPath::draw
