@@ -141,9 +141,13 @@ class Shadows final : public Technique {
 
  private:
   LightCamera light_at(std::uint32_t index) const;
-  // `seen`: the observer sees the caster itself (a pixel of the ID buffer).
-  CasterResult decide(const CasterMesh& c, const LightCamera& light, const scene::NBufferLevels& lo,
-                      const scene::NBufferLevels& hi, bool seen) const;
+  // A caster's light-space rectangle, bounds depths and eight lookups; decision Volume unless it is
+  // outside the light's frustum or crosses its near plane (then final).
+  CasterResult measure(const CasterMesh& c, const LightCamera& light, const scene::NBufferLevels& lo,
+                       const scene::NBufferLevels& hi) const;
+  // The decision and planes of a measured caster from the depth range of the receivers that may lie
+  // in its rectangle, [slab_min, slab_max].
+  void decide(CasterResult& r, const LightCamera& light, double slab_min, double slab_max) const;
   VolumeEnds ends_of(const CasterResult& r, bool clamped) const;
   // Uploads `positions` (three a triangle) to the volume buffer.
   void upload(const std::vector<glm::vec4>& positions);
@@ -260,8 +264,8 @@ LightCamera Shadows::light_at(std::uint32_t index) const {
   return l;
 }
 
-CasterResult Shadows::decide(const CasterMesh& c, const LightCamera& light, const scene::NBufferLevels& lo,
-                             const scene::NBufferLevels& hi, bool seen) const {
+CasterResult Shadows::measure(const CasterMesh& c, const LightCamera& light, const scene::NBufferLevels& lo,
+                              const scene::NBufferLevels& hi) const {
   CasterResult r;
   const scene::Aabb& b = scene_.scene.objects[c.object];
   double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, d0 = INFINITY, d1 = -INFINITY;
@@ -298,26 +302,23 @@ CasterResult Shadows::decide(const CasterMesh& c, const LightCamera& light, cons
     r.z_max = std::max(r.z_max, hi.texels[at]);
   }
   r.lookups = 2u * static_cast<std::uint32_t>(cov.count);
-  // The slab of visible receivers, widened: [near, far] in light window depth. A caster the
-  // observer sees receives its own shadow on its faces turned from the light, which the litmaps see
-  // edge-on, thinner than a lexel, and miss: its own bounds' depth range joins the slab (so a
-  // caster the observer sees is never culled).
-  const double slab_min = seen ? std::min(static_cast<double>(r.z_min), d0) : r.z_min;
-  const double slab_max = seen ? std::max(static_cast<double>(r.z_max), d1) : r.z_max;
-  const double far = light.depth_of_distance(light.distance_of_depth(slab_max) * (1.0 + kClampRel) + kClampM);
-  if (far < std::max(slab_min, d0)) {
-    r.decision = CasterDecision::Culled;
-    return r;
-  }
-  {  // the planes: clamped mode ends its volume there, the others cut its sides there
-    r.clamp_far = static_cast<float>(far);
-    const double near_m = light.distance_of_depth(slab_min) * (1.0 - kClampRel) - kClampM;
-    const double near = near_m > light.near_m ? light.depth_of_distance(near_m) : 0.0;
-    // Only when every receiver is behind the whole caster: a plane through the caster would cut
-    // its lit faces off the volume's near cap.
-    if (near >= d1) r.clamp_near = static_cast<float>(near);
-  }
   return r;
+}
+
+void Shadows::decide(CasterResult& r, const LightCamera& light, double slab_min, double slab_max) const {
+  // The slab of visible receivers, widened: [near, far] in light window depth.
+  const double far = light.depth_of_distance(light.distance_of_depth(slab_max) * (1.0 + kClampRel) + kClampM);
+  if (far < std::max(slab_min, static_cast<double>(r.caster_near))) {
+    r.decision = CasterDecision::Culled;
+    return;
+  }
+  // The planes: clamped mode ends its volume there, the others cut its sides there.
+  r.clamp_far = static_cast<float>(far);
+  const double near_m = light.distance_of_depth(slab_min) * (1.0 - kClampRel) - kClampM;
+  const double near = near_m > light.near_m ? light.depth_of_distance(near_m) : 0.0;
+  // Only when every receiver is behind the whole caster: a plane through the caster would cut its
+  // lit faces off the volume's near cap.
+  if (near >= r.caster_far) r.clamp_near = static_cast<float>(near);
 }
 
 VolumeEnds Shadows::ends_of(const CasterResult& r, bool clamped) const {
@@ -465,8 +466,41 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   std::vector<CasterResult> results(casters_.size());
   std::vector<glm::vec4> positions;
   std::vector<std::pair<std::size_t, std::size_t>> ranges(casters_.size());  // first vertex, count
+  for (std::size_t c = 0; c < casters_.size(); ++c) results[c] = measure(casters_[c], light, min_levels, max_levels);
+  // The receivers the litmaps may miss: faces of casters that the light sees nearly edge-on (a
+  // caster's own faces turned from the light, a neighbour's walls), whose depth changes across one
+  // lexel by more than the clamp margin, and faces smaller than two lexels. Every caster the
+  // observer sees adds to the slab of each caster whose rectangle its own overlaps the depth range
+  // of those triangles inside that rectangle, and its own bounds' depth range to its own slab (one
+  // crossing the light's near plane adds [0, 1] everywhere). Open receivers (the plane, the
+  // terrain) come from the litmaps alone.
+  const double lexel_ndc = 2.0 / litmap_;
+  // A face whose depth changes by at most the clamp margin across 1.5 lexels is sampled well enough.
+  const double max_tan = kClampRel / (1.5 * lexel_ndc * std::tan(light.fov_y_deg * 3.14159265358979323846 / 360.0));
+  std::vector<std::size_t> seen_casters;
+  std::vector<std::vector<std::array<glm::dvec3, 3>>> thin(casters_.size());
+  for (std::size_t c = 0; c < casters_.size(); ++c)
+    if (seen[casters_[c].object] && results[c].decision != CasterDecision::OutsideLight) {
+      seen_casters.push_back(c);
+      if (results[c].decision == CasterDecision::Volume) thin[c] = thin_triangles(scene_, casters_[c], light, glm::dvec3(pose.eye), max_tan, lexel_ndc);
+    }
   for (std::size_t c = 0; c < casters_.size(); ++c) {
-    results[c] = decide(casters_[c], light, min_levels, max_levels, seen[casters_[c].object] != 0);
+    CasterResult& r = results[c];
+    if (r.decision == CasterDecision::Volume) {
+      double slab_min = r.z_min, slab_max = r.z_max;
+      if (seen[casters_[c].object]) slab_min = std::min(slab_min, static_cast<double>(r.caster_near)), slab_max = std::max(slab_max, static_cast<double>(r.caster_far));
+      for (std::size_t k : seen_casters) {
+        const CasterResult& o = results[k];
+        if (o.decision == CasterDecision::CrossesNear) {
+          slab_min = 0.0, slab_max = 1.0;
+        } else if (k != c && o.x < r.x + r.w && r.x < o.x + o.w && o.y < r.y + r.h && r.y < o.y + o.h) {
+          for (const auto& t : thin[k])
+            depth_range_in_rect(light, {t.begin(), t.end()}, r.x * lexel_ndc - 1.0, (r.x + r.w) * lexel_ndc - 1.0, r.y * lexel_ndc - 1.0,
+                                (r.y + r.h) * lexel_ndc - 1.0, slab_min, slab_max);
+        }
+      }
+      decide(r, light, slab_min, slab_max);
+    }
     const bool dropped = results[c].decision == CasterDecision::Culled || results[c].decision == CasterDecision::OutsideLight;
     if (mode_ != Mode::Infinite && dropped) continue;
     const std::size_t first = positions.size();
