@@ -10,8 +10,11 @@
 //  3. a min and a max N-buffer over them (GLSL, the shared glsl_nbuffer.h, every level);
 //  4. per caster: its light-space rectangle (its bounds' 8 corners, grown by one lexel), z_min
 //     (min N-buffer: the nearest visible receiver) and z_max (max N-buffer: the farthest), four
-//     lookups each, read from the levels GL built; the decision (culled when z_max < max(z_min,
-//     caster_near), widened by a margin) and the clamp planes;
+//     lookups each, read from the levels GL built; the slab of receivers [z_min, z_max] widened
+//     for what litmaps cannot sample (faces of casters the observer sees that the light sees
+//     edge-on or smaller than two lexels, clipped to the rectangle; a seen caster's own bounds);
+//     the decision (culled when the slab's far end, plus a margin, is nearer than max(slab's near
+//     end, caster_near)) and the clamp planes;
 //  5. the shadow volumes of --shadow-mode, one draw a caster (role ShadowVolume): z-fail with caps
 //     (Carmack's reverse), two-sided stencil in one pass (back faces INCR_WRAP, front faces
 //     DECR_WRAP on depth fail), depth test LESS without depth writes, no face culling, depth clamp
