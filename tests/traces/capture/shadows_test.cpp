@@ -81,6 +81,8 @@ std::vector<FrameResult> check_trace(const fs::path& file, const std::string& mo
     if (f->technique_records.size() != 1) return out;
     const auto& rec = f->technique_records[0];
     EXPECT_EQ(rec.type, trace::kShadowsChunk);
+    for (const auto& fl : rec.fields)
+      if (fl.name == "mask_diff_pixels") EXPECT_EQ(std::get<std::uint64_t>(fl.value), 0u) << "the recorded count of differing mask pixels";
     const auto& decision = field<std::uint32_t>(rec, "decision");
     const auto& draw = field<std::int32_t>(rec, "draw");
     const auto& clamp_far = field<float>(rec, "clamp_far");
