@@ -81,8 +81,11 @@ std::vector<FrameResult> check_trace(const fs::path& file, const std::string& mo
     if (f->technique_records.size() != 1) return out;
     const auto& rec = f->technique_records[0];
     EXPECT_EQ(rec.type, trace::kShadowsChunk);
-    for (const auto& fl : rec.fields)
-      if (fl.name == "mask_diff_pixels") EXPECT_EQ(std::get<std::uint64_t>(fl.value), 0u) << "the recorded count of differing mask pixels";
+    for (const auto& fl : rec.fields) {
+      if (fl.name == "mask_diff_pixels") {
+        EXPECT_EQ(std::get<std::uint64_t>(fl.value), 0u) << "the recorded count of differing mask pixels";
+      }
+    }
     const auto& decision = field<std::uint32_t>(rec, "decision");
     const auto& draw = field<std::int32_t>(rec, "draw");
     const auto& clamp_far = field<float>(rec, "clamp_far");
@@ -149,7 +152,10 @@ TEST(ShadowsTest, EverySceneAndModeKeepsTheMask) {
 // "X,Y,Z,TX,TY,TZ" for --light.
 std::string fmt_light(float x, float y, float z, float tx, float ty, float tz) {
   std::string out;
-  for (float v : {x, y, z, tx, ty, tz}) out += (out.empty() ? "" : ",") + std::to_string(v);
+  for (float v : {x, y, z, tx, ty, tz}) {
+    if (!out.empty()) out += ',';
+    out += std::to_string(v);
+  }
   return out;
 }
 
