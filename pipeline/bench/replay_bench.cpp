@@ -23,8 +23,11 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
   if (std::sscanf(o.size.c_str(), "%dx%d", &c.width, &c.height) != 2) c.width = c.height = 512;
   c.frames = o.frames;
   c.technique = o.technique;
-  c.scene = "city";
+  c.scene = o.scene.empty() ? "city" : o.scene;
   const bool particles = o.technique == "particles";
+  if (c.scene != "city" && o.technique != "shadows")
+    throw InputError(fmt::format("--scene {}: {} benches the city only (the other scenes are the shadows technique's)", c.scene,
+                                 o.technique));
   std::string mode = o.mode;
   if (particles) {
     if (mode.empty()) mode = "nb";
@@ -36,8 +39,14 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
     if (!parse_enum_name<scene::TestMode>(scene::kTestModeNames, mode))
       throw InputError(fmt::format("--mode '{}' is not an occlusion_culling mode ({})", mode, fmt::join(name_list(scene::kTestModeNames), ", ")));
     c.options = {{"mode", mode}, {"levels-every", "0"}};
+  } else if (o.technique == "shadows") {
+    if (mode.empty()) mode = "clamped";
+    if (mode != "infinite" && mode != "culled" && mode != "clamped")
+      throw InputError(fmt::format("--mode '{}' is not a shadows mode (infinite, culled, clamped)", mode));
+    c.path = "fly";
+    c.options = {{"shadow-mode", mode}, {"levels-every", "0"}};
   } else {
-    throw InputError(fmt::format("--technique '{}' is not one of occlusion_culling, particles", o.technique));
+    throw InputError(fmt::format("--technique '{}' is not one of {}", o.technique, fmt::join(kReplayBenchTechniques, ", ")));
   }
   const auto file = std::filesystem::temp_directory_path() / ("nbsim_bench_" + std::to_string(::getpid()) + ".nbt");
   const capture::CaptureSummary cap = capture::capture(c, file.string());
@@ -63,6 +72,7 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
     j["particles"] = o.particles;
     j["sprite"] = o.sprite;
   }
+  if (o.technique == "shadows") j["scene"] = c.scene;
   j["draws"] = s.draws;
   j["gl_ms"] = cap.gl_ms;
   j["replay_ms"] = s.host_seconds * 1e3;

@@ -107,8 +107,9 @@ void add_bench_commands(CLI::App& app, Action& action) {
         ->check(CLI::IsMember(std::vector<std::string>(std::begin(bench::kReplayBenchTechniques), std::end(bench::kReplayBenchTechniques))))
         ->capture_default_str();
     rep->add_option("--mode", ro->mode,
-                    "Capture test mode: occlusion_culling's (oq, oq_hier, nb, nb_hier, none; default oq) or particles' "
-                    "(none, center, nb, hiz; default nb)");
+                    "Capture test mode: occlusion_culling's (oq, oq_hier, nb, nb_hier, none; default oq), particles' "
+                    "(none, center, nb, hiz; default nb) or shadows' (infinite, culled, clamped; default clamped)");
+    rep->add_option("--scene", ro->scene, "Scene: city (default); shadows also terrain or boxes (flown over)");
     rep->add_option("--particles", ro->particles, "Particles a frame (technique particles)")->capture_default_str();
     rep->add_option("--sprite", ro->sprite, "Sprite size: 16, 24 or atten (technique particles)")->capture_default_str();
     rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes; particles: scene, partial N-buffer or Hi-Z\n"

@@ -1,4 +1,4 @@
-// BenchReplayCliTest: `nbsim bench replay` from the outside, for the particles technique: one JSON
+// BenchReplayCliTest: `nbsim bench replay` from the outside, for particles and shadows: one JSON
 // object with llvmpipe's time, the model's replay time and their ratio, measured in the same run
 // (the ratio is printed and recorded, never asserted: it depends on the machine), and bad
 // arguments refused with exit 2.
@@ -39,13 +39,32 @@ TEST(BenchReplayCliTest, ParticlesRatioPrinted) {
               j.at("gl_ms").get<double>(), j.at("replay_ms").get<double>());
 }
 
+// A small shadows capture (boxes, flown over) replayed in the same run: the volume draws with their
+// stencil state are exact and the stencil buffer equals GL's (within_thresholds covers it).
+TEST(BenchReplayCliTest, ShadowsRatioPrinted) {
+  const CliResult r = run_nbsim("bench replay --technique shadows --scene boxes --size 128x96 --frames 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("technique"), "shadows");
+  EXPECT_EQ(j.at("mode"), "clamped") << "the shadows default mode";
+  EXPECT_EQ(j.at("scene"), "boxes");
+  EXPECT_GT(j.at("gl_ms").get<double>(), 0.0);
+  EXPECT_GT(j.at("ratio").get<double>(), 0.0);
+  EXPECT_GT(j.at("draws").get<int>(), 0);
+  EXPECT_EQ(j.at("draws_exact"), j.at("draws"));
+  EXPECT_TRUE(j.at("within_thresholds").get<bool>());
+}
+
 // Bad arguments exit 2 with a message naming them.
 TEST(BenchReplayCliTest, BadArgumentsExitTwo) {
   struct Case {
     const char* args;
     const char* message;
   };
-  for (const Case& c : {Case{"--technique shadows", "--technique"},
+  for (const Case& c : {Case{"--technique raytracing", "--technique"},
+                        Case{"--technique shadows --mode nb", "--mode 'nb' is not a shadows mode (infinite, culled, clamped)"},
+                        Case{"--technique particles --scene boxes", "--scene boxes: particles benches the city only"},
+                        Case{"--technique shadows --scene forest", "forest"},
                         Case{"--technique particles --mode oq", "--mode 'oq' is not a particles mode"},
                         Case{"--mode hiz", "--mode 'hiz' is not an occlusion_culling mode"},
                         Case{"--particles 500", "--particles and --sprite need --technique particles"},
