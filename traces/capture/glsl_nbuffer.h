@@ -15,6 +15,7 @@
 #include "model/scene/frame.h"
 #include "traces/capture/draw_recorder.h"
 #include "traces/capture/gl_program.h"
+#include "traces/capture/level_chain.h"
 
 namespace nbsim::capture {
 
@@ -40,17 +41,14 @@ class GlslNBuffer {
   scene::NBufferLevels read() const;
 
   // The levels as a 2D array texture, one R32F layer a level (for a technique's own queries).
-  GLuint texture() const noexcept { return level_array_; }
+  GLuint texture() const noexcept { return chain_.array(); }
 
  private:
   int width_ = 0, height_ = 0, levels_ = 1;
   FarOp op_ = FarOp::Max;
-  GLuint build_prog_ = 0, query_prog_ = 0, empty_vao_ = 0;
+  GLuint build_prog_ = 0, query_prog_ = 0;
   GLuint query_ssbo_ = 0, result_ssbo_ = 0;
-  // One R32F texture per level to render into (no feedback loop), copied into the array texture
-  // that the passes and the queries read.
-  std::vector<GLuint> level_tex_, level_fbo_;
-  GLuint level_array_ = 0;
+  LevelChain chain_;  // every level full size
 };
 
 }  // namespace nbsim::capture

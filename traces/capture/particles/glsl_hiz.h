@@ -11,6 +11,7 @@
 #include "model/scene/frame.h"
 #include "traces/capture/draw_recorder.h"
 #include "traces/capture/gl_program.h"
+#include "traces/capture/level_chain.h"
 
 namespace nbsim::capture {
 
@@ -21,18 +22,17 @@ class GlslHiZ {
   GlslHiZ(const GlslHiZ&) = delete;
   GlslHiZ& operator=(const GlslHiZ&) = delete;
 
-  int levels() const noexcept { return levels_; }
-  GLuint texture() const noexcept { return level_array_; }
+  int levels() const noexcept { return chain_.levels(); }
+  GLuint texture() const noexcept { return chain_.array(); }
 
   // Builds every level from `depth_texture`, recording each pass (role HiZBuild, its level, `state`).
   // Leaves back-face culling on and depth testing off.
   void build(GLuint depth_texture, DrawRecorder& recorder, const scene::DepthState& state);
 
  private:
-  int width_ = 0, height_ = 0, levels_ = 1;
-  GLuint build_prog_ = 0, empty_vao_ = 0;
-  std::vector<GLuint> level_tex_, level_fbo_;
-  GLuint level_array_ = 0;
+  int width_ = 0, height_ = 0;
+  GLuint build_prog_ = 0;
+  LevelChain chain_;  // level k: ceil(W / 2^k) x ceil(H / 2^k)
 };
 
 }  // namespace nbsim::capture
