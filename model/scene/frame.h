@@ -53,6 +53,8 @@ enum class DrawRole : std::uint8_t {
   Scene = 7,          // a scene object drawn to fill the depth buffer, nothing culled (particles)
   Particles = 8,      // point sprites, depth test on, depth write off, culled in the vertex stage (particles)
   HiZBuild = 9,       // a full-screen pass building one level of a Hi-Z max/min mip pyramid (particles' hiz mode)
+  ShadowVolume = 10,  // a caster's stencil shadow volume (shadows): z-fail, two-sided, depth write off, depth clamp
+  Litmap = 11,        // a scene object drawn from the light into a litmap, observer-hidden fragments discarded (shadows)
 };
 
 // The culling technique a frame ran (ARCHITECTURE.md Table 2 modes).

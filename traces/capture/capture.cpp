@@ -75,7 +75,7 @@ CaptureSummary capture(const CaptureOptions& o, const std::string& out_path, con
       {"gl_vendor", gl.vendor},
       {"mesa_version", mesa},
       {"viewport", fmt::format("{}x{}", o.width, o.height)},
-      {"depth_format", "DEPTH_COMPONENT32F"},
+      {"depth_format", renderer.technique().depth_format()},
       {"depth_func", trace::gl_name(o.reversed_z ? trace::DepthFunc::Greater : trace::DepthFunc::Less)},
       {"clip_control", trace::gl_name(o.reversed_z ? trace::ClipControl::ZeroToOne : trace::ClipControl::NegativeOneToOne)},
       {"depth_clear", o.reversed_z ? "0" : "1"},
@@ -103,6 +103,8 @@ CaptureSummary capture(const CaptureOptions& o, const std::string& out_path, con
     for (const auto& d : fr.draws) writer.write(d);
     for (const auto& d : fr.depths) writer.write(d);
     for (const auto& l : fr.levels) writer.write(l);
+    for (const auto& s : fr.stencils) writer.write(s);
+    if (fr.light) writer.write_light(*fr.light);
     for (const auto& r : fr.technique_records) writer.write(r);
     if (fr.truth) writer.write(*fr.truth);
     writer.end_frame(fr.end);

@@ -4,7 +4,9 @@
 // levels the largest sprite needs); queried in batches of rectangles by a compute shader
 // (shaders/common/nbuffer_query.comp, occlusion culling's bounds tests) or sampled by a technique's
 // own shaders (texture()), read back as the trace's level record. Levels are R32F; max under LESS,
-// min under reversed Z.
+// min under reversed Z, and one of each over the shadows technique's max and min litmaps. Texels
+// outside the image are skipped, never read (the paper's border value: +inf for a min N-buffer,
+// -inf for a max one), so the same level chain serves both ops.
 #pragma once
 
 #include <vector>

@@ -5,16 +5,17 @@
 
 namespace nbsim::capture {
 
-RenderTarget::RenderTarget(int width, int height) : width_(width), height_(height) {
+RenderTarget::RenderTarget(int width, int height, GLenum depth_format) : width_(width), height_(height) {
   glCreateTextures(GL_TEXTURE_2D, 1, &depth_tex_);
-  glTextureStorage2D(depth_tex_, 1, GL_DEPTH_COMPONENT32F, width, height);
+  glTextureStorage2D(depth_tex_, 1, depth_format, width, height);
   glTextureParameteri(depth_tex_, GL_TEXTURE_COMPARE_MODE, GL_NONE);
   glTextureParameteri(depth_tex_, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTextureParameteri(depth_tex_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   glCreateTextures(GL_TEXTURE_2D, 1, &id_tex_);
   glTextureStorage2D(id_tex_, 1, GL_R32UI, width, height);
   glCreateFramebuffers(1, &fbo_);
-  glNamedFramebufferTexture(fbo_, GL_DEPTH_ATTACHMENT, depth_tex_, 0);
+  glNamedFramebufferTexture(fbo_, depth_format == GL_DEPTH24_STENCIL8 ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
+                            depth_tex_, 0);
   glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, id_tex_, 0);
   if (glCheckNamedFramebufferStatus(fbo_, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
     throw std::runtime_error("the capture framebuffer is incomplete");
@@ -35,6 +36,15 @@ void RenderTarget::clear_depth(bool reversed) const {
   const float clear = reversed ? 0.0f : 1.0f;
   glDepthMask(GL_TRUE);  // clears obey the write masks
   glClearNamedFramebufferfv(fbo_, GL_DEPTH, 0, &clear);
+}
+
+}  // namespace nbsim::capture
+
+namespace nbsim::capture {
+
+void RenderTarget::clear_stencil(int value) const {
+  glStencilMask(0xFFu);  // clears obey the write masks
+  glClearNamedFramebufferiv(fbo_, GL_STENCIL, 0, &value);
 }
 
 }  // namespace nbsim::capture

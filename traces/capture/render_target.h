@@ -1,6 +1,7 @@
 // The framebuffer a capture technique renders into: a DEPTH_COMPONENT32F depth texture (read back
-// exactly, sampled without compare mode) and an R32UI colour texture for object ids (the ID buffer
-// of the ground truth). Window depth in [0, 1], y up (model/common/depth.h).
+// exactly, sampled without compare mode; or DEPTH24_STENCIL8 for techniques that use the stencil
+// buffer, sampled as depth) and an R32UI colour texture for object ids (the ID buffer of the
+// ground truth). Window depth in [0, 1], y up (model/common/depth.h).
 #pragma once
 
 #include "traces/capture/gl_program.h"
@@ -9,7 +10,8 @@ namespace nbsim::capture {
 
 class RenderTarget {
  public:
-  RenderTarget(int width, int height);
+  // depth_format: GL_DEPTH_COMPONENT32F or GL_DEPTH24_STENCIL8 (attached as depth and stencil).
+  RenderTarget(int width, int height, GLenum depth_format = GL_DEPTH_COMPONENT32F);
   ~RenderTarget();
   RenderTarget(const RenderTarget&) = delete;
   RenderTarget& operator=(const RenderTarget&) = delete;
@@ -18,6 +20,8 @@ class RenderTarget {
   void bind() const;
   // Clears the depth to the far value of the convention (1, or 0 under reversed Z).
   void clear_depth(bool reversed) const;
+  // Clears the stencil to `value` (with GL_DEPTH24_STENCIL8).
+  void clear_stencil(int value) const;
 
   int width() const noexcept { return width_; }
   int height() const noexcept { return height_; }

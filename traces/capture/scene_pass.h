@@ -43,6 +43,9 @@ class ScenePass {
   void draw_ids(const std::vector<std::uint32_t>& objects, std::uint32_t counter_slot) const;
 
   const CaptureScene& scene() const noexcept { return scene_; }
+  // The scene's vertex array (positions at attribute 0, the indices bound), for a technique's own
+  // programs over the same geometry.
+  GLuint scene_vertex_array() const noexcept { return scene_vao_; }
 
  private:
   std::size_t draw(DrawRecorder& recorder, scene::DrawRecord record, bool box, std::uint32_t index_count,

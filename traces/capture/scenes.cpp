@@ -3,7 +3,9 @@
 
 #include <fmt/format.h>
 
+#include "traces/capture/boxes.h"
 #include "traces/capture/city.h"
+#include "traces/capture/terrain.h"
 
 namespace nbsim::capture {
 
@@ -29,12 +31,36 @@ CaptureScene make_city_scene(const OptionValues& options) {
   return s;
 }
 
+const OptionSpec kTowers{"towers", "Towers on the terrain", "40", OptionSpec::Kind::Integer, 0, 10000, {}};
+const OptionSpec kBirds{"birds", "Birds (small flying casters) over the terrain and around it", "2000", OptionSpec::Kind::Integer, 0, 200000, {}};
+const OptionSpec kBoxes{"boxes", "Boxes on the plane", "30", OptionSpec::Kind::Integer, 0, 10000, {}};
+
+CaptureScene make_terrain_scene(const OptionValues& options) {
+  TerrainParams p;
+  p.seed = static_cast<std::uint32_t>(options.integer(seed_option()));
+  p.towers = static_cast<int>(options.integer(kTowers));
+  p.birds = static_cast<int>(options.integer(kBirds));
+  return make_terrain(p);
+}
+
+CaptureScene make_boxes_scene(const OptionValues& options) {
+  BoxesParams p;
+  p.seed = static_cast<std::uint32_t>(options.integer(seed_option()));
+  p.boxes = static_cast<int>(options.integer(kBoxes));
+  return make_boxes(p);
+}
+
 }  // namespace
 
 const std::vector<SceneRow>& scene_table() {
   static const std::vector<SceneRow> table = {
       {{"city", "Procedural city: street grid, buildings and street props, with a BVH (N-buffer paper, 4.2)", {seed_option(), kObjects}},
        make_city_scene},
+      {{"terrain", "Heightfield terrain with towers and many small flying casters (birds), most out of view (N-buffer paper, 4.4)",
+        {seed_option(), kTowers, kBirds}},
+       make_terrain_scene},
+      {{"boxes", "Boxes on a plane: the simple scene of the shadow-volume experiments (N-buffer paper, 4.4)", {seed_option(), kBoxes}},
+       make_boxes_scene},
   };
   return table;
 }

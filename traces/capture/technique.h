@@ -52,6 +52,8 @@ class Technique {
   // setting_properties(), the tool's. (This is the order of every trace captured so far.)
   virtual trace::Properties variant_properties() const = 0;   // what the technique is (e.g. test_mode)
   virtual trace::Properties setting_properties() const = 0;   // how it is tuned (e.g. nearest_margin)
+  // The header's "depth_format": the GL format of the depth buffer the technique renders into.
+  virtual std::string depth_format() const { return "DEPTH_COMPONENT32F"; }
 
   // Renders frame `index` (0, 1, ... in order) from `pose`.
   virtual CapturedFrame render(std::uint32_t index, const CameraPose& pose) = 0;

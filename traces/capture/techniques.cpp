@@ -2,6 +2,7 @@
 // own (traces/capture/<name>/, shaders/<name>/) and one row here.
 #include "traces/capture/occlusion/occlusion_culling.h"
 #include "traces/capture/particles/particles.h"
+#include "traces/capture/shadows/shadows.h"
 #include "traces/capture/technique.h"
 
 namespace nbsim::capture {
@@ -17,6 +18,11 @@ const std::vector<TechniqueRow>& technique_table() {
         "reference pass for popping (N-buffer paper, 3.2 and 4.3)",
         particles_options()},
        make_particles},
+      {{"shadows",
+        "Stencil shadow volumes of a spot light (z-fail, two-sided): infinite, culled or clamped with min/max litmaps and "
+        "two N-buffers, with an infinite reference pass for the mask (N-buffer paper, 3.3 and 4.4)",
+        shadows_options()},
+       make_shadows},
   };
   return table;
 }

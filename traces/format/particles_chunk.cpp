@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 
 #include <string>
-#include <type_traits>
 #include <variant>
 
 namespace nbsim::trace {
@@ -14,16 +13,7 @@ namespace {
 // The rule of particles_chunk_spec(): what a reader refuses beyond the field types.
 std::string particles_rule(const TechniqueRecord& r) {
   const std::uint64_t count = std::get<std::uint64_t>(r.fields.at(0).value);
-  for (const TechniqueField& f : r.fields) {
-    const std::size_t n = std::visit(
-        [](const auto& v) -> std::size_t {
-          if constexpr (requires { v.size(); } && !std::is_same_v<std::decay_t<decltype(v)>, std::string>) return v.size();
-          return 0;
-        },
-        f.value);
-    if (f.name != "count" && n != count)
-      return fmt::format("field '{}' has {} elements, but count is {} (one a particle)", f.name, n, count);
-  }
+  if (std::string problem = vector_lengths_problem(r, count, {"count"}, "particle"); !problem.empty()) return problem;
   for (const TechniqueField& f : r.fields) {
     if (f.name != "culled" && f.name != "lookups") continue;
     const auto& v = std::get<std::vector<std::uint32_t>>(f.value);

@@ -7,11 +7,14 @@
 #include <array>
 #include <mutex>
 #include <set>
+#include <type_traits>
+#include <variant>
 
 #include "model/common/error.h"
 #include "traces/format/bytes.h"
 #include "traces/format/codec.h"
 #include "traces/format/particles_chunk.h"
+#include "traces/format/shadows_chunk.h"
 
 namespace nbsim::trace {
 
@@ -29,7 +32,7 @@ struct Registry {
 
 // The chunk types of the techniques this build knows, registered before anything else so that
 // every reader decodes them (a technique's own test types register later, at run time).
-std::vector<ChunkSpec> built_in_chunks() { return {particles_chunk_spec()}; }
+std::vector<ChunkSpec> built_in_chunks() { return {particles_chunk_spec(), shadows_chunk_spec()}; }
 
 Registry& registry() {
   static Registry r{{}, built_in_chunks()};
@@ -149,6 +152,21 @@ std::string technique_table(const ChunkSpec& spec) {
     t += fmt::format("| {} | {} | `{}` | {} |\n", i + 1, kind_name(spec.fields[i].kind), spec.fields[i].name,
                      spec.fields[i].meaning);
   return t;
+}
+
+std::string vector_lengths_problem(const TechniqueRecord& record, std::uint64_t count, std::initializer_list<std::string_view> scalars,
+                                   std::string_view one_a) {
+  for (const TechniqueField& f : record.fields) {
+    if (std::find(scalars.begin(), scalars.end(), f.name) != scalars.end()) continue;
+    const std::size_t n = std::visit(
+        [](const auto& v) -> std::size_t {
+          if constexpr (requires { v.size(); } && !std::is_same_v<std::decay_t<decltype(v)>, std::string>) return v.size();
+          return 0;
+        },
+        f.value);
+    if (n != count) return fmt::format("field '{}' has {} elements, but count is {} (one a {})", f.name, n, count, one_a);
+  }
+  return {};
 }
 
 std::string dump_technique(const TechniqueRecord& record) {

@@ -8,8 +8,10 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "traces/format/records.h"
@@ -35,6 +37,12 @@ struct ChunkSpec {
   // (InputError naming the chunk), the writer aborts on one.
   std::string (*rule)(const TechniqueRecord& record) = nullptr;
 };
+
+// For a spec's rule: why a vector field of `record` (other than the fields named in `scalars`) does
+// not have `count` elements ("field 'x' has 2 elements, but count is 3 (one a particle)", with
+// `one_a` = "particle"), or empty when every one has.
+std::string vector_lengths_problem(const TechniqueRecord& record, std::uint64_t count, std::initializer_list<std::string_view> scalars,
+                                   std::string_view one_a);
 
 // Registers a chunk type. A bad spec (a core or already registered type, an unprintable fourcc,
 // no fields, duplicate field names) is a bug of the technique: it aborts.

@@ -9,6 +9,7 @@
 #include "tests/traces/format/sample_trace.h"
 #include "traces/format/bytes.h"
 #include "traces/format/particles_chunk.h"
+#include "traces/format/shadows_chunk.h"
 
 namespace {
 
@@ -314,7 +315,7 @@ TEST(TraceCorruptionTest, FieldValuesOutOfRange) {
     std::string message;
   };
   const Row rows[] = {
-      {ChunkType::Draw, [](Bytes& p) { p[4] = 10; }, "field 'role' is 10"},                     // DrawRole 0..9
+      {ChunkType::Draw, [](Bytes& p) { p[4] = 12; }, "field 'role' is 12"},                     // DrawRole 0..11
       {ChunkType::Draw, [](Bytes& p) { p[15] = 2; }, "field 'state.write' is 2, not 0 or 1"},   // bools are 0/1
       {ChunkType::Draw, [](Bytes& p) { p[14] = 8; }, "state.func"},                             // DepthFunc 0..7
       {ChunkType::Draw, [](Bytes& p) { p[13] = 32; }, "field 'level' is 32"},                  // levels below 32
@@ -328,7 +329,7 @@ TEST(TraceCorruptionTest, FieldValuesOutOfRange) {
       {ChunkType::Levels, [](Bytes& p) { p[19] = 2; }, "field 'op' is 2"},                      // FarOp 0..1
       {ChunkType::Levels, [](Bytes& p) { put_le32(p, 28, 33); }, "field 'levels' is 33"},       // at most 32 levels
       {ChunkType::Draw, [](Bytes& p) { p[80 + 48] = 2; }, "field 'topology' is 2"},            // Topology 0..1
-      {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 4] = 10; }, "field 'role' is 10"},              // each draw checked
+      {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 4] = 12; }, "field 'role' is 12"},              // each draw checked
       // The batch's first draw: 128 bytes of version 1 fields, topology, 3 point sizes, stencil.test,
       // stencil.front.func, ref, value_mask, write_mask, then stencil.front.fail at 4 + 159.
       {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 159] = 8; }, "field 'stencil.front.fail' is 8"},  // StencilOp 0..7
@@ -585,6 +586,93 @@ TEST(TraceCorruptionTest, ParticleChunk) {
     broken.payload = o.take();
     e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(broken).add(FrameEnd{0, 0, 0}).end(1).b);
     EXPECT_TRUE(has(e, "chunk 2 (PRTC)") && has(e, b.message)) << e;
+  }
+}
+
+// The shadows technique's SHDC record (traces/format/shadows_chunk.h) is decoded by every reader;
+// each flipped byte, a payload one byte short or long, a vector count past the payload and broken
+// rules (lengths, decisions, rectangles outside the litmap, draws below -1) are refused naming it.
+TEST(TraceCorruptionTest, ShadowChunk) {
+  struct Fields {
+    std::vector<std::int32_t> x{0, 10, 0}, w{0, 6, 64};
+    std::vector<std::uint32_t> decision{2, 0, 3};
+    std::vector<std::int32_t> draw{-1, 7, 8};
+  };
+  auto payload = [](const Fields& f) {
+    bytes::Out o;
+    o.u32(3);
+    o.u32(64);                                              // litmap_size
+    o.counted_words(std::vector<std::uint32_t>{1, 2, 5});  // object
+    o.counted_words(f.x);
+    o.counted_words(std::vector<std::int32_t>{0, 20, 0});  // y
+    o.counted_words(f.w);
+    o.counted_words(std::vector<std::int32_t>{0, 5, 64});  // h
+    for (int k = 0; k < 4; ++k) o.counted_words(std::vector<float>{0.5f, 0.25f, 1.0f});  // caster_near/far, z_min/max
+    o.counted_words(std::vector<std::uint32_t>{0, 8, 0});  // lookups
+    o.counted_words(f.decision);
+    o.counted_words(std::vector<float>{0.0f, 0.3f, 0.0f});  // clamp_near
+    o.counted_words(std::vector<float>{INFINITY, 0.9f, INFINITY});  // clamp_far
+    o.counted_words(f.draw);
+    return o.take();
+  };
+  TechniqueRecord raw;
+  raw.type = kShadowsChunk;
+  raw.payload = payload(Fields{});
+  const TechniqueRecord r = decode_technique(kShadowsChunk, raw.payload);
+  ASSERT_TRUE(r.decoded) << "the format library registers SHDC";
+  EXPECT_EQ(encode(r), raw.payload) << "SHDC encodes back to the same bytes";
+  const Properties P;
+  Builder t;
+  t.add(P).add(sample_frame_begin(0)).technique(r).add(FrameEnd{0, 0, 0}).end(1);
+  {
+    FrameReader frames(TraceReader(t.b, "t.nbtrace"));
+    const auto f = frames.next();
+    ASSERT_TRUE(f);
+    ASSERT_EQ(f->technique_records.size(), 1u);
+    expect_same(r, f->technique_records[0]);
+  }
+  const std::vector<std::size_t> offsets = chunk_offsets(t.b);
+  for (std::size_t i = offsets[2]; i < offsets[3]; ++i) {  // HEAD, FRAM, SHDC
+    Bytes b = t.b;
+    b[i] ^= 0x01;
+    const std::string e = read_error(b);
+    ASSERT_TRUE(has(e, "chunk 2 ")) << "byte " << i << " of SHDC flipped: " << e;
+  }
+  auto error_of = [&](std::vector<std::uint8_t> bytes_in) {
+    TechniqueRecord x;
+    x.type = kShadowsChunk;
+    x.payload = std::move(bytes_in);
+    return read_error(Builder().add(P).add(sample_frame_begin(0)).technique(x).add(FrameEnd{0, 0, 0}).end(1).b);
+  };
+  std::vector<std::uint8_t> shorter = raw.payload;
+  shorter.pop_back();
+  std::string e = error_of(shorter);
+  EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "decodes short")) << e;
+  std::vector<std::uint8_t> longer = raw.payload;
+  longer.push_back(0);
+  e = error_of(longer);
+  EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "decodes long")) << e;
+  std::vector<std::uint8_t> hostile = raw.payload;
+  put_le32(hostile, 8, 0xFFFFFFFFu);  // the object vector's count
+  e = error_of(hostile);
+  EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "4294967295")) << e;
+  struct Broken {
+    Fields f;
+    std::string message;
+  };
+  Broken rows[] = {{Fields{}, "field 'x' has 2 elements, but count is 3"},
+                   {Fields{}, "field 'decision' of caster 1 is 4, above 3"},
+                   {Fields{}, "caster 2's rectangle (0, 0, 65x64) is not inside the 64x64 litmap"},
+                   {Fields{}, "caster 1's rectangle (-1, 20, 6x5) is not inside"},
+                   {Fields{}, "field 'draw' of caster 0 is -2, below -1"}};
+  rows[0].f.x = {0, 10};
+  rows[1].f.decision = {2, 4, 3};
+  rows[2].f.w = {0, 6, 65};
+  rows[3].f.x = {0, -1, 0};
+  rows[4].f.draw = {-2, 7, 8};
+  for (const Broken& b : rows) {
+    e = error_of(payload(b.f));
+    EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, b.message)) << b.message << ": " << e;
   }
 }
 

@@ -1,0 +1,228 @@
+// ShadowsTest: the shadows technique (traces/capture/shadows/) run headless on the three scenes in
+// the three modes, checked on GL's own records: the shadow mask of every mode equals the infinite
+// reference on every frame (the recorded count is 0 and the images are equal), the masks of the
+// three captures are equal, the fill is clamped <= culled <= infinite, the SHDC record is whole
+// and its volume draws are the ShadowVolume draws; and two hard cases of issue 13 (the ground
+// facing the light, the camera inside a shadow volume).
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <cmath>
+#include <map>
+#include <string>
+#include <variant>
+
+#include "model/common/error.h"
+#include "traces/capture/capture.h"
+#include "traces/capture/renderer.h"
+#include "traces/capture/scenes.h"
+#include "traces/format/reader.h"
+#include "traces/format/shadows_chunk.h"
+
+namespace nbsim::capture {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name) {
+  return fs::path(::testing::TempDir()) / ("shadows_" + std::to_string(::getpid()) + "_" + name + ".nbt");
+}
+
+// A small capture: 128x96, 2 frames of the flyover, litmaps of 128, small scenes.
+CaptureOptions small(const std::string& scene, const std::string& mode) {
+  CaptureOptions o;
+  o.technique = "shadows";
+  o.scene = scene;
+  o.path = "fly";
+  o.width = 128;
+  o.height = 96;
+  o.frames = 2;
+  o.options = {{"shadow-mode", mode}, {"litmap", "128"}, {"levels-every", "1"}, {"seed", "4"}};
+  if (scene == "city") o.options.set("objects", "300");
+  if (scene == "terrain") o.options.set("birds", "400"), o.options.set("towers", "20");
+  return o;
+}
+
+template <class T>
+const std::vector<T>& field(const scene::TechniqueRecord& r, const std::string& name) {
+  for (const auto& f : r.fields)
+    if (f.name == name) return std::get<std::vector<T>>(f.value);
+  static const std::vector<T> none;
+  ADD_FAILURE() << "no field " << name;
+  return none;
+}
+
+struct FrameResult {
+  std::vector<std::uint8_t> mask, reference;
+  std::uint64_t fill = 0;
+};
+
+// Reads a shadows trace, checks what every mode must satisfy and returns each frame's mask and fill.
+std::vector<FrameResult> check_trace(const fs::path& file, const std::string& mode) {
+  std::vector<FrameResult> out;
+  trace::FrameReader frames(file);
+  EXPECT_EQ(*frames.trace().property("technique"), "shadows");
+  EXPECT_EQ(*frames.trace().property("shadow_mode"), mode);
+  EXPECT_EQ(*frames.trace().property("depth_format"), "DEPTH24_STENCIL8");
+  while (auto f = frames.next()) {
+    FrameResult r;
+    EXPECT_TRUE(f->light.has_value()) << "the light camera is recorded";
+    for (const char* name : {"final", "litmap_min", "litmap_max"}) EXPECT_NE(f->depth(name), nullptr) << name;
+    for (const char* name : {"stencil", "light_region", "shadow_mask", "shadow_mask_infinite"}) EXPECT_NE(f->stencil(name), nullptr) << name;
+    EXPECT_NE(f->nbuffer("litmap_min", FarOp::Min), nullptr) << "the min N-buffer over the min litmap";
+    EXPECT_NE(f->nbuffer("litmap_max", FarOp::Max), nullptr) << "the max N-buffer over the max litmap";
+    if (!f->stencil("shadow_mask") || !f->stencil("shadow_mask_infinite")) return out;
+    r.mask = f->stencil("shadow_mask")->texels;
+    r.reference = f->stencil("shadow_mask_infinite")->texels;
+    EXPECT_EQ(r.mask, r.reference) << "frame " << f->begin.frame << ": the " << mode << " mask differs from the infinite one";
+    EXPECT_EQ(f->technique_records.size(), 1u) << "one SHDC record a frame";
+    if (f->technique_records.size() != 1) return out;
+    const auto& rec = f->technique_records[0];
+    EXPECT_EQ(rec.type, trace::kShadowsChunk);
+    const auto& decision = field<std::uint32_t>(rec, "decision");
+    const auto& draw = field<std::int32_t>(rec, "draw");
+    const auto& clamp_far = field<float>(rec, "clamp_far");
+    std::map<std::int32_t, bool> volume_draws;
+    for (const auto& d : f->draws) {
+      EXPECT_LE(d.gl.samples_passed, d.gl.fragments) << "draw " << d.index;
+      if (d.role != trace::DrawRole::ShadowVolume) continue;
+      r.fill += d.gl.fragments;
+      volume_draws[static_cast<std::int32_t>(d.index)] = true;
+      EXPECT_TRUE(d.stencil.test && d.state.depth_clamp && !d.state.write) << "z-fail volumes: stencil, depth clamp, no depth writes";
+      EXPECT_EQ(d.stencil.back.depth_fail, trace::StencilOp::IncrWrap);
+      EXPECT_EQ(d.stencil.front.depth_fail, trace::StencilOp::DecrWrap);
+      EXPECT_EQ(d.clip_positions.size() % 3, 0u) << "triangles captured by transform feedback";
+      EXPECT_FALSE(d.clip_positions.empty());
+    }
+    std::size_t drawn = 0;
+    for (std::size_t c = 0; c < decision.size(); ++c) {
+      const bool dropped = decision[c] == 1 || decision[c] == 2;
+      EXPECT_EQ(draw[c] >= 0, mode == "infinite" || !dropped) << "caster " << c << " decision " << decision[c];
+      if (draw[c] >= 0) {
+        ++drawn;
+        EXPECT_TRUE(volume_draws.count(draw[c])) << "caster " << c << "'s draw is a volume";
+      }
+      if (dropped) {
+        EXPECT_TRUE(std::isinf(clamp_far[c])) << "a culled caster has no clamp planes";
+      }
+    }
+    EXPECT_EQ(drawn, volume_draws.size()) << "one volume draw a drawn caster";
+    out.push_back(std::move(r));
+  }
+  EXPECT_EQ(out.size(), 2u);
+  return out;
+}
+
+// Every scene in every mode: masks equal to the infinite reference on every frame and across the
+// modes; fill clamped <= culled <= infinite; shadows exist and some casters are culled.
+TEST(ShadowsTest, EverySceneAndModeKeepsTheMask) {
+  for (const std::string scene : {"boxes", "terrain", "city"}) {
+    std::map<std::string, std::vector<FrameResult>> by_mode;
+    std::map<std::string, CaptureSummary> sums;
+    for (const std::string mode : {"infinite", "culled", "clamped"}) {
+      SCOPED_TRACE(scene + " " + mode);
+      const fs::path file = scratch(scene + "_" + mode);
+      sums[mode] = capture(small(scene, mode), file.string());
+      by_mode[mode] = check_trace(file, mode);
+      fs::remove(file);
+      std::map<std::string, std::uint64_t> counts(sums[mode].technique_counts.begin(), sums[mode].technique_counts.end());
+      EXPECT_EQ(counts["mask_diff_pixels"], 0u) << "the recorded count of mask pixels that differ from infinite";
+      EXPECT_GT(counts["mask_pixels"], 0u) << "the scene casts visible shadows";
+      EXPECT_GT(counts["casters_culled"], 0u) << "some casters cast no visible shadow";
+    }
+    ASSERT_EQ(by_mode["infinite"].size(), 2u);
+    for (std::size_t f = 0; f < 2 && by_mode["clamped"].size() == 2 && by_mode["culled"].size() == 2; ++f) {
+      SCOPED_TRACE(scene + " frame " + std::to_string(f));
+      EXPECT_EQ(by_mode["culled"][f].mask, by_mode["infinite"][f].mask) << "culling keeps the mask";
+      EXPECT_EQ(by_mode["clamped"][f].mask, by_mode["infinite"][f].mask) << "clamping keeps the mask";
+      EXPECT_LE(by_mode["clamped"][f].fill, by_mode["culled"][f].fill) << "clamping only removes fill";
+      EXPECT_LE(by_mode["culled"][f].fill, by_mode["infinite"][f].fill) << "culling only removes fill";
+    }
+    EXPECT_LT(by_mode["clamped"][0].fill, by_mode["infinite"][0].fill) << scene << ": clamping saves fill";
+  }
+}
+
+// "X,Y,Z,TX,TY,TZ" for --light.
+std::string fmt_light(float x, float y, float z, float tx, float ty, float tz) {
+  std::string out;
+  for (float v : {x, y, z, tx, ty, tz}) out += (out.empty() ? "" : ",") + std::to_string(v);
+  return out;
+}
+
+// One frame from a pose of our choice through the renderer; its counts by name.
+std::map<std::string, std::uint64_t> render_once(const std::string& scene_name, const OptionValues& options, const CameraPose& pose,
+                                                 scene::Frame* frame = nullptr) {
+  const CaptureScene scene = find_scene(scene_name).make(options);
+  RendererOptions ro;
+  ro.technique = "shadows";
+  ro.width = 128;
+  ro.height = 96;
+  ro.options = options;
+  Renderer renderer(scene, ro);
+  CapturedFrame cf = renderer.render(0, pose);
+  if (frame) *frame = std::move(cf.frame);
+  return {cf.counts.begin(), cf.counts.end()};
+}
+
+// The ground facing the light: a light straight above the boxes looks at the plane square on, so
+// a caster's receivers on the plane all have one light depth (z_min == z_max for the ground
+// around it): the zero-thickness slab, widened by the clamp margin, keeps every shadow.
+TEST(ShadowsTest, GroundFacingTheLightKeepsItsShadow) {
+  OptionValues o{{"boxes", "12"}, {"seed", "2"}, {"litmap", "256"}, {"light", "60,400,60,60,0,60"}, {"light-fov", "30"}};
+  scene::Frame f;
+  const auto counts = render_once("boxes", o, {{60.0f, 25.0f, -5.0f}, {60.0f, 0.0f, 40.0f}}, &f);
+  EXPECT_GT(counts.at("mask_pixels"), 0u) << "the boxes' shadows are seen";
+  EXPECT_EQ(counts.at("mask_diff_pixels"), 0u) << "clamped to a zero-thickness slab, the mask is the infinite one";
+  ASSERT_EQ(f.technique_records.size(), 1u);
+  const auto& z_min = field<float>(f.technique_records[0], "z_min");
+  const auto& z_max = field<float>(f.technique_records[0], "z_max");
+  const auto& decision = field<std::uint32_t>(f.technique_records[0], "decision");
+  std::size_t kept = 0;
+  for (std::size_t c = 0; c < decision.size(); ++c) kept += decision[c] == 0 && z_min[c] <= z_max[c];
+  EXPECT_GT(kept, 0u) << "some volumes are clamped to the ground's slab";
+}
+
+// The camera inside a shadow volume (standing in a box's ground shadow, a light low on one side):
+// z-fail with caps counts right there, so the mask is non-empty and equal to the infinite one.
+TEST(ShadowsTest, CameraInsideAShadowVolume) {
+  OptionValues o{{"boxes", "1"}, {"seed", "5"}, {"litmap", "256"}};
+  const CaptureScene scene = find_scene("boxes").make(o);
+  const scene::Aabb& b = scene.scene.objects[1];
+  const float cz = 0.5f * (b.lo[2] + b.hi[2]), height = b.hi[1];
+  // The light 100 m to the -x side and 100 m up: the shadow falls on +x, 45 degrees down.
+  o.set("light", fmt_light(b.lo[0] - 100.0f, 100.0f, cz, b.hi[0], 0.0f, cz));
+  scene::Frame f;
+  // The eye 0.5 m above the ground, 0.5 m past the box: its light ray crosses the box (1 m up at
+  // the box's face, the box at least 2 m tall).
+  const auto counts = render_once("boxes", o, {{b.hi[0] + 0.5f, 0.5f, cz}, {b.hi[0] + 30.0f, 0.0f, cz}}, &f);
+  ASSERT_GE(height, 2.0f);
+  EXPECT_GT(counts.at("mask_pixels"), 0u) << "the ground around the eye is in shadow";
+  EXPECT_EQ(counts.at("mask_diff_pixels"), 0u);
+  const auto* mask = f.stencil("shadow_mask");
+  ASSERT_NE(mask, nullptr);
+  EXPECT_EQ(mask->texels[static_cast<std::size_t>(2 * 128 + 64)], 1) << "the ground just in front of the eye is in shadow";
+}
+
+// A light inside a caster is refused with an InputError naming it, before any frame.
+TEST(ShadowsTest, LightInsideACasterIsRefused) {
+  OptionValues o{{"boxes", "3"}, {"seed", "7"}};
+  const CaptureScene scene = find_scene("boxes").make(o);
+  const scene::Aabb& b = scene.scene.objects[2];
+  o.set("light", fmt_light(0.5f * (b.lo[0] + b.hi[0]), 0.5f * (b.lo[1] + b.hi[1]), 0.5f * (b.lo[2] + b.hi[2]), 0, 0, 0));
+  RendererOptions ro;
+  ro.technique = "shadows";
+  ro.width = 32;
+  ro.height = 24;
+  ro.options = o;
+  try {
+    Renderer renderer(scene, ro);
+    ADD_FAILURE() << "a light inside a caster was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is inside caster object 2"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace nbsim::capture

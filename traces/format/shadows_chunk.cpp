@@ -1,0 +1,76 @@
+// The shadows technique's chunk description; see shadows_chunk.h.
+#include "traces/format/shadows_chunk.h"
+
+#include <fmt/format.h>
+
+#include <string>
+#include <variant>
+
+namespace nbsim::trace {
+
+namespace {
+
+template <class T>
+const std::vector<T>& vec(const TechniqueRecord& r, const char* name) {
+  for (const TechniqueField& f : r.fields)
+    if (f.name == name) return std::get<std::vector<T>>(f.value);
+  static const std::vector<T> none;
+  return none;
+}
+
+std::uint64_t scalar(const TechniqueRecord& r, const char* name) {
+  for (const TechniqueField& f : r.fields)
+    if (f.name == name) return std::get<std::uint64_t>(f.value);
+  return 0;
+}
+
+// The rule of shadows_chunk_spec(): what a reader refuses beyond the field types.
+std::string shadows_rule(const TechniqueRecord& r) {
+  const std::uint64_t count = scalar(r, "count"), size = scalar(r, "litmap_size");
+  if (std::string problem = vector_lengths_problem(r, count, {"count", "litmap_size"}, "caster"); !problem.empty()) return problem;
+  const auto& decision = vec<std::uint32_t>(r, "decision");
+  const auto &x = vec<std::int32_t>(r, "x"), &y = vec<std::int32_t>(r, "y"), &w = vec<std::int32_t>(r, "w"), &h = vec<std::int32_t>(r, "h");
+  const auto& draw = vec<std::int32_t>(r, "draw");
+  for (std::size_t c = 0; c < count; ++c) {
+    if (decision[c] > 3) return fmt::format("field 'decision' of caster {} is {}, above 3", c, decision[c]);
+    const auto s = static_cast<std::int64_t>(size);
+    if (x[c] < 0 || y[c] < 0 || w[c] < 0 || h[c] < 0 || x[c] + static_cast<std::int64_t>(w[c]) > s ||
+        y[c] + static_cast<std::int64_t>(h[c]) > s)
+      return fmt::format("caster {}'s rectangle ({}, {}, {}x{}) is not inside the {}x{} litmap", c, x[c], y[c], w[c], h[c], size, size);
+    if (draw[c] < -1) return fmt::format("field 'draw' of caster {} is {}, below -1", c, draw[c]);
+  }
+  return {};
+}
+
+}  // namespace
+
+ChunkSpec shadows_chunk_spec() {
+  ChunkSpec spec{
+      kShadowsChunk,
+      "shadows",
+      "ShadowCasters",
+      {{"count", FieldKind::U32, "casters in the scene (every vector below has this many elements)"},
+       {"litmap_size", FieldKind::U32, "side of the square litmaps and N-buffers, lexels"},
+       {"object", FieldKind::VecU32, "the caster's object id"},
+       {"x", FieldKind::VecI32, "light-space rectangle: left lexel (grown by one lexel, clipped to the litmap)"},
+       {"y", FieldKind::VecI32, "bottom lexel, y up"},
+       {"w", FieldKind::VecI32, "width, lexels (0: outside the litmap)"},
+       {"h", FieldKind::VecI32, "height, lexels"},
+       {"caster_near", FieldKind::VecF32, "nearest light window depth of the caster's bounds, [0, 1] (LESS: 0 at the light)"},
+       {"caster_far", FieldKind::VecF32, "farthest light window depth of the caster's bounds"},
+       {"z_min", FieldKind::VecF32, "min N-buffer over the rectangle: the nearest visible receiver from the light (1: none)"},
+       {"z_max", FieldKind::VecF32, "max N-buffer over the rectangle: the farthest visible receiver from the light (0: none)"},
+       {"lookups", FieldKind::VecU32, "N-buffer texels read: 2 to 8 (1, 2 or 4 each), 0 when not tested"},
+       {"decision", FieldKind::VecU32, "0 volume drawn, 1 culled (z_max, widened by the clamp margin, < max(z_min, caster_near)), 2 outside the light's "
+        "frustum, 3 crosses the light's near plane (never culled, drawn infinite)"},
+       {"clamp_near", FieldKind::VecF32,
+        "near plane, light window depth (0: none): z_min narrowed by the clamp margin, set only when every receiver of the "
+        "rectangle lies behind the whole caster; mode clamped starts the volume there, the other modes cut its sides there"},
+       {"clamp_far", FieldKind::VecF32, "far plane: z_max widened by the clamp margin (+inf for a caster with decision 1, 2 or 3); mode clamped ends "
+        "the volume there, the other modes cut its sides there (so the pieces between the planes are the same triangles in every mode)"},
+       {"draw", FieldKind::VecI32, "the frame's draw (role shadow_volume) of its volume, -1 when none"}}};
+  spec.rule = shadows_rule;
+  return spec;
+}
+
+}  // namespace nbsim::trace

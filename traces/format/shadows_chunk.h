@@ -1,0 +1,30 @@
+// The shadows technique's chunk type (N-buffer paper, 3.3/4.4): per frame, one record of every
+// shadow caster of the scene with its light-space rectangle, the visible receivers' depth range the
+// min and max N-buffers gave over it, the decision and the clamp planes its shadow volume used.
+// Built into the format library (technique_chunks.cpp registers it with the other techniques'
+// types), so every reader decodes it. The capture side is traces/capture/shadows/.
+#pragma once
+
+#include <cstdint>
+
+#include "traces/format/records.h"
+#include "traces/format/technique_chunks.h"
+
+namespace nbsim::trace {
+
+inline constexpr std::uint32_t kShadowsChunk = fourcc("SHDC");
+
+// Decisions of the SHDC field `decision` (fixed values: they are in files).
+enum class CasterDecision : std::uint32_t {
+  Volume = 0,       // its shadow volume was drawn (clamped in mode clamped)
+  Culled = 1,       // z_max (+ margin) < max(z_min, caster_near): no visible receiver behind it (dropped in culled and clamped)
+  OutsideLight = 2, // its light-space rectangle misses the litmap: outside the spot's frustum (dropped likewise)
+  CrossesNear = 3,  // its bounds cross the light's near plane: never culled or clamped (drawn infinite)
+};
+
+// Its description: fields in this order (every vector has `count` elements, caster c's values at
+// index c). Its rule: every vector has `count` elements, decision at most 3, rectangles inside the
+// litmap (x, y >= 0, w, h >= 0, x + w and y + h at most litmap_size), draw -1 or a draw index.
+ChunkSpec shadows_chunk_spec();
+
+}  // namespace nbsim::trace
