@@ -27,7 +27,7 @@ std::uint64_t scalar(const TechniqueRecord& r, const char* name) {
 // The rule of shadows_chunk_spec(): what a reader refuses beyond the field types.
 std::string shadows_rule(const TechniqueRecord& r) {
   const std::uint64_t count = scalar(r, "count"), size = scalar(r, "litmap_size");
-  if (std::string problem = vector_lengths_problem(r, count, {"count", "litmap_size"}, "caster"); !problem.empty()) return problem;
+  if (std::string problem = vector_lengths_problem(r, count, {"count", "litmap_size", "reference_fill", "mask_diff_pixels"}, "caster"); !problem.empty()) return problem;
   const auto& decision = vec<std::uint32_t>(r, "decision");
   const auto &x = vec<std::int32_t>(r, "x"), &y = vec<std::int32_t>(r, "y"), &w = vec<std::int32_t>(r, "w"), &h = vec<std::int32_t>(r, "h");
   const auto& draw = vec<std::int32_t>(r, "draw");
@@ -68,7 +68,11 @@ ChunkSpec shadows_chunk_spec() {
         "rectangle lies behind the whole caster; mode clamped starts the volume there, the other modes cut its sides there"},
        {"clamp_far", FieldKind::VecF32, "far plane: z_max widened by the clamp margin (+inf for a caster with decision 1, 2 or 3); mode clamped ends "
         "the volume there, the other modes cut its sides there (so the pieces between the planes are the same triangles in every mode)"},
-       {"draw", FieldKind::VecI32, "the frame's draw (role shadow_volume) of its volume, -1 when none"}}};
+       {"draw", FieldKind::VecI32, "the frame's draw (role shadow_volume) of its volume, -1 when none"},
+       {"reference_fill", FieldKind::U64,
+        "rasterized fragments of the reference pass: every caster's infinite volume (not recorded as draws)"},
+       {"mask_diff_pixels", FieldKind::U64,
+        "pixels where the STNC shadow_mask differs from shadow_mask_infinite (0 for a correct frame)"}}};
   spec.rule = shadows_rule;
   return spec;
 }

@@ -23,7 +23,7 @@ enum class CasterDecision : std::uint32_t {
 };
 
 // Its description: fields in this order (every vector has `count` elements, caster c's values at
-// index c). Its rule: every vector has `count` elements, decision at most 3, rectangles inside the
+// index c), then the frame's reference fill and mask difference. Its rule: every vector has `count` elements, decision at most 3, rectangles inside the
 // litmap (x, y >= 0, w, h >= 0, x + w and y + h at most litmap_size), draw -1 or a draw index.
 ChunkSpec shadows_chunk_spec();
 

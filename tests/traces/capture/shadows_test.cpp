@@ -81,6 +81,8 @@ std::vector<FrameResult> check_trace(const fs::path& file, const std::string& mo
     if (f->technique_records.size() != 1) return out;
     const auto& rec = f->technique_records[0];
     EXPECT_EQ(rec.type, trace::kShadowsChunk);
+    for (const auto& fl : rec.fields)
+      if (fl.name == "mask_diff_pixels") EXPECT_EQ(std::get<std::uint64_t>(fl.value), 0u) << "the recorded count of differing mask pixels";
     const auto& decision = field<std::uint32_t>(rec, "decision");
     const auto& draw = field<std::int32_t>(rec, "draw");
     const auto& clamp_far = field<float>(rec, "clamp_far");
@@ -166,22 +168,32 @@ std::map<std::string, std::uint64_t> render_once(const std::string& scene_name, 
   return {cf.counts.begin(), cf.counts.end()};
 }
 
-// The ground facing the light: a light straight above the boxes looks at the plane square on, so
-// a caster's receivers on the plane all have one light depth (z_min == z_max for the ground
-// around it): the zero-thickness slab, widened by the clamp margin, keeps every shadow.
+// The ground facing the light: a light straight above the plane (its axis perpendicular to it)
+// and a box the observer does not see, whose shadow on the plane the observer sees: the only
+// receivers in the box's rectangle are the plane at one light depth, so z_min == z_max, a slab of
+// zero thickness. The margin keeps the shadow: the caster is kept, and the mask is the infinite one.
 TEST(ShadowsTest, GroundFacingTheLightKeepsItsShadow) {
-  OptionValues o{{"boxes", "12"}, {"seed", "2"}, {"litmap", "256"}, {"light", "60,400,60,60,0,60"}, {"light-fov", "30"}};
+  OptionValues o{{"boxes", "1"}, {"seed", "2"}, {"litmap", "1024"}, {"light-fov", "170"}};
+  const CaptureScene scene = find_scene("boxes").make(o);
+  const scene::Aabb& b = scene.scene.objects[1];
+  const float h = b.hi[1], bx = 0.5f * (b.lo[0] + b.hi[0]), bz = 0.5f * (b.lo[2] + b.hi[2]);
+  // The light 50 m to the box's -x side, 6 h high, looking straight down: the shadow on the plane
+  // runs from the box's +x face about 10 m on.
+  o.set("light", fmt_light(bx - 50.0f, 6.0f * h, bz, bx - 50.0f, 0.0f, bz));
   scene::Frame f;
-  const auto counts = render_once("boxes", o, {{60.0f, 25.0f, -5.0f}, {60.0f, 0.0f, 40.0f}}, &f);
-  EXPECT_GT(counts.at("mask_pixels"), 0u) << "the boxes' shadows are seen";
+  // The eye 3 m above the shadow's middle, looking down and away from the box.
+  const auto counts = render_once("boxes", o, {{b.hi[0] + 5.0f, 3.0f, bz}, {b.hi[0] + 5.5f, 0.0f, bz}}, &f);
+  EXPECT_GT(counts.at("mask_pixels"), 0u) << "the box's shadow is seen";
   EXPECT_EQ(counts.at("mask_diff_pixels"), 0u) << "clamped to a zero-thickness slab, the mask is the infinite one";
   ASSERT_EQ(f.technique_records.size(), 1u);
-  const auto& z_min = field<float>(f.technique_records[0], "z_min");
-  const auto& z_max = field<float>(f.technique_records[0], "z_max");
-  const auto& decision = field<std::uint32_t>(f.technique_records[0], "decision");
-  std::size_t kept = 0;
-  for (std::size_t c = 0; c < decision.size(); ++c) kept += decision[c] == 0 && z_min[c] <= z_max[c];
-  EXPECT_GT(kept, 0u) << "some volumes are clamped to the ground's slab";
+  const auto& rec = f.technique_records[0];
+  const auto& object = field<std::uint32_t>(rec, "object");
+  ASSERT_EQ(object.size(), 1u) << "one caster: the box (the plane is open)";
+  EXPECT_EQ(object[0], 1u);
+  EXPECT_EQ(field<std::uint32_t>(rec, "decision")[0], 0u) << "the caster is kept";
+  const float z_min = field<float>(rec, "z_min")[0], z_max = field<float>(rec, "z_max")[0];
+  EXPECT_NEAR(z_min, z_max, 1e-6f) << "only the plane, square to the light, is in the rectangle";
+  EXPECT_GT(field<float>(rec, "clamp_far")[0], z_max) << "the far plane lies beyond the slab by the margin";
 }
 
 // The camera inside a shadow volume (standing in a box's ground shadow, a light low on one side):

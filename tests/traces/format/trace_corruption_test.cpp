@@ -613,6 +613,8 @@ TEST(TraceCorruptionTest, ShadowChunk) {
     o.counted_words(std::vector<float>{0.0f, 0.3f, 0.0f});  // clamp_near
     o.counted_words(std::vector<float>{INFINITY, 0.9f, INFINITY});  // clamp_far
     o.counted_words(f.draw);
+    o.u64(1234567);  // reference_fill
+    o.u64(0);        // mask_diff_pixels
     return o.take();
   };
   TechniqueRecord raw;

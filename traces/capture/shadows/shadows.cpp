@@ -645,7 +645,9 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
                 {"decision", std::move(decision)},
                 {"clamp_near", std::move(clamp_near)},
                 {"clamp_far", std::move(clamp_far)},
-                {"draw", std::move(draw)}};
+                {"draw", std::move(draw)},
+                {"reference_fill", reference_fill},
+                {"mask_diff_pixels", diff}};
   f.technique_records.push_back(std::move(rec));
   out.counts = {{"fill", fill},
                 {"fill_infinite", reference_fill},
