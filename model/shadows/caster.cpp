@@ -58,10 +58,15 @@ const std::vector<T>& field(const scene::TechniqueRecord& rec, std::string_view 
   return scene::record_field<T>(rec, name, "ShadowCasters (SHDC)", frame);
 }
 
-std::uint64_t scalar(const scene::TechniqueRecord& rec, std::string_view name, std::uint64_t frame) {
+std::optional<std::uint64_t> optional_scalar(const scene::TechniqueRecord& rec, std::string_view name) {
   for (const scene::TechniqueField& f : rec.fields)
     if (f.name == name)
       if (const auto* v = std::get_if<std::uint64_t>(&f.value)) return *v;
+  return std::nullopt;
+}
+
+std::uint64_t scalar(const scene::TechniqueRecord& rec, std::string_view name, std::uint64_t frame) {
+  if (const auto v = optional_scalar(rec, name)) return *v;
   throw InputError(fmt::format("frame {}: the ShadowCasters (SHDC) record has no '{}'", frame, name));
 }
 
@@ -91,6 +96,8 @@ FrameCasters read_casters(const scene::Frame& f) {
   c.z_max = field<float>(*rec, "z_max", frame);
   c.clamp_near = field<float>(*rec, "clamp_near", frame);
   c.clamp_far = field<float>(*rec, "clamp_far", frame);
+  c.reference_fill = optional_scalar(*rec, "reference_fill");
+  c.mask_diff_pixels = optional_scalar(*rec, "mask_diff_pixels");
   for (std::size_t n : {c.lookups.size(), c.decision.size(), c.x.size(), c.y.size(), c.w.size(), c.h.size(), c.draw.size(),
                         c.caster_near.size(), c.caster_far.size(), c.z_min.size(), c.z_max.size(), c.clamp_near.size(),
                         c.clamp_far.size(), c.object.size()})

@@ -56,6 +56,10 @@ ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& r
       volume_draws_(stats().counter("volume_draws", "draws", "shadow-volume draws issued")),
       fill_(stats().counter("fill", "fragments", "rasterized fragments of the shadow-volume draws (the fill)")),
       gl_fill_(stats().counter("gl_fill", "fragments", "GL's rasterized fragments of the shadow-volume draws")),
+      reference_fill_(stats().counter("reference_fill", "fragments",
+                                      "GL's fill of every caster's infinite volume (SHDC reference_fill: the capture's reference "
+                                      "pass, not recorded as draws; the infinite mode's own fill in an infinite capture)")),
+      reference_frames_(stats().counter("reference_frames", "frames", "frames whose SHDC record holds reference_fill")),
       stencil_tests_(stats().counter("stencil_tests", "tests", "stencil tests of the shadow-volume draws")),
       mask_pixels_(stats().counter("mask_pixels", "pixels", "shadowed pixels of the model's mask")),
       gl_mask_pixels_(stats().counter("gl_mask_pixels", "pixels", "shadowed pixels of GL's shadow_mask")),
@@ -144,6 +148,7 @@ void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, co
               "an N-buffer answered another number of queries");
   casters_ += n;
   measured_ += index_.size();
+  if (c.reference_fill) reference_fill_ += *c.reference_fill, ++reference_frames_;
   for (std::size_t k = 0; k < index_.size(); ++k) {
     const std::size_t i = index_[k];
     const nbuffer::QueryAnswer& lo = min_answers_[k];

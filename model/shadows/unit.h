@@ -82,7 +82,7 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
   stats::Counter &frames_, &casters_, &measured_, &culled_, &gl_culled_, &outside_, &crossing_near_, &kept_by_slab_,
       &decision_mismatches_, &zmin_mismatches_, &zmax_mismatches_, &not_conservative_, &unsafe_culls_, &culls_lost_,
       &lookups_, &lookup_mismatches_, &build_texels_, &litmap_draws_, &litmap_reprojections_, &scene_depth_tests_,
-      &volume_draws_, &fill_, &gl_fill_, &stencil_tests_, &mask_pixels_, &gl_mask_pixels_, &mask_diff_, &mask_diff_infinite_,
+      &volume_draws_, &fill_, &gl_fill_, &reference_fill_, &reference_frames_, &stencil_tests_, &mask_pixels_, &gl_mask_pixels_, &mask_diff_, &mask_diff_infinite_,
       &gl_mask_diff_;
 
   std::vector<Rect> rects_;

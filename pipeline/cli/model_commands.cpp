@@ -494,10 +494,11 @@ void add_model_commands(CLI::App& app, Action& action) {
   {
     // One replay per shadows trace (one capture per shadow_mode: GL's volumes depend on it), in
     // child processes, and a row each from its run.json's /summary/shadows beside the paper's
-    // figures (fill 20 M -> 512 K px in the city, 2.5%; about 20% on simpler scenes). The trace
-    // does not record the infinite reference's fill (the capture prints it), so the ratio to
-    // infinite divides by the fill per frame of an `infinite` row of the same scene, seed,
-    // viewport and frames given in the same command ("-" when there is none).
+    // figures (fill 20 M -> 512 K px in the city, 2.5%; about 20% on simpler scenes). The ratio to
+    // infinite divides by the trace's own reference fill (SHDC reference_fill: GL's infinite volumes
+    // of the same frames); a trace captured before that field gets the fill per frame of an
+    // `infinite` row of the same scene, seed, viewport and frames given in the same command ("-"
+    // when there is none); `ratio_reference` says which.
     auto* cmd = app.add_subcommand(
         "shadows", "Replay shadows traces (one per shadow mode) and print the shadows table; exit 1 when a mask pixel differs");
     auto a = std::make_shared<TableCommandArgs>();
@@ -525,7 +526,7 @@ void add_model_commands(CLI::App& app, Action& action) {
           for (const char* k : {"scene", "shadow_mode", "litmap_size"}) r[k] = p->contains(k) ? (*p)[k] : nlohmann::json("");
           r["settings"] = settings_of(a->mo);
           for (const char* k : {"frames", "casters_per_frame", "culled_per_frame", "gl_culled_per_frame", "outside_per_frame", "fill_per_frame",
-                                "gl_fill_per_frame", "build_texels_per_frame", "lookups_per_frame", "stencil_tests_per_frame",
+                                "gl_fill_per_frame", "reference_fill_per_frame", "fill_ratio_to_infinite", "build_texels_per_frame", "lookups_per_frame", "stencil_tests_per_frame",
                                 "litmap_reprojections_per_frame", "cycles_per_frame", "nbuffer_memory_bytes", "mask_diff",
                                 "mask_diff_infinite", "decision_mismatches", "zmin_mismatches", "zmax_mismatches",
                                 "not_conservative", "unsafe_culls", "kept_by_slab"})
@@ -536,12 +537,14 @@ void add_model_commands(CLI::App& app, Action& action) {
           r["stencil_pixels"] = sum->value("stencil_pixels", 0);
           rows[i] = std::move(r);
         }
-        // The ratio to infinite: the fill per frame of an infinite row with the same key.
+        // The ratio to infinite: the trace's own reference fill, else an infinite row with the same key.
         std::uint64_t differing = 0;
         for (std::size_t i = 0; i < rows.size(); ++i) {
           nlohmann::ordered_json& r = rows[i];
-          r["ratio_to_infinite"] = nullptr;
-          for (std::size_t k = 0; k < rows.size(); ++k)
+          r["ratio_to_infinite"] = r["fill_ratio_to_infinite"];
+          r["ratio_reference"] = r["ratio_to_infinite"].is_number() ? nlohmann::ordered_json("reference_fill")
+                                                                     : nlohmann::ordered_json(nullptr);
+          for (std::size_t k = 0; k < rows.size() && r["ratio_to_infinite"].is_null(); ++k)
             if (keys[k] == keys[i] && rows[k]["shadow_mode"] == "infinite" && rows[k]["fill_per_frame"].get<double>() > 0.0) {
               r["ratio_to_infinite"] = r["fill_per_frame"].get<double>() / rows[k]["fill_per_frame"].get<double>();
               r["ratio_reference"] = rows[k]["trace"];

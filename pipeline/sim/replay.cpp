@@ -28,8 +28,8 @@ constexpr std::array<const char*, 11> kParticlesFrameCounts = {
     "particles", "culled", "kept_too_large", "lookups", "particle_fragments", "build_texels", "decision_mismatches",
     "popping", "false_culls", "exactly_hidden", "hidden_kept"};
 // The shadows program's counters in run.json's per-frame values (differences at frame ends).
-constexpr std::array<const char*, 17> kShadowsFrameCounts = {
-    "casters",     "culled",          "gl_culled",       "outside",    "crossing_near",       "kept_by_slab",
+constexpr std::array<const char*, 18> kShadowsFrameCounts = {
+    "casters",     "culled",          "gl_culled",       "outside",    "crossing_near",       "kept_by_slab", "reference_fill",
     "lookups",     "build_texels",    "litmap_reprojections", "volume_draws", "fill", "gl_fill", "stencil_tests",
     "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches"};
 
@@ -298,10 +298,16 @@ nlohmann::ordered_json shadows_summary(const nlohmann::ordered_json& p, std::uin
   j["frames"] = frames;
   for (const char* name : {"casters", "measured", "culled", "gl_culled", "outside", "crossing_near", "kept_by_slab", "lookups",
                            "build_texels", "litmap_draws", "litmap_reprojections", "volume_draws", "fill", "gl_fill",
-                           "stencil_tests", "mask_pixels", "scene_depth_tests"}) {
+                           "reference_fill", "stencil_tests", "mask_pixels", "scene_depth_tests"}) {
     j[name] = stat(p, name);
     j[std::string(name) + "_per_frame"] = per_frame(stat(p, name));
   }
+  // The fill against GL's infinite reference of the same frames (null when the trace predates
+  // SHDC's reference_fill on some frame).
+  const std::uint64_t reference = stat(p, "reference_fill");
+  j["fill_ratio_to_infinite"] = stat(p, "reference_frames") == frames && reference > 0
+                                    ? nlohmann::ordered_json(static_cast<double>(stat(p, "fill")) / static_cast<double>(reference))
+                                    : nlohmann::ordered_json(nullptr);
   j["cycles"] = cycles;
   j["cycles_per_frame"] = per_frame(cycles);
   for (const char* name : {"decision_mismatches", "zmin_mismatches", "zmax_mismatches", "not_conservative", "unsafe_culls",
@@ -465,7 +471,8 @@ ReplaySummary replay(const ReplayOptions& o) {
     s.shadows["nbuffer_memory_bytes"] = bytes;  // both units' levels
     nlohmann::ordered_json per_frame = nlohmann::ordered_json::array();
     for (const auto& pf : sink.per_frame_)
-      per_frame.push_back({{"frame", pf["frame"]}, {"fill", pf.value("fill", std::uint64_t{0})}, {"culled", pf.value("culled", std::uint64_t{0})},
+      per_frame.push_back({{"frame", pf["frame"]}, {"fill", pf.value("fill", std::uint64_t{0})},
+                           {"reference_fill", pf.value("reference_fill", std::uint64_t{0})}, {"culled", pf.value("culled", std::uint64_t{0})},
                            {"gl_culled", pf.value("gl_culled", std::uint64_t{0})}, {"mask_diff", pf.value("mask_diff", std::uint64_t{0})},
                            {"mask_diff_infinite", pf.value("mask_diff_infinite", std::uint64_t{0})}, {"cycles", pf["cycles"]}});
     s.shadows["per_frame"] = per_frame;

@@ -57,7 +57,7 @@ class ShadowsReplayTest : public ::testing::TestWithParam<std::string> {};
 // as the capture's, and fill clamped <= culled <= infinite.
 TEST_P(ShadowsReplayTest, ReplaysExactlyInEveryMode) {
   const std::string scene = GetParam();
-  std::map<std::string, double> fill;
+  std::map<std::string, double> fill, reference;
   for (const std::string mode : {"infinite", "culled", "clamped"}) {
     SCOPED_TRACE(scene + " " + mode);
     const auto run = replay(capture(scene, mode));
@@ -89,7 +89,13 @@ TEST_P(ShadowsReplayTest, ReplaysExactlyInEveryMode) {
     EXPECT_EQ(s["stencil_tests"], s["fill"]) << "one stencil test per volume fragment";
     EXPECT_EQ(s["per_frame"].size(), 2u);
     fill[mode] = s["fill_per_frame"].get<double>();
+    reference[mode] = s["reference_fill_per_frame"].get<double>();
+    ASSERT_TRUE(s["fill_ratio_to_infinite"].is_number()) << "every frame's SHDC holds GL's reference fill";
+    EXPECT_LE(s["fill_ratio_to_infinite"].get<double>(), 1.0);
   }
+  EXPECT_EQ(reference["infinite"], fill["infinite"]) << "an infinite capture's reference is its own fill";
+  EXPECT_EQ(reference["culled"], fill["infinite"]) << "the reference pass draws what the infinite capture draws";
+  EXPECT_EQ(reference["clamped"], fill["infinite"]);
   EXPECT_LE(fill["clamped"], fill["culled"]);
   EXPECT_LE(fill["culled"], fill["infinite"]);
   EXPECT_GT(fill["infinite"], 0.0);
@@ -177,7 +183,7 @@ TEST(ShadowsBadInputTest, MissingLitmapRefused) {
   expect_refused(bad, "frame 1: no 'litmap_max' depth image: the max N-buffer has nothing to be built from");
 }
 
-// `nbsim shadows --json`: a row per trace, the ratio to the infinite row of the same scene and seed.
+// `nbsim shadows --json`: a row per trace, the ratio to the trace's own reference fill.
 TEST(ShadowsTableTest, JsonRowsWithRatioToInfinite) {
   const fs::path inf = capture("boxes", "infinite"), cl = capture("boxes", "clamped");
   const CliResult r = run_nbsim("shadows " + inf.string() + " " + cl.string() + " --json");
@@ -189,11 +195,16 @@ TEST(ShadowsTableTest, JsonRowsWithRatioToInfinite) {
   EXPECT_EQ(rows[1]["shadow_mode"], "clamped");
   ASSERT_TRUE(rows[1]["ratio_to_infinite"].is_number());
   EXPECT_LE(rows[1]["ratio_to_infinite"].get<double>(), 1.0);
+  EXPECT_EQ(rows[1]["ratio_reference"], "reference_fill");
+  EXPECT_DOUBLE_EQ(rows[1]["ratio_to_infinite"].get<double>(),
+                   rows[1]["fill_per_frame"].get<double>() / rows[0]["fill_per_frame"].get<double>())
+      << "the reference pass's fill is the infinite capture's";
   EXPECT_EQ(rows[1]["mask_diff"], 0);
   EXPECT_EQ(rows[1]["draws_exact"], rows[1]["draws"]);
   const CliResult alone = run_nbsim("shadows " + cl.string() + " --json");
   ASSERT_EQ(alone.status, 0) << alone.err;
-  EXPECT_TRUE(nlohmann::json::parse(alone.out)[0]["ratio_to_infinite"].is_null()) << "no infinite row: no ratio";
+  EXPECT_EQ(nlohmann::json::parse(alone.out)[0]["ratio_to_infinite"], rows[1]["ratio_to_infinite"])
+      << "the trace alone gives its ratio";
   const CliResult text = run_nbsim("shadows " + cl.string());
   EXPECT_EQ(text.status, 0);
   EXPECT_TRUE(has(text.out, "Shadows: fill per frame")) << text.out;
