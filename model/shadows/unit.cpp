@@ -223,8 +223,11 @@ void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Co
   // 3. Both N-buffers from the litmaps (each unit's engine builds while the scene is drawn).
   build_texels_ += build(min_nb_, *f, "litmap_min");
   build_texels_ += build(max_nb_, *f, "litmap_max");
-  // 4. The casters' queries and decisions (the query ports wait for their engines).
+  // 4. The casters' queries and decisions (the query ports wait for their engines; a frame with no
+  // caster to query still waits for both builds).
   query_casters(*f, c, *light);
+  min_nb_.unit().drain();
+  max_nb_.unit().drain();
   ++frames_;
   // 5. The volumes, after the scene's depth (the draws keep their order in the pipeline).
   issue_role(f, scene::DrawRole::ShadowVolume, cp);

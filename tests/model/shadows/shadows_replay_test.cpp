@@ -183,6 +183,29 @@ TEST(ShadowsBadInputTest, MissingLitmapRefused) {
   expect_refused(bad, "frame 1: no 'litmap_max' depth image: the max N-buffer has nothing to be built from");
 }
 
+// A mask pixel unlike the model's (GL's shadow_mask flipped at one lit pixel): the replay completes,
+// the pixel is counted, and `nbsim shadows` exits 1.
+TEST(ShadowsTableTest, MaskPixelDifferingExits1) {
+  const fs::path good = capture("boxes", "clamped");
+  const fs::path bad = scratch("flipped_mask.nbt");
+  rewrite(good, bad, [](nbsim::scene::Frame& f) {
+    const auto* region = f.stencil("light_region");
+    for (auto& st : f.stencils)
+      if (st.name == "shadow_mask")
+        for (std::size_t i = 0; i < st.texels.size(); ++i)
+          if (region->texels[i]) {
+            st.texels[i] = st.texels[i] ? 0 : 1;
+            return;
+          }
+  });
+  const auto s = replay(bad)["summary"]["shadows"];
+  EXPECT_EQ(s["mask_diff"], 1) << "one pixel of GL's mask flipped";
+  EXPECT_EQ(s["mask_diff_infinite"], 0);
+  const CliResult r = run_nbsim("shadows " + bad.string() + " --json");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)[0]["mask_diff"], 1);
+}
+
 // `nbsim shadows --json`: a row per trace, the ratio to the trace's own reference fill.
 TEST(ShadowsTableTest, JsonRowsWithRatioToInfinite) {
   const fs::path inf = capture("boxes", "infinite"), cl = capture("boxes", "clamped");
