@@ -43,15 +43,18 @@ std::string_view property(const ProgramContext& c, std::string_view key, std::st
   throw InputError(fmt::format("the {} trace's header has no '{}' property", technique, key));
 }
 
+// A technique with its own culling refuses occlusion culling's cull.mode (`how`: what it culls with).
+void require_no_cull_mode(const ProgramContext& c, std::string_view how) {
+  if (c.config.cull.parsed_mode() != cull::CullMode::Trace)
+    throw InputError(fmt::format("cull.mode={} is occlusion culling's; {} (leave cull.mode at trace)", c.config.cull.mode, how));
+  c.config.cull.parsed_granularity();
+}
+
 // Point-sprite particles (the N-buffer paper, 3.2/4.3): the trace's particle_mode is the test; the
 // N-buffer instance "nbuffer" (mode nb) is built up to the capture's top level (levels_built - 1)
 // unless nbuffer.level_cap sets another; mode hiz reads the "hiz" instance's format and timing.
 Program particles(const ProgramContext& c) {
-  if (c.config.cull.parsed_mode() != cull::CullMode::Trace)
-    throw InputError(fmt::format("cull.mode={} is occlusion culling's; a particles trace culls with its own particle_mode "
-                                 "(leave cull.mode at trace)",
-                                 c.config.cull.mode));
-  c.config.cull.parsed_granularity();
+  require_no_cull_mode(c, "a particles trace culls with its own particle_mode");
   particles::ParticlesSetup s;
   s.width_px = c.setup.width_px;
   s.height_px = c.setup.height_px;
@@ -114,11 +117,7 @@ Program particles(const ProgramContext& c) {
 // volumes; the min and max N-buffer instances "litmap_min" and "litmap_max" are built over the
 // litmaps (litmap_size square) and queried per caster, and the model's stencil gives the mask.
 Program shadows(const ProgramContext& c) {
-  if (c.config.cull.parsed_mode() != cull::CullMode::Trace)
-    throw InputError(fmt::format("cull.mode={} is occlusion culling's; a shadows trace culls its casters with the litmaps "
-                                 "(leave cull.mode at trace)",
-                                 c.config.cull.mode));
-  c.config.cull.parsed_granularity();
+  require_no_cull_mode(c, "a shadows trace culls its casters with the litmaps");
   shadows::ShadowsSetup s;
   s.width_px = c.setup.width_px;
   s.height_px = c.setup.height_px;
