@@ -11,6 +11,7 @@
 #include "model/common/error.h"
 #include "model/common/names.h"
 #include "model/raster/point_setup.h"
+#include "model/scene/technique_record.h"
 
 namespace nbsim::particles {
 
@@ -125,26 +126,15 @@ namespace {
 
 template <class T>
 const std::vector<T>& field(const scene::TechniqueRecord& rec, std::string_view name, std::uint64_t frame) {
-  for (const scene::TechniqueField& f : rec.fields)
-    if (f.name == name) {
-      if (const auto* v = std::get_if<std::vector<T>>(&f.value)) return *v;
-      throw InputError(fmt::format("frame {}: the ParticleCulling record's field '{}' has the wrong type", frame, name));
-    }
-  throw InputError(fmt::format("frame {}: the ParticleCulling record has no field '{}'", frame, name));
+  return scene::record_field<T>(rec, name, "ParticleCulling", frame);
 }
 
 }  // namespace
 
 FrameParticles read_particles(const scene::Frame& f) {
   const std::uint64_t frame = f.begin.frame;
-  const scene::TechniqueRecord* rec = nullptr;
-  for (const scene::TechniqueRecord& r : f.technique_records)
-    if (r.type == kParticlesRecordType) {
-      if (rec) throw InputError(fmt::format("frame {}: more than one ParticleCulling (PRTC) record", frame));
-      rec = &r;
-    }
-  if (!rec) throw InputError(fmt::format("frame {}: no ParticleCulling (PRTC) record: nothing to decide for its particle draws", frame));
-  if (!rec->decoded) throw InputError(fmt::format("frame {}: the ParticleCulling (PRTC) record was not decoded", frame));
+  const scene::TechniqueRecord* rec =
+      &scene::single_record(f, kParticlesRecordType, "ParticleCulling (PRTC)", "nothing to decide for its particle draws");
   std::uint64_t count = 0;
   bool has_count = false;
   for (const scene::TechniqueField& fl : rec->fields)

@@ -1,4 +1,4 @@
-// `nbsim replay`, `nbsim compare`, `nbsim table2`, `nbsim particles` and `nbsim config`: the SystemC model from the
+// `nbsim replay`, `nbsim compare`, `nbsim table2`, `nbsim particles`, `nbsim shadows` and `nbsim config`: the SystemC model from the
 // command line. table2 runs one replay per row of the table the trace's technique declares
 // (pipeline/techniques/results.h; occlusion culling: one per culling mode), each in a child process
 // of this executable (SystemC allows one elaboration per process), and prints the paper's Table 2
@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -131,6 +132,90 @@ const nlohmann::ordered_json* row_named(const techniques::TableSpec& table, cons
   for (const auto& r : list)
     if (r[table.row_column] == value) return &r;
   return nullptr;
+}
+
+// The arguments of a technique's table command (`nbsim particles`, `nbsim shadows`): its traces,
+// one replay each in a child process, and where the table goes.
+struct TableCommandArgs {
+  std::vector<std::string> traces;
+  std::string out;
+  bool json = false;
+  int jobs = 2;
+  ModelOptions mo;
+
+  void add_options(CLI::App* cmd, const std::string& traces_help, const std::string& table_file) {
+    cmd->add_option("TRACE", traces, traces_help)->required();
+    cmd->add_option("--out", out, "Keep each replay's outputs in OUT/<trace name> and the table in OUT/" + table_file);
+    cmd->add_flag("--json", json, "Print a JSON list, one object per trace");
+    cmd->add_option("--jobs", jobs, "Replays run at a time (one process each)")->check(CLI::Range(1, 16));
+    mo.add_options(cmd);
+  }
+
+  // Refuses a bad config and any trace that is missing or not of `technique` before any child
+  // starts; hands each trace's reader to `each`.
+  void check(const std::string& technique, const std::function<void(const trace::TraceReader&)>& each) const {
+    pipeline::GpuConfig config;
+    nlohmann::ordered_json values;
+    mo.apply(config, values);
+    for (const std::string& t : traces) {
+      if (!std::filesystem::exists(t)) throw InputError(fmt::format("trace '{}' does not exist", t));
+      const trace::TraceReader reader(t);
+      const std::string* name = reader.property("technique");
+      if (!name || *name != technique)
+        throw InputError(fmt::format("trace '{}' is not a {} trace (technique '{}')", t, technique, name ? *name : ""));
+      each(reader);
+    }
+  }
+};
+
+// Replays every trace as `nbsim replay TRACE --out DIR/<i>_<stem> [config]` in child processes,
+// `jobs` at a time, into `out` (or a temporary folder removed afterwards), and returns each run.json
+// (`nbsim particles`, `nbsim shadows`). Throws InputError naming every replay that failed or whose
+// run.json has no `section`.
+std::vector<nlohmann::json> replay_each(const std::vector<std::string>& traces, const std::string& out, int jobs,
+                                        const ModelOptions& mo, const std::string& section) {
+  std::filesystem::path dir;
+  const bool temporary = out.empty();
+  if (temporary) {
+    std::string tmpl = (std::filesystem::temp_directory_path() / "nbsim_replays_XXXXXX").string();
+    if (!mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary folder");
+    dir = tmpl;
+  } else {
+    dir = out;
+  }
+  std::vector<explore::ChildJob> children;
+  for (std::size_t i = 0; i < traces.size(); ++i) {
+    const std::filesystem::path d = dir / fmt::format("{}_{}", i, std::filesystem::path(traces[i]).stem().string());
+    std::vector<std::string> args = {"replay", std::filesystem::absolute(traces[i]).string(), "--out", d.string()};
+    if (!mo.config_file.empty()) args.insert(args.end(), {"--config", mo.config_file});
+    for (const auto& s : mo.sets) args.insert(args.end(), {"--set", s});
+    children.push_back({std::move(args), d});
+  }
+  std::vector<nlohmann::json> runs(traces.size());
+  std::string failures;
+  explore::run_children(explore::self_executable(), children, jobs, [&](std::size_t i, const explore::ChildOutcome& o) {
+    if (!o.ok) {
+      failures += fmt::format("{}: replay failed: {}\n", traces[i], o.error);
+      return;
+    }
+    std::ifstream in(children[i].dir / "run.json");
+    nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !techniques::at_pointer(j, section))
+      failures += fmt::format("{}: its run.json has no {}\n", traces[i], section);
+    else
+      runs[i] = std::move(j);
+  });
+  if (temporary) std::filesystem::remove_all(dir);
+  if (!failures.empty()) throw InputError(failures.substr(0, failures.size() - 1));
+  return runs;
+}
+
+// The run's settings, so that a table read later says what it was made with.
+nlohmann::ordered_json settings_of(const ModelOptions& mo) {
+  nlohmann::ordered_json settings = nlohmann::ordered_json::array();
+  if (!mo.config_file.empty()) settings.push_back("--config " + mo.config_file);
+  for (const auto& s : mo.sets) settings.push_back(s);
+  return settings;
 }
 
 }  // namespace
@@ -338,72 +423,27 @@ void add_model_commands(CLI::App& app, Action& action) {
     auto* cmd = app.add_subcommand(
         "particles",
         "Replay particles traces (one per mode, or one `none` capture with --set particles.mode=M) and print the particles table");
-    auto traces = std::make_shared<std::vector<std::string>>();
-    auto out = std::make_shared<std::string>();
-    auto json = std::make_shared<bool>(false);
-    auto jobs = std::make_shared<int>(2);
-    auto mo = std::make_shared<ModelOptions>();
-    cmd->add_option("TRACE", *traces, "Particles traces (nbsim capture particles), e.g. one per --mode")->required();
-    cmd->add_option("--out", *out, "Keep each replay's outputs in OUT/<trace name> and the table in OUT/particles.json");
-    cmd->add_flag("--json", *json, "Print a JSON list, one object per trace");
-    cmd->add_option("--jobs", *jobs, "Replays run at a time (one process each)")->check(CLI::Range(1, 16));
-    mo->add_options(cmd);
-    cmd->callback([&action, traces, out, json, jobs, mo] {
-      action = [traces, out, json, jobs, mo] {
-        pipeline::GpuConfig config;  // a bad config is refused here, before any child starts
-        nlohmann::ordered_json values;
-        mo->apply(config, values);
+    auto a = std::make_shared<TableCommandArgs>();
+    a->add_options(cmd, "Particles traces (nbsim capture particles), e.g. one per --mode", "particles.json");
+    cmd->callback([&action, a] {
+      action = [a] {
         std::vector<std::string> sprites;
-        for (const std::string& t : *traces) {
-          if (!std::filesystem::exists(t)) throw InputError(fmt::format("trace '{}' does not exist", t));
-          const trace::TraceReader reader(t);
-          const std::string* technique = reader.property("technique");
-          if (!technique || *technique != "particles")
-            throw InputError(fmt::format("trace '{}' is not a particles trace (technique '{}')", t, technique ? *technique : ""));
+        a->check("particles", [&](const trace::TraceReader& reader) {
           const std::string* sprite = reader.property("sprite");
           sprites.push_back(sprite ? *sprite : "");
-        }
-        std::filesystem::path dir;
-        const bool temporary = out->empty();
-        if (temporary) {
-          std::string tmpl = (std::filesystem::temp_directory_path() / "nbsim_particles_XXXXXX").string();
-          if (!mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary folder");
-          dir = tmpl;
-        } else {
-          dir = *out;
-        }
-        std::vector<explore::ChildJob> children;
-        for (std::size_t i = 0; i < traces->size(); ++i) {
-          const std::filesystem::path d = dir / fmt::format("{}_{}", i, std::filesystem::path((*traces)[i]).stem().string());
-          std::vector<std::string> args = {"replay", std::filesystem::absolute((*traces)[i]).string(), "--out", d.string()};
-          if (!mo->config_file.empty()) args.insert(args.end(), {"--config", mo->config_file});
-          for (const auto& s : mo->sets) args.insert(args.end(), {"--set", s});
-          children.push_back({std::move(args), d});
-        }
-        std::vector<nlohmann::ordered_json> rows(traces->size());
-        std::string failures;
-        explore::run_children(explore::self_executable(), children, *jobs, [&](std::size_t i, const explore::ChildOutcome& o) {
-          if (!o.ok) {
-            failures += fmt::format("{}: replay failed: {}\n", (*traces)[i], o.error);
-            return;
-          }
-          std::ifstream in(children[i].dir / "run.json");
-          const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-          const nlohmann::json* p = j.is_discarded() ? nullptr : techniques::at_pointer(j, "/summary/particles");
-          if (!p) {
-            failures += fmt::format("{}: its run.json has no /summary/particles\n", (*traces)[i]);
-            return;
-          }
+        });
+        const std::vector<nlohmann::json> runs = replay_each(a->traces, a->out, a->jobs, a->mo, "/summary/particles");
+        const std::filesystem::path dir = a->out;
+        const bool temporary = a->out.empty();
+        std::vector<nlohmann::ordered_json> rows(a->traces.size());
+        for (std::size_t i = 0; i < a->traces.size(); ++i) {
+          const nlohmann::json* p = techniques::at_pointer(runs[i], "/summary/particles");
           nlohmann::ordered_json r;
-          r["trace"] = (*traces)[i];
+          r["trace"] = (a->traces)[i];
           r["mode"] = (*p)["mode"];
           r["capture_mode"] = p->contains("capture_mode") ? (*p)["capture_mode"] : (*p)["mode"];
           r["sprite"] = sprites[i];
-          // The run's settings, so that a table read later says what it was made with.
-          nlohmann::ordered_json settings = nlohmann::ordered_json::array();
-          if (!mo->config_file.empty()) settings.push_back("--config " + mo->config_file);
-          for (const auto& s : mo->sets) settings.push_back(s);
-          r["settings"] = std::move(settings);
+          r["settings"] = settings_of(a->mo);
           const double n = (*p)["particles_per_frame"].get<double>();
           r["particles_per_frame"] = n;
           // The paper's claim for 16 px sprites: 256 N by rasterization (none), N with the N-buffer.
@@ -417,9 +457,7 @@ void add_model_commands(CLI::App& app, Action& action) {
                                 "false_culls", "decision_mismatches", "kept_too_large", "redrawn"})
             r[k] = (*p)[k];
           rows[i] = std::move(r);
-        });
-        if (temporary) std::filesystem::remove_all(dir);
-        if (!failures.empty()) throw InputError(failures.substr(0, failures.size() - 1));
+        }
         nlohmann::ordered_json list = nlohmann::ordered_json::array();
         for (auto& r : rows) list.push_back(std::move(r));
         if (!temporary) {
@@ -427,7 +465,7 @@ void add_model_commands(CLI::App& app, Action& action) {
           f << list.dump(2) << "\n";
           if (!f) throw InputError(fmt::format("cannot write '{}'", (dir / "particles.json").string()));
         }
-        if (*json) {
+        if (a->json) {
           fmt::print("{}\n", list.dump());
           return 0;
         }
@@ -450,6 +488,99 @@ void add_model_commands(CLI::App& app, Action& action) {
                      r["popping"].dump(), r["false_culls"].dump(), r["decision_mismatches"].dump());
         }
         return 0;
+      };
+    });
+  }
+  {
+    // One replay per shadows trace (one capture per shadow_mode: GL's volumes depend on it), in
+    // child processes, and a row each from its run.json's /summary/shadows beside the paper's
+    // figures (fill 20 M -> 512 K px in the city, 2.5%; about 20% on simpler scenes). The ratio to
+    // infinite divides by the trace's own reference fill (SHDC reference_fill: GL's infinite volumes
+    // of the same frames); a trace captured before that field gets the fill per frame of an
+    // `infinite` row of the same scene, seed, viewport and frames given in the same command ("-"
+    // when there is none); `ratio_reference` says which.
+    auto* cmd = app.add_subcommand(
+        "shadows", "Replay shadows traces (one per shadow mode) and print the shadows table; exit 1 when a mask pixel differs");
+    auto a = std::make_shared<TableCommandArgs>();
+    a->add_options(cmd, "Shadows traces (nbsim capture shadows), e.g. one per --shadow-mode", "shadows.json");
+    cmd->callback([&action, a] {
+      action = [a] {
+        std::vector<std::string> keys;  // scene, seed, viewport and frames: rows comparable for the ratio
+        a->check("shadows", [&](const trace::TraceReader& reader) {
+          std::string key;
+          for (const char* k : {"scene", "seed", "viewport", "frames", "path", "objects", "litmap_size", "light"}) {
+            const std::string* v = reader.property(k);
+            key += fmt::format("{}={};", k, v ? *v : "");
+          }
+          keys.push_back(std::move(key));
+        });
+        const std::vector<nlohmann::json> runs = replay_each(a->traces, a->out, a->jobs, a->mo, "/summary/shadows");
+        const std::filesystem::path dir = a->out;
+        const bool temporary = a->out.empty();
+        std::vector<nlohmann::ordered_json> rows(a->traces.size());
+        for (std::size_t i = 0; i < a->traces.size(); ++i) {
+          const nlohmann::json* p = techniques::at_pointer(runs[i], "/summary/shadows");
+          const nlohmann::json* sum = techniques::at_pointer(runs[i], "/summary");
+          nlohmann::ordered_json r;
+          r["trace"] = (a->traces)[i];
+          for (const char* k : {"scene", "shadow_mode", "litmap_size"}) r[k] = p->contains(k) ? (*p)[k] : nlohmann::json("");
+          r["settings"] = settings_of(a->mo);
+          for (const char* k : {"frames", "casters_per_frame", "culled_per_frame", "gl_culled_per_frame", "outside_per_frame", "fill_per_frame",
+                                "gl_fill_per_frame", "reference_fill_per_frame", "fill_ratio_to_infinite", "build_texels_per_frame", "lookups_per_frame", "stencil_tests_per_frame",
+                                "litmap_reprojections_per_frame", "cycles_per_frame", "nbuffer_memory_bytes", "mask_diff",
+                                "mask_diff_infinite", "decision_mismatches", "zmin_mismatches", "zmax_mismatches",
+                                "not_conservative", "unsafe_culls", "kept_by_slab"})
+            r[k] = (*p)[k];
+          r["draws"] = (*sum)["draws"];
+          r["draws_exact"] = (*sum)["draws_exact"];
+          r["stencil_pixels_matching"] = sum->value("stencil_pixels_matching", 0);
+          r["stencil_pixels"] = sum->value("stencil_pixels", 0);
+          rows[i] = std::move(r);
+        }
+        // The ratio to infinite: the trace's own reference fill, else an infinite row with the same key.
+        std::uint64_t differing = 0;
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+          nlohmann::ordered_json& r = rows[i];
+          r["ratio_to_infinite"] = r["fill_ratio_to_infinite"];
+          r["ratio_reference"] = r["ratio_to_infinite"].is_number() ? nlohmann::ordered_json("reference_fill")
+                                                                     : nlohmann::ordered_json(nullptr);
+          for (std::size_t k = 0; k < rows.size() && r["ratio_to_infinite"].is_null(); ++k)
+            if (keys[k] == keys[i] && rows[k]["shadow_mode"] == "infinite" && rows[k]["fill_per_frame"].get<double>() > 0.0) {
+              r["ratio_to_infinite"] = r["fill_per_frame"].get<double>() / rows[k]["fill_per_frame"].get<double>();
+              r["ratio_reference"] = rows[k]["trace"];
+              break;
+            }
+          differing += r["mask_diff"].get<std::uint64_t>() + r["mask_diff_infinite"].get<std::uint64_t>();
+        }
+        nlohmann::ordered_json list = nlohmann::ordered_json::array();
+        for (auto& r : rows) list.push_back(std::move(r));
+        if (!temporary) {
+          std::ofstream f(dir / "shadows.json");
+          f << list.dump(2) << "\n";
+          if (!f) throw InputError(fmt::format("cannot write '{}'", (dir / "shadows.json").string()));
+        }
+        if (a->json) {
+          fmt::print("{}\n", list.dump());
+          return differing == 0 ? 0 : 1;
+        }
+        fmt::print("Shadows: fill per frame (paper, 640x480: city 20 M -> 512 K px, 2.5%; simpler scenes about 20%)\n");
+        fmt::print("{:<8} {:<9} {:>12} {:>8} {:>7} {:>14} {:>10} {:>8} {:>11} {:>8} {:>8} {:>10}\n", "scene", "mode", "fill/frame",
+                   "ratio", "paper", "culled/casters", "build", "lookups", "cycles", "mask", "mask_inf", "mismatches");
+        for (const auto& r : list) {
+          const auto num = [&](const char* k) { return r[k].is_number() ? r[k].get<double>() : 0.0; };
+          const std::string scene = r["scene"].get<std::string>();
+          const std::string paper = r["shadow_mode"] == "clamped" ? (scene == "boxes" ? "~20%" : "2.5%") : "-";
+          fmt::print("{:<8} {:<9} {:>12.0f} {:>8} {:>7} {:>14} {:>10.0f} {:>8.0f} {:>11.0f} {:>8} {:>8} {:>10}\n", scene,
+                     r["shadow_mode"].get<std::string>(), num("fill_per_frame"),
+                     r["ratio_to_infinite"].is_number() ? fmt::format("{:.1f}%", 100.0 * num("ratio_to_infinite")) : std::string("-"),
+                     paper, fmt::format("{:.1f}/{:.0f}", num("gl_culled_per_frame") + num("outside_per_frame"), num("casters_per_frame")),
+                     num("build_texels_per_frame"), num("lookups_per_frame"), num("cycles_per_frame"), r["mask_diff"].dump(),
+                     r["mask_diff_infinite"].dump(),
+                     r["decision_mismatches"].get<std::uint64_t>() + r["zmin_mismatches"].get<std::uint64_t>() +
+                         r["zmax_mismatches"].get<std::uint64_t>());
+        }
+        if (differing) fmt::print("mask pixels differing from GL's: {}\n", differing);
+        return differing == 0 ? 0 : 1;
       };
     });
   }

@@ -18,6 +18,7 @@ void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
   s.add("memory.latency_cycles", c.memory.latency_cycles, "cycles", "from request to data", 0, 100000);
   cull::CullUnitConfig::describe(s, c.cull);
   particles::ParticlesUnitConfig::describe(s, c.particles);
+  shadows::ShadowsUnitConfig::describe(s, c.shadows);
   for (auto& [name, config] : c.nbuffers) nbuffer::NBufferUnitConfig::describe(s, config, name);
   for (auto& [name, config] : c.hiz) HiZUnitConfig::describe(s, config, name);
   s.add("gpu.fifo_depth", c.fifo_depth, "work items", "depth of the fifos between units", 1, 4096);

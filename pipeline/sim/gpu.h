@@ -24,6 +24,7 @@
 #include "model/geometry/unit.h"
 #include "model/memory/memory.h"
 #include "model/particles/unit.h"
+#include "model/shadows/unit.h"
 #include "model/query/units.h"
 #include "model/raster/unit.h"
 #include "pipeline/sim/programs.h"
@@ -38,6 +39,7 @@ struct GpuConfig {
   memory::ChannelConfig memory;
   cull::CullUnitConfig cull;
   particles::ParticlesUnitConfig particles;
+  shadows::ShadowsUnitConfig shadows;
   // The query-structure instances (programs.h structure_instances()) by name, one config each
   // (keys "<name>.<field>"): "nbuffer" and "hiz" for occlusion culling's modes.
   std::map<std::string, nbuffer::NBufferUnitConfig, std::less<>> nbuffers;
@@ -49,7 +51,7 @@ struct GpuConfig {
   int quantum_cycles = 0;
 
   // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.", "particles.",
-  // "nbuffer.", "hiz.", "gpu.").
+  // "shadows.", "nbuffer.", "hiz.", "gpu.").
   static void describe(config::Schema& s, GpuConfig& c);
   // Throws InputError naming the key when a unit's value is out of its limits or inconsistent
   // (the checks the units make when they are built, for a config checked before any run).

@@ -37,21 +37,24 @@ Program occlusion_culling(const ProgramContext& c) {
   return p;
 }
 
-std::string_view property(const ProgramContext& c, std::string_view key) {
+std::string_view property(const ProgramContext& c, std::string_view key, std::string_view technique = "particles") {
   for (const auto& [k, v] : c.setup.properties)
     if (k == key) return v;
-  throw InputError(fmt::format("the particles trace's header has no '{}' property", key));
+  throw InputError(fmt::format("the {} trace's header has no '{}' property", technique, key));
+}
+
+// A technique with its own culling refuses occlusion culling's cull.mode (`how`: what it culls with).
+void require_no_cull_mode(const ProgramContext& c, std::string_view how) {
+  if (c.config.cull.parsed_mode() != cull::CullMode::Trace)
+    throw InputError(fmt::format("cull.mode={} is occlusion culling's; {} (leave cull.mode at trace)", c.config.cull.mode, how));
+  c.config.cull.parsed_granularity();
 }
 
 // Point-sprite particles (the N-buffer paper, 3.2/4.3): the trace's particle_mode is the test; the
 // N-buffer instance "nbuffer" (mode nb) is built up to the capture's top level (levels_built - 1)
 // unless nbuffer.level_cap sets another; mode hiz reads the "hiz" instance's format and timing.
 Program particles(const ProgramContext& c) {
-  if (c.config.cull.parsed_mode() != cull::CullMode::Trace)
-    throw InputError(fmt::format("cull.mode={} is occlusion culling's; a particles trace culls with its own particle_mode "
-                                 "(leave cull.mode at trace)",
-                                 c.config.cull.mode));
-  c.config.cull.parsed_granularity();
+  require_no_cull_mode(c, "a particles trace culls with its own particle_mode");
   particles::ParticlesSetup s;
   s.width_px = c.setup.width_px;
   s.height_px = c.setup.height_px;
@@ -110,7 +113,46 @@ Program particles(const ProgramContext& c) {
   return p;
 }
 
-constexpr std::array<ProgramRow, 2> kPrograms = {{
+// Shadow volumes with litmaps (the N-buffer paper, 3.3/4.4): the trace's shadow_mode drew the
+// volumes; the min and max N-buffer instances "litmap_min" and "litmap_max" are built over the
+// litmaps (litmap_size square) and queried per caster, and the model's stencil gives the mask.
+Program shadows(const ProgramContext& c) {
+  require_no_cull_mode(c, "a shadows trace culls its casters with the litmaps");
+  shadows::ShadowsSetup s;
+  s.width_px = c.setup.width_px;
+  s.height_px = c.setup.height_px;
+  const std::string mode(property(c, "shadow_mode", "shadows")), size(property(c, "litmap_size", "shadows"));
+  const std::string margin(property(c, "clamp_margin", "shadows"));
+  const auto m = shadows::parse_mode(mode);
+  if (!m) throw InputError(fmt::format("the shadows trace's shadow_mode '{}' is not one of infinite, culled, clamped", mode));
+  s.mode = *m;
+  try {
+    std::size_t used = 0;
+    s.litmap_size = std::stoi(size, &used);
+    if (used != size.size() || s.litmap_size < 1 || s.litmap_size > 16384) throw std::invalid_argument("range");
+  } catch (const std::exception&) {
+    throw InputError(fmt::format("the shadows trace's litmap_size '{}' is not a side of 1 to 16384 lexels", size));
+  }
+  const auto cm = shadows::parse_clamp_margin(margin);
+  if (!cm) throw InputError(fmt::format("the shadows trace's clamp_margin '{}' is not '<relative> + <metres> m'", margin));
+  s.margin = *cm;
+  Program p;
+  const auto nbuffer = [&](const char* instance, FarOp op) {
+    return std::make_unique<query::NBufferStructure>(instance, c.registry, c.config.nbuffers.at(instance), s.litmap_size,
+                                                     s.litmap_size, op, &c.memory);
+  };
+  auto min_nb = nbuffer("litmap_min", FarOp::Min);
+  auto max_nb = nbuffer("litmap_max", FarOp::Max);
+  auto unit = std::make_unique<shadows::ShadowsUnit>("shadows", c.registry, c.config.shadows, s, c.stencil_buffer, *min_nb, *max_nb);
+  p.structures.push_back(std::move(min_nb));
+  p.structures.push_back(std::move(max_nb));
+  p.frames = unit.get();
+  p.depth_listener = unit.get();
+  p.unit = std::move(unit);
+  return p;
+}
+
+constexpr std::array<ProgramRow, 3> kPrograms = {{
     {"occlusion_culling",
      "occlusion culling of a scene's objects (cull.mode: trace replays the recorded draws; none, oq, oq_hier, nb, "
      "nb_hier, hiz_tile, hiz_pyramid cull every candidate again)",
@@ -119,15 +161,24 @@ constexpr std::array<ProgramRow, 2> kPrograms = {{
      "point-sprite particles culled in the vertex stage (the trace's particle_mode: none, center, nb, hiz), each "
      "decision made again by the model and compared with GL's; GL's particle draws rasterized",
      particles},
+    {"shadows",
+     "shadow volumes culled and clamped with min/max litmaps (the trace's shadow_mode): GL's scene and volume draws "
+     "rasterized with the stencil test, a min and a max N-buffer built over GL's litmaps and queried per caster, the "
+     "decisions and the shadow mask compared with GL's",
+     shadows},
 }};
 
-constexpr std::array<StructureInstance, 2> kInstances = {{
+constexpr std::array<StructureInstance, 4> kInstances = {{
     {"nbuffer", InstanceKind::NBuffer,
      "occlusion culling's N-buffer unit (cull.mode nb, nb_hier); the particles' max N-buffer (particle_mode nb, level_cap -1: "
      "the capture's levels)"},
     {"hiz", InstanceKind::HiZ,
      "occlusion culling's Hi-Z baselines (cull.mode hiz_tile, hiz_pyramid); the particles' Hi-Z pyramid format and timing "
      "(particle_mode hiz)"},
+    {"litmap_min", InstanceKind::NBuffer,
+     "shadows: the min N-buffer over the min litmap (litmap_size square), queried for each caster's z_min"},
+    {"litmap_max", InstanceKind::NBuffer,
+     "shadows: the max N-buffer over the max litmap (litmap_size square), queried for each caster's z_max"},
 }};
 
 std::string technique_list() {

@@ -27,6 +27,11 @@ constexpr std::array<const char*, 11> kCullFrameCounts = {
 constexpr std::array<const char*, 11> kParticlesFrameCounts = {
     "particles", "culled", "kept_too_large", "lookups", "particle_fragments", "build_texels", "decision_mismatches",
     "popping", "false_culls", "exactly_hidden", "hidden_kept"};
+// The shadows program's counters in run.json's per-frame values (differences at frame ends).
+constexpr std::array<const char*, 18> kShadowsFrameCounts = {
+    "casters",     "culled",          "gl_culled",       "outside",    "crossing_near",       "kept_by_slab", "reference_fill",
+    "lookups",     "build_texels",    "litmap_reprojections", "volume_draws", "fill", "gl_fill", "stencil_tests",
+    "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches"};
 
 // A statistic of a group's values (0 when the group has none of that name).
 std::uint64_t stat(const nlohmann::ordered_json& group, const char* name) {
@@ -145,6 +150,11 @@ class Collector : public depth::ResultSink {
       for (const char* name : kParticlesFrameCounts) pf[name] = delta(name);
       last_particles_ = now;
     }
+    if (const stats::Group* g = registry_.find("gpu.shadows")) {
+      const nlohmann::ordered_json now = g->values();
+      for (const char* name : kShadowsFrameCounts) pf[name] = stat(now, name) - stat(last_shadows_, name);
+      last_shadows_ = now;
+    }
     per_frame_.push_back(std::move(pf));
     last_cycle_ = cycle;
     for (const auto& d : w.frame->draws)
@@ -171,6 +181,7 @@ class Collector : public depth::ResultSink {
   const stats::Registry& registry_;
   nlohmann::ordered_json last_cull_ = nlohmann::ordered_json::object();  // gpu.cull at the last frame end
   nlohmann::ordered_json last_particles_ = nlohmann::ordered_json::object();  // gpu.particles at the last frame end
+  nlohmann::ordered_json last_shadows_ = nlohmann::ordered_json::object();    // gpu.shadows at the last frame end
   std::ofstream draws_, frames_;
   FrameTotals frame_;
   std::uint64_t last_cycle_ = 0;
@@ -278,6 +289,33 @@ nlohmann::ordered_json particles_summary(const nlohmann::ordered_json& p, std::s
   return j;
 }
 
+// The shadows program's run totals (summary "shadows"), from its statistics and both N-buffers'
+// when the run is done; the per-frame values (fill, culled casters, cycles) are run.json's frames.
+nlohmann::ordered_json shadows_summary(const nlohmann::ordered_json& p, std::uint64_t cycles) {
+  const std::uint64_t frames = stat(p, "frames");
+  const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
+  nlohmann::ordered_json j;
+  j["frames"] = frames;
+  for (const char* name : {"casters", "measured", "culled", "gl_culled", "outside", "crossing_near", "kept_by_slab", "lookups",
+                           "build_texels", "litmap_draws", "litmap_reprojections", "volume_draws", "fill", "gl_fill",
+                           "reference_fill", "stencil_tests", "mask_pixels", "scene_depth_tests"}) {
+    j[name] = stat(p, name);
+    j[std::string(name) + "_per_frame"] = per_frame(stat(p, name));
+  }
+  // The fill against GL's infinite reference of the same frames (null when the trace predates
+  // SHDC's reference_fill on some frame).
+  const std::uint64_t reference = stat(p, "reference_fill");
+  j["fill_ratio_to_infinite"] = stat(p, "reference_frames") == frames && reference > 0
+                                    ? nlohmann::ordered_json(static_cast<double>(stat(p, "fill")) / static_cast<double>(reference))
+                                    : nlohmann::ordered_json(nullptr);
+  j["cycles"] = cycles;
+  j["cycles_per_frame"] = per_frame(cycles);
+  for (const char* name : {"decision_mismatches", "zmin_mismatches", "zmax_mismatches", "not_conservative", "unsafe_culls",
+                           "culls_lost", "lookup_mismatches", "mask_diff", "mask_diff_infinite", "gl_mask_diff", "gl_mask_pixels"})
+    j[name] = stat(p, name);
+  return j;
+}
+
 double rel(std::uint64_t a, std::uint64_t b) {
   if (b == 0) return a == 0 ? 0.0 : 1.0;
   return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
@@ -328,6 +366,7 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   j["within_thresholds"] = within_thresholds();
   if (!cull.is_null()) j["cull"] = cull;
   if (!particles.is_null()) j["particles"] = particles;
+  if (!shadows.is_null()) j["shadows"] = shadows;
   return j;
 }
 
@@ -420,6 +459,23 @@ ReplaySummary replay(const ReplayOptions& o) {
     s.particles["capture_mode"] = capture_mode;
     const auto& structures = gpu.program().structures;
     s.particles["nbuffer_memory_bytes"] = structures.empty() ? 0 : structures.front()->storage_bytes();
+  }
+
+  if (s.stats.contains("gpu.shadows")) {
+    s.shadows = shadows_summary(s.stats["gpu.shadows"], sink.last_frame_cycle());
+    for (const char* key : {"shadow_mode", "scene", "litmap_size", "seed"})
+      for (const auto& [k, v] : tr.properties())
+        if (k == key) s.shadows[key] = v;
+    long long bytes = 0;
+    for (const auto& structure : gpu.program().structures) bytes += structure->storage_bytes();
+    s.shadows["nbuffer_memory_bytes"] = bytes;  // both units' levels
+    nlohmann::ordered_json per_frame = nlohmann::ordered_json::array();
+    for (const auto& pf : sink.per_frame_)
+      per_frame.push_back({{"frame", pf["frame"]}, {"fill", pf.value("fill", std::uint64_t{0})},
+                           {"reference_fill", pf.value("reference_fill", std::uint64_t{0})}, {"culled", pf.value("culled", std::uint64_t{0})},
+                           {"gl_culled", pf.value("gl_culled", std::uint64_t{0})}, {"mask_diff", pf.value("mask_diff", std::uint64_t{0})},
+                           {"mask_diff_infinite", pf.value("mask_diff_infinite", std::uint64_t{0})}, {"cycles", pf["cycles"]}});
+    s.shadows["per_frame"] = per_frame;
   }
 
   if (o.out) {

@@ -69,6 +69,9 @@ struct ReplaySummary {
   // Particles traces: totals and per-frame averages of the particles program (particles_summary in
   // replay.cpp); null otherwise.
   nlohmann::ordered_json particles;
+  // Shadows traces: totals, per-frame averages and per-frame values of the shadows program
+  // (shadows_summary in replay.cpp), the header's shadow_mode and scene; null otherwise.
+  nlohmann::ordered_json shadows;
 
   double fragment_error() const;  // |model - gl| / gl over all draws
   double passed_error() const;

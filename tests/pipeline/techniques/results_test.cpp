@@ -195,6 +195,10 @@ nlohmann::json real_run(const std::string& technique) {
     const CliResult c = run_nbsim("capture particles --scene city --path walk --size 96x64 --frames 2 --objects 600 "
                                   "--particles 400 --sprite 16 --mode nb -o " + trace);
     EXPECT_EQ(c.status, 0) << c.out << c.err;
+  } else if (technique == "shadows") {
+    trace = scratch("shadows.nbt").string();
+    const CliResult c = run_nbsim("capture shadows --scene boxes --path fly --size 96x64 --frames 2 --litmap 32 -o " + trace);
+    EXPECT_EQ(c.status, 0) << c.out << c.err;
   } else {
     ADD_FAILURE() << technique << ": no real run.json to check its row against (add its trace to real_run)";
     return nlohmann::json();

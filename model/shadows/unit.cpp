@@ -1,0 +1,240 @@
+// ShadowsUnit: the shadow-volume technique's frame program and counters; see unit.h.
+#include "model/shadows/unit.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "model/common/error.h"
+
+namespace nbsim::shadows {
+
+void ShadowsUnitConfig::describe(config::Schema& s, ShadowsUnitConfig& c) {
+  s.add("shadows.tests_per_cycle", c.tests_per_cycle, "casters/cycle",
+        "casters through the rectangle and cull-decision stage a cycle (the queries are the N-buffer units')", 0.01, 1024.0);
+  s.add("shadows.latency_cycles", c.latency_cycles, "cycles", "latency of a frame's batch of caster decisions", 0, 100000);
+}
+
+ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ShadowsUnitConfig& config,
+                         const ShadowsSetup& setup, const raster::StencilImage& stencil, query::NBufferStructure& min_nb,
+                         query::NBufferStructure& max_nb)
+    : sim::Unit(name, registry),
+      config_(config),
+      setup_(setup),
+      stencil_(stencil),
+      min_nb_(min_nb),
+      max_nb_(max_nb),
+      frames_(stats().counter("frames", "frames", "frames replayed")),
+      casters_(stats().counter("casters", "casters", "casters in the SHDC records")),
+      measured_(stats().counter("measured", "casters", "casters with a rectangle in the litmap, queried by the model")),
+      culled_(stats().counter("culled", "casters", "casters the cull rule culls on the model's z_min/z_max")),
+      gl_culled_(stats().counter("gl_culled", "casters", "casters GL culled (decision 1)")),
+      outside_(stats().counter("outside", "casters", "casters outside the light's frustum (decision 2, as recorded)")),
+      crossing_near_(stats().counter("crossing_near", "casters", "casters crossing the light's near plane (decision 3, as recorded)")),
+      kept_by_slab_(stats().counter("kept_by_slab", "casters",
+                                    "casters GL kept that the litmap rule culls on GL's values: the capture's slab, widened for "
+                                    "receivers the litmaps cannot sample (scene triangles the trace does not hold)")),
+      decision_mismatches_(stats().counter("decision_mismatches", "casters",
+                                           "casters GL culled that the rule on GL's own values keeps (expected 0)")),
+      zmin_mismatches_(stats().counter("zmin_mismatches", "casters", "casters whose model z_min differs from GL's")),
+      zmax_mismatches_(stats().counter("zmax_mismatches", "casters", "casters whose model z_max differs from GL's")),
+      not_conservative_(stats().counter("not_conservative", "casters",
+                                        "casters whose model z_min is above the exact minimum of the rectangle's litmap_min lexels, or z_max below the "
+                                        "exact maximum of its litmap_max lexels (must be 0)")),
+      unsafe_culls_(stats().counter("unsafe_culls", "casters",
+                                    "casters the model culls that the rule on the rectangle's exact depth range keeps (must be 0)")),
+      culls_lost_(stats().counter("culls_lost", "casters", "casters GL culled that the model keeps (a looser design's cost)")),
+      lookups_(stats().counter("lookups", "texels", "N-buffer texels the caster queries read, both units")),
+      lookup_mismatches_(stats().counter("lookup_mismatches", "casters",
+                                         "casters whose texels read differ from the capture's count")),
+      build_texels_(stats().counter("build_texels", "texels", "N-buffer texels computed building both units from the litmaps")),
+      litmap_draws_(stats().counter("litmap_draws", "draws", "litmap draws of the trace (not rasterized: no clip positions)")),
+      litmap_reprojections_(stats().counter("litmap_reprojections", "fragments",
+                                            "litmap fragments reprojected into the observer's view (GL's fragment counter of "
+                                            "the litmap draws; each reads up to 3x3 observer depth texels)")),
+      scene_depth_tests_(stats().counter("scene_depth_tests", "tests", "depth tests of the scene draws")),
+      volume_draws_(stats().counter("volume_draws", "draws", "shadow-volume draws issued")),
+      fill_(stats().counter("fill", "fragments", "rasterized fragments of the shadow-volume draws (the fill)")),
+      gl_fill_(stats().counter("gl_fill", "fragments", "GL's rasterized fragments of the shadow-volume draws")),
+      reference_fill_(stats().counter("reference_fill", "fragments",
+                                      "GL's fill of every caster's infinite volume (SHDC reference_fill: the capture's reference "
+                                      "pass, not recorded as draws; the infinite mode's own fill in an infinite capture)")),
+      reference_frames_(stats().counter("reference_frames", "frames", "frames whose SHDC record holds reference_fill")),
+      stencil_tests_(stats().counter("stencil_tests", "tests", "stencil tests of the shadow-volume draws")),
+      mask_pixels_(stats().counter("mask_pixels", "pixels", "shadowed pixels of the model's mask")),
+      gl_mask_pixels_(stats().counter("gl_mask_pixels", "pixels", "shadowed pixels of GL's shadow_mask")),
+      mask_diff_(stats().counter("mask_diff", "pixels", "pixels where the model's mask differs from GL's shadow_mask (must be 0)")),
+      mask_diff_infinite_(stats().counter("mask_diff_infinite", "pixels",
+                                          "pixels where the model's mask differs from GL's shadow_mask_infinite (must be 0)")),
+      gl_mask_diff_(stats().counter("gl_mask_diff", "pixels", "pixels where GL's shadow_mask differs from its shadow_mask_infinite")) {
+  NBSIM_CHECK(min_nb_.op() == FarOp::Min && max_nb_.op() == FarOp::Max, "the shadows program needs a min and a max N-buffer");
+}
+
+void ShadowsUnit::wait_all() {
+  sim::blocking([&] {
+    while (completed_ < issued_ || clears_ < frames_begun_) wait(completed_event_);
+  });
+  sim::catch_up(heard_cycle_);
+}
+
+void ShadowsUnit::depth_cleared(float) {
+  heard_cycle_ = std::max(heard_cycle_, sim::local_cycles());
+  ++clears_;
+  completed_event_.notify(sc_core::SC_ZERO_TIME);
+}
+
+void ShadowsUnit::draw_finished(const cp::Work& w, const depth::DrawResult& r) {
+  ++completed_;
+  const scene::DrawRecord& d = w.record();
+  if (d.role == scene::DrawRole::ShadowVolume) {
+    fill_ += r.depth.fragments;
+    gl_fill_ += d.gl.fragments;
+    stencil_tests_ += r.stencil.tests;
+  } else if (d.role == scene::DrawRole::Scene) {
+    scene_depth_tests_ += r.depth.depth_tests;
+  }
+  heard_cycle_ = std::max(heard_cycle_, r.done_cycle);
+  completed_event_.notify(sc_core::SC_ZERO_TIME);
+}
+
+void ShadowsUnit::issue_role(const std::shared_ptr<const scene::Frame>& f, scene::DrawRole role, cp::CommandProcessor& cp) {
+  for (std::size_t i = 0; i < f->draws.size(); ++i) {
+    const scene::DrawRecord& d = f->draws[i];
+    if (d.role != role || d.clip_positions.empty()) continue;
+    auto w = std::make_shared<cp::Work>();
+    w->frame = f;
+    w->draw = static_cast<std::uint32_t>(i);
+    ++issued_;
+    if (role == scene::DrawRole::ShadowVolume) ++volume_draws_;
+    cp.issue_draw(std::move(w));
+  }
+}
+
+std::uint64_t ShadowsUnit::build(query::NBufferStructure& nb, const scene::Frame& f, std::string_view name) {
+  const scene::DepthSnapshot* s = f.depth(name);
+  if (!s) throw InputError(fmt::format("frame {}: no '{}' depth image: the {} N-buffer has nothing to be built from", f.begin.frame,
+                                       name, name == "litmap_min" ? "min" : "max"));
+  if (s->width != setup_.litmap_size || s->height != setup_.litmap_size)
+    throw InputError(fmt::format("frame {}: the '{}' depth image is {}x{}, the trace's litmap_size {}", f.begin.frame, name,
+                                 s->width, s->height, setup_.litmap_size));
+  image_.width = s->width, image_.height = s->height;
+  image_.texels = s->texels;
+  // Every level of every texel from the new image (the litmaps are redrawn each frame).
+  nbuffer::NBufferUnit& unit = nb.unit();
+  std::uint64_t texels = unit.depth_changed(image_, Rect{0, 0, s->width, s->height}).recomputed();
+  texels += unit.end_of_pass().recomputed();
+  return texels;
+}
+
+void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, const LightDepth& light) {
+  const std::size_t n = c.size();
+  label_with([&] { return fmt::format("{} caster decisions", n); });
+  work(sim::batch_cycles(n, config_.tests_per_cycle, config_.latency_cycles));
+  rects_.clear(), nearest_.clear(), index_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto decision = static_cast<Decision>(c.decision[i]);
+    outside_ += decision == Decision::OutsideLight ? 1 : 0;
+    crossing_near_ += decision == Decision::CrossesNear ? 1 : 0;
+    gl_culled_ += decision == Decision::Culled ? 1 : 0;
+    if (decision != Decision::Volume && decision != Decision::Culled) continue;
+    index_.push_back(i);
+    rects_.push_back(c.rect(i));
+    nearest_.push_back(0.0f);  // the answer's value is what the program uses, not its hidden bit
+  }
+  // The two units' query ports work in parallel: the frame waits for the slower.
+  min_nb_.unit().query_batch(rects_, nearest_, min_answers_);
+  max_nb_.unit().query_batch(rects_, nearest_, max_answers_);
+  NBSIM_CHECK(min_answers_.size() == index_.size() && max_answers_.size() == index_.size(),
+              "an N-buffer answered another number of queries");
+  casters_ += n;
+  measured_ += index_.size();
+  if (c.reference_fill) reference_fill_ += *c.reference_fill, ++reference_frames_;
+  for (std::size_t k = 0; k < index_.size(); ++k) {
+    const std::size_t i = index_[k];
+    const nbuffer::QueryAnswer& lo = min_answers_[k];
+    const nbuffer::QueryAnswer& hi = max_answers_[k];
+    const auto texels = static_cast<std::uint32_t>(lo.lookups + hi.lookups);
+    lookups_ += texels;
+    lookup_mismatches_ += texels != c.lookups[i] ? 1 : 0;
+    build_texels_ += lo.update.recomputed() + hi.update.recomputed();  // lazy policy
+    const DepthRange exact = exact_range(*f.depth("litmap_min"), *f.depth("litmap_max"), rects_[k]);  // off the clock
+    const CasterCheck k2 = check_caster(c, i, lo.value, hi.value, exact, light, setup_.margin);
+    culled_ += k2.model_culled ? 1 : 0;
+    kept_by_slab_ += k2.kept_by_slab ? 1 : 0;
+    decision_mismatches_ += k2.decision_mismatch ? 1 : 0;
+    zmin_mismatches_ += k2.zmin_mismatch ? 1 : 0;
+    zmax_mismatches_ += k2.zmax_mismatch ? 1 : 0;
+    not_conservative_ += k2.not_conservative ? 1 : 0;
+    unsafe_culls_ += k2.unsafe_cull ? 1 : 0;
+    culls_lost_ += k2.cull_lost ? 1 : 0;
+  }
+}
+
+void ShadowsUnit::compare_masks(const scene::Frame& f) {
+  const auto image = [&](std::string_view name) -> const scene::StencilSnapshot& {
+    const scene::StencilSnapshot* s = f.stencil(name);
+    if (!s) throw InputError(fmt::format("frame {}: no '{}' stencil image: the shadow mask cannot be checked", f.begin.frame, name));
+    if (s->width != setup_.width_px || s->height != setup_.height_px)
+      throw InputError(fmt::format("frame {}: the '{}' stencil image is {}x{}, the viewport {}x{}", f.begin.frame, name, s->width,
+                                   s->height, setup_.width_px, setup_.height_px));
+    return *s;
+  };
+  const scene::StencilSnapshot& region = image("light_region");
+  const scene::StencilSnapshot& mask = image("shadow_mask");
+  const scene::StencilSnapshot& infinite = image("shadow_mask_infinite");
+  std::uint64_t set = 0;
+  mask_diff_ += mask_pixels_differing(stencil_.texels, region, mask, &set);
+  mask_pixels_ += set;
+  mask_diff_infinite_ += mask_pixels_differing(stencil_.texels, region, infinite);
+  std::uint64_t gl_set = 0, gl_diff = 0;
+  for (std::size_t i = 0; i < mask.texels.size(); ++i) {
+    gl_set += mask.texels[i] != 0 ? 1 : 0;
+    gl_diff += (mask.texels[i] != 0) != (infinite.texels[i] != 0) ? 1 : 0;
+  }
+  gl_mask_pixels_ += gl_set;
+  gl_mask_diff_ += gl_diff;
+}
+
+void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) {
+  ++frames_begun_;
+  // Everything the frame needs is checked before anything is issued (a damaged trace: exit 2).
+  const FrameCasters c = read_casters(*f);
+  if (static_cast<int>(c.litmap_size) != setup_.litmap_size)
+    throw InputError(fmt::format("frame {}: the ShadowCasters record's litmap_size {} is not the header's {}", f->begin.frame,
+                                 c.litmap_size, setup_.litmap_size));
+  if (!f->light) throw InputError(fmt::format("frame {}: no light camera (LGHT)", f->begin.frame));
+  const std::optional<LightDepth> light = LightDepth::make(*f->light);
+  if (!light)
+    throw InputError(fmt::format("frame {}: the light camera's projection is not a perspective frustum with near < far",
+                                 f->begin.frame));
+  for (const char* name : {"litmap_min", "litmap_max"})
+    if (!f->depth(name))
+      throw InputError(fmt::format("frame {}: no '{}' depth image: the {} N-buffer has nothing to be built from", f->begin.frame,
+                                   name, std::string_view(name) == "litmap_min" ? "min" : "max"));
+  for (const char* name : {"light_region", "shadow_mask", "shadow_mask_infinite"})
+    if (!f->stencil(name))
+      throw InputError(fmt::format("frame {}: no '{}' stencil image: the shadow mask cannot be checked", f->begin.frame, name));
+
+  // 1. The observer's depth.
+  issue_role(f, scene::DrawRole::Scene, cp);
+  // 2. The litmap pass: GL's images; its reprojections are its fragments (no clip positions).
+  for (const scene::DrawRecord& d : f->draws)
+    if (d.role == scene::DrawRole::Litmap) ++litmap_draws_, litmap_reprojections_ += d.gl.fragments;
+  // 3. Both N-buffers from the litmaps (each unit's engine builds while the scene is drawn).
+  build_texels_ += build(min_nb_, *f, "litmap_min");
+  build_texels_ += build(max_nb_, *f, "litmap_max");
+  // 4. The casters' queries and decisions (the query ports wait for their engines; a frame with no
+  // caster to query still waits for both builds).
+  query_casters(*f, c, *light);
+  min_nb_.unit().drain();
+  max_nb_.unit().drain();
+  ++frames_;
+  // 5. The volumes, after the scene's depth (the draws keep their order in the pipeline).
+  issue_role(f, scene::DrawRole::ShadowVolume, cp);
+  wait_all();
+  // 6. The shadow mask from the model's stencil buffer.
+  compare_masks(*f);
+  cp.issue_snapshot(f, scene::DepthWhich::Final);
+}
+
+}  // namespace nbsim::shadows

@@ -1,0 +1,95 @@
+// ShadowsUnit: the frame program of shadow volumes with litmaps (N-buffer paper 3.3/4.4). Per frame:
+//  1. the recorded Scene draws (the observer's depth and, with DEPTH24_STENCIL8, its stencil);
+//  2. the litmaps: GL's litmap draws have no clip positions (their fragment shader discards what
+//     the observer does not see after reprojecting each fragment into the observer's view, a
+//     step the model does not replay), so the program takes the `litmap_min` and `litmap_max`
+//     depth images as GL computed them and counts the pass's reprojections as the litmap draws'
+//     rasterized fragments (GL's counter: one reprojection a fragment, reading up to 3x3 texels);
+//  3. a min N-buffer over litmap_min and a max N-buffer over litmap_max (two instances of the
+//     N-buffer unit, "litmap_min" and "litmap_max", each with its own config), built from those
+//     images (every texel of every level, timed by each unit's update engine);
+//  4. per caster of the SHDC record with a rectangle: a query of each unit over it (four lookups
+//     each), the model's z_min/z_max compared with GL's, and the capture's cull rule recomputed
+//     (caster.h) on the model's values and on GL's; the record's outside/crossing casters are
+//     taken as recorded (the rectangle comes from the capture's double-precision light camera);
+//  5. the recorded ShadowVolume draws (clip positions from transform feedback, depth clamp,
+//     two-sided z-fail stencil) through the pipeline: the fill and the stencil tests;
+//  6. at the end, the model's stencil buffer gives the shadow mask (STNC light_region AND
+//     stencil != 0), compared pixel by pixel with GL's `shadow_mask` and `shadow_mask_infinite`.
+// The volume geometry is GL's for the capture's mode: the model's decisions are checked, not
+// drawn (another mode needs the casters' meshes to regenerate volumes; the trace does not hold them).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "model/config/schema.h"
+#include "model/cp/unit.h"
+#include "model/depth/unit.h"
+#include "model/query/units.h"
+#include "model/raster/stencil_test.h"
+#include "model/shadows/caster.h"
+
+namespace nbsim::shadows {
+
+struct ShadowsUnitConfig {
+  double tests_per_cycle = 1.0;  // casters through the rectangle/decision stage a cycle; tunable
+  int latency_cycles = 20;       // per frame's batch of caster decisions; tunable
+
+  // Declares "shadows.<field>".
+  static void describe(config::Schema& s, ShadowsUnitConfig& c);
+};
+
+// What the program needs to know about the trace (its header).
+struct ShadowsSetup {
+  int width_px = 0, height_px = 0;
+  int litmap_size = 0;
+  Mode mode = Mode::Clamped;
+  ClampMargin margin;
+};
+
+class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthListener {
+ public:
+  // `min_nb` (op min, over litmap_min) and `max_nb` (op max, over litmap_max), litmap_size square.
+  ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ShadowsUnitConfig& config,
+              const ShadowsSetup& setup, const raster::StencilImage& stencil, query::NBufferStructure& min_nb,
+              query::NBufferStructure& max_nb);
+
+  void run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
+
+  void depth_cleared(float depth) override;
+  void depth_written(const cp::Work&, const DepthImage&, const Rect&) override {}
+  void draw_finished(const cp::Work& w, const depth::DrawResult& r) override;
+
+ private:
+  void issue_role(const std::shared_ptr<const scene::Frame>& f, scene::DrawRole role, cp::CommandProcessor& cp);
+  void wait_all();
+  // Builds one N-buffer from the frame's depth image `name`; returns the texels recomputed.
+  std::uint64_t build(query::NBufferStructure& nb, const scene::Frame& f, std::string_view name);
+  void query_casters(const scene::Frame& f, const FrameCasters& c, const LightDepth& light);
+  void compare_masks(const scene::Frame& f);
+
+  ShadowsUnitConfig config_;
+  ShadowsSetup setup_;
+  const raster::StencilImage& stencil_;
+  query::NBufferStructure& min_nb_;
+  query::NBufferStructure& max_nb_;
+
+  std::uint64_t issued_ = 0, completed_ = 0, frames_begun_ = 0, clears_ = 0, heard_cycle_ = 0;
+  sc_core::sc_event completed_event_;
+
+  stats::Counter &frames_, &casters_, &measured_, &culled_, &gl_culled_, &outside_, &crossing_near_, &kept_by_slab_,
+      &decision_mismatches_, &zmin_mismatches_, &zmax_mismatches_, &not_conservative_, &unsafe_culls_, &culls_lost_,
+      &lookups_, &lookup_mismatches_, &build_texels_, &litmap_draws_, &litmap_reprojections_, &scene_depth_tests_,
+      &volume_draws_, &fill_, &gl_fill_, &reference_fill_, &reference_frames_, &stencil_tests_, &mask_pixels_, &gl_mask_pixels_, &mask_diff_, &mask_diff_infinite_,
+      &gl_mask_diff_;
+
+  std::vector<Rect> rects_;
+  std::vector<float> nearest_;
+  std::vector<std::size_t> index_;
+  std::vector<nbuffer::QueryAnswer> min_answers_, max_answers_;
+  DepthImage image_;
+};
+
+}  // namespace nbsim::shadows

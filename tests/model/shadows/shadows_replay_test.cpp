@@ -1,0 +1,236 @@
+// ShadowsReplayTest: fresh shadows captures (128x96, 2 frames, 64-lexel litmaps) of boxes, terrain
+// and city in every shadow mode, replayed by the shadows program: every draw's fragments and passed
+// samples equal GL's, the stencil buffer and both shadow masks equal GL's, the model's z_min/z_max
+// and lookups equal the capture's and no decision unlike the capture's rule; the fill falls from
+// infinite to culled to clamped. A u16, divisor-2 or level-capped N-buffer stays conservative; a
+// damaged SHDC record or a missing litmap is refused with exit 2; `nbsim shadows --json` rows.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <variant>
+
+#include "tests/common/run_nbsim.h"
+#include "traces/format/reader.h"
+#include "traces/format/writer.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nbsim::testing::CliResult;
+using nbsim::testing::has;
+using nbsim::testing::run_nbsim;
+
+fs::path scratch(const std::string& name) { return nbsim::testing::scratch_path("nbsim_shadows_replay", name); }
+
+// The scenes, kept small: a capture takes well under a second each.
+const std::map<std::string, std::string> kSceneArgs = {
+    {"boxes", "--scene boxes"},
+    {"terrain", "--scene terrain --towers 8 --birds 120"},
+    {"city", "--scene city --objects 400"},
+};
+
+// Captures `scene` in `mode` once per test binary run (cached by name).
+fs::path capture(const std::string& scene, const std::string& mode, const std::string& extra = "") {
+  const fs::path t = scratch(scene + "_" + mode + (extra.empty() ? "" : "_x") + ".nbt");
+  if (fs::exists(t)) return t;
+  const CliResult c = run_nbsim("capture shadows " + kSceneArgs.at(scene) + " --path fly --size 128x96 --frames 2 --litmap 64 "
+                                "--shadow-mode " + mode + " " + extra + " -o " + t.string());
+  EXPECT_EQ(c.status, 0) << scene << " " << mode << ": " << c.out << c.err;
+  return t;
+}
+
+nlohmann::json replay(const fs::path& t, const std::string& sets = "", const std::string& tag = "run") {
+  const fs::path dir = t.parent_path() / (t.stem().string() + "_" + tag);
+  const CliResult r = run_nbsim("replay " + t.string() + " --out " + dir.string() + sets);
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  std::ifstream in(dir / "run.json");
+  return nlohmann::json::parse(in);
+}
+
+class ShadowsReplayTest : public ::testing::TestWithParam<std::string> {};
+
+// Each scene in each mode: exact draws, stencil and masks equal to GL's, the queries and decisions
+// as the capture's, and fill clamped <= culled <= infinite.
+TEST_P(ShadowsReplayTest, ReplaysExactlyInEveryMode) {
+  const std::string scene = GetParam();
+  std::map<std::string, double> fill, reference;
+  for (const std::string mode : {"infinite", "culled", "clamped"}) {
+    SCOPED_TRACE(scene + " " + mode);
+    const auto run = replay(capture(scene, mode));
+    const auto& sum = run["summary"];
+    EXPECT_GT(sum["draws"].get<int>(), 0);
+    EXPECT_EQ(sum["draws_exact"], sum["draws"]) << "every draw's fragments and passed samples equal GL's";
+    EXPECT_EQ(sum["stencil_pixels_matching"], sum["stencil_pixels"]) << "the stencil buffer equals GL's";
+    EXPECT_EQ(sum["depth_pixels_matching"], sum["depth_pixels"]);
+    const auto& s = sum["shadows"];
+    EXPECT_EQ(s["frames"], 2);
+    EXPECT_EQ(s["shadow_mode"], mode);
+    EXPECT_EQ(s["scene"], scene);
+    EXPECT_GT(s["casters"].get<int>(), 0);
+    EXPECT_GT(s["measured"].get<int>(), 0) << "some caster has a rectangle in the litmap";
+    EXPECT_EQ(s["mask_diff"], 0) << "the model's mask equals GL's";
+    EXPECT_EQ(s["mask_diff_infinite"], 0) << "and the infinite reference's";
+    EXPECT_EQ(s["gl_mask_diff"], 0);
+    EXPECT_EQ(s["mask_pixels"], s["gl_mask_pixels"]);
+    EXPECT_EQ(s["zmin_mismatches"], 0) << "f32 full resolution: GL's z_min";
+    EXPECT_EQ(s["zmax_mismatches"], 0) << "f32 full resolution: GL's z_max";
+    EXPECT_EQ(s["lookup_mismatches"], 0) << "as many texels as the capture read";
+    EXPECT_EQ(s["decision_mismatches"], 0);
+    EXPECT_EQ(s["unsafe_culls"], 0);
+    EXPECT_EQ(s["not_conservative"], 0);
+    EXPECT_EQ(s["fill"], s["gl_fill"]) << "the fill is GL's";
+    EXPECT_GE(s["culled"].get<int>(), s["gl_culled"].get<int>()) << "the litmap rule culls at least what GL culled";
+    EXPECT_GT(s["build_texels"].get<int>(), 0);
+    EXPECT_GT(s["litmap_reprojections"].get<int>(), 0);
+    EXPECT_EQ(s["stencil_tests"], s["fill"]) << "one stencil test per volume fragment";
+    EXPECT_EQ(s["per_frame"].size(), 2u);
+    fill[mode] = s["fill_per_frame"].get<double>();
+    reference[mode] = s["reference_fill_per_frame"].get<double>();
+    ASSERT_TRUE(s["fill_ratio_to_infinite"].is_number()) << "every frame's SHDC holds GL's reference fill";
+    EXPECT_LE(s["fill_ratio_to_infinite"].get<double>(), 1.0);
+  }
+  EXPECT_EQ(reference["infinite"], fill["infinite"]) << "an infinite capture's reference is its own fill";
+  EXPECT_EQ(reference["culled"], fill["infinite"]) << "the reference pass draws what the infinite capture draws";
+  EXPECT_EQ(reference["clamped"], fill["infinite"]);
+  EXPECT_LE(fill["clamped"], fill["culled"]);
+  EXPECT_LE(fill["culled"], fill["infinite"]);
+  EXPECT_GT(fill["infinite"], 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, ShadowsReplayTest, ::testing::Values("boxes", "terrain", "city"),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// Lossy N-buffer designs (u16, divisor 2, level cap 2) stay conservative: no z_min above GL's, no
+// z_max below, no caster culled that GL's values keep; the mask (GL's volumes) is unchanged.
+TEST(ShadowsDesignTest, ReducedNBuffersStayConservative) {
+  const fs::path t = capture("terrain", "clamped");
+  const struct {
+    const char* tag;
+    const char* sets;
+  } designs[] = {
+      {"u16", " --set litmap_min.format=u16 --set litmap_max.format=u16"},
+      {"div2", " --set litmap_min.resolution_divisor=2 --set litmap_max.resolution_divisor=2"},
+      {"cap2", " --set litmap_min.level_cap=2 --set litmap_max.level_cap=2"},
+  };
+  for (const auto& d : designs) {
+    SCOPED_TRACE(d.tag);
+    const auto s = replay(t, d.sets, d.tag)["summary"]["shadows"];
+    EXPECT_EQ(s["not_conservative"], 0);
+    EXPECT_EQ(s["unsafe_culls"], 0) << "never culls a caster GL's values keep";
+    EXPECT_EQ(s["mask_diff"], 0);
+    EXPECT_LE(s["culled"].get<int>(), s["measured"].get<int>());
+  }
+  const auto u16 = replay(t, designs[0].sets, "u16b")["summary"]["shadows"];
+  const auto full = replay(t)["summary"]["shadows"];
+  EXPECT_LE(u16["culled"].get<int>(), full["culled"].get<int>()) << "a looser design culls no more";
+}
+
+// Rewrites `good` into `bad`, frame 1 changed by `edit`.
+template <class Edit>
+void rewrite(const fs::path& good, const fs::path& bad, Edit edit) {
+  nbsim::trace::FrameReader in(good);
+  nbsim::trace::TraceWriter w(bad, in.trace().properties());
+  if (in.trace().scene()) w.write(*in.trace().scene());
+  while (auto f = in.next()) {
+    if (f->ordinal == 1) edit(*f);
+    w.begin_frame(f->begin);
+    for (const auto& d : f->draws) w.write(d);
+    for (const auto& d : f->depths) w.write(d);
+    for (const auto& l : f->levels) w.write(l);
+    for (const auto& s : f->stencils) w.write(s);
+    if (f->light) w.write_light(*f->light);
+    for (const auto& r : f->technique_records) w.write(r);
+    if (f->truth) w.write(*f->truth);
+    w.end_frame(f->end);
+  }
+  w.close();
+}
+
+void expect_refused(const fs::path& bad, const std::string& message) {
+  const fs::path dir = bad.parent_path() / (bad.stem().string() + "_run");
+  const CliResult r = run_nbsim("replay " + bad.string() + " --out " + dir.string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, message)) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "run.json")) << "a refused replay leaves no run.json";
+  const CliResult s = run_nbsim("shadows " + bad.string());
+  EXPECT_EQ(s.status, 2) << s.out << s.err;
+}
+
+// A caster naming a draw that is not a shadow volume: exit 2, frame and caster named.
+TEST(ShadowsBadInputTest, DamagedCasterRecordRefused) {
+  const fs::path good = capture("boxes", "clamped");
+  const fs::path bad = scratch("bad_record.nbt");
+  rewrite(good, bad, [](nbsim::scene::Frame& f) {
+    for (auto& r : f.technique_records)
+      for (auto& fl : r.fields)
+        if (fl.name == "draw")
+          if (auto* v = std::get_if<std::vector<std::int32_t>>(&fl.value)) (*v)[0] = 0;  // draw 0 is a scene draw
+  });
+  expect_refused(bad, "frame 1: caster 0 names draw 0, which is not a shadow_volume draw of the frame");
+}
+
+// A frame without its max litmap: exit 2 naming it.
+TEST(ShadowsBadInputTest, MissingLitmapRefused) {
+  const fs::path good = capture("boxes", "clamped");
+  const fs::path bad = scratch("no_litmap.nbt");
+  rewrite(good, bad, [](nbsim::scene::Frame& f) {
+    std::erase_if(f.depths, [](const auto& d) { return d.name == "litmap_max"; });
+  });
+  expect_refused(bad, "frame 1: no 'litmap_max' depth image: the max N-buffer has nothing to be built from");
+}
+
+// A mask pixel unlike the model's (GL's shadow_mask flipped at one lit pixel): the replay completes,
+// the pixel is counted, and `nbsim shadows` exits 1.
+TEST(ShadowsTableTest, MaskPixelDifferingExits1) {
+  const fs::path good = capture("boxes", "clamped");
+  const fs::path bad = scratch("flipped_mask.nbt");
+  rewrite(good, bad, [](nbsim::scene::Frame& f) {
+    const auto* region = f.stencil("light_region");
+    for (auto& st : f.stencils)
+      if (st.name == "shadow_mask")
+        for (std::size_t i = 0; i < st.texels.size(); ++i)
+          if (region->texels[i]) {
+            st.texels[i] = st.texels[i] ? 0 : 1;
+            return;
+          }
+  });
+  const auto s = replay(bad)["summary"]["shadows"];
+  EXPECT_EQ(s["mask_diff"], 1) << "one pixel of GL's mask flipped";
+  EXPECT_EQ(s["mask_diff_infinite"], 0);
+  const CliResult r = run_nbsim("shadows " + bad.string() + " --json");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)[0]["mask_diff"], 1);
+}
+
+// `nbsim shadows --json`: a row per trace, the ratio to the trace's own reference fill.
+TEST(ShadowsTableTest, JsonRowsWithRatioToInfinite) {
+  const fs::path inf = capture("boxes", "infinite"), cl = capture("boxes", "clamped");
+  const CliResult r = run_nbsim("shadows " + inf.string() + " " + cl.string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0]["shadow_mode"], "infinite");
+  EXPECT_DOUBLE_EQ(rows[0]["ratio_to_infinite"].get<double>(), 1.0);
+  EXPECT_EQ(rows[1]["shadow_mode"], "clamped");
+  ASSERT_TRUE(rows[1]["ratio_to_infinite"].is_number());
+  EXPECT_LE(rows[1]["ratio_to_infinite"].get<double>(), 1.0);
+  EXPECT_EQ(rows[1]["ratio_reference"], "reference_fill");
+  EXPECT_DOUBLE_EQ(rows[1]["ratio_to_infinite"].get<double>(),
+                   rows[1]["fill_per_frame"].get<double>() / rows[0]["fill_per_frame"].get<double>())
+      << "the reference pass's fill is the infinite capture's";
+  EXPECT_EQ(rows[1]["mask_diff"], 0);
+  EXPECT_EQ(rows[1]["draws_exact"], rows[1]["draws"]);
+  const CliResult alone = run_nbsim("shadows " + cl.string() + " --json");
+  ASSERT_EQ(alone.status, 0) << alone.err;
+  EXPECT_EQ(nlohmann::json::parse(alone.out)[0]["ratio_to_infinite"], rows[1]["ratio_to_infinite"])
+      << "the trace alone gives its ratio";
+  const CliResult text = run_nbsim("shadows " + cl.string());
+  EXPECT_EQ(text.status, 0);
+  EXPECT_TRUE(has(text.out, "Shadows: fill per frame")) << text.out;
+}
+
+}  // namespace
