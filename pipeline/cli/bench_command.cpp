@@ -115,7 +115,10 @@ void add_bench_commands(CLI::App& app, Action& action) {
     rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes; particles: scene, partial N-buffer or Hi-Z\n"
                 "build and the culled particle draws, not the reference pass), replay_ms (the SystemC model), ratio\n"
                 "replay/gl, depth_tests_per_s and cycles_per_s of the model, measured in the same run; for particles\n"
-                "also particles_summary (the replay's particles totals).");
+                "also particles_summary (the replay's particles totals), for shadows shadows_summary (fill, casters\n"
+                "culled, mask pixels differing, N-buffer cost). Shadows: gl_ms spans the observer's depth, the litmaps,\n"
+                "both N-buffers, the CPU's per-caster work and the volumes, not the reference pass; the model replays\n"
+                "the observer and volume draws and builds both N-buffers, and takes the litmaps as GL made them.");
     rep->callback([&action, ro] {
       action = [ro] {
         parse_size(ro->size, "--size");

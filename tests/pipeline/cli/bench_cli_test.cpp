@@ -53,6 +53,8 @@ TEST(BenchReplayCliTest, ShadowsRatioPrinted) {
   EXPECT_GT(j.at("draws").get<int>(), 0);
   EXPECT_EQ(j.at("draws_exact"), j.at("draws"));
   EXPECT_TRUE(j.at("within_thresholds").get<bool>());
+  ASSERT_TRUE(j.at("shadows_summary").is_object()) << r.out;
+  EXPECT_FALSE(j.at("shadows_summary").contains("per_frame"));
 }
 
 // Bad arguments exit 2 with a message naming them.
