@@ -350,12 +350,15 @@ class Report:
                             "cost the most."))
 
     # ------------------------------------------------------------------------------ particles
-    def particles_path(self):
-        """DIR/particles/particles.json (the demo's layout) or DIR/particles.json (nbsim particles --out DIR)."""
-        for p in (self.root / "particles" / "particles.json", self.root / "particles.json"):
+    def technique_table_path(self, name):
+        """DIR/NAME/NAME.json (the demo's layout) or DIR/NAME.json (nbsim NAME TRACE... --out DIR); None when neither is."""
+        for p in (self.root / name / f"{name}.json", self.root / f"{name}.json"):
             if p.is_file():
                 return p
         return None
+
+    def particles_path(self):
+        return self.technique_table_path("particles")
 
     def particles(self):
         path = self.particles_path()
@@ -440,11 +443,7 @@ class Report:
 
     # ------------------------------------------------------------------------------ shadows
     def shadows_path(self):
-        """DIR/shadows/shadows.json (the demo's layout) or DIR/shadows.json (nbsim shadows --out DIR)."""
-        for p in (self.root / "shadows" / "shadows.json", self.root / "shadows.json"):
-            if p.is_file():
-                return p
-        return None
+        return self.technique_table_path("shadows")
 
     def shadows(self):
         path = self.shadows_path()

@@ -312,23 +312,34 @@ PARTICLE_NEED = ["mode", "particles_per_frame", "culled_per_frame", "query_depth
 PAPER_RASTER_PER_SPRITE = 256
 
 
-def load_particles(path):
-    """The rows of particles.json (a JSON list, one object per replayed trace), checked; BadInput otherwise."""
+def load_rows(path, command, need, strings, numbers):
+    """The rows of a table a technique command writes with --out (a non-empty JSON list of objects), each
+    with the keys `need`, `strings` of them strings and `numbers` (when present and not null) numbers;
+    BadInput naming the file otherwise."""
     t = load_json(path)
     if not isinstance(t, list) or not t:
-        raise BadInput(f"{path}: expected a non-empty JSON list of rows (nbsim particles --out)")
+        raise BadInput(f"{path}: expected a non-empty JSON list of rows ({command} --out)")
     for i, r in enumerate(t):
         if not isinstance(r, dict):
             raise BadInput(f"{path}: rows[{i}] is not an object")
-        lacking = [k for k in PARTICLE_NEED if k not in r]
+        lacking = [k for k in need if k not in r]
         if lacking:
             raise BadInput(f"{path}: rows[{i}] lacks {', '.join(lacking)}")
-        if not isinstance(r["mode"], str):
-            raise BadInput(f"{path}: rows[{i}].mode is not a string: {r['mode']!r}")
-        for k in PARTICLE_NEED[1:] + ["paper_depth_tests_per_frame", "decision_mismatches", "kept_too_large"]:
+        for k in strings:
+            if not isinstance(r[k], str):
+                raise BadInput(f"{path}: rows[{i}].{k} is not a string: {r[k]!r}")
+        for k in numbers:
             v = r.get(k)
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
                 raise BadInput(f"{path}: rows[{i}].{k} is not a number: {v!r}")
+    return t
+
+
+def load_particles(path):
+    """The rows of particles.json (a JSON list, one object per replayed trace), checked; BadInput otherwise."""
+    t = load_rows(path, "nbsim particles", PARTICLE_NEED, ["mode"],
+                  PARTICLE_NEED[1:] + ["paper_depth_tests_per_frame", "decision_mismatches", "kept_too_large"])
+    for i, r in enumerate(t):
         if r["particles_per_frame"] <= 0:
             raise BadInput(f"{path}: rows[{i}].particles_per_frame must be above 0, not {r['particles_per_frame']!r}")
     return t
@@ -463,22 +474,8 @@ PAPER_CLAMPED_RATIO = {"city": (0.025, "2.5% (20 M -> 512 K px)"), "terrain": (0
 
 def load_shadows(path):
     """The rows of shadows.json (a JSON list, one object per replayed trace), checked; BadInput otherwise."""
-    t = load_json(path)
-    if not isinstance(t, list) or not t:
-        raise BadInput(f"{path}: expected a non-empty JSON list of rows (nbsim shadows --out)")
+    t = load_rows(path, "nbsim shadows", SHADOW_NEED, ["scene", "shadow_mode"], SHADOW_NEED[2:] + SHADOW_OPTIONAL_NUMBERS)
     for i, r in enumerate(t):
-        if not isinstance(r, dict):
-            raise BadInput(f"{path}: rows[{i}] is not an object")
-        lacking = [k for k in SHADOW_NEED if k not in r]
-        if lacking:
-            raise BadInput(f"{path}: rows[{i}] lacks {', '.join(lacking)}")
-        for k in ("scene", "shadow_mode"):
-            if not isinstance(r[k], str):
-                raise BadInput(f"{path}: rows[{i}].{k} is not a string: {r[k]!r}")
-        for k in SHADOW_NEED[2:] + SHADOW_OPTIONAL_NUMBERS:
-            v = r.get(k)
-            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
-                raise BadInput(f"{path}: rows[{i}].{k} is not a number: {v!r}")
         if r["frames"] <= 0 or r["casters_per_frame"] < 0 or r["fill_per_frame"] < 0:
             raise BadInput(f"{path}: rows[{i}]: frames must be above 0 and casters and fill not negative")
     return t
