@@ -143,15 +143,16 @@ def short_value(key, v):
 
 
 def short_label(params, keys):
-    """'nb_hier div=2 u16': the values of the given parameters, keys abbreviated."""
+    """'nb_hier div=2 u16': the values of the given parameters, keys abbreviated. Another N-buffer instance's
+    keys (litmap_min.format) take the nbuffer.* abbreviations; a part two instances share is named once."""
     parts = []
     for k in keys:
-        abbr = SHORT.get(k, k.split(".")[-1])
+        abbr = SHORT.get(k, SHORT.get("nbuffer." + k.split(".")[-1], k.split(".")[-1]))
         v = short_value(k, params.get(k, ""))
         if v == "":
             continue
         parts.append(v if abbr == "" else f"{abbr}={v}")
-    return " ".join(parts)
+    return " ".join(dict.fromkeys(parts))
 
 
 def sorted_modes(modes):

@@ -339,6 +339,21 @@ class Labels(unittest.TestCase):
         plt.close(fig)
 
 
+class ShortLabels(unittest.TestCase):
+    """short_label: the point labels of sweep tables and plots."""
+
+    def test_two_nbuffer_instances_named_once(self):
+        # litmap_min.* and litmap_max.* set alike (the shadows sweep) read as one N-buffer design; set apart, both show
+        keys = [f"{u}.{f}" for u in ("litmap_min", "litmap_max") for f in ("resolution_divisor", "format", "level_cap")]
+        alike = {f"{u}.{f}": v for u in ("litmap_min", "litmap_max")
+                 for f, v in (("resolution_divisor", "2"), ("format", "u16"), ("level_cap", "4"))}
+        self.assertEqual(report_data.short_label(alike, keys), "div=2 u16 cap=4")
+        apart = dict(alike, **{"litmap_max.resolution_divisor": "4"})
+        self.assertEqual(report_data.short_label(apart, keys), "div=2 u16 cap=4 div=4")
+        self.assertEqual(report_data.short_label({"nbuffer.resolution_divisor": "2", "nbuffer.format": "u16"},
+                                                 ["nbuffer.resolution_divisor", "nbuffer.format"]), "div=2 u16")
+
+
 class Table2Ratio(unittest.TestCase):
     def test_ratio_against_paper(self):
         # oq/nb and oq_hier/nb_hier from query depth tests, beside the paper's 400x and 3143x
