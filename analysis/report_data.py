@@ -547,8 +547,8 @@ def shadows_reading(rows):
     if nb:
         lo = min(r["build_texels_per_frame"] / r["lookups_per_frame"] for r in nb)
         hi = max(r["build_texels_per_frame"] / r["lookups_per_frame"] for r in nb)
-        out.append(f"The two N-buffers' build costs {lo:,.0f} to {hi:,.0f} times their lookups (texels a frame): the "
-                   "build dominates the N-buffer cost, the lookups are four a caster at most.")
+        out.append(f"The two N-buffers' build costs {lo:,.0f} to {hi:,.0f} times their lookups (texels a frame): "
+                   + ("the build dominates the N-buffer cost." if lo > 1 else "the lookups cost more in some row."))
     mism = [r for r in rows if (r.get("decision_mismatches") or 0) > 0]
     if mism:
         out.append("Cull decisions unlike the cull rule on GL's own values in " +

@@ -499,6 +499,7 @@ class ShadowsReading(unittest.TestCase):
                       "ours is 4.0 times the paper's)", text)
         self.assertIn("city: culling alone keeps 60.0% of the fill; clamping the volumes that remain takes it to 10.0%", text)
         self.assertIn("fall from 50,000 (infinite) to 5,000 (clamped), 10.0 times fewer", text)
+        self.assertIn("build costs 100 to 100 times their lookups (texels a frame): the build dominates", text)
         text = self.reading([shadow_row("boxes", "clamped")])
         self.assertIn("(the paper: ~20%; ours is 2.0 times lower)", text)
         self.assertIn("45.0 of 100 casters culled a frame", text, "GL's culls and the casters outside the light")
