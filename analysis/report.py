@@ -11,6 +11,7 @@ marks). The inputs, and the nbsim commands that write them:
   DIR/sweeps/NAME/results.csv        nbsim explore SWEEP.json --out DIR/sweeps/NAME  (and sweep.json, technique_results.json)
   DIR/results.csv                    nbsim explore SWEEP.json --out DIR  (DIR is then one sweep, named after it)
   DIR/particles/particles.json       nbsim particles TRACE... --out DIR/particles  (or DIR/particles.json: --out DIR)
+  DIR/shadows/shadows.json           nbsim shadows TRACE... --out DIR/shadows  (or DIR/shadows.json: --out DIR)
 The data side (reading, Pareto marks, labels, headline.md) is in report_data.py; plot helpers in
 report_plots.py. Every section whose inputs exist is rendered; the page names the inputs the others were missing.
 Exit 0 when at least one section rendered; 2 when DIR does not exist or holds nothing usable, or when
@@ -36,7 +37,8 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 import plot_coverage  # noqa: E402
 import table1  # noqa: E402
 from report_data import (FIDELITY_KNOBS, NUMERIC, BadInput, Missing, fmt, headline_particles,  # noqa: E402
-                         headline_sweep, headline_table2, kib_key, load_particles, particles_reading, particles_rows,
+                         headline_shadows, headline_sweep, headline_table2, kib_key, load_particles, load_shadows,
+                         particles_reading, particles_rows, shadows_reading, shadows_rows,
                          technique_results,
                          load_json, mark_pareto, number, pct, read_csv, short_label, sorted_modes, table2_ratios,
                          trace_name)
@@ -52,7 +54,7 @@ class Report:
         self.inputs = []     # (relative path, section)
         self.versions = set()
         self.headline = []   # Markdown blocks for report/headline.md (what scripts/demo prints)
-        self.headline_last = []  # blocks printed after every other one (the particles table)
+        self.headline_last = []  # blocks printed after every other one (the particles and shadows tables)
 
     def rel(self, p):
         return os.path.relpath(p, self.root)
@@ -348,12 +350,15 @@ class Report:
                             "cost the most."))
 
     # ------------------------------------------------------------------------------ particles
-    def particles_path(self):
-        """DIR/particles/particles.json (the demo's layout) or DIR/particles.json (nbsim particles --out DIR)."""
-        for p in (self.root / "particles" / "particles.json", self.root / "particles.json"):
+    def technique_table_path(self, name):
+        """DIR/NAME/NAME.json (the demo's layout) or DIR/NAME.json (nbsim NAME TRACE... --out DIR); None when neither is."""
+        for p in (self.root / name / f"{name}.json", self.root / f"{name}.json"):
             if p.is_file():
                 return p
         return None
+
+    def particles_path(self):
+        return self.technique_table_path("particles")
 
     def particles(self):
         path = self.particles_path()
@@ -435,6 +440,88 @@ class Report:
                             "culling test's queries (red), the sprite fragments GL drew (blue) and the N-buffer or "
                             "Hi-Z build (orange). Read off: how small the N-buffer's queries are against "
                             "rasterizing every sprite, and whether the build eats what culling saves."))
+
+    # ------------------------------------------------------------------------------ shadows
+    def shadows_path(self):
+        return self.technique_table_path("shadows")
+
+    def shadows(self):
+        path = self.shadows_path()
+        if path is None:
+            raise Missing(["shadows/shadows.json"])
+        rows = shadows_rows(load_shadows(path))
+        self.used(path, "shadows")
+        for r in rows:
+            r["trace_name"] = trace_name(str(r.get("trace", "?")))
+        ratio = lambda v: "-" if v is None else f"{100 * v:.1f}%"  # noqa: E731
+        cols = [("scene", "scene", None), ("mode", "shadow_mode", None), ("litmap (lexels)", "litmap_size", None),
+                ("trace", "trace_name", None), ("frames", "frames", None),
+                ("fill/frame", "fill_per_frame", None), ("ratio to infinite", "ratio", ratio),
+                ("paper", "paper_text", lambda v: v or "-"),
+                ("casters/frame", "casters_per_frame", None), ("casters culled/frame", "casters_culled_per_frame", None),
+                ("N-buffer build texels/frame", "build_texels_per_frame", None),
+                ("N-buffer lookups/frame", "lookups_per_frame", None), ("cycles/frame", "cycles_per_frame", None),
+                ("mask px differing (GL's)", "mask_diff", None),
+                ("mask px differing (infinite)", "mask_diff_infinite", None)]
+        tab = self.table("shadows", cols, rows, row_class=lambda r: "bad" if r["mask_pixels_differing"] else "")
+        reading = shadows_reading(rows)
+        traces = ", ".join(dict.fromkeys(r["trace_name"] for r in rows))
+        label = (traces if len(rows) <= 3 else
+                 f"{len(rows)} traces of {', '.join(dict.fromkeys(r['scene'] for r in rows))}")
+        self.headline_last.append(headline_shadows(label, rows, reading))
+
+        # per scene: one bar per mode (and litmap size), log scale; the paper's clamped ratio marked on the
+        # clamped bars as the fill it would give (paper ratio x the trace's infinite reference fill)
+        fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
+        colours = {"infinite": "#999999", "culled": "#6fa8dc", "clamped": "#b2182b"}
+        scenes = list(dict.fromkeys(r["scene"] for r in rows))
+        x, ticks, labels = 0.0, [], []
+        marked = False
+        for scene in scenes:
+            g = [r for r in rows if r["scene"] == scene]
+            start = x
+            for r in g:
+                v = max(float(r["fill_per_frame"]), 1.0)  # log scale: an empty fill sits on the floor
+                ax.bar(x, v, 0.8, color=colours.get(r["shadow_mode"], "#555555"),
+                       label=r["shadow_mode"] if r["shadow_mode"] not in ax.get_legend_handles_labels()[1] else None)
+                text = ratio(r["ratio"]) + (f"\n{r['litmap_size']}" if len(g) > len({x["shadow_mode"] for x in g}) else "")
+                ax.annotate(text, (x, v), xytext=(0, 2), textcoords="offset points", ha="center", va="bottom", fontsize=7)
+                ref = r.get("reference_fill_per_frame")
+                if r["paper_ratio"] is not None and ref:
+                    ax.plot([x - 0.45, x + 0.45], [r["paper_ratio"] * ref] * 2, color="black", lw=2, ls="--",
+                            label=None if marked else "paper's clamped / infinite ratio x our infinite fill")
+                    marked = True
+                x += 1
+            ticks.append((start + x - 1) / 2)
+            labels.append(scene)
+            x += 0.8
+        ax.set_yscale("log")
+        ax.set_ylim(top=ax.get_ylim()[1] * 4)  # headroom for the labels and the legend
+        ax.set_xticks(ticks, labels)
+        ax.set_xlabel("scene")
+        ax.set_ylabel("shadow-volume fill per frame (fragments, log scale)")
+        ax.set_title(f"Shadows: fill per frame by mode, beside the paper's ratio ({len(rows)} traces)", fontsize=10)
+        ax.grid(axis="y", alpha=0.3, which="both")
+        ax.legend(fontsize=7, loc="upper left", ncols=2)
+        img = self.save(fig, "shadows.png")
+        settings = sorted({s for r in rows for s in (r.get("settings") or [])})
+        setting_text = ("settings: <code>" + html.escape(" ".join(f"--set {s}" for s in settings)) + "</code>") if settings \
+            else ("the model's default settings" if all("settings" in r for r in rows) else "their settings are not recorded there")
+        return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim shadows TRACE... --out</code>: one replay per trace, "
+                f"traces {html.escape(traces)}, each in the shadow mode it was captured in on Mesa; {setting_text}). Fill: rasterized fragments of "
+                "the shadow-volume draws; ratio: the fill over GL's infinite volumes of the same frames (every capture "
+                "also draws them as a reference). The paper (Décoret 2005, 4.4, 640x480) gives clamped / infinite: "
+                "2.5% in its city (20 M -> 512 K pixels) and on its terrain, about 20% on simpler scenes. Casters "
+                "culled: by GL, outside the light's frustum included. N-buffer build and lookups: texels of both "
+                "litmap N-buffers (min and max) built and read per frame. Mask pixels differing: the model's shadow "
+                "mask against GL's and against GL's infinite reference, over every frame; rows with any are red."
+                "</p>" + tab +
+                "<p><b>What it shows</b> (computed from the table):</p><ul>" +
+                "".join(f"<li>{html.escape(s)}</li>" for s in reading) + "</ul>" +
+                self.figure(img, "Per scene: the fill per frame of each mode (log scale: grey infinite, blue culled, red "
+                            "clamped; the number on a bar is its ratio to infinite) and, dashed, the fill the paper's "
+                            "ratio would give on our infinite volumes. Read off: how far clamping goes toward the "
+                            "paper's figure in each scene."))
 
     # ------------------------------------------------------------------------------ sweeps
     def sweep_dirs(self):
@@ -792,6 +879,8 @@ def main(argv):
     rep.run("walkthrough", "Depth tests per frame along the walkthrough", rep.walkthrough, root / "table2")
     rep.run("particles", "Particles: depth tests per frame beside the paper's claim", rep.particles,
             rep.particles_path() or root / "particles" / "particles.json")
+    rep.run("shadows", "Shadows: fill per frame beside the paper's ratios", rep.shadows,
+            rep.shadows_path() or root / "shadows" / "shadows.json")
     dirs = rep.sweep_dirs()
     if not dirs:
         rep.missing.append(("Sweeps (architecture exploration)", ["sweeps/NAME/results.csv"]))
@@ -806,7 +895,8 @@ def main(argv):
         except OSError:
             pass
         print(f"report: nothing usable in {a.dir}: looked for table1.jsonl, figure4_map.csv, table2/table2.json, "
-              "table2/MODE/run.json, particles/particles.json, particles.json, sweeps/NAME/results.csv, results.csv", file=sys.stderr)
+              "table2/MODE/run.json, particles/particles.json, particles.json, shadows/shadows.json, shadows.json, "
+              "sweeps/NAME/results.csv, results.csv", file=sys.stderr)
         return 2
     rep.write_html()
     print(f"report: wrote {rep.out / 'index.html'} ({rendered} sections"

@@ -143,15 +143,16 @@ def short_value(key, v):
 
 
 def short_label(params, keys):
-    """'nb_hier div=2 u16': the values of the given parameters, keys abbreviated."""
+    """'nb_hier div=2 u16': the values of the given parameters, keys abbreviated. Another N-buffer instance's
+    keys (litmap_min.format) take the nbuffer.* abbreviations; a part two instances share is named once."""
     parts = []
     for k in keys:
-        abbr = SHORT.get(k, k.split(".")[-1])
+        abbr = SHORT.get(k, SHORT.get("nbuffer." + k.split(".")[-1], k.split(".")[-1]))
         v = short_value(k, params.get(k, ""))
         if v == "":
             continue
         parts.append(v if abbr == "" else f"{abbr}={v}")
-    return " ".join(parts)
+    return " ".join(dict.fromkeys(parts))
 
 
 def sorted_modes(modes):
@@ -312,23 +313,34 @@ PARTICLE_NEED = ["mode", "particles_per_frame", "culled_per_frame", "query_depth
 PAPER_RASTER_PER_SPRITE = 256
 
 
-def load_particles(path):
-    """The rows of particles.json (a JSON list, one object per replayed trace), checked; BadInput otherwise."""
+def load_rows(path, command, need, strings, numbers):
+    """The rows of a table a technique command writes with --out (a non-empty JSON list of objects), each
+    with the keys `need`, `strings` of them strings and `numbers` (when present and not null) numbers;
+    BadInput naming the file otherwise."""
     t = load_json(path)
     if not isinstance(t, list) or not t:
-        raise BadInput(f"{path}: expected a non-empty JSON list of rows (nbsim particles --out)")
+        raise BadInput(f"{path}: expected a non-empty JSON list of rows ({command} --out)")
     for i, r in enumerate(t):
         if not isinstance(r, dict):
             raise BadInput(f"{path}: rows[{i}] is not an object")
-        lacking = [k for k in PARTICLE_NEED if k not in r]
+        lacking = [k for k in need if k not in r]
         if lacking:
             raise BadInput(f"{path}: rows[{i}] lacks {', '.join(lacking)}")
-        if not isinstance(r["mode"], str):
-            raise BadInput(f"{path}: rows[{i}].mode is not a string: {r['mode']!r}")
-        for k in PARTICLE_NEED[1:] + ["paper_depth_tests_per_frame", "decision_mismatches", "kept_too_large"]:
+        for k in strings:
+            if not isinstance(r[k], str):
+                raise BadInput(f"{path}: rows[{i}].{k} is not a string: {r[k]!r}")
+        for k in numbers:
             v = r.get(k)
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
                 raise BadInput(f"{path}: rows[{i}].{k} is not a number: {v!r}")
+    return t
+
+
+def load_particles(path):
+    """The rows of particles.json (a JSON list, one object per replayed trace), checked; BadInput otherwise."""
+    t = load_rows(path, "nbsim particles", PARTICLE_NEED, ["mode"],
+                  PARTICLE_NEED[1:] + ["paper_depth_tests_per_frame", "decision_mismatches", "kept_too_large"])
+    for i, r in enumerate(t):
         if r["particles_per_frame"] <= 0:
             raise BadInput(f"{path}: rows[{i}].particles_per_frame must be above 0, not {r['particles_per_frame']!r}")
     return t
@@ -442,4 +454,119 @@ def headline_particles(label, rows, reading):
                      f"{r['raster_depth_tests_per_frame']:,.0f} | {r['build_texels_per_frame']:,.0f} | "
                      f"{r['total_depth_tests_per_frame']:,.0f} | {r['cycles_per_frame']:,.0f} | "
                      f"{r['popping']:,.0f} | {r['false_culls']:,.0f} |")
+    return "\n".join(lines + [""] + [f"- {s}" for s in reading])
+
+
+# --------------------------------------------------------------------------------------- shadows
+
+SHADOW_SCENES = ["boxes", "terrain", "city"]
+SHADOW_MODES = ["infinite", "culled", "clamped"]
+# What a row of shadows.json (nbsim shadows --out) must hold for the report's table and reading.
+SHADOW_NEED = ["scene", "shadow_mode", "frames", "casters_per_frame", "gl_culled_per_frame", "outside_per_frame",
+               "fill_per_frame", "build_texels_per_frame", "lookups_per_frame", "cycles_per_frame", "mask_diff",
+               "mask_diff_infinite"]
+SHADOW_OPTIONAL_NUMBERS = ["reference_fill_per_frame", "ratio_to_infinite", "decision_mismatches", "draws", "draws_exact",
+                           "nbuffer_memory_bytes"]
+# The paper's fill ratio clamped / infinite (Décoret 2005, 4.4, 640x480): 2.5 % in the city (20 M -> 512 K
+# pixels) and on the terrain, "about 20 %" on simpler scenes (our boxes). Fixed by the paper.
+PAPER_CLAMPED_RATIO = {"city": (0.025, "2.5% (20 M -> 512 K px)"), "terrain": (0.025, "2.5%"),
+                       "boxes": (0.20, "~20%")}
+
+
+def load_shadows(path):
+    """The rows of shadows.json (a JSON list, one object per replayed trace), checked; BadInput otherwise."""
+    t = load_rows(path, "nbsim shadows", SHADOW_NEED, ["scene", "shadow_mode"], SHADOW_NEED[2:] + SHADOW_OPTIONAL_NUMBERS)
+    for i, r in enumerate(t):
+        if r["frames"] <= 0 or r["casters_per_frame"] < 0 or r["fill_per_frame"] < 0:
+            raise BadInput(f"{path}: rows[{i}]: frames must be above 0 and casters and fill not negative")
+    return t
+
+
+def _order(names, v):
+    return names.index(v) if v in names else len(names)
+
+
+def shadows_rows(rows):
+    """The rows by scene (boxes, terrain, city, then others), mode (infinite, culled, clamped) and litmap size, each
+    with casters_culled_per_frame (GL's culls, outside the light's frustum included), ratio (fill over GL's
+    infinite fill of the same frames: the row's ratio_to_infinite, else fill / reference_fill) and the paper's
+    ratio for clamped rows."""
+    out = []
+    for r in sorted(rows, key=lambda r: (_order(SHADOW_SCENES, r["scene"]), r["scene"],
+                                         _order(SHADOW_MODES, r["shadow_mode"]), str(r.get("litmap_size", "")))):
+        rr = dict(r)
+        rr["casters_culled_per_frame"] = r["gl_culled_per_frame"] + r["outside_per_frame"]
+        ratio = r.get("ratio_to_infinite")
+        if ratio is None and r.get("reference_fill_per_frame"):
+            ratio = r["fill_per_frame"] / r["reference_fill_per_frame"]
+        rr["ratio"] = ratio
+        paper = PAPER_CLAMPED_RATIO.get(r["scene"]) if r["shadow_mode"] == "clamped" else None
+        rr["paper_ratio"] = paper[0] if paper else None
+        rr["paper_text"] = paper[1] if paper else ""
+        rr["mask_pixels_differing"] = r["mask_diff"] + r["mask_diff_infinite"]
+        out.append(rr)
+    return out
+
+
+def shadows_reading(rows):
+    """What the shadows table shows, as plain sentences computed from its rows."""
+    out = []
+    bad = [r for r in rows if r["mask_pixels_differing"] > 0]
+    total_frames = sum(r["frames"] for r in rows)
+    if bad:
+        out.append("MASK PIXELS DIFFERING in " + ", ".join(
+            f"{r['scene']} {r['shadow_mode']} ({r['mask_diff']:,} from GL's mask, {r['mask_diff_infinite']:,} from its "
+            "infinite reference)" for r in bad) + ": culling and clamping must change no pixel.")
+    else:
+        out.append(f"Culling and clamping changed no shadow-mask pixel: 0 differing from GL's mask and from its infinite "
+                   f"reference in every row ({len(rows)} traces, {total_frames} frames).")
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        g = [r for r in rows if r["scene"] == scene]
+        for r in (r for r in g if r["shadow_mode"] == "clamped" and r["ratio"] is not None):
+            lit = f" (litmap {r['litmap_size']})" if r.get("litmap_size") and \
+                sum(1 for x in g if x["shadow_mode"] == "clamped") > 1 else ""
+            s = f"{scene}{lit}: clamping cuts the fill to {r['ratio']:.1%} of the infinite volumes'"
+            if r["paper_ratio"] is not None:
+                f = r["ratio"] / r["paper_ratio"]
+                s += (f" (the paper: {r['paper_text']}; ours is {f:.1f} times the paper's)" if f >= 1.05 else
+                      f" (the paper: {r['paper_text']}; ours is {1 / f:.1f} times lower)" if f <= 0.95 else
+                      f" (the paper: {r['paper_text']}, alike)")
+            out.append(s + f", {r['casters_culled_per_frame']:,.1f} of {r['casters_per_frame']:,.0f} casters culled a frame.")
+        culled = [r for r in g if r["shadow_mode"] == "culled" and r["ratio"] is not None]
+        clamped = [r for r in g if r["shadow_mode"] == "clamped" and r["ratio"] is not None]
+        if culled and clamped:
+            out.append(f"{scene}: culling alone keeps {culled[0]['ratio']:.1%} of the fill; clamping the volumes that "
+                       f"remain takes it to {clamped[0]['ratio']:.1%}.")
+        inf = next((r for r in g if r["shadow_mode"] == "infinite"), None)
+        if inf and clamped and inf["cycles_per_frame"] > 0:
+            c = clamped[0]
+            out.append(f"{scene}: the model's cycles per frame fall from {inf['cycles_per_frame']:,.0f} (infinite) to "
+                       f"{c['cycles_per_frame']:,.0f} (clamped), {inf['cycles_per_frame'] / max(c['cycles_per_frame'], 1):.1f} "
+                       "times fewer.")
+    nb = [r for r in rows if r["lookups_per_frame"] > 0]
+    if nb:
+        lo = min(r["build_texels_per_frame"] / r["lookups_per_frame"] for r in nb)
+        hi = max(r["build_texels_per_frame"] / r["lookups_per_frame"] for r in nb)
+        out.append(f"The two N-buffers' build costs {lo:,.0f} to {hi:,.0f} times their lookups (texels a frame): "
+                   + ("the build dominates the N-buffer cost." if lo > 1 else "the lookups cost more in some row."))
+    mism = [r for r in rows if (r.get("decision_mismatches") or 0) > 0]
+    if mism:
+        out.append("Cull decisions unlike the cull rule on GL's own values in " +
+                   ", ".join(f"{r['scene']} {r['shadow_mode']}" for r in mism) + ".")
+    return out
+
+
+def headline_shadows(label, rows, reading):
+    """The shadows table beside the paper's ratios and its reading, as Markdown."""
+    lines = [f"Shadows ({label}): fill per frame beside the paper's clamped / infinite ratio (640x480: city 20 M -> "
+             "512 K px, 2.5%; simpler scenes about 20%)",
+             "",
+             "| scene | mode | litmap | fill | ratio | paper | casters culled | build | lookups | cycles | mask px differing |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r['scene']} | {r['shadow_mode']} | {r.get('litmap_size') or '-'} | {r['fill_per_frame']:,.0f} | "
+                     f"{pct(r['ratio'])} | {r['paper_text'] or '-'} | "
+                     f"{r['casters_culled_per_frame']:,.1f} of {r['casters_per_frame']:,.0f} | "
+                     f"{r['build_texels_per_frame']:,.0f} | {r['lookups_per_frame']:,.0f} | {r['cycles_per_frame']:,.0f} | "
+                     f"{r['mask_diff']:,}, {r['mask_diff_infinite']:,} |")
     return "\n".join(lines + [""] + [f"- {s}" for s in reading])

@@ -82,6 +82,9 @@ std::optional<double> derive(techniques::Derivation d, double p, double r) {
     case techniques::Derivation::RelativeToReference:
       if (r > 0) return (p - r) / r;
       return std::nullopt;
+    case techniques::Derivation::LossRelativeToReference:
+      if (r > 0) return (r - p) / r;
+      return std::nullopt;
     case techniques::Derivation::None: break;
   }
   return std::nullopt;

@@ -37,6 +37,7 @@ enum class Derivation {
   ReferenceMinusPoint,  // r - p (a quality the reference maximises: efficiency lost)
   PointMinusReference,  // p - r
   RelativeToReference,  // (p - r) / r, empty when r is 0
+  LossRelativeToReference,  // (r - p) / r, empty when r is 0 (a count the reference maximises, lost as a fraction of it)
 };
 
 struct Metric {

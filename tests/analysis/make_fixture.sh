@@ -1,7 +1,7 @@
 #!/bin/sh
 # Regenerates tests/analysis/fixture/, the input folder of analysis/report.py's tests, from real nbsim
 # outputs on the small samples (city_small_oq.nbt, and city_small_nb_reversed.nbt for a second trace
-# in two sweeps) and on four tiny particles captures. Big files are trimmed to what the report reads.
+# in two sweeps) on four tiny particles captures and nine tiny shadows captures. Big files are trimmed to what the report reads.
 # About a minute on 2 cores.
 # Usage: tests/analysis/make_fixture.sh [NBSIM]   (default: build/pipeline/nbsim; run from anywhere)
 set -eu
@@ -70,6 +70,20 @@ mkdir -p "$out/particles"
  done &&
  "$nbsim" particles particles_none.nbt particles_center.nbt particles_nb.nbt particles_hiz.nbt --out particles >/dev/null)
 cp "$tmp/particles/particles.json" "$out/particles/"
+
+# Shadows: tiny captures (128x96, 2 frames, 64-lexel litmaps) of boxes, terrain and a small city in
+# modes infinite, culled and clamped, and the table nbsim shadows writes (shadows.json alone).
+mkdir -p "$out/shadows"
+(cd "$tmp" && for s in boxes terrain city; do
+   case $s in terrain) extra="--towers 8 --birds 120" ;; city) extra="--objects 400" ;; *) extra="" ;; esac
+   for m in infinite culled clamped; do
+     # shellcheck disable=SC2086
+     "$nbsim" capture shadows --scene $s $extra --path fly --size 128x96 --frames 2 --litmap 64 --shadow-mode "$m" \
+       -o "shadows_${s}_$m.nbt" >/dev/null
+   done
+ done &&
+ "$nbsim" shadows shadows_*_*.nbt --out shadows >/dev/null)
+cp "$tmp/shadows/shadows.json" "$out/shadows/"
 
 du -sh "$out"
 echo "wrote $out"

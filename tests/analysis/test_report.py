@@ -138,8 +138,11 @@ class FixtureReport(unittest.TestCase):
         self.assertIn("every point culls alike", fidelity)
         self.assertIn("largest |cycle error|", fidelity)
         self.assertTrue(text.split("\n\n", 1)[0].startswith("Table 2"), "Table 2 comes first")
-        self.assertIn("Particles (particles_none, particles_center, particles_nb, particles_hiz)",
-                      text.split("Sweep fidelity:")[1], "the particles table is the last block (scripts/demo ends on it)")
+        last = text.split("Sweep fidelity:")[1]
+        self.assertIn("Particles (particles_none, particles_center, particles_nb, particles_hiz)", last,
+                      "the particles table follows the sweeps (scripts/demo ends on it and the shadows table)")
+        self.assertIn("Shadows (9 traces of boxes, terrain, city)", last.split("Particles (")[1],
+                      "the shadows table is the last block, after the particles table")
 
     def test_particles_section_per_mode_beside_the_paper(self):
         # particles/particles.json: one row per mode beside the paper's 256 N and N, its CSV copy, and a
@@ -167,6 +170,48 @@ class FixtureReport(unittest.TestCase):
         self.assertGreater(rows["center"]["popping"], 0, "the fixture's center capture pops")
         self.assertIn(f"center {rows['center']['popping']:,.0f}; 0 in none, nb and hiz", self.html)
         self.assertIn("particles.png", self.html)
+
+
+    def test_shadows_section_per_scene_and_mode_beside_the_paper(self):
+        # shadows/shadows.json: one row per scene and mode in scene and mode order, its CSV copy, the paper's
+        # clamped ratio on the clamped rows, and a reading whose numbers are the fixture's own
+        rows = json.loads((FIXTURE / "shadows" / "shadows.json").read_text())
+        self.assertEqual({(r["scene"], r["shadow_mode"]) for r in rows},
+                         {(s, m) for s in ["boxes", "terrain", "city"] for m in ["infinite", "culled", "clamped"]},
+                         "the fixture has one capture per scene and mode")
+        self.assertIn("Shadows: fill per frame beside the paper", self.html)
+        self.assertIn("shadows/shadows.json", self.html, "the page names its input")
+        with open(self.dir / "report" / "shadows.csv") as f:
+            table = list(csv.DictReader(f))
+        self.assertEqual([(r["scene"], r["shadow_mode"]) for r in table],
+                         [(s, m) for s in ["boxes", "terrain", "city"] for m in ["infinite", "culled", "clamped"]],
+                         "rows by scene, then mode")
+        by = {(r["scene"], r["shadow_mode"]): r for r in rows}
+        for t in table:
+            r = by[(t["scene"], t["shadow_mode"])]
+            for k in ["fill_per_frame", "build_texels_per_frame", "lookups_per_frame", "cycles_per_frame", "mask_diff",
+                      "mask_diff_infinite"]:
+                self.assertEqual(float(t[k]), float(r[k]), f"shadows.csv {t['scene']} {t['shadow_mode']}.{k} is not shadows.json's")
+            self.assertEqual(float(t["casters_culled_per_frame"]), r["gl_culled_per_frame"] + r["outside_per_frame"],
+                             "casters culled: GL's culls and the casters outside the light's frustum")
+            self.assertAlmostEqual(float(t["ratio"]), r["ratio_to_infinite"], msg="the ratio is nbsim shadows' own")
+            self.assertEqual(t["paper_text"], {"boxes": "~20%", "terrain": "2.5%", "city": "2.5% (20 M -> 512 K px)"}[
+                t["scene"]] if t["shadow_mode"] == "clamped" else "", "the paper's ratio on clamped rows only")
+        for scene in ["boxes", "terrain", "city"]:
+            c = by[(scene, "clamped")]
+            self.assertIn(f"{scene}: clamping cuts the fill to {c['ratio_to_infinite']:.1%} of the infinite volumes&#x27;",
+                          self.html, "the reading quotes the table's ratio")
+            i = by[(scene, "infinite")]
+            self.assertIn(f"fall from {i['cycles_per_frame']:,.0f} (infinite) to {c['cycles_per_frame']:,.0f} (clamped)",
+                          self.html)
+        self.assertIn("Culling and clamping changed no shadow-mask pixel", self.html, "every fixture row has 0 mask pixels")
+        self.assertIn("shadows.png", self.html)
+        png_size(self.dir / "report" / "shadows.png")
+        text = (self.dir / "report" / "headline.md").read_text()
+        block = text.split("Shadows (")[1]
+        lines = [line for line in block.splitlines() if line.startswith("| ") and not line.startswith("| scene")]
+        self.assertEqual(len(lines), 9, block)
+        self.assertIn("| city | clamped | 64 |", block)
 
 
 class Pareto(unittest.TestCase):
@@ -294,6 +339,21 @@ class Labels(unittest.TestCase):
         plt.close(fig)
 
 
+class ShortLabels(unittest.TestCase):
+    """short_label: the point labels of sweep tables and plots."""
+
+    def test_two_nbuffer_instances_named_once(self):
+        # litmap_min.* and litmap_max.* set alike (the shadows sweep) read as one N-buffer design; set apart, both show
+        keys = [f"{u}.{f}" for u in ("litmap_min", "litmap_max") for f in ("resolution_divisor", "format", "level_cap")]
+        alike = {f"{u}.{f}": v for u in ("litmap_min", "litmap_max")
+                 for f, v in (("resolution_divisor", "2"), ("format", "u16"), ("level_cap", "4"))}
+        self.assertEqual(report_data.short_label(alike, keys), "div=2 u16 cap=4")
+        apart = dict(alike, **{"litmap_max.resolution_divisor": "4"})
+        self.assertEqual(report_data.short_label(apart, keys), "div=2 u16 cap=4 div=4")
+        self.assertEqual(report_data.short_label({"nbuffer.resolution_divisor": "2", "nbuffer.format": "u16"},
+                                                 ["nbuffer.resolution_divisor", "nbuffer.format"]), "div=2 u16")
+
+
 class Table2Ratio(unittest.TestCase):
     def test_ratio_against_paper(self):
         # oq/nb and oq_hier/nb_hier from query depth tests, beside the paper's 400x and 3143x
@@ -414,6 +474,52 @@ def particle_row(mode, **kw):
     return r
 
 
+def shadow_row(scene, mode, **kw):
+    """A shadows.json row (nbsim shadows --out): 100 casters, 4 frames, no mask pixel differing; kw overrides."""
+    fill = {"infinite": 100000.0, "culled": 60000.0, "clamped": 10000.0}[mode]
+    r = {"trace": f"{scene}_{mode}.nbt", "scene": scene, "shadow_mode": mode, "litmap_size": "64", "settings": [],
+         "frames": 4, "casters_per_frame": 100.0, "culled_per_frame": 50.0, "gl_culled_per_frame": 40.0,
+         "outside_per_frame": 5.0, "fill_per_frame": fill, "reference_fill_per_frame": 100000.0,
+         "ratio_to_infinite": fill / 100000.0, "build_texels_per_frame": 50000.0, "lookups_per_frame": 500.0,
+         "cycles_per_frame": fill / 2, "mask_diff": 0, "mask_diff_infinite": 0, "decision_mismatches": 0}
+    r.update(kw)
+    return r
+
+
+class ShadowsReading(unittest.TestCase):
+    """The shadows section's reading follows the rows it is given, not fixed text."""
+
+    def reading(self, rows):
+        return " ".join(report_data.shadows_reading(report_data.shadows_rows(rows)))
+
+    def test_ratios_against_the_paper(self):
+        # the clamped ratio is compared with the paper's figure of its scene, in either direction
+        text = self.reading([shadow_row("city", m) for m in ["infinite", "culled", "clamped"]])
+        self.assertIn("city: clamping cuts the fill to 10.0% of the infinite volumes' (the paper: 2.5% (20 M -> 512 K px); "
+                      "ours is 4.0 times the paper's)", text)
+        self.assertIn("city: culling alone keeps 60.0% of the fill; clamping the volumes that remain takes it to 10.0%", text)
+        self.assertIn("fall from 50,000 (infinite) to 5,000 (clamped), 10.0 times fewer", text)
+        self.assertIn("build costs 100 to 100 times their lookups (texels a frame): the build dominates", text)
+        text = self.reading([shadow_row("boxes", "clamped")])
+        self.assertIn("(the paper: ~20%; ours is 2.0 times lower)", text)
+        self.assertIn("45.0 of 100 casters culled a frame", text, "GL's culls and the casters outside the light")
+        self.assertNotIn("culling alone", text, "no culled row: nothing said about it")
+
+    def test_mask_pixels_differing_are_named(self):
+        # a row whose mask differs is named, and the all-clear sentence goes
+        text = self.reading([shadow_row("terrain", "infinite"), shadow_row("terrain", "clamped", mask_diff_infinite=3)])
+        self.assertIn("MASK PIXELS DIFFERING in terrain clamped (0 from GL's mask, 3 from its infinite reference)", text)
+        self.assertNotIn("changed no shadow-mask pixel", text)
+        self.assertIn("changed no shadow-mask pixel", self.reading([shadow_row("terrain", "clamped")]))
+
+    def test_ratio_from_the_reference_fill_when_absent(self):
+        # a row without ratio_to_infinite takes fill / reference_fill; without either, no ratio sentence
+        r = shadow_row("city", "clamped", ratio_to_infinite=None, fill_per_frame=25000.0)
+        self.assertIn("clamping cuts the fill to 25.0%", self.reading([r]))
+        r = shadow_row("city", "clamped", ratio_to_infinite=None, reference_fill_per_frame=None)
+        self.assertNotIn("clamping cuts", self.reading([r]))
+
+
 class ParticlesReading(unittest.TestCase):
     """The particles section's reading follows the rows it is given, not fixed text."""
 
@@ -492,7 +598,8 @@ class MissingAndBroken(unittest.TestCase):
         self.assertEqual(rc, 0, err)
         html = (self.dir / "report" / "index.html").read_text()
         self.assertIn("Table 1: N-buffer build cost", html)
-        for missing in ["figure4_map.csv", "table2/table2.json", "sweeps/NAME/results.csv", "particles/particles.json"]:
+        for missing in ["figure4_map.csv", "table2/table2.json", "sweeps/NAME/results.csv", "particles/particles.json",
+                        "shadows/shadows.json"]:
             self.assertIn(missing, html, f"the page does not say {missing} is missing")
         self.assertIn("missing inputs", out)
 
@@ -589,6 +696,25 @@ class MissingAndBroken(unittest.TestCase):
             (self.dir / "particles.json").write_text(bad)
             rc, _, err = run_report(self.dir)
             self.assertBroken(rc, err, "particles.json")
+            self.assertIn(says, err, bad)
+
+    def test_shadows_json_of_nbsim_shadows_out_dir(self):
+        # DIR/shadows.json (nbsim shadows --out DIR) renders alone; a malformed one exits 2 naming the file
+        (self.dir / "shadows.json").write_text(json.dumps([shadow_row("boxes", "infinite"), shadow_row("boxes", "clamped")]))
+        rc, out, err = run_report(self.dir)
+        self.assertEqual(rc, 0, err)
+        self.assertIn("1 sections", out)
+        self.assertIn("Shadows (boxes_infinite, boxes_clamped)", (self.dir / "report" / "headline.md").read_text())
+        self.assertIn("the model's default settings", (self.dir / "report" / "index.html").read_text())
+        for bad, says in [("[]", "non-empty JSON list"), ('{"rows": []}', "non-empty JSON list"),
+                          (json.dumps([{"scene": "city"}]), "lacks shadow_mode"),
+                          (json.dumps([shadow_row("city", "clamped", mask_diff="none")]), "rows[0].mask_diff is not a number"),
+                          (json.dumps([shadow_row("city", "clamped", shadow_mode=3)]), "rows[0].shadow_mode is not a string"),
+                          (json.dumps([shadow_row("city", "clamped", frames=0)]), "frames must be above 0"),
+                          ("[{", "broken JSON")]:
+            (self.dir / "shadows.json").write_text(bad)
+            rc, _, err = run_report(self.dir)
+            self.assertBroken(rc, err, "shadows.json")
             self.assertIn(says, err, bad)
 
     def test_help(self):

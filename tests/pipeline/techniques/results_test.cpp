@@ -110,6 +110,7 @@ TEST(TechniqueResultsTest, EveryRowIsComplete) {
     const auto* error = tq::find_metric(t, t.headline_error);
     ASSERT_NE(error, nullptr) << t.technique << ": headline error '" << t.headline_error << "' is not a metric";
     EXPECT_EQ(error->kind, tq::MetricKind::Error);
+    EXPECT_EQ(error->unit, "fraction") << t.technique << ": the report plots the headline error in points of %";
     if (!t.fallback_error.empty()) {
       ASSERT_NE(tq::find_metric(t, t.fallback_error), nullptr) << t.fallback_error;
       EXPECT_EQ(tq::find_metric(t, t.fallback_error)->unit, "fraction") << "plotted as 1 - value";
