@@ -57,7 +57,9 @@ CaptureSummary capture(const CaptureOptions& o, const std::string& out_path, con
 
   const auto t0 = std::chrono::steady_clock::now();
   const CaptureScene scene = scene_row.make(o.options);
-  const auto poses = path_row.make(scene, o.frames, o.options);
+  if (!o.poses.empty() && o.poses.size() != static_cast<std::size_t>(o.frames))
+    throw InputError(fmt::format("{} camera poses given for {} frames", o.poses.size(), o.frames));
+  const auto poses = o.poses.empty() ? path_row.make(scene, o.frames, o.options) : o.poses;
   RendererOptions ro;
   ro.technique = o.technique;
   ro.width = o.width;
@@ -93,41 +95,52 @@ CaptureSummary capture(const CaptureOptions& o, const std::string& out_path, con
   props.emplace_back("nbsim_version", NBSIM_VERSION);
   props.emplace_back("command_line", o.command_line.empty() ? canonical_command_line(o, out_path) : o.command_line);
 
-  trace::TraceWriter writer(out_path, props);
-  writer.write(scene.scene);
+  // Written under a temporary name, renamed when whole; removed on any failure.
+  const std::filesystem::path final_path(out_path), partial(out_path + ".partial");
   CaptureSummary sum;
-  for (int f = 0; f < o.frames; ++f) {
-    const CapturedFrame cf = renderer.render(static_cast<std::uint32_t>(f), poses[static_cast<std::size_t>(f)]);
-    const scene::Frame& fr = cf.frame;
-    writer.begin_frame(fr.begin);
-    for (const auto& d : fr.draws) writer.write(d);
-    for (const auto& d : fr.depths) writer.write(d);
-    for (const auto& l : fr.levels) writer.write(l);
-    for (const auto& s : fr.stencils) writer.write(s);
-    if (fr.light) writer.write_light(*fr.light);
-    for (const auto& r : fr.technique_records) writer.write(r);
-    if (fr.truth) writer.write(*fr.truth);
-    writer.end_frame(fr.end);
-    sum.frames++;
-    sum.gl_ms += fr.end.gl_ms;
-    sum.draws += fr.draws.size();
-    for (const auto& [name, value] : cf.counts) {
-      auto it = std::find_if(sum.technique_counts.begin(), sum.technique_counts.end(), [&](const auto& c) { return c.first == name; });
-      if (it == sum.technique_counts.end()) it = sum.technique_counts.insert(it, {name, 0});
-      it->second += value;
-    }
-    if (cf.rendered_objects && fr.truth) {
-      const auto& rendered = *cf.rendered_objects;
-      sum.objects_rendered += rendered.size();
-      for (std::size_t obj = 0; obj < fr.truth->visible_pixels.size(); ++obj) {
-        if (!fr.truth->visible_pixels[obj]) continue;
-        ++sum.objects_visible;
-        if (!std::binary_search(rendered.begin(), rendered.end(), static_cast<std::uint32_t>(obj))) ++sum.visible_not_rendered;
+  try {
+    trace::TraceWriter writer(partial.string(), props);
+    writer.write(scene.scene);
+    for (int f = 0; f < o.frames; ++f) {
+      const CapturedFrame cf = renderer.render(static_cast<std::uint32_t>(f), poses[static_cast<std::size_t>(f)]);
+      const scene::Frame& fr = cf.frame;
+      writer.begin_frame(fr.begin);
+      for (const auto& d : fr.draws) writer.write(d);
+      for (const auto& d : fr.depths) writer.write(d);
+      for (const auto& l : fr.levels) writer.write(l);
+      for (const auto& s : fr.stencils) writer.write(s);
+      if (fr.light) writer.write_light(*fr.light);
+      for (const auto& r : fr.technique_records) writer.write(r);
+      if (fr.truth) writer.write(*fr.truth);
+      writer.end_frame(fr.end);
+      sum.frames++;
+      sum.gl_ms += fr.end.gl_ms;
+      sum.draws += fr.draws.size();
+      for (const auto& [name, value] : cf.counts) {
+        auto it = std::find_if(sum.technique_counts.begin(), sum.technique_counts.end(), [&](const auto& c) { return c.first == name; });
+        if (it == sum.technique_counts.end()) it = sum.technique_counts.insert(it, {name, 0});
+        it->second += value;
       }
+      if (cf.rendered_objects && fr.truth) {
+        const auto& rendered = *cf.rendered_objects;
+        sum.objects_rendered += rendered.size();
+        for (std::size_t obj = 0; obj < fr.truth->visible_pixels.size(); ++obj) {
+          if (!fr.truth->visible_pixels[obj]) continue;
+          ++sum.objects_visible;
+          if (!std::binary_search(rendered.begin(), rendered.end(), static_cast<std::uint32_t>(obj))) ++sum.visible_not_rendered;
+        }
+      }
+      if (progress) progress(f + 1, o.frames);
     }
-    if (progress) progress(f + 1, o.frames);
+    writer.close();
+    std::error_code renamed;
+    std::filesystem::rename(partial, final_path, renamed);
+    if (renamed) throw InputError(fmt::format("cannot write trace '{}': renaming '{}' to it: {}", out_path, partial.string(), renamed.message()));
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(partial, ignored);
+    throw;
   }
-  writer.close();
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   sum.bytes = std::filesystem::file_size(out_path);
   return sum;

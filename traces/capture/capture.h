@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "traces/capture/camera.h"
 #include "traces/capture/plugin.h"
 
 namespace nbsim::capture {
@@ -26,6 +27,9 @@ struct CaptureOptions {
   // "1", ...); unset ones take their defaults, one that none of the three declares is an error.
   OptionValues options;
   std::string command_line;  // header property; canonical_command_line() when empty
+  // A test hook (no command-line spelling): when not empty, these camera poses replace the path's,
+  // one a frame (`frames` must be their number), so that a test can place the camera exactly.
+  std::vector<CameraPose> poses;
 };
 
 struct CaptureSummary {
@@ -44,7 +48,9 @@ struct CaptureSummary {
 using Progress = std::function<void(int, int)>;
 
 // Throws InputError on an unknown technique, scene or path, a bad or undeclared option, a bad size
-// or frame count, or a file that cannot be written.
+// or frame count, or a file that cannot be written. The frames go to a temporary file beside
+// `out_path` ("OUT.partial"), renamed to `out_path` once the trace is whole; a capture that fails
+// removes it, so a failure never leaves a partial trace (nor touches an existing `out_path`).
 CaptureSummary capture(const CaptureOptions& options, const std::string& out_path, const Progress& progress = {});
 
 // The command line that repeats a capture in the current spelling, every option spelled out:

@@ -120,25 +120,34 @@ TechniqueRecord decode_technique(std::uint32_t type, std::span<const std::uint8_
   r.payload.assign(payload.begin(), payload.end());
   const ChunkSpec* spec = find_technique_chunk(type);
   if (!spec) return r;
-  bytes::In in(payload);
-  for (const FieldSpec& fs : spec->fields) {
-    TechniqueField f;
-    f.name = fs.name;
-    const char* n = fs.name.c_str();
-    switch (fs.kind) {
-      case FieldKind::U32: f.value = std::uint64_t{in.u32(n)}; break;
-      case FieldKind::U64: f.value = in.u64(n); break;
-      case FieldKind::I32: f.value = std::int64_t{in.i32(n)}; break;
-      case FieldKind::F32: f.value = static_cast<double>(in.f32(n)); break;
-      case FieldKind::F64: f.value = in.f64(n); break;
-      case FieldKind::String: f.value = in.str(kMaxStringBytes, n); break;
-      case FieldKind::VecF32: in.counted_words(f.value.emplace<std::vector<float>>(), n); break;
-      case FieldKind::VecU32: in.counted_words(f.value.emplace<std::vector<std::uint32_t>>(), n); break;
-      case FieldKind::VecI32: in.counted_words(f.value.emplace<std::vector<std::int32_t>>(), n); break;
+  // A payload of another layout (a trace captured by a build whose description of this type had
+  // other fields) is refused naming the type and where to see the fields this build reads.
+  try {
+    bytes::In in(payload);
+    for (const FieldSpec& fs : spec->fields) {
+      TechniqueField f;
+      f.name = fs.name;
+      const char* n = fs.name.c_str();
+      switch (fs.kind) {
+        case FieldKind::U32: f.value = std::uint64_t{in.u32(n)}; break;
+        case FieldKind::U64: f.value = in.u64(n); break;
+        case FieldKind::I32: f.value = std::int64_t{in.i32(n)}; break;
+        case FieldKind::F32: f.value = static_cast<double>(in.f32(n)); break;
+        case FieldKind::F64: f.value = in.f64(n); break;
+        case FieldKind::String: f.value = in.str(kMaxStringBytes, n); break;
+        case FieldKind::VecF32: in.counted_words(f.value.emplace<std::vector<float>>(), n); break;
+        case FieldKind::VecU32: in.counted_words(f.value.emplace<std::vector<std::uint32_t>>(), n); break;
+        case FieldKind::VecI32: in.counted_words(f.value.emplace<std::vector<std::int32_t>>(), n); break;
+      }
+      r.fields.push_back(std::move(f));
     }
-    r.fields.push_back(std::move(f));
+    in.finish();
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("technique chunk {} ({}, technique {}) does not have this nbsim's layout: {} ({} fields of {} read; "
+                                 "`nbsim trace format {}` lists the fields this nbsim reads)",
+                                 chunk_type_name(type), spec->record, spec->technique, e.what(), r.fields.size(), spec->fields.size(),
+                                 chunk_type_name(type)));
   }
-  in.finish();
   r.decoded = true;
   if (spec->rule)
     if (const std::string broken = spec->rule(r); !broken.empty()) throw InputError(fmt::format("{}: {}", spec->record, broken));

@@ -3,7 +3,7 @@
 // samples equal GL's, the stencil buffer and both shadow masks equal GL's, the model's z_min/z_max
 // and lookups equal the capture's and no decision unlike the capture's rule; the fill falls from
 // infinite to culled to clamped. A u16, divisor-2 or level-capped N-buffer stays conservative; a
-// damaged SHDC record or a missing litmap is refused with exit 2; `nbsim shadows --json` rows.
+// damaged SHDC record, a missing litmap or a truncated trace is refused with exit 2; `nbsim shadows --json` rows.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -156,8 +156,10 @@ void expect_refused(const fs::path& bad, const std::string& message) {
   EXPECT_EQ(r.status, 2) << r.out << r.err;
   EXPECT_TRUE(has(r.err, message)) << r.err;
   EXPECT_FALSE(fs::exists(dir / "run.json")) << "a refused replay leaves no run.json";
-  const CliResult s = run_nbsim("shadows " + bad.string());
+  const fs::path table = bad.parent_path() / (bad.stem().string() + "_table");
+  const CliResult s = run_nbsim("shadows " + bad.string() + " --out " + table.string());
   EXPECT_EQ(s.status, 2) << s.out << s.err;
+  EXPECT_FALSE(fs::exists(table / "shadows.json")) << "a refused table leaves no shadows.json";
 }
 
 // A caster naming a draw that is not a shadow volume: exit 2, frame and caster named.
@@ -181,6 +183,20 @@ TEST(ShadowsBadInputTest, MissingLitmapRefused) {
     std::erase_if(f.depths, [](const auto& d) { return d.name == "litmap_max"; });
   });
   expect_refused(bad, "frame 1: no 'litmap_max' depth image: the max N-buffer has nothing to be built from");
+}
+
+// A shadows trace cut anywhere (here: in its middle, and 40 bytes before its end): `replay` and
+// `nbsim shadows` exit 2 with a message, and the replay leaves no run.json.
+TEST(ShadowsBadInputTest, TruncatedTraceRefused) {
+  const fs::path good = capture("boxes", "clamped");
+  const auto size = fs::file_size(good);
+  for (const std::uintmax_t keep : {size / 2, size - 40}) {
+    SCOPED_TRACE(keep);
+    const fs::path bad = scratch("truncated_" + std::to_string(keep) + ".nbt");
+    fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+    fs::resize_file(bad, keep);
+    expect_refused(bad, "nbsim: error: ");
+  }
 }
 
 // A mask pixel unlike the model's (GL's shadow_mask flipped at one lit pixel): the replay completes,

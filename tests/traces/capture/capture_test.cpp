@@ -3,7 +3,10 @@
 // consistent, the ID-buffer ground truth adds up, and no culling mode hides a visible object.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 
 #include <filesystem>
@@ -255,6 +258,44 @@ TEST(CaptureTest, EveryTechniqueRunsOnEverySceneAndPath) {
         std::filesystem::remove(file);
       }
   EXPECT_GE(runs, 2) << "occlusion culling on the city along walk and fly at least";
+}
+
+// A capture that fails mid-way (here: after its first frame, by its progress callback) leaves no
+// partial trace, for every technique: neither OUT nor its temporary OUT.partial exists after it,
+// and an OUT already there is left as it was.
+TEST(CaptureTest, FailedCaptureLeavesNoPartialFile) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / ("partial_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const TechniqueRow& t : technique_table()) {
+    SCOPED_TRACE(t.info.name);
+    CaptureOptions o;
+    o.technique = t.info.name;
+    o.scene = "boxes";
+    o.path = "fly";
+    o.width = 32;
+    o.height = 24;
+    o.frames = 2;
+    const std::filesystem::path out = dir / (t.info.name + ".nbt"), kept = dir / (t.info.name + "_kept.nbt");
+    const auto stop = [](int done, int) {
+      if (done == 1) throw InputError("stopped after frame 0");
+    };
+    EXPECT_THROW(capture(o, out.string(), stop), InputError);
+    EXPECT_FALSE(std::filesystem::exists(out)) << "no partial trace";
+    EXPECT_FALSE(std::filesystem::exists(out.string() + ".partial")) << "no temporary file left";
+    {
+      std::FILE* f = std::fopen(kept.string().c_str(), "wb");
+      ASSERT_NE(f, nullptr);
+      std::fputs("an older trace", f);
+      std::fclose(f);
+    }
+    EXPECT_THROW(capture(o, kept.string(), stop), InputError);
+    EXPECT_EQ(std::filesystem::file_size(kept), 14u) << "an existing OUT is left as it was";
+    const CaptureSummary whole = capture(o, out.string());
+    EXPECT_EQ(whole.frames, 2);
+    EXPECT_EQ(whole.bytes, std::filesystem::file_size(out));
+    EXPECT_FALSE(std::filesystem::exists(out.string() + ".partial"));
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

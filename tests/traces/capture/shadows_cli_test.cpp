@@ -1,6 +1,6 @@
 // ShadowsCliTest: `nbsim capture shadows` from the outside: bad modes, litmap sizes and lights (a
-// degenerate light frustum; a light inside a caster is shadows_test's) exit 2 naming the problem before any file is
-// written; a capture prints its counts, and `trace verify`, `info --json` and `dump --records` read
+// degenerate light frustum, a light inside a caster, litmaps above the trace format's per-frame
+// limit) exit 2 naming the problem before any file is written; a capture prints its counts, and `trace verify`, `info --json` and `dump --records` read
 // its SHDC record, light and stencil images back.
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include <string>
 
 #include "tests/common/run_nbsim.h"
+#include "traces/capture/scenes.h"
 
 namespace nbsim {
 namespace {
@@ -32,13 +33,39 @@ TEST(ShadowsCliTest, BadArgumentsExitTwo) {
                         Case{"--light 1,2,x,4,5,6", "'x' is not a number"},
                         Case{"--light 10,50,10,10,50,10", "the light camera's frustum is degenerate"},
                         Case{"--light 60,400,60,60,400,60.0000000001", "the light camera's frustum is degenerate"},
-                        Case{"--reversed-z", "drop --reversed-z"}}) {
+                        Case{"--reversed-z", "drop --reversed-z"},
+                        Case{"--litmap 1000", "above the trace format's per-frame limit"},
+                        Case{"--litmap 4096 --levels-every 0", "--litmap 4096: the two 4096x4096 litmaps come to"}}) {
     const CliResult r = run_nbsim(std::string("capture shadows --scene boxes --path fly --size 32x24 --frames 1 ") + c.args + " -o " +
                                   out.string());
     EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
     EXPECT_TRUE(has(r.err, c.message)) << c.args << ": " << r.err;
     EXPECT_FALSE(fs::exists(out)) << c.args << " wrote a file";
   }
+  fs::remove_all(out.parent_path());
+}
+
+// The review's case: --litmap 1000 at 160x120 (its litmaps and N-buffer levels come to about 88 MB
+// a frame, the format allows 64 MiB + 128 bytes a pixel) exits 2 naming the limit, before writing
+// anything; a light inside a caster exits 2 through the command line too.
+TEST(ShadowsCliTest, FrameBudgetAndLightInsideACasterExitTwo) {
+  const fs::path out = testing::scratch_path("nbsim_shadows_cli_budget", "never.nbt");
+  const CliResult big = run_nbsim("capture shadows --scene boxes --path fly --size 160x120 --frames 2 --litmap 1000 -o " + out.string());
+  EXPECT_EQ(big.status, 2) << big.out << big.err;
+  EXPECT_TRUE(has(big.err, "--litmap 1000: the two 1000x1000 litmaps and both N-buffers'")) << big.err;
+  EXPECT_TRUE(has(big.err, "above the trace format's per-frame limit of 69566464 bytes (64 MiB + 128 bytes a pixel of the 160x120 viewport)"))
+      << big.err;
+  EXPECT_FALSE(fs::exists(out)) << "nothing written";
+  EXPECT_FALSE(fs::exists(out.string() + ".partial"));
+  const capture::CaptureScene scene = capture::find_scene("boxes").make(capture::OptionValues{{"boxes", "3"}, {"seed", "7"}});
+  const scene::Aabb& b = scene.scene.objects[2];
+  const std::string light = std::to_string(0.5f * (b.lo[0] + b.hi[0])) + "," + std::to_string(0.5f * (b.lo[1] + b.hi[1])) + "," +
+                            std::to_string(0.5f * (b.lo[2] + b.hi[2])) + ",0,0,0";
+  const CliResult inside = run_nbsim("capture shadows --scene boxes --boxes 3 --seed 7 --path fly --size 32x24 --frames 1 --light " + light +
+                                     " -o " + out.string());
+  EXPECT_EQ(inside.status, 2) << inside.out << inside.err;
+  EXPECT_TRUE(has(inside.err, "is inside caster object 2")) << inside.err;
+  EXPECT_FALSE(fs::exists(out));
   fs::remove_all(out.parent_path());
 }
 

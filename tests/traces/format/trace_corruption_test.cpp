@@ -654,6 +654,14 @@ TEST(TraceCorruptionTest, ShadowChunk) {
   longer.push_back(0);
   e = error_of(longer);
   EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "decodes long")) << e;
+  // The layout before reference_fill and mask_diff_pixels were appended (never on main; only
+  // traces captured on the shadows-capture branch have it): refused naming the type, the missing
+  // field and where this nbsim's fields are listed.
+  std::vector<std::uint8_t> old_layout(raw.payload.begin(), raw.payload.end() - 16);
+  e = error_of(old_layout);
+  EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "technique chunk SHDC (ShadowCasters, technique shadows) does not have this nbsim's layout") &&
+              has(e, "'reference_fill'") && has(e, "16 fields of 18 read") && has(e, "`nbsim trace format SHDC`"))
+      << e;
   std::vector<std::uint8_t> hostile = raw.payload;
   put_le32(hostile, 8, 0xFFFFFFFFu);  // the object vector's count
   e = error_of(hostile);

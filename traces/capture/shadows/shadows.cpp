@@ -26,6 +26,7 @@
 #include "traces/capture/render_target.h"
 #include "traces/capture/scene_pass.h"
 #include "traces/capture/shadows/volumes.h"
+#include "traces/format/header.h"
 #include "traces/format/shadows_chunk.h"
 
 namespace nbsim::capture {
@@ -104,6 +105,28 @@ std::array<double, 6> parse_light(const std::string& text) {
   if (i != 6 || pos <= text.size())
     throw InputError(fmt::format("--light '{}' does not have six numbers X,Y,Z,TX,TY,TZ (or write auto)", text));
   return v;
+}
+
+// Refuses (InputError) a --litmap whose images alone exceed the trace format's per-frame limit for
+// the viewport, before any GL object is made or anything written. What a frame surely records: both
+// litmaps and, on a levels frame (frame 0 is one unless --levels-every is 0), every level of both
+// N-buffers, 4 bytes a lexel; the observer's depth (4 bytes a pixel) and four stencil images (1
+// byte a pixel each). Draws come on top (a frame that still exceeds the limit fails when written,
+// and the capture leaves no file).
+void check_frame_budget(const TechniqueSetup& s) {
+  const auto litmap = static_cast<int>(s.options.integer(litmap_option()));
+  const bool levels_recorded = s.options.integer(levels_every_option()) > 0;
+  const auto lexels = static_cast<std::uint64_t>(litmap) * static_cast<std::uint64_t>(litmap);
+  const std::uint64_t levels = levels_recorded ? static_cast<std::uint64_t>(nbuffer_level_count(litmap, litmap)) : 0;
+  const std::uint64_t pixels = static_cast<std::uint64_t>(s.width) * static_cast<std::uint64_t>(s.height);
+  const std::uint64_t needed = 2 * 4 * lexels * (1 + levels) + 8 * pixels;
+  trace::Header h;
+  h.viewport = trace::Viewport{s.width, s.height};
+  if (needed > h.frame_byte_limit())
+    throw InputError(fmt::format("--litmap {}: the two {}x{} litmaps{} come to {} bytes a frame, above the trace format's per-frame limit "
+                                 "of {} bytes ({}); use a smaller --litmap{}, or a larger --size",
+                                 litmap, litmap, litmap, levels ? fmt::format(" and both N-buffers' {} levels", levels) : "", needed,
+                                 h.frame_byte_limit(), h.frame_byte_limit_rule(), levels ? " or --levels-every 0" : ""));
 }
 
 glm::dmat4 to_dmat(const glm::mat4& m) { return glm::dmat4(m); }
@@ -670,6 +693,9 @@ const std::vector<OptionSpec>& shadows_options() {
   return options;
 }
 
-std::unique_ptr<Technique> make_shadows(const TechniqueSetup& setup) { return std::make_unique<Shadows>(setup); }
+std::unique_ptr<Technique> make_shadows(const TechniqueSetup& setup) {
+  check_frame_budget(setup);
+  return std::make_unique<Shadows>(setup);
+}
 
 }  // namespace nbsim::capture
