@@ -41,7 +41,10 @@ fs::path scratch(const std::string& name) { return nbsim::testing::scratch_path(
 
 std::string fmt_light(const glm::vec3& eye, const glm::vec3& target) {
   std::string out;
-  for (float v : {eye.x, eye.y, eye.z, target.x, target.y, target.z}) out += (out.empty() ? "" : ",") + std::to_string(v);
+  for (float v : {eye.x, eye.y, eye.z, target.x, target.y, target.z}) {
+    if (!out.empty()) out += ',';
+    out += std::to_string(v);
+  }
   return out;
 }
 
