@@ -163,10 +163,10 @@ int caster_of(const scene::TechniqueRecord& rec, std::uint32_t object) {
 // Receivers smaller than a lexel: 16-lexel litmaps over 40 boxes, the light high and oblique, so
 // that every box's bounds span less than a lexel of the litmap (the litmaps may miss a box's faces
 // entirely); the observer looks down at the boxes, which receive each other's shadows.
-// Open bug (found by this test, not fixed): the clamped mode loses mask pixels here (GL's own
-// count, which the model reproduces exactly: 46 pixels over 2 frames); culled and infinite agree. Disabled until the
-// slab is widened for it; run with --gtest_also_run_disabled_tests.
-TEST(ShadowsHardCasesTest, DISABLED_ReceiversSmallerThanALexel) {
+// Found a bug (fixed): the clamped mode lost 46 mask pixels over 2 frames: each 16-lexel lexel
+// spans tens of metres of ground, whose lexel-centre samples ended 218.6 m from the light while
+// mask pixels lay up to 223.6 m; the slab now holds the light depth of every mask pixel's receiver.
+TEST(ShadowsHardCasesTest, ReceiversSmallerThanALexel) {
   Case c;
   c.options = {{"boxes", "40"}, {"seed", "3"}, {"litmap", "16"}, {"light-fov", "60"}};
   const CaptureScene scene = find_scene("boxes").make(c.options);
@@ -200,10 +200,10 @@ TEST(ShadowsHardCasesTest, DISABLED_ReceiversSmallerThanALexel) {
 // Receivers at grazing angles from the light: a light 2 m above the ground, 150 m beyond the
 // site's edge, looking across it: the ground meets its rays at about 1 degree; the boxes' shadows
 // are long streaks on it, seen from above.
-// Open bug (found by this test, not fixed): the clamped mode loses mask pixels here (GL's own
-// count, which the model reproduces exactly: 1,031 pixels); culled and infinite agree. Disabled until the
-// slab is widened for it; run with --gtest_also_run_disabled_tests.
-TEST(ShadowsHardCasesTest, DISABLED_ReceiversAtGrazingAngles) {
+// Found a bug (fixed): the clamped mode lost 1,031 mask pixels: one lexel row spans up to about
+// 100 m of ground, so the far planes from lexel centres (212 to 260 m) fell short of shadowed
+// ground seen by the observer (up to 270 m); the slab now holds every mask pixel's receiver.
+TEST(ShadowsHardCasesTest, ReceiversAtGrazingAngles) {
   Case c;
   c.options = {{"boxes", "12"}, {"seed", "6"}, {"litmap", "128"}, {"light-fov", "40"}};
   const CaptureScene scene = find_scene("boxes").make(c.options);
@@ -256,10 +256,11 @@ TEST(ShadowsHardCasesTest, CasterCrossingTheLightsNearPlane) {
 // two boxes, beyond the taller one A, so that A stands between the light and the other box B. In
 // B's light-space rectangle the nearest visible receiver is A, in front of B: B's slab starts
 // before B, so its volume is loose (no near plane) but drawn and correct.
-// Open bug (found by this test, not fixed): the clamped mode loses mask pixels here (GL's own
-// count, which the model reproduces exactly: 59 pixels); culled and infinite agree. Disabled until the
-// slab is widened for it; run with --gtest_also_run_disabled_tests.
-TEST(ShadowsHardCasesTest, DISABLED_IntermediateOccluder) {
+// Found a bug (fixed): the clamped mode lost 59 mask pixels: B's far plane from the lexel centres
+// (z_max 0.998497, 101.8 m with the margin) fell short of ground behind B that the observer sees
+// (up to 111.6 m; the light is low, so the ground's depth changes metres within a lexel); the
+// slab now holds every mask pixel's receiver.
+TEST(ShadowsHardCasesTest, IntermediateOccluder) {
   Case c;
   c.options = {{"boxes", "2"}, {"seed", "12"}, {"litmap", "256"}, {"light-fov", "60"}};
   const CaptureScene scene = find_scene("boxes").make(c.options);

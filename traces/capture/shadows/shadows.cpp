@@ -18,6 +18,7 @@
 
 #include "model/common/error.h"
 #include "model/nbuffer/covering.h"
+#include "model/nbuffer/nbuffer.h"
 #include "model/scene/visibility.h"
 #include "nbsim_shaders.h"
 #include "traces/capture/draw_recorder.h"
@@ -485,18 +486,53 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   nb_max_.build(litmap_max_.depth_texture(), recorder_, build_state);
   scene::NBufferLevels min_levels = nb_min_.read(), max_levels = nb_max_.read();
 
+  // The receivers the shadow mask samples: the surface point at each observer pixel's centre, at
+  // the depth the stencil test compares with (the observer's depth buffer, unprojected), when the
+  // point lies inside the light's frustum. The litmaps sample receivers at lexel centres only, so a
+  // receiver point the observer sees may have no lexel centre on its surface (a receiver smaller
+  // than a lexel, a face at a grazing angle to the light whose depth changes by metres within a
+  // lexel, a receiver hidden from the lexel centres' rays by an intermediate occluder but seen by
+  // the observer); a volume clamped short of that point's light depth loses its mask pixel. Every
+  // such point is scattered into the lexel it projects to (a min and a max image, rounded outward to
+  // f32) and two CPU N-buffers over them give the depth range of the mask's own receivers in each
+  // caster's rectangle (which covers its light-space footprint), merged into its slab below: a
+  // mask pixel whose receiver lies in the caster's footprint then lies between its clamp planes.
+  const glm::dmat4 unproject = glm::inverse(to_dmat(view_proj));
+  scene::DepthSnapshot depth = read_depth(target_.framebuffer(), width_, height_, scene::DepthWhich::Final);
+  std::vector<char> in_light_frustum(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), 0);
+  DepthImage seen_lo(litmap_, litmap_, neutral_depth(FarOp::Min)), seen_hi(litmap_, litmap_, neutral_depth(FarOp::Max));
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
+      const double d = depth.texels[i];
+      if (d >= 1.0) continue;
+      const glm::dvec4 w = unproject * glm::dvec4((x + 0.5) / width_ * 2.0 - 1.0, (y + 0.5) / height_ * 2.0 - 1.0, 2.0 * d - 1.0, 1.0);
+      const glm::dvec4 q = light.clip(glm::dvec3(w) / w.w);
+      if (!(q.w > 0.0 && std::abs(q.x) <= q.w && std::abs(q.y) <= q.w && std::abs(q.z) <= q.w)) continue;
+      in_light_frustum[i] = 1;
+      const int lx = std::clamp(static_cast<int>(std::floor((q.x / q.w * 0.5 + 0.5) * litmap_)), 0, litmap_ - 1);
+      const int ly = std::clamp(static_cast<int>(std::floor((q.y / q.w * 0.5 + 0.5) * litmap_)), 0, litmap_ - 1);
+      const double z = q.z / q.w * 0.5 + 0.5;
+      float& lo_z = seen_lo.at(lx, ly);
+      float& hi_z = seen_hi.at(lx, ly);
+      lo_z = std::min(lo_z, std::nextafter(static_cast<float>(z), 0.0f));
+      hi_z = std::max(hi_z, std::nextafter(static_cast<float>(z), 2.0f));
+    }
+  const NBuffer seen_min(seen_lo, NBufferConfig{FarOp::Min}), seen_max(seen_hi, NBufferConfig{FarOp::Max});
+
   // 4. Each caster's rectangle, eight lookups and decision; 5. the volumes of the mode.
   std::vector<CasterResult> results(casters_.size());
   std::vector<glm::vec4> positions;
   std::vector<std::pair<std::size_t, std::size_t>> ranges(casters_.size());  // first vertex, count
   for (std::size_t c = 0; c < casters_.size(); ++c) results[c] = measure(casters_[c], light, min_levels, max_levels);
-  // The receivers the litmaps may miss: faces of casters that the light sees nearly edge-on (a
-  // caster's own faces turned from the light, a neighbour's walls), whose depth changes across one
-  // lexel by more than the clamp margin, and faces smaller than two lexels. Every caster the
-  // observer sees adds to the slab of each caster whose rectangle its own overlaps the depth range
-  // of those triangles inside that rectangle, and its own bounds' depth range to its own slab (one
-  // crossing the light's near plane adds [0, 1] everywhere). Open receivers (the plane, the
-  // terrain) come from the litmaps alone.
+  // Each slab: the litmaps' [z_min, z_max], the mask's receivers in the rectangle (above), and
+  // (an earlier, partial widening for the same fault, now redundant for the mask and kept) faces of
+  // seen casters that the light sees nearly edge-on (a caster's own faces turned from the light, a
+  // neighbour's walls), whose depth changes across one lexel by more than the clamp margin, and
+  // faces smaller than two lexels. Every caster the observer sees adds to the slab of each caster
+  // whose rectangle its own overlaps the depth range of those triangles inside that rectangle, and
+  // its own bounds' depth range to its own slab (one crossing the light's near plane adds [0, 1]
+  // everywhere).
   const double lexel_ndc = 2.0 / litmap_;
   // A face whose depth changes by at most the clamp margin across 1.5 lexels is sampled well enough.
   const double max_tan = kClampRel / (1.5 * lexel_ndc * std::tan(light.fov_y_deg * 3.14159265358979323846 / 360.0));
@@ -511,6 +547,9 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
     CasterResult& r = results[c];
     if (r.decision == CasterDecision::Volume) {
       double slab_min = r.z_min, slab_max = r.z_max;
+      const Rect rect{r.x, r.y, r.w, r.h};
+      slab_min = std::min(slab_min, static_cast<double>(seen_min.query(rect).value));
+      slab_max = std::max(slab_max, static_cast<double>(seen_max.query(rect).value));
       if (seen[casters_[c].object]) slab_min = std::min(slab_min, static_cast<double>(r.caster_near)), slab_max = std::max(slab_max, static_cast<double>(r.caster_far));
       for (std::size_t k : seen_casters) {
         const CasterResult& o = results[k];
@@ -594,14 +633,12 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   glEnable(GL_CULL_FACE);
 
   // The records.
-  scene::DepthSnapshot depth = read_depth(target_.framebuffer(), width_, height_, scene::DepthWhich::Final);
   for (const bool max : {false, true}) {
     scene::DepthSnapshot lm = read_depth((max ? litmap_max_ : litmap_min_).framebuffer(), litmap_, litmap_, scene::DepthWhich::Final);
     lm.name = max ? "litmap_max" : "litmap_min";
     f.depths.push_back(std::move(lm));
   }
   // Receivers lit by the spot: pixels with a surface whose point lies inside the light's frustum.
-  const glm::dmat4 unproject = glm::inverse(to_dmat(view_proj));
   scene::StencilSnapshot region{"light_region", width_, height_, std::vector<std::uint8_t>(stencil.size())};
   scene::StencilSnapshot mask{"shadow_mask", width_, height_, std::vector<std::uint8_t>(stencil.size())};
   scene::StencilSnapshot ref_mask{"shadow_mask_infinite", width_, height_, std::vector<std::uint8_t>(stencil.size())};
@@ -609,11 +646,7 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
-      const double d = depth.texels[i];
-      if (d >= 1.0) continue;
-      const glm::dvec4 w = unproject * glm::dvec4((x + 0.5) / width_ * 2.0 - 1.0, (y + 0.5) / height_ * 2.0 - 1.0, 2.0 * d - 1.0, 1.0);
-      const glm::dvec4 q = light.clip(glm::dvec3(w) / w.w);
-      const bool lit = q.w > 0.0 && std::abs(q.x) <= q.w && std::abs(q.y) <= q.w && std::abs(q.z) <= q.w;
+      const bool lit = in_light_frustum[i] != 0;
       region.texels[i] = lit;
       mask.texels[i] = lit && stencil[i] != 0;
       ref_mask.texels[i] = lit && reference[i] != 0;
