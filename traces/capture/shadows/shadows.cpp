@@ -45,9 +45,9 @@ constexpr std::array<const char*, 3> kModeNames = {"infinite", "culled", "clampe
 // depth of its 3x3 pixels by more than 1% + 5 cm of view distance (tunable; larger is more
 // conservative and only loosens [z_min, z_max]).
 constexpr float kReprojectRel = 0.01f, kReprojectM = 0.05f;
-// Clamp planes and the cull decision are widened by 1% + 10 cm of light distance (tunable): the
-// litmaps sample receivers at lexel centres only, and a clamp plane through a receiver would make
-// its stencil count a depth tie.
+// Clamp planes and the cull decision are widened by 1% + 10 cm of light distance (tunable): a clamp
+// plane through a receiver would make its stencil count a depth tie, and the mask's receivers are
+// unprojected from 24-bit depth and rounded to f32.
 constexpr double kClampRel = 0.01, kClampM = 0.1;
 // The auto light: this far above the scene's top, as a fraction of the site's side (tunable).
 constexpr double kLightHeight = 0.5;
@@ -525,24 +525,14 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   std::vector<glm::vec4> positions;
   std::vector<std::pair<std::size_t, std::size_t>> ranges(casters_.size());  // first vertex, count
   for (std::size_t c = 0; c < casters_.size(); ++c) results[c] = measure(casters_[c], light, min_levels, max_levels);
-  // Each slab: the litmaps' [z_min, z_max], the mask's receivers in the rectangle (above), and
-  // (an earlier, partial widening for the same fault, now redundant for the mask and kept) faces of
-  // seen casters that the light sees nearly edge-on (a caster's own faces turned from the light, a
-  // neighbour's walls), whose depth changes across one lexel by more than the clamp margin, and
-  // faces smaller than two lexels. Every caster the observer sees adds to the slab of each caster
-  // whose rectangle its own overlaps the depth range of those triangles inside that rectangle, and
-  // its own bounds' depth range to its own slab (one crossing the light's near plane adds [0, 1]
-  // everywhere).
-  const double lexel_ndc = 2.0 / litmap_;
-  // A face whose depth changes by at most the clamp margin across 1.5 lexels is sampled well enough.
-  const double max_tan = kClampRel / (1.5 * lexel_ndc * std::tan(light.fov_y_deg * 3.14159265358979323846 / 360.0));
-  std::vector<std::size_t> seen_casters;
-  std::vector<std::vector<std::array<glm::dvec3, 3>>> thin(casters_.size());
+  // Each slab: the litmaps' [z_min, z_max] and the mask's receivers in the rectangle (above); a
+  // seen caster's own bounds join its own slab, and a seen caster crossing the light's near plane
+  // makes every slab [0, 1] (both older widenings, kept: they only loosen the slab). The mask's
+  // receivers replace the former widening by the seen casters' edge-on and sub-lexel faces, which
+  // sampled the same fault (receivers the lexel centres miss) only in part.
+  bool near_crossing_seen = false;
   for (std::size_t c = 0; c < casters_.size(); ++c)
-    if (seen[casters_[c].object] && results[c].decision != CasterDecision::OutsideLight) {
-      seen_casters.push_back(c);
-      if (results[c].decision == CasterDecision::Volume) thin[c] = thin_triangles(scene_, casters_[c], light, glm::dvec3(pose.eye), max_tan, lexel_ndc);
-    }
+    near_crossing_seen = near_crossing_seen || (seen[casters_[c].object] && results[c].decision == CasterDecision::CrossesNear);
   for (std::size_t c = 0; c < casters_.size(); ++c) {
     CasterResult& r = results[c];
     if (r.decision == CasterDecision::Volume) {
@@ -551,16 +541,7 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
       slab_min = std::min(slab_min, static_cast<double>(seen_min.query(rect).value));
       slab_max = std::max(slab_max, static_cast<double>(seen_max.query(rect).value));
       if (seen[casters_[c].object]) slab_min = std::min(slab_min, static_cast<double>(r.caster_near)), slab_max = std::max(slab_max, static_cast<double>(r.caster_far));
-      for (std::size_t k : seen_casters) {
-        const CasterResult& o = results[k];
-        if (o.decision == CasterDecision::CrossesNear) {
-          slab_min = 0.0, slab_max = 1.0;
-        } else if (k != c && o.x < r.x + r.w && r.x < o.x + o.w && o.y < r.y + r.h && r.y < o.y + o.h) {
-          for (const auto& t : thin[k])
-            depth_range_in_rect(light, {t.begin(), t.end()}, r.x * lexel_ndc - 1.0, (r.x + r.w) * lexel_ndc - 1.0, r.y * lexel_ndc - 1.0,
-                                (r.y + r.h) * lexel_ndc - 1.0, slab_min, slab_max);
-        }
-      }
+      if (near_crossing_seen) slab_min = 0.0, slab_max = 1.0;
       decide(r, light, slab_min, slab_max);
     }
     const bool dropped = results[c].decision == CasterDecision::Culled || results[c].decision == CasterDecision::OutsideLight;

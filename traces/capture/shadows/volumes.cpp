@@ -134,50 +134,6 @@ void append_volume(const CaptureScene& scene, const CasterMesh& caster, const Li
   }
 }
 
-bool depth_range_in_rect(const LightCamera& light, std::vector<glm::dvec3> poly, double x0, double x1, double y0, double y1,
-                         double& depth_min, double& depth_max) {
-  const glm::dmat4 m = light.proj * light.view;
-  const glm::dvec4 row_x{m[0][0], m[1][0], m[2][0], m[3][0]}, row_y{m[0][1], m[1][1], m[2][1], m[3][1]},
-      row_w{m[0][3], m[1][3], m[2][3], m[3][3]};
-  // Inside when every plane's value is >= 0: x >= x0 w, x <= x1 w, y >= y0 w, y <= y1 w (clip space).
-  for (const glm::dvec4& pl : {row_x - x0 * row_w, x1 * row_w - row_x, row_y - y0 * row_w, y1 * row_w - row_y}) {
-    std::vector<glm::dvec3> kept;  // Sutherland-Hodgman against one plane
-    for (std::size_t i = 0; i < poly.size(); ++i) {
-      const glm::dvec3 &a = poly[i], &b = poly[(i + 1) % poly.size()];
-      const double da = glm::dot(pl, glm::dvec4(a, 1.0)), db = glm::dot(pl, glm::dvec4(b, 1.0));
-      if (da >= 0.0) kept.push_back(a);
-      if ((da >= 0.0) != (db >= 0.0)) kept.push_back(a + (b - a) * (da / (da - db)));
-    }
-    poly = std::move(kept);
-    if (poly.empty()) return false;
-  }
-  for (const glm::dvec3& p : poly) {
-    const double d = light.window_depth(p);
-    depth_min = std::min(depth_min, d), depth_max = std::max(depth_max, d);
-  }
-  return true;
-}
-
-std::vector<std::array<glm::dvec3, 3>> thin_triangles(const CaptureScene& scene, const CasterMesh& caster, const LightCamera& light,
-                                                      const glm::dvec3& eye, double max_tan, double lexel_ndc) {
-  std::vector<std::array<glm::dvec3, 3>> out;
-  for (const auto& t : caster.triangles) {
-    const std::array<glm::dvec3, 3> p = {vertex(scene, t[0]), vertex(scene, t[1]), vertex(scene, t[2])};
-    const glm::dvec3 n = glm::cross(p[1] - p[0], p[2] - p[0]), ray = (p[0] + p[1] + p[2]) / 3.0 - light.eye;
-    if (glm::dot(n, eye - p[0]) <= 0.0) continue;  // a back face for the observer
-    const double cos = std::abs(glm::dot(n, ray)) / (glm::length(n) * glm::length(ray));
-    bool thin = !(cos > 0.0) || std::sqrt(std::max(0.0, 1.0 - cos * cos)) > max_tan * cos;
-    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-    for (const glm::dvec3& v : p) {
-      const glm::dvec4 c = light.clip(v);
-      x0 = std::min(x0, c.x / c.w), x1 = std::max(x1, c.x / c.w), y0 = std::min(y0, c.y / c.w), y1 = std::max(y1, c.y / c.w);
-    }
-    thin = thin || x1 - x0 < 2.0 * lexel_ndc || y1 - y0 < 2.0 * lexel_ndc;
-    if (thin) out.push_back(p);
-  }
-  return out;
-}
-
 std::size_t silhouette_edges(const CaptureScene& scene, const CasterMesh& caster, const glm::dvec3& light) {
   std::size_t n = 0;
   for (std::size_t t = 0; t < caster.triangles.size(); ++t) {

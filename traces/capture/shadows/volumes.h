@@ -70,21 +70,6 @@ struct VolumeEnds {
 void append_volume(const CaptureScene& scene, const CasterMesh& caster, const LightCamera& light, const VolumeEnds& ends,
                    std::vector<glm::vec4>& out);
 
-// The light window depth range of the part of polygon `poly` (world space, convex, in front of the
-// light's near plane) whose light-space projection lies in the rectangle [x0, x1] x [y0, y1] of
-// normalized device coordinates (the polygon clipped by the four planes through the light and the
-// rectangle's sides), merged into [depth_min, depth_max]; false when no part does.
-bool depth_range_in_rect(const LightCamera& light, std::vector<glm::dvec3> poly, double x0, double x1, double y0, double y1,
-                         double& depth_min, double& depth_max);
-
-// The triangles of `caster` that face the observer at `eye` (the others are back faces the
-// observer's depth pass culls: never visible) and that the litmaps may not sample well: seen from
-// the light within `max_tan` of edge-on (tan of the angle between the face and the light ray above
-// max_tan), or smaller than two lexels across (`lexel_ndc`: a lexel's side in normalized device
-// coordinates).
-std::vector<std::array<glm::dvec3, 3>> thin_triangles(const CaptureScene& scene, const CasterMesh& caster, const LightCamera& light,
-                                                      const glm::dvec3& eye, double max_tan, double lexel_ndc);
-
 // Silhouette edges of `caster` from the light (for counts and tests).
 std::size_t silhouette_edges(const CaptureScene& scene, const CasterMesh& caster, const glm::dvec3& light);
 
