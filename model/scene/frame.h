@@ -55,6 +55,7 @@ enum class DrawRole : std::uint8_t {
   HiZBuild = 9,       // a full-screen pass building one level of a Hi-Z max/min mip pyramid (particles' hiz mode)
   ShadowVolume = 10,  // a caster's stencil shadow volume (shadows): z-fail, two-sided, depth write off, depth clamp
   Litmap = 11,        // a scene object drawn from the light into a litmap, observer-hidden fragments discarded (shadows)
+  ReceiverSplat = 12, // the observer's receivers as one-pixel points from the light into a litmap (shadows)
 };
 
 // The culling technique a frame ran (ARCHITECTURE.md Table 2 modes).

@@ -32,8 +32,8 @@ ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& r
       outside_(stats().counter("outside", "casters", "casters outside the light's frustum (decision 2, as recorded)")),
       crossing_near_(stats().counter("crossing_near", "casters", "casters crossing the light's near plane (decision 3, as recorded)")),
       kept_by_slab_(stats().counter("kept_by_slab", "casters",
-                                    "casters GL kept that the litmap rule culls on GL's values: the capture's slab, widened for "
-                                    "receivers the litmaps cannot sample (scene triangles the trace does not hold)")),
+                                    "casters GL kept that the litmap rule culls on GL's values: the capture's slab, widened by a "
+                                    "seen caster's own bounds or a near-plane crossing (scene data the trace does not hold)")),
       decision_mismatches_(stats().counter("decision_mismatches", "casters",
                                            "casters GL culled that the rule on GL's own values keeps (expected 0)")),
       zmin_mismatches_(stats().counter("zmin_mismatches", "casters", "casters whose model z_min differs from GL's")),
@@ -52,6 +52,9 @@ ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& r
       litmap_reprojections_(stats().counter("litmap_reprojections", "fragments",
                                             "litmap fragments reprojected into the observer's view (GL's fragment counter of "
                                             "the litmap draws; each reads up to 3x3 observer depth texels)")),
+      receiver_splats_(stats().counter("receiver_splats", "points",
+                                       "observer receivers splatted into the litmaps as points (GL's fragment counter of the "
+                                       "receiver_splat draws, both litmaps; each reads one observer depth texel)")),
       scene_depth_tests_(stats().counter("scene_depth_tests", "tests", "depth tests of the scene draws")),
       volume_draws_(stats().counter("volume_draws", "draws", "shadow-volume draws issued")),
       fill_(stats().counter("fill", "fragments", "rasterized fragments of the shadow-volume draws (the fill)")),
@@ -217,9 +220,11 @@ void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Co
 
   // 1. The observer's depth.
   issue_role(f, scene::DrawRole::Scene, cp);
-  // 2. The litmap pass: GL's images; its reprojections are its fragments (no clip positions).
+  // 2. The litmap pass: GL's images; its reprojections are its fragments (no clip positions), and
+  //    the receiver splat's points (one observer texel read each) are its fragments.
   for (const scene::DrawRecord& d : f->draws)
     if (d.role == scene::DrawRole::Litmap) ++litmap_draws_, litmap_reprojections_ += d.gl.fragments;
+    else if (d.role == scene::DrawRole::ReceiverSplat) receiver_splats_ += d.gl.fragments;
   // 3. Both N-buffers from the litmaps (each unit's engine builds while the scene is drawn).
   build_texels_ += build(min_nb_, *f, "litmap_min");
   build_texels_ += build(max_nb_, *f, "litmap_max");

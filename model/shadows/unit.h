@@ -4,7 +4,8 @@
 //     the observer does not see after reprojecting each fragment into the observer's view, a
 //     step the model does not replay), so the program takes the `litmap_min` and `litmap_max`
 //     depth images as GL computed them and counts the pass's reprojections as the litmap draws'
-//     rasterized fragments (GL's counter: one reprojection a fragment, reading up to 3x3 texels);
+//     rasterized fragments (GL's counter: one reprojection a fragment, reading up to 3x3 texels),
+//     and the receiver splat's points (role ReceiverSplat, one observer texel read each);
 //  3. a min N-buffer over litmap_min and a max N-buffer over litmap_max (two instances of the
 //     N-buffer unit, "litmap_min" and "litmap_max", each with its own config), built from those
 //     images (every texel of every level, timed by each unit's update engine);
@@ -81,7 +82,7 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
 
   stats::Counter &frames_, &casters_, &measured_, &culled_, &gl_culled_, &outside_, &crossing_near_, &kept_by_slab_,
       &decision_mismatches_, &zmin_mismatches_, &zmax_mismatches_, &not_conservative_, &unsafe_culls_, &culls_lost_,
-      &lookups_, &lookup_mismatches_, &build_texels_, &litmap_draws_, &litmap_reprojections_, &scene_depth_tests_,
+      &lookups_, &lookup_mismatches_, &build_texels_, &litmap_draws_, &litmap_reprojections_, &receiver_splats_, &scene_depth_tests_,
       &volume_draws_, &fill_, &gl_fill_, &reference_fill_, &reference_frames_, &stencil_tests_, &mask_pixels_, &gl_mask_pixels_, &mask_diff_, &mask_diff_infinite_,
       &gl_mask_diff_;
 

@@ -527,7 +527,7 @@ void add_model_commands(CLI::App& app, Action& action) {
           r["settings"] = settings_of(a->mo);
           for (const char* k : {"frames", "casters_per_frame", "culled_per_frame", "gl_culled_per_frame", "outside_per_frame", "fill_per_frame",
                                 "gl_fill_per_frame", "reference_fill_per_frame", "fill_ratio_to_infinite", "build_texels_per_frame", "lookups_per_frame", "stencil_tests_per_frame",
-                                "litmap_reprojections_per_frame", "cycles_per_frame", "nbuffer_memory_bytes", "mask_diff",
+                                "litmap_reprojections_per_frame", "receiver_splats_per_frame", "cycles_per_frame", "nbuffer_memory_bytes", "mask_diff",
                                 "mask_diff_infinite", "decision_mismatches", "zmin_mismatches", "zmax_mismatches",
                                 "not_conservative", "unsafe_culls", "kept_by_slab"})
             r[k] = (*p)[k];

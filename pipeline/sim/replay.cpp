@@ -28,10 +28,10 @@ constexpr std::array<const char*, 11> kParticlesFrameCounts = {
     "particles", "culled", "kept_too_large", "lookups", "particle_fragments", "build_texels", "decision_mismatches",
     "popping", "false_culls", "exactly_hidden", "hidden_kept"};
 // The shadows program's counters in run.json's per-frame values (differences at frame ends).
-constexpr std::array<const char*, 18> kShadowsFrameCounts = {
+constexpr std::array<const char*, 19> kShadowsFrameCounts = {
     "casters",     "culled",          "gl_culled",       "outside",    "crossing_near",       "kept_by_slab", "reference_fill",
-    "lookups",     "build_texels",    "litmap_reprojections", "volume_draws", "fill", "gl_fill", "stencil_tests",
-    "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches"};
+    "lookups",     "build_texels",    "litmap_reprojections", "receiver_splats", "volume_draws", "fill", "gl_fill",
+    "stencil_tests", "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches"};
 
 // A statistic of a group's values (0 when the group has none of that name).
 std::uint64_t stat(const nlohmann::ordered_json& group, const char* name) {
@@ -297,7 +297,7 @@ nlohmann::ordered_json shadows_summary(const nlohmann::ordered_json& p, std::uin
   nlohmann::ordered_json j;
   j["frames"] = frames;
   for (const char* name : {"casters", "measured", "culled", "gl_culled", "outside", "crossing_near", "kept_by_slab", "lookups",
-                           "build_texels", "litmap_draws", "litmap_reprojections", "volume_draws", "fill", "gl_fill",
+                           "build_texels", "litmap_draws", "litmap_reprojections", "receiver_splats", "volume_draws", "fill", "gl_fill",
                            "reference_fill", "stencil_tests", "mask_pixels", "scene_depth_tests"}) {
     j[name] = stat(p, name);
     j[std::string(name) + "_per_frame"] = per_frame(stat(p, name));

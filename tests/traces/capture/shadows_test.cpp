@@ -84,6 +84,18 @@ std::vector<FrameResult> check_trace(const fs::path& file, const std::string& mo
     const auto& draw = field<std::int32_t>(rec, "draw");
     const auto& clamp_far = field<float>(rec, "clamp_far");
     std::map<std::int32_t, bool> volume_draws;
+    // The receiver splat: one point draw into each litmap, one point a receiver pixel in the light's
+    // frustum (GL's fragment counter against the capture's double-precision light_region).
+    std::uint64_t region_pixels = 0;
+    for (std::uint8_t t : f->stencil("light_region")->texels) region_pixels += t;
+    std::vector<std::uint64_t> splats;
+    for (const auto& d : f->draws)
+      if (d.role == trace::DrawRole::ReceiverSplat) {
+        splats.push_back(d.gl.fragments);
+        EXPECT_EQ(d.topology, trace::Topology::Points);
+        EXPECT_TRUE(d.state.write) << "the splat writes the litmap's depth";
+      }
+    EXPECT_EQ(splats, std::vector<std::uint64_t>(2, region_pixels)) << "frame " << f->begin.frame << ": one point per receiver, per litmap";
     for (const auto& d : f->draws) {
       EXPECT_LE(d.gl.samples_passed, d.gl.fragments) << "draw " << d.index;
       if (d.role != trace::DrawRole::ShadowVolume) continue;

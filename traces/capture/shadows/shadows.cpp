@@ -18,7 +18,6 @@
 
 #include "model/common/error.h"
 #include "model/nbuffer/covering.h"
-#include "model/nbuffer/nbuffer.h"
 #include "model/scene/visibility.h"
 #include "nbsim_shaders.h"
 #include "traces/capture/draw_recorder.h"
@@ -191,7 +190,8 @@ class Shadows final : public Technique {
   RenderTarget litmap_min_, litmap_max_;    // DEPTH_COMPONENT32F
   DrawRecorder recorder_;
   GlslNBuffer nb_min_, nb_max_;
-  GLuint litmap_prog_ = 0, volume_prog_ = 0;
+  GLuint litmap_prog_ = 0, splat_prog_ = 0, volume_prog_ = 0;
+  GLuint splat_vao_ = 0;  // no attributes: the splat's vertices come from gl_VertexID
   GLuint volume_vao_ = 0, volume_vbo_ = 0, reference_count_ = 0;
   std::size_t volume_capacity_ = 0;  // bytes
 };
@@ -228,6 +228,10 @@ Shadows::Shadows(const TechniqueSetup& s)
   litmap_prog_ = link_program({compile_shader(GL_VERTEX_SHADER, shaders::shadows_litmap_vert, "shadows/litmap.vert"),
                                compile_shader(GL_FRAGMENT_SHADER, shaders::shadows_litmap_frag, "shadows/litmap.frag")},
                               "litmap");
+  splat_prog_ = link_program({compile_shader(GL_VERTEX_SHADER, shaders::shadows_splat_vert, "shadows/splat.vert"),
+                              compile_shader(GL_FRAGMENT_SHADER, shaders::shadows_splat_frag, "shadows/splat.frag")},
+                             "receiver_splat");
+  glCreateVertexArrays(1, &splat_vao_);
   volume_prog_ = link_program({compile_shader(GL_VERTEX_SHADER, shaders::shadows_volume_vert, "shadows/volume.vert"),
                                compile_shader(GL_FRAGMENT_SHADER, shaders::common_count_frag, "common/count.frag")},
                               "shadow_volume", true);
@@ -241,8 +245,10 @@ Shadows::Shadows(const TechniqueSetup& s)
 
 Shadows::~Shadows() {
   glDeleteProgram(litmap_prog_);
+  glDeleteProgram(splat_prog_);
   glDeleteProgram(volume_prog_);
   glDeleteVertexArrays(1, &volume_vao_);
+  glDeleteVertexArrays(1, &splat_vao_);
   const GLuint buffers[] = {volume_vbo_, reference_count_};
   glDeleteBuffers(2, buffers);
 }
@@ -450,6 +456,15 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   glUniform1f(glGetUniformLocation(litmap_prog_, "tolerance_m"), kReprojectM);
   glUniform1i(glGetUniformLocation(litmap_prog_, "observer_depth"), 1);
   const GLint u_slot = glGetUniformLocation(litmap_prog_, "draw_slot");
+  glUseProgram(splat_prog_);
+  const glm::dmat4 unproject = glm::inverse(to_dmat(view_proj));
+  const glm::dmat4 light_clip = light.proj * light.view;
+  glUniformMatrix4dv(glGetUniformLocation(splat_prog_, "unproject"), 1, GL_FALSE, glm::value_ptr(unproject));
+  glUniformMatrix4dv(glGetUniformLocation(splat_prog_, "light_view_proj"), 1, GL_FALSE, glm::value_ptr(light_clip));
+  glUniform2i(glGetUniformLocation(splat_prog_, "size"), width_, height_);
+  glUniform1i(glGetUniformLocation(splat_prog_, "observer_depth"), 1);
+  const GLint u_splat_slot = glGetUniformLocation(splat_prog_, "draw_slot");
+  glUseProgram(litmap_prog_);
   glBindTextureUnit(1, target_.depth_texture());
   glBindVertexArray(pass_.scene_vertex_array());
   recorder_.bind();
@@ -477,6 +492,22 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
                      reinterpret_cast<const void*>(static_cast<std::uintptr_t>(m.first_index) * 4));
       recorder_.end_draw();
     }
+    // The receiver splat (shaders/shadows/splat.vert): every observer pixel's surface point in the
+    // light's frustum as a one-pixel point, same depth func; back to the litmap program after.
+    glUseProgram(splat_prog_);
+    DrawRecord d;
+    d.role = DrawRole::ReceiverSplat;
+    d.state = depth_state(false, true, true);
+    d.state.func = max ? scene::DepthFunc::Gequal : scene::DepthFunc::Lequal;
+    d.state.cull = scene::CullFace::None;
+    d.topology = scene::Topology::Points;
+    const std::size_t slot = recorder_.begin_draw(std::move(d), 0);
+    glUniform1ui(u_splat_slot, static_cast<GLuint>(slot));
+    glBindVertexArray(splat_vao_);
+    glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(width_) * static_cast<GLsizei>(height_));
+    recorder_.end_draw();
+    glBindVertexArray(pass_.scene_vertex_array());
+    glUseProgram(litmap_prog_);
   }
 
   // 3. A min and a max N-buffer over them.
@@ -486,50 +517,15 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   nb_max_.build(litmap_max_.depth_texture(), recorder_, build_state);
   scene::NBufferLevels min_levels = nb_min_.read(), max_levels = nb_max_.read();
 
-  // The receivers the shadow mask samples: the surface point at each observer pixel's centre, at
-  // the depth the stencil test compares with (the observer's depth buffer, unprojected), when the
-  // point lies inside the light's frustum. The litmaps sample receivers at lexel centres only, so a
-  // receiver point the observer sees may have no lexel centre on its surface (a receiver smaller
-  // than a lexel, a face at a grazing angle to the light whose depth changes by metres within a
-  // lexel, a receiver hidden from the lexel centres' rays by an intermediate occluder but seen by
-  // the observer); a volume clamped short of that point's light depth loses its mask pixel. Every
-  // such point is scattered into the lexel it projects to (a min and a max image, rounded outward to
-  // f32) and two CPU N-buffers over them give the depth range of the mask's own receivers in each
-  // caster's rectangle (which covers its light-space footprint), merged into its slab below: a
-  // mask pixel whose receiver lies in the caster's footprint then lies between its clamp planes.
-  const glm::dmat4 unproject = glm::inverse(to_dmat(view_proj));
-  scene::DepthSnapshot depth = read_depth(target_.framebuffer(), width_, height_, scene::DepthWhich::Final);
-  std::vector<char> in_light_frustum(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), 0);
-  DepthImage seen_lo(litmap_, litmap_, neutral_depth(FarOp::Min)), seen_hi(litmap_, litmap_, neutral_depth(FarOp::Max));
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
-      const double d = depth.texels[i];
-      if (d >= 1.0) continue;
-      const glm::dvec4 w = unproject * glm::dvec4((x + 0.5) / width_ * 2.0 - 1.0, (y + 0.5) / height_ * 2.0 - 1.0, 2.0 * d - 1.0, 1.0);
-      const glm::dvec4 q = light.clip(glm::dvec3(w) / w.w);
-      if (!(q.w > 0.0 && std::abs(q.x) <= q.w && std::abs(q.y) <= q.w && std::abs(q.z) <= q.w)) continue;
-      in_light_frustum[i] = 1;
-      const int lx = std::clamp(static_cast<int>(std::floor((q.x / q.w * 0.5 + 0.5) * litmap_)), 0, litmap_ - 1);
-      const int ly = std::clamp(static_cast<int>(std::floor((q.y / q.w * 0.5 + 0.5) * litmap_)), 0, litmap_ - 1);
-      const double z = q.z / q.w * 0.5 + 0.5;
-      float& lo_z = seen_lo.at(lx, ly);
-      float& hi_z = seen_hi.at(lx, ly);
-      lo_z = std::min(lo_z, std::nextafter(static_cast<float>(z), 0.0f));
-      hi_z = std::max(hi_z, std::nextafter(static_cast<float>(z), 2.0f));
-    }
-  const NBuffer seen_min(seen_lo, NBufferConfig{FarOp::Min}), seen_max(seen_hi, NBufferConfig{FarOp::Max});
-
   // 4. Each caster's rectangle, eight lookups and decision; 5. the volumes of the mode.
   std::vector<CasterResult> results(casters_.size());
   std::vector<glm::vec4> positions;
   std::vector<std::pair<std::size_t, std::size_t>> ranges(casters_.size());  // first vertex, count
   for (std::size_t c = 0; c < casters_.size(); ++c) results[c] = measure(casters_[c], light, min_levels, max_levels);
-  // Each slab: the litmaps' [z_min, z_max] and the mask's receivers in the rectangle (above); a
-  // seen caster's own bounds join its own slab, and a seen caster crossing the light's near plane
-  // makes every slab [0, 1] (both older widenings, kept: they only loosen the slab). The mask's
-  // receivers replace the former widening by the seen casters' edge-on and sub-lexel faces, which
-  // sampled the same fault (receivers the lexel centres miss) only in part.
+  // Each slab: the litmaps' [z_min, z_max] (with the receiver splat, every receiver the mask samples
+  // in the rectangle lies inside it); a seen caster's own bounds join its own slab, and a seen
+  // caster crossing the light's near plane makes every slab [0, 1] (both older widenings, kept:
+  // they only loosen the slab).
   bool near_crossing_seen = false;
   for (std::size_t c = 0; c < casters_.size(); ++c)
     near_crossing_seen = near_crossing_seen || (seen[casters_[c].object] && results[c].decision == CasterDecision::CrossesNear);
@@ -537,9 +533,6 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
     CasterResult& r = results[c];
     if (r.decision == CasterDecision::Volume) {
       double slab_min = r.z_min, slab_max = r.z_max;
-      const Rect rect{r.x, r.y, r.w, r.h};
-      slab_min = std::min(slab_min, static_cast<double>(seen_min.query(rect).value));
-      slab_max = std::max(slab_max, static_cast<double>(seen_max.query(rect).value));
       if (seen[casters_[c].object]) slab_min = std::min(slab_min, static_cast<double>(r.caster_near)), slab_max = std::max(slab_max, static_cast<double>(r.caster_far));
       if (near_crossing_seen) slab_min = 0.0, slab_max = 1.0;
       decide(r, light, slab_min, slab_max);
@@ -614,6 +607,7 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   glEnable(GL_CULL_FACE);
 
   // The records.
+  scene::DepthSnapshot depth = read_depth(target_.framebuffer(), width_, height_, scene::DepthWhich::Final);
   for (const bool max : {false, true}) {
     scene::DepthSnapshot lm = read_depth((max ? litmap_max_ : litmap_min_).framebuffer(), litmap_, litmap_, scene::DepthWhich::Final);
     lm.name = max ? "litmap_max" : "litmap_min";
@@ -627,7 +621,11 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
-      const bool lit = in_light_frustum[i] != 0;
+      const double d = depth.texels[i];
+      if (d >= 1.0) continue;
+      const glm::dvec4 w = unproject * glm::dvec4((x + 0.5) / width_ * 2.0 - 1.0, (y + 0.5) / height_ * 2.0 - 1.0, 2.0 * d - 1.0, 1.0);
+      const glm::dvec4 q = light.clip(glm::dvec3(w) / w.w);
+      const bool lit = q.w > 0.0 && std::abs(q.x) <= q.w && std::abs(q.y) <= q.w && std::abs(q.z) <= q.w;
       region.texels[i] = lit;
       mask.texels[i] = lit && stencil[i] != 0;
       ref_mask.texels[i] = lit && reference[i] != 0;
