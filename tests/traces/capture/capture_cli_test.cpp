@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "tests/common/refused.h"
 #include "tests/common/run_nbsim.h"
 #include "traces/format/reader.h"
 
@@ -105,23 +106,15 @@ TEST(CaptureCliTest, HelpListsTheTables) {
 // known names, before any file is written.
 TEST(CaptureCliTest, BadInputExitsTwo) {
   const fs::path out = testing::scratch_path("nbsim_capture_cli_bad", "never.nbt");
-  const std::string o = " -o " + out.string();
-  struct Case {
-    const char* args;
-    const char* message;
-  };
-  for (const Case& c : {Case{"capture raytracing --frames 1", "occlusion_culling"},
-                        Case{"capture occlusion_culling --scene forest --frames 1", "known scenes are city"},
-                        Case{"capture occlusion_culling --path orbit --frames 1", "known camera paths are walk, fly"},
-                        Case{"capture occlusion_culling --mode zbuffer --frames 1", "oq, oq_hier, nb, nb_hier, none"},
-                        Case{"capture city --objects 1 --frames 1", "--objects 1 is out of range"},
-                        Case{"capture occlusion_culling --levels-every often --frames 1", "--levels-every 'often' is not an integer"},
-                        Case{"capture occlusion_culling --size 0x5 --frames 1", "--size"}}) {
-    const CliResult r = run_nbsim(std::string(c.args) + o);
-    EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
-    EXPECT_TRUE(has(r.err, c.message)) << c.args << ": " << r.err;
-    EXPECT_FALSE(fs::exists(out)) << c.args << " wrote a file";
-  }
+  testing::expect_refused("",
+                          {{"capture raytracing --frames 1", "occlusion_culling"},
+                           {"capture occlusion_culling --scene forest --frames 1", "known scenes are city"},
+                           {"capture occlusion_culling --path orbit --frames 1", "known camera paths are walk, fly"},
+                           {"capture occlusion_culling --mode zbuffer --frames 1", "oq, oq_hier, nb, nb_hier, none"},
+                           {"capture city --objects 1 --frames 1", "--objects 1 is out of range"},
+                           {"capture occlusion_culling --levels-every often --frames 1", "--levels-every 'often' is not an integer"},
+                           {"capture occlusion_culling --size 0x5 --frames 1", "--size"}},
+                          " -o " + out.string(), out);
   fs::remove_all(out.parent_path());
 }
 
