@@ -24,6 +24,7 @@
 #include <variant>
 #include <vector>
 
+#include "tests/common/light_text.h"
 #include "tests/common/run_nbsim.h"
 #include "tests/common/technique_record.h"
 #include "traces/capture/capture.h"
@@ -38,15 +39,6 @@ namespace fs = std::filesystem;
 using trace::CasterDecision;
 
 fs::path scratch(const std::string& name) { return nbsim::testing::scratch_path("nbsim_shadows_hard", name); }
-
-std::string fmt_light(const glm::vec3& eye, const glm::vec3& target) {
-  std::string out;
-  for (float v : {eye.x, eye.y, eye.z, target.x, target.y, target.z}) {
-    if (!out.empty()) out += ',';
-    out += std::to_string(v);
-  }
-  return out;
-}
 
 glm::vec3 lo_of(const scene::Aabb& b) { return {b.lo[0], b.lo[1], b.lo[2]}; }
 glm::vec3 hi_of(const scene::Aabb& b) { return {b.hi[0], b.hi[1], b.hi[2]}; }
@@ -172,7 +164,7 @@ TEST(ShadowsHardCasesTest, ReceiversSmallerThanALexel) {
   const CaptureScene scene = find_scene("boxes").make(c.options);
   const float e = static_cast<float>(scene.site.extent_m);
   const glm::vec3 centre{0.5f * e, 0.0f, 0.5f * e};
-  c.options.set("light", fmt_light(centre + glm::vec3(-0.8f * e, 1.4f * e, 0.1f * e), centre));
+  c.options.set("light", nbsim::testing::light_text(centre + glm::vec3(-0.8f * e, 1.4f * e, 0.1f * e), centre));
   c.poses = {{centre + glm::vec3(0.0f, 0.5f * e, -0.45f * e), centre}, {centre + glm::vec3(0.3f * e, 0.35f * e, -0.4f * e), centre}};
   const auto runs = run_case(c, "small_receivers");
   // The boxes' light-space footprints, from the recorded light camera.
@@ -209,7 +201,7 @@ TEST(ShadowsHardCasesTest, ReceiversAtGrazingAngles) {
   const CaptureScene scene = find_scene("boxes").make(c.options);
   const float e = static_cast<float>(scene.site.extent_m);
   const glm::vec3 light{-150.0f, 2.0f, 0.5f * e}, target{0.5f * e, 0.0f, 0.5f * e};
-  c.options.set("light", fmt_light(light, target));
+  c.options.set("light", nbsim::testing::light_text(light, target));
   c.poses = {{{0.5f * e, 0.6f * e, 0.1f * e}, target}};
   const auto runs = run_case(c, "grazing");
   const float near_angle = std::atan2(light.y, 150.0f) * 57.29578f, far_angle = std::atan2(light.y, 150.0f + e) * 57.29578f;
@@ -238,7 +230,7 @@ TEST(ShadowsHardCasesTest, CasterCrossingTheLightsNearPlane) {
   const scene::Aabb& b = scene.scene.objects[1];
   const glm::vec3 lo = lo_of(b), hi = hi_of(b);
   const float cz = 0.5f * (lo.z + hi.z);
-  c.options.set("light", fmt_light({lo.x - 0.2f, hi.y + 0.2f, cz}, {hi.x + 20.0f, 0.0f, cz}));
+  c.options.set("light", nbsim::testing::light_text({lo.x - 0.2f, hi.y + 0.2f, cz}, {hi.x + 20.0f, 0.0f, cz}));
   c.poses = {{{hi.x + 12.0f, 8.0f, lo.z - 14.0f}, {hi.x + 5.0f, 0.0f, cz}}};
   const auto runs = run_case(c, "near_plane");
   for (const std::string mode : {"infinite", "culled", "clamped"}) {
@@ -270,7 +262,7 @@ TEST(ShadowsHardCasesTest, IntermediateOccluder) {
   const glm::vec3 lb = lo_of(scene.scene.objects[b]), hb = hi_of(scene.scene.objects[b]);
   const glm::vec3 pa = 0.5f * (la + ha), pb = 0.5f * (lb + hb);  // pa.y >= pb.y: the light is above the ground
   const glm::vec3 light = pa + (pa - pb) * (15.0f / glm::length(pa - pb));
-  c.options.set("light", fmt_light(light, pb));
+  c.options.set("light", nbsim::testing::light_text(light, pb));
   const glm::vec3 mid = 0.5f * (pa + pb), along = glm::normalize(pb - pa), side{-along.z, 0.0f, along.x};
   c.poses = {{mid + side * (glm::length(pb - pa) + 25.0f) + glm::vec3(0.0f, 12.0f, 0.0f), glm::vec3(mid.x, 0.0f, mid.z)}};
   const auto runs = run_case(c, "intermediate_occluder");
@@ -301,7 +293,7 @@ TEST(ShadowsHardCasesTest, ReprojectionAtDepthDiscontinuities) {
   const glm::vec3 lo = lo_of(b), hi = hi_of(b);
   const float cz = 0.5f * (lo.z + hi.z);
   // The light on the -x side, 45 degrees up: the shadow falls on +x, over the box's z extent.
-  c.options.set("light", fmt_light({lo.x - 40.0f, 40.0f + hi.y, cz}, {hi.x, 0.0f, cz}));
+  c.options.set("light", nbsim::testing::light_text({lo.x - 40.0f, 40.0f + hi.y, cz}, {hi.x, 0.0f, cz}));
   // The eye on the -x, -z side: the box's right silhouette is its (hi.x, lo.z) edge, the shadowed
   // ground right behind it.
   c.poses = {{{lo.x - 4.0f, 0.6f * hi.y, lo.z - 16.0f}, {hi.x + 2.0f, 0.0f, 0.5f * (lo.z + cz)}},

@@ -15,6 +15,7 @@
 #include <variant>
 
 #include "model/common/error.h"
+#include "tests/common/light_text.h"
 #include "tests/common/technique_record.h"
 #include "traces/capture/capture.h"
 #include "traces/capture/renderer.h"
@@ -155,16 +156,6 @@ TEST(ShadowsTest, EverySceneAndModeKeepsTheMask) {
   }
 }
 
-// "X,Y,Z,TX,TY,TZ" for --light.
-std::string fmt_light(float x, float y, float z, float tx, float ty, float tz) {
-  std::string out;
-  for (float v : {x, y, z, tx, ty, tz}) {
-    if (!out.empty()) out += ',';
-    out += std::to_string(v);
-  }
-  return out;
-}
-
 // One frame from a pose of our choice through the renderer; its counts by name.
 std::map<std::string, std::uint64_t> render_once(const std::string& scene_name, const OptionValues& options, const CameraPose& pose,
                                                  scene::Frame* frame = nullptr) {
@@ -192,7 +183,7 @@ TEST(ShadowsTest, GroundFacingTheLightKeepsItsShadow) {
   const float h = b.hi[1], bx = 0.5f * (b.lo[0] + b.hi[0]), bz = 0.5f * (b.lo[2] + b.hi[2]);
   // The light 50 m to the box's -x side, 6 h high, looking straight down: the shadow on the plane
   // runs from the box's +x face about 10 m on.
-  o.set("light", fmt_light(bx - 50.0f, 6.0f * h, bz, bx - 50.0f, 0.0f, bz));
+  o.set("light", nbsim::testing::light_text({bx - 50.0f, 6.0f * h, bz}, {bx - 50.0f, 0.0f, bz}));
   scene::Frame f;
   // The eye 3 m above the shadow's middle, looking down and away from the box.
   const auto counts = render_once("boxes", o, {{b.hi[0] + 5.0f, 3.0f, bz}, {b.hi[0] + 5.5f, 0.0f, bz}}, &f);
@@ -217,7 +208,7 @@ TEST(ShadowsTest, CameraInsideAShadowVolume) {
   const scene::Aabb& b = scene.scene.objects[1];
   const float cz = 0.5f * (b.lo[2] + b.hi[2]), height = b.hi[1];
   // The light 100 m to the -x side and 100 m up: the shadow falls on +x, 45 degrees down.
-  o.set("light", fmt_light(b.lo[0] - 100.0f, 100.0f, cz, b.hi[0], 0.0f, cz));
+  o.set("light", nbsim::testing::light_text({b.lo[0] - 100.0f, 100.0f, cz}, {b.hi[0], 0.0f, cz}));
   scene::Frame f;
   // The eye 0.5 m above the ground, 0.5 m past the box: its light ray crosses the box (1 m up at
   // the box's face, the box at least 2 m tall).
@@ -235,7 +226,7 @@ TEST(ShadowsTest, LightInsideACasterIsRefused) {
   OptionValues o{{"boxes", "3"}, {"seed", "7"}};
   const CaptureScene scene = find_scene("boxes").make(o);
   const scene::Aabb& b = scene.scene.objects[2];
-  o.set("light", fmt_light(0.5f * (b.lo[0] + b.hi[0]), 0.5f * (b.lo[1] + b.hi[1]), 0.5f * (b.lo[2] + b.hi[2]), 0, 0, 0));
+  o.set("light", nbsim::testing::light_text({0.5f * (b.lo[0] + b.hi[0]), 0.5f * (b.lo[1] + b.hi[1]), 0.5f * (b.lo[2] + b.hi[2])}, {0.0f, 0.0f, 0.0f}));
   RendererOptions ro;
   ro.technique = "shadows";
   ro.width = 32;
