@@ -26,6 +26,22 @@ std::string joined(const std::vector<std::string>& words) {
 
 }  // namespace
 
+OptionSpec integer_option(std::string name, std::string help, std::int64_t default_value, std::int64_t min, std::int64_t max) {
+  return OptionSpec{std::move(name), std::move(help), std::to_string(default_value), OptionSpec::Kind::Integer, min, max, {}};
+}
+
+OptionSpec choice_option(std::string name, std::string help, std::string default_value, std::vector<std::string> choices) {
+  return OptionSpec{std::move(name), std::move(help), std::move(default_value), OptionSpec::Kind::Choice, 0, 0, std::move(choices)};
+}
+
+OptionSpec text_option(std::string name, std::string help, std::string default_value) {
+  return OptionSpec{std::move(name), std::move(help), std::move(default_value), OptionSpec::Kind::Text, 0, 0, {}};
+}
+
+OptionSpec levels_every_spec(const std::string& what) {
+  return integer_option("levels-every", "Record " + what + " every K-th frame (0: never)", 10, 0, 1000000);
+}
+
 std::string option_problem(const OptionSpec& spec, const std::string& value) {
   switch (spec.kind) {
     case OptionSpec::Kind::Integer: {

@@ -25,6 +25,13 @@ struct OptionSpec {
   std::vector<std::string> choices;  // Choice: the allowed values
 };
 
+// The three kinds of spec, written the same way by every technique and scene.
+OptionSpec integer_option(std::string name, std::string help, std::int64_t default_value, std::int64_t min, std::int64_t max);
+OptionSpec choice_option(std::string name, std::string help, std::string default_value, std::vector<std::string> choices);
+OptionSpec text_option(std::string name, std::string help, std::string default_value);
+// --levels-every: record `what` (e.g. "the GLSL N-buffer levels") every K-th frame, 0 never; default 10.
+OptionSpec levels_every_spec(const std::string& what);
+
 // Why `value` is not a valid value of `spec` (a sentence naming the option), or empty when it is.
 std::string option_problem(const OptionSpec& spec, const std::string& value);
 

@@ -11,7 +11,7 @@ namespace nbsim::capture {
 
 namespace {
 
-const OptionSpec kObjects{"objects", "Objects in the city, ground included", "6000", OptionSpec::Kind::Integer, 2, 1000000, {}};
+const OptionSpec kObjects = integer_option("objects", "Objects in the city, ground included", 6000, 2, 1000000);
 
 CaptureScene make_city_scene(const OptionValues& options) {
   CityParams p;
@@ -31,9 +31,9 @@ CaptureScene make_city_scene(const OptionValues& options) {
   return s;
 }
 
-const OptionSpec kTowers{"towers", "Towers on the terrain", "40", OptionSpec::Kind::Integer, 0, 10000, {}};
-const OptionSpec kBirds{"birds", "Birds (small flying casters) over the terrain and around it", "2000", OptionSpec::Kind::Integer, 0, 200000, {}};
-const OptionSpec kBoxes{"boxes", "Boxes on the plane", "30", OptionSpec::Kind::Integer, 0, 10000, {}};
+const OptionSpec kTowers = integer_option("towers", "Towers on the terrain", 40, 0, 10000);
+const OptionSpec kBirds = integer_option("birds", "Birds (small flying casters) over the terrain and around it", 2000, 0, 200000);
+const OptionSpec kBoxes = integer_option("boxes", "Boxes on the plane", 30, 0, 10000);
 
 CaptureScene make_terrain_scene(const OptionValues& options) {
   TerrainParams p;

@@ -42,20 +42,15 @@ std::vector<std::string> test_mode_names() {
 }
 
 const OptionSpec& mode_option() {
-  static const OptionSpec spec{"mode",
-                               "Visibility test: oq, oq_hier (occlusion queries, flat or over the BVH), nb, nb_hier "
-                               "(GLSL N-buffer), none",
-                               "nb_hier",
-                               OptionSpec::Kind::Choice,
-                               0,
-                               0,
-                               test_mode_names()};
+  static const OptionSpec spec = choice_option("mode",
+                                                "Visibility test: oq, oq_hier (occlusion queries, flat or over the BVH), nb, nb_hier "
+                                                "(GLSL N-buffer), none",
+                                                "nb_hier", test_mode_names());
   return spec;
 }
 
 const OptionSpec& levels_every_option() {
-  static const OptionSpec spec{"levels-every", "Record the GLSL N-buffer levels every K-th frame (0: never)", "10",
-                               OptionSpec::Kind::Integer, 0, 1000000, {}};
+  static const OptionSpec spec = levels_every_spec("the GLSL N-buffer levels");
   return spec;
 }
 

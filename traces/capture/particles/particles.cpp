@@ -53,47 +53,35 @@ using particles::kModeNames;
 constexpr std::array<const char*, 4> kModeDefines = {"MODE_NONE", "MODE_CENTER", "MODE_NB", "MODE_HIZ"};
 
 const OptionSpec& particles_option() {
-  static const OptionSpec spec{"particles", "Particles a frame, shared out over the emitters", "10000", OptionSpec::Kind::Integer, 1,
-                               kMaxParticles, {}};
+  static const OptionSpec spec = integer_option("particles", "Particles a frame, shared out over the emitters", 10000, 1, kMaxParticles);
   return spec;
 }
 const OptionSpec& sprite_option() {
-  static const OptionSpec spec{"sprite",
-                               "Sprite side: 16 or 24 pixels, or atten (distance-attenuated, 1 to 64 pixels)",
-                               "16",
-                               OptionSpec::Kind::Choice,
-                               0,
-                               0,
-                               {"16", "24", "atten"}};
+  static const OptionSpec spec =
+      choice_option("sprite", "Sprite side: 16 or 24 pixels, or atten (distance-attenuated, 1 to 64 pixels)", "16", {"16", "24", "atten"});
   return spec;
 }
 const OptionSpec& mode_option() {
-  static const OptionSpec spec{"mode",
-                               "Vertex-stage culling: none, center (one depth lookup at the centre: pops), nb (the "
-                               "N-buffer: 1 to 4 lookups), hiz (a Hi-Z pyramid, 1 to 4 lookups)",
-                               "nb",
-                               OptionSpec::Kind::Choice,
-                               0,
-                               0,
-                               {kModeNames.begin(), kModeNames.end()}};
+  static const OptionSpec spec = choice_option("mode",
+                                                "Vertex-stage culling: none, center (one depth lookup at the centre: pops), nb (the "
+                                                "N-buffer: 1 to 4 lookups), hiz (a Hi-Z pyramid, 1 to 4 lookups)",
+                                                "nb", {kModeNames.begin(), kModeNames.end()});
   return spec;
 }
 const OptionSpec& level_cap_option() {
-  static const OptionSpec spec{"level-cap",
-                               "Highest N-buffer (or Hi-Z) level built; sprites that need a higher one are never culled",
-                               "5", OptionSpec::Kind::Integer, 0, 12, {}};
+  static const OptionSpec spec = integer_option(
+      "level-cap", "Highest N-buffer (or Hi-Z) level built; sprites that need a higher one are never culled", 5, 0, 12);
   return spec;
 }
 const OptionSpec& emitters_option() {
-  static const OptionSpec spec{"emitters",
-                               "auto (12 emitters around the site's centre) or ground positions X:Z,X:Z,... in metres, "
-                               "kinds in turn smoke, fire, sparks, birds; each must be inside the scene",
-                               "auto", OptionSpec::Kind::Text, 0, 0, {}};
+  static const OptionSpec spec = text_option("emitters",
+                                              "auto (12 emitters around the site's centre) or ground positions X:Z,X:Z,... in metres, "
+                                              "kinds in turn smoke, fire, sparks, birds; each must be inside the scene",
+                                              "auto");
   return spec;
 }
 const OptionSpec& levels_every_option() {
-  static const OptionSpec spec{"levels-every", "Record the GLSL N-buffer levels every K-th frame (0: never)", "10",
-                               OptionSpec::Kind::Integer, 0, 1000000, {}};
+  static const OptionSpec spec = levels_every_spec("the GLSL N-buffer levels");
   return spec;
 }
 

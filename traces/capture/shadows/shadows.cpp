@@ -52,35 +52,30 @@ constexpr double kClampRel = 0.01, kClampM = 0.1;
 constexpr double kLightHeight = 0.5;
 
 const OptionSpec& shadow_mode_option() {
-  static const OptionSpec spec{"shadow-mode",
-                               "Shadow volumes: infinite (every caster, to infinity), culled (casters with no visible "
-                               "receiver behind them dropped), clamped (culled, and each volume clamped between z_min and z_max)",
-                               "clamped",
-                               OptionSpec::Kind::Choice,
-                               0,
-                               0,
-                               {kModeNames.begin(), kModeNames.end()}};
+  static const OptionSpec spec =
+      choice_option("shadow-mode",
+                    "Shadow volumes: infinite (every caster, to infinity), culled (casters with no visible "
+                    "receiver behind them dropped), clamped (culled, and each volume clamped between z_min and z_max)",
+                    "clamped", {kModeNames.begin(), kModeNames.end()});
   return spec;
 }
 const OptionSpec& litmap_option() {
-  static const OptionSpec spec{"litmap", "Side of the square litmaps and their N-buffers, lexels", "512", OptionSpec::Kind::Integer, 16,
-                               4096, {}};
+  static const OptionSpec spec = integer_option("litmap", "Side of the square litmaps and their N-buffers, lexels", 512, 16, 4096);
   return spec;
 }
 const OptionSpec& light_option() {
-  static const OptionSpec spec{"light",
-                               "auto (a spot light above the scene circling its centre, from the seed) or a fixed light "
-                               "X,Y,Z,TX,TY,TZ: its position and the point it looks at, metres",
-                               "auto", OptionSpec::Kind::Text, 0, 0, {}};
+  static const OptionSpec spec = text_option("light",
+                                              "auto (a spot light above the scene circling its centre, from the seed) or a fixed light "
+                                              "X,Y,Z,TX,TY,TZ: its position and the point it looks at, metres",
+                                              "auto");
   return spec;
 }
 const OptionSpec& light_fov_option() {
-  static const OptionSpec spec{"light-fov", "The spot light's field of view, degrees", "60", OptionSpec::Kind::Integer, 1, 179, {}};
+  static const OptionSpec spec = integer_option("light-fov", "The spot light's field of view, degrees", 60, 1, 179);
   return spec;
 }
 const OptionSpec& levels_every_option() {
-  static const OptionSpec spec{"levels-every", "Record both N-buffers' levels every K-th frame (0: never)", "10",
-                               OptionSpec::Kind::Integer, 0, 1000000, {}};
+  static const OptionSpec spec = levels_every_spec("both N-buffers' levels");
   return spec;
 }
 
