@@ -9,6 +9,7 @@
 #include "model/common/depth.h"
 #include "model/raster/setup.h"
 #include "tests/model/raster/coverage.h"
+#include "tests/model/raster/compare_funcs.h"
 
 namespace nbsim::raster {
 namespace {
@@ -17,20 +18,10 @@ using namespace nbsim::raster::testing;
 
 // Each depth function against a stored 0.5 (and NaN-free equality), a table.
 TEST(DepthTestTest, DepthFunctions) {
-  struct Row {
-    DepthFunc f;
-    bool less, equal, greater;
-  };
-  const Row rows[] = {
-      {DepthFunc::Never, false, false, false},  {DepthFunc::Less, true, false, false},
-      {DepthFunc::Equal, false, true, false},   {DepthFunc::Lequal, true, true, false},
-      {DepthFunc::Greater, false, false, true}, {DepthFunc::NotEqual, true, false, true},
-      {DepthFunc::Gequal, false, true, true},   {DepthFunc::Always, true, true, true},
-  };
-  for (const Row& r : rows) {
-    EXPECT_EQ(depth_passes(r.f, 0.25f, 0.5f), r.less) << "func " << static_cast<int>(r.f) << ", fragment nearer";
+  for (const CompareRow& r : kCompareFuncs) {
+    EXPECT_EQ(depth_passes(r.f, 0.25f, 0.5f), r.below) << "func " << static_cast<int>(r.f) << ", fragment nearer";
     EXPECT_EQ(depth_passes(r.f, 0.5f, 0.5f), r.equal) << "func " << static_cast<int>(r.f) << ", equal depth";
-    EXPECT_EQ(depth_passes(r.f, 0.75f, 0.5f), r.greater) << "func " << static_cast<int>(r.f) << ", fragment farther";
+    EXPECT_EQ(depth_passes(r.f, 0.75f, 0.5f), r.above) << "func " << static_cast<int>(r.f) << ", fragment farther";
   }
   EXPECT_TRUE(depth_passes(DepthFunc::NotEqual, NAN, 0.5f)) << "NOTEQUAL is unordered";
   EXPECT_FALSE(depth_passes(DepthFunc::Less, NAN, 0.5f)) << "LESS is ordered";

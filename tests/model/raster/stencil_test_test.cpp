@@ -13,6 +13,7 @@
 
 #include "model/common/error.h"
 #include "model/raster/raster_path.h"
+#include "tests/model/raster/compare_funcs.h"
 
 namespace nbsim::raster {
 namespace {
@@ -21,20 +22,10 @@ using geometry::ClipPosition;
 
 // Every func with ref < stored, ref == stored and ref > stored (GL: "LESS passes if ref < stored").
 TEST(StencilTestTest, EveryFunc) {
-  struct Row {
-    DepthFunc f;
-    bool ref_below, equal, ref_above;
-  };
-  const Row rows[] = {
-      {DepthFunc::Never, false, false, false},  {DepthFunc::Less, true, false, false},
-      {DepthFunc::Equal, false, true, false},   {DepthFunc::Lequal, true, true, false},
-      {DepthFunc::Greater, false, false, true}, {DepthFunc::NotEqual, true, false, true},
-      {DepthFunc::Gequal, false, true, true},   {DepthFunc::Always, true, true, true},
-  };
-  for (const Row& r : rows) {
-    EXPECT_EQ(stencil_passes(r.f, 3, 7, 0xFF), r.ref_below) << "func " << static_cast<int>(r.f) << ", ref 3 stored 7";
+  for (const testing::CompareRow& r : testing::kCompareFuncs) {
+    EXPECT_EQ(stencil_passes(r.f, 3, 7, 0xFF), r.below) << "func " << static_cast<int>(r.f) << ", ref 3 stored 7";
     EXPECT_EQ(stencil_passes(r.f, 7, 7, 0xFF), r.equal) << "func " << static_cast<int>(r.f) << ", ref 7 stored 7";
-    EXPECT_EQ(stencil_passes(r.f, 200, 7, 0xFF), r.ref_above) << "func " << static_cast<int>(r.f) << ", ref 200 stored 7";
+    EXPECT_EQ(stencil_passes(r.f, 200, 7, 0xFF), r.above) << "func " << static_cast<int>(r.f) << ", ref 200 stored 7";
   }
 }
 
