@@ -35,13 +35,18 @@ VptResult walk_layers(int layers, float z, Fetch fetch) {
 VptResult vpt_layers(const Ldi& ldi, int x, int y, float z) {
   check_depth(z);
   if (x < 0 || y < 0 || x >= ldi.width() || y >= ldi.height()) return {};
-  return walk_layers(ldi.layer_count(), z, [&](int k) { return ldi.depth(x, y, k); });
+  VptResult res = walk_layers(ldi.layer_count(), z, [&](int k) { return ldi.depth(x, y, k); });
+  res.texel = static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(ldi.width()) + static_cast<std::uint64_t>(x);
+  return res;
 }
 
 VptResult vpt_layers(const CroppedLdi& c, int x, int y, float z) {
   check_depth(z);
-  if (!c.crop.rect.contains(x, y)) return {};
-  return walk_layers(c.crop.depth_complexity, z, [&](int k) { return c.depth(x, y, k); });
+  const Rect& r = c.crop.rect;
+  if (!r.contains(x, y)) return {};
+  VptResult res = walk_layers(c.crop.depth_complexity, z, [&](int k) { return c.depth(x, y, k); });
+  res.texel = static_cast<std::uint64_t>(y - r.y) * static_cast<std::uint64_t>(r.w) + static_cast<std::uint64_t>(x - r.x);
+  return res;
 }
 
 VptResult vpt_ranges(const CompressedLdi& c, int x, int y, float z) {
@@ -54,7 +59,9 @@ VptResult vpt_ranges(const CompressedLdi& c, int x, int y, float z) {
     throw InputError(fmt::format("compressed LDI: index texel {} is outside the {}x{} texture", t, c.side, c.side));
   VptResult res;
   res.fetches = 1;
+  res.texel = t;
   const auto [offset, k] = c.texel(t);
+  res.first_range = offset;
   if (std::uint64_t{offset} + k > total)
     throw InputError(fmt::format("compressed LDI: index texel {} has ranges [{}, {}) past the {}x{} texture", t, offset,
                                  std::uint64_t{offset} + k, c.side, c.side));

@@ -29,6 +29,12 @@ struct VptResult {
   // A point whose texel is outside the texture (the crop, for the cropped and compressed readers)
   // is outside with 0 fetches: the shader compares it with the crop rectangle, a uniform.
   int fetches = 0;
+  // Where the fetches go (texel numbers of the texture read, for the memory client's addresses;
+  // meaningful when fetches > 0). Layered: fetch i reads texel + i * (texels per layer) (the crop's
+  // or the full LDI's), texel = cy * w + cx. Compressed: fetch 0 reads the index texel `texel`,
+  // fetch i >= 1 reads first_range + i - 1 (first_range = the index's offset).
+  std::uint64_t texel = 0;
+  std::uint32_t first_range = 0;
 };
 
 // Uncompressed, on the full LDI (x in [0, width), y in [0, height); up to layer_count() fetches).

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <limits>
 #include <utility>
@@ -82,7 +83,8 @@ TEST(LdiVptTest, TieRuleTable) {
 // On seeded random LDIs (ties, odd counts, empty texels, trailing layers), every texel in and one
 // ring around the crop and every test depth: the three readers give the brute-force parity, and
 // their fetches equal the closed forms: min(L, front + 1) layered (L = layers read: all stored for
-// the full LDI, d for the cropped), 1 + min(k, passed + 1) compressed, 0 outside the crop.
+// the full LDI, d for the cropped), 1 + min(k, passed + 1) compressed, 0 outside the crop; the
+// texels they read are the texel's own and its first range at I + the ranges before it.
 TEST(LdiVptTest, ReadersAgreeWithBruteForceExhaustively) {
   test_support::RandomLdi gen(7);
   const std::vector<float> depths = test_depths();
@@ -93,6 +95,11 @@ TEST(LdiVptTest, ReadersAgreeWithBruteForceExhaustively) {
     const CompressedLdi cc = compress(l);
     const nbsim::Rect& r = cl.crop.rect;
     const int d = cl.crop.depth_complexity;
+    // Each cropped texel's first range texel, counted independently: I + the ranges before it.
+    std::vector<std::uint32_t> first_range;
+    std::uint32_t next = static_cast<std::uint32_t>(r.area());
+    for (int y = r.y; y < r.y1(); ++y)
+      for (int x = r.x; x < r.x1(); ++x) first_range.push_back(next), next += static_cast<std::uint32_t>(l.count(x, y) + 1) / 2;
     for (int y = std::min(r.y, 0) - 1; y <= std::max(r.y1(), l.height()); ++y)
       for (int x = std::min(r.x, 0) - 1; x <= std::max(r.x1(), l.width()); ++x)
         for (float z : depths) {
@@ -109,6 +116,15 @@ TEST(LdiVptTest, ReadersAgreeWithBruteForceExhaustively) {
           const int k = in_crop ? (l.count(x, y) + 1) / 2 : 0;
           ASSERT_EQ(comp.fetches, in_crop ? 1 + std::min(k, ranges_passed(l, x, y, z) + 1) : 0)
               << "LDI " << i << " texel (" << x << ", " << y << ") z " << z << ": compressed fetches";
+          if (in_ldi) {
+            ASSERT_EQ(full.texel, static_cast<std::uint64_t>(y * l.width() + x)) << "full reader's texel";
+          }
+          if (in_crop) {
+            const auto ct = static_cast<std::size_t>((y - r.y) * r.w + (x - r.x));
+            ASSERT_EQ(cropped.texel, ct) << "cropped reader's texel";
+            ASSERT_EQ(comp.texel, ct) << "compressed reader's index texel";
+            ASSERT_EQ(comp.first_range, first_range[ct]) << "compressed reader's first range texel";
+          }
           ++points;
           if (in_ldi)
             for (int j = 0; j < l.count(x, y); ++j) ties += l.depth(x, y, j) == z ? 1 : 0;
