@@ -46,7 +46,8 @@ struct NestedParams {
 TriMesh make_nested_shells(const NestedParams& p = {});
 
 // A helical tube spring around the z axis with `turns` turns, closed by flat caps at both ends.
-// Seen along its axis, a line through the coil's rim crosses the tube twice per turn (d = 2 turns);
+// Seen along its axis, a line through the coil's rim crosses the tube twice per turn (d = 2 turns, up
+// to 2 turns + 2 where a line also meets an end cap);
 // the pitch keeps successive turns apart (pitch > 2 tube radius, tested).
 struct CoilParams {
   int turns = 4;               // >= 1
