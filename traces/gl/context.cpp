@@ -13,7 +13,27 @@
 #include <dlfcn.h>
 #include <link.h>
 
+#include <sanitizer/asan_interface.h>
+
 #include <cstring>
+
+// Sanitizer builds only, in every program that opens a GL context: LeakSanitizer must not take the
+// main thread's dynamic TLS blocks from its `__tls_get_addr` interceptor. Mesa's llvmpipe pulls in
+// libLLVM-15 with dlopen, so its thread_locals live in a dynamic TLS block that glibc (>= 2.25)
+// allocates with malloc, i.e. with ASan's allocator. GCC 12's runtime still guesses that block's
+// bounds with a glibc 2.19 heuristic: a block that starts 16 bytes into a page is taken to follow a
+// {size, start} header, so when ASan's heap happens to put it there the 16 bytes of ASan's own chunk
+// header before it become the bounds, and the exit-time leak scan reads them as an address range and
+// crashes ("Tracer caught signal 11", "DTLS 10 at 0x...207b-0x...317d" with
+// LSAN_OPTIONS=verbosity=1:log_threads=1). Whether it happens depends only on the heap layout (the
+// particles capture with --level-cap 3 hit it every time, and only at some output paths).
+// google/sanitizers#1322; LLVM fixed it in 2023 (the allocator is asked for the block's bounds), GCC 12
+// does not have the fix. With the interceptor off, the blocks are ordinary heap chunks that
+// LeakSanitizer reaches through glibc's DTV, so what they point to still counts as reachable and
+// leaks are still reported. The ASAN_OPTIONS environment variable is read after this.
+extern "C" __attribute__((visibility("default"), used)) const char* __asan_default_options() {
+  return "intercept_tls_get_addr=0";
+}
 #endif
 
 namespace nbsim::gl {

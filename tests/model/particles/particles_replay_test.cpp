@@ -3,8 +3,6 @@
 // GL's, the model's vertex-stage decisions equal GL's, no popping and no false cull for nb and hiz,
 // popping for center, and nb's depth tests far below none's. A damaged PRTC record is refused.
 #include <gtest/gtest.h>
-
-#include <cstdlib>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -68,12 +66,6 @@ class ParticlesReplayTest : public ::testing::TestWithParam<Variant> {};
 // Each mode and sprite: exact draws, GL's decisions, the mode's correctness.
 TEST_P(ParticlesReplayTest, ReplaysExactlyAndDecidesAsGl) {
   const Variant& v = GetParam();
-  // Under the sanitizers (scripts/sanitize sets NBSIM_SANITIZED) LeakSanitizer's own exit-time
-  // tracer crashes ("Tracer caught signal 11") at the end of this one capture, every time since
-  // 2026-12-02, while the Release build passes it: LSan's fault, not a finding, still to be
-  // understood (README "Sanitizers"). The other variants run under the sanitizers.
-  if (std::getenv("NBSIM_SANITIZED") != nullptr && std::string(v.name) == "nb16_cap3")
-    GTEST_SKIP() << "LeakSanitizer's tracer crashes at this capture's exit (see the comment)";
   const fs::path t = capture(std::string(v.name) + ".nbt", v.args);
   expect_compare_exact(t);
   const auto run = replay(t);
