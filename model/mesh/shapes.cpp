@@ -140,6 +140,17 @@ TriMesh make_nested_shells(const NestedParams& p) {
   return m;
 }
 
+TriMesh make_box(float lo, float hi) {
+  TriMesh m;
+  for (int i = 0; i < 8; ++i) m.vertices.push_back({i & 1 ? hi : lo, i & 2 ? hi : lo, i & 4 ? hi : lo});
+  constexpr std::uint32_t kFaces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& f : kFaces) {
+    m.triangles.push_back({f[0], f[1], f[2]});
+    m.triangles.push_back({f[0], f[2], f[3]});
+  }
+  return m;
+}
+
 TriMesh make_coil(const CoilParams& p) {
   require(p.turns >= 1 && p.samples_per_turn >= 3 && p.tube_sides >= 3,
           "a coil needs turns >= 1, samples_per_turn >= 3 and tube_sides >= 3");

@@ -57,6 +57,11 @@ struct CoilParams {
 };
 TriMesh make_coil(const CoilParams& p = {});
 
+// An axis-aligned cube [lo, hi]^3: 8 shared corners (bit 0 = x, bit 1 = y, bit 2 = z), 12
+// triangles counter-clockwise seen from outside. The unit cube itself (the default) is the shape
+// that touches every face of the LDI's cube, and its edges fall on texel centres: the tie cases.
+TriMesh make_box(float lo = 0.0f, float hi = 1.0f);
+
 // The shape table (a capture's `--shape NAME [--shape-param N]`): one row per shape. `parameter`
 // names its one integer parameter ("" when it has none), with its default and limits.
 struct ShapeEntry {

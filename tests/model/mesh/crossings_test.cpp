@@ -17,16 +17,6 @@ namespace {
 
 using LD = long double;
 
-TriMesh box(float lo = 0.0f, float hi = 1.0f) {
-  TriMesh m;
-  for (int i = 0; i < 8; ++i) m.vertices.push_back({i & 1 ? hi : lo, i & 2 ? hi : lo, i & 4 ? hi : lo});
-  const std::uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-  for (const auto& f : faces) {
-    m.triangles.push_back({f[0], f[1], f[2]});
-    m.triangles.push_back({f[0], f[2], f[3]});
-  }
-  return m;
-}
 
 // The brute force: every triangle against the line o + s d in 3D, long double, Pluecker signs
 // (no projection, no grid, no snapping). Valid for lines in general position (no ties).
@@ -92,7 +82,7 @@ void compare_random_lines(const TriMesh& m, int directions, int lines_per_direct
 }
 
 // A unit cube from 200 random directions x 20 lines.
-TEST(CrossingsTest, CubeMatchesBruteForce) { compare_random_lines(box(), 200, 20, 1); }
+TEST(CrossingsTest, CubeMatchesBruteForce) { compare_random_lines(make_box(), 200, 20, 1); }
 
 // The paper's sphere, in the unit cube, from 100 random directions x 20 lines.
 TEST(CrossingsTest, SphereMatchesBruteForce) {
@@ -104,7 +94,7 @@ TEST(CrossingsTest, SphereMatchesBruteForce) {
 // Lines exactly through the front and back faces' shared diagonal, and along a row of points on it
 // and on the square's edges: each crossing counted once.
 TEST(CrossingsTest, SharedDiagonalCountsOnce) {
-  const CrossingReference ref(box(), OrthoFrame::look_along({0.0, 0.0, -1.0}));
+  const CrossingReference ref(make_box(), OrthoFrame::look_along({0.0, 0.0, -1.0}));
   for (int i = 1; i < 16; ++i) {
     const double s = i / 16.0;
     const CrossingCount c = ref.count({s, s, 0.5});
@@ -142,7 +132,7 @@ TEST(CrossingsTest, SharedHorizontalAndVerticalEdgesCountOnce) {
 // moved by (+e, -e^2): the left (x = 0) and top (y = 1) sides count 2, the right and bottom 0,
 // never 1; the side faces, edge-on, count nothing.
 TEST(CrossingsTest, SilhouetteFollowsTheTieRule) {
-  const CrossingReference ref(box(), OrthoFrame::look_along({0.0, 0.0, -1.0}));
+  const CrossingReference ref(make_box(), OrthoFrame::look_along({0.0, 0.0, -1.0}));
   struct Case {
     double x, y;
     std::uint32_t total;
@@ -166,7 +156,7 @@ TEST(CrossingsTest, SilhouetteFollowsTheTieRule) {
 // (0,0,0) by six back ones, projected onto one point: the line through both crosses twice; lines
 // through the front's shared edges (from that corner to the silhouette) too.
 TEST(CrossingsTest, SharedVertexCountsOnce) {
-  const CrossingReference ref(box(), OrthoFrame::look_along({-1.0, -1.0, -1.0}));
+  const CrossingReference ref(make_box(), OrthoFrame::look_along({-1.0, -1.0, -1.0}));
   const CrossingCount c = ref.count({0.5, 0.5, 0.5});
   EXPECT_EQ(c.in_front, 1u) << "the front corner, once";
   EXPECT_EQ(c.beyond, 1u) << "the back corner, once";
@@ -246,7 +236,7 @@ TEST(CrossingsTest, EdgeOnAndSingleTriangleTies) {
 // Depth bookkeeping: a point on the surface is at_point with distance 0; otherwise the nearest
 // crossing's distance; lines missing the mesh, and far away, cross nothing.
 TEST(CrossingsTest, DepthsAndNearestDistance) {
-  const CrossingReference ref(box(), OrthoFrame::look_along({0.0, 0.0, -1.0}));
+  const CrossingReference ref(make_box(), OrthoFrame::look_along({0.0, 0.0, -1.0}));
   const CrossingCount on = ref.count({0.3, 0.4, 1.0});
   EXPECT_EQ(on.at_point, 1u);
   EXPECT_EQ(on.beyond, 1u);
@@ -268,12 +258,12 @@ TEST(CrossingsTest, BadInputIsRefused) {
   EXPECT_THROW(OrthoFrame::look_along({NAN, 0.0, 1.0}), InputError);
   EXPECT_THROW(OrthoFrame::look_along({0.0, 2.0, 0.0}), InputError) << "parallel to the default up hint";
   const OrthoFrame f = OrthoFrame::look_along({0.0, 0.0, -1.0});
-  const CrossingReference ref(box(), f);
+  const CrossingReference ref(make_box(), f);
   EXPECT_THROW(ref.count({NAN, 0.0, 0.0}), InputError);
-  TriMesh bad = box();
+  TriMesh bad = make_box();
   bad.triangles[0][0] = 42;
   EXPECT_THROW(CrossingReference(bad, f), InputError);
-  bad = box();
+  bad = make_box();
   bad.vertices[0][0] = INFINITY;
   EXPECT_THROW(CrossingReference(bad, f), InputError);
 }

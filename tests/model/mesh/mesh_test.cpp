@@ -7,21 +7,11 @@
 
 #include "model/common/error.h"
 #include "model/mesh/mesh.h"
+#include "model/mesh/shapes.h"
 
 namespace nbsim::mesh {
 namespace {
 
-// A closed box [lo, hi]^3: 8 shared corners (bit 0 = x, 1 = y, 2 = z), 12 triangles CCW outward.
-TriMesh box(float lo = 0.0f, float hi = 1.0f) {
-  TriMesh m;
-  for (int i = 0; i < 8; ++i) m.vertices.push_back({i & 1 ? hi : lo, i & 2 ? hi : lo, i & 4 ? hi : lo});
-  const std::uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-  for (const auto& f : faces) {
-    m.triangles.push_back({f[0], f[1], f[2]});
-    m.triangles.push_back({f[0], f[2], f[3]});
-  }
-  return m;
-}
 
 // The same box with every triangle on its own three vertices (an STL-like soup).
 TriMesh soup(const TriMesh& m) {
@@ -38,18 +28,18 @@ bool mentions(const std::string& text, const std::string& part) { return text.fi
 
 // A closed, outward box passes, with 18 edges, and its volume is positive.
 TEST(MeshTest, ClosedBoxPasses) {
-  const MeshReport r = check_mesh(box());
+  const MeshReport r = check_mesh(make_box());
   EXPECT_TRUE(r.closed()) << r.first_problem;
   EXPECT_TRUE(r.ok());
   EXPECT_EQ(r.edge_count, 18u);
   EXPECT_EQ(r.welded_vertex_count, 8u);
   EXPECT_EQ(r.first_problem, "");
-  EXPECT_DOUBLE_EQ(signed_volume(box()), 1.0) << "outward orientation gives a positive volume";
+  EXPECT_DOUBLE_EQ(signed_volume(make_box()), 1.0) << "outward orientation gives a positive volume";
 }
 
 // Duplicated vertices at one position are welded first: a triangle soup of the box is closed.
 TEST(MeshTest, SoupIsWeldedByPosition) {
-  const MeshReport r = check_mesh(soup(box()));
+  const MeshReport r = check_mesh(soup(make_box()));
   EXPECT_EQ(r.vertex_count, 36u);
   EXPECT_EQ(r.welded_vertex_count, 8u);
   EXPECT_TRUE(r.ok()) << r.first_problem;
@@ -57,7 +47,7 @@ TEST(MeshTest, SoupIsWeldedByPosition) {
 
 // -0.0 and +0.0 are one position.
 TEST(MeshTest, NegativeZeroWeldsWithZero) {
-  TriMesh m = soup(box());
+  TriMesh m = soup(make_box());
   for (Vec3f& v : m.vertices)
     for (float& c : v)
       if (c == 0.0f && (&v - m.vertices.data()) % 2 == 0) c = -0.0f;
@@ -66,7 +56,7 @@ TEST(MeshTest, NegativeZeroWeldsWithZero) {
 
 // A missing triangle is a hole: its three edges are boundary edges, named in the message.
 TEST(MeshTest, HoleIsReportedWithItsBoundary) {
-  TriMesh m = box();
+  TriMesh m = make_box();
   m.triangles.erase(m.triangles.begin() + 4);
   const MeshReport r = check_mesh(m);
   EXPECT_FALSE(r.closed());
@@ -83,7 +73,7 @@ TEST(MeshTest, HoleIsReportedWithItsBoundary) {
 
 // A flipped triangle leaves every edge used twice, but three of them in the same direction.
 TEST(MeshTest, FlippedTriangleIsInconsistent) {
-  TriMesh m = box();
+  TriMesh m = make_box();
   std::swap(m.triangles[7][1], m.triangles[7][2]);
   const MeshReport r = check_mesh(m);
   EXPECT_EQ(r.boundary_edges, 0u);
@@ -95,7 +85,7 @@ TEST(MeshTest, FlippedTriangleIsInconsistent) {
 
 // A triangle repeated (a duplicate face) makes its edges non-manifold.
 TEST(MeshTest, DuplicateFaceIsNonManifold) {
-  TriMesh m = box();
+  TriMesh m = make_box();
   m.triangles.push_back(m.triangles[0]);
   const MeshReport r = check_mesh(m);
   EXPECT_EQ(r.non_manifold_edges, 3u);
@@ -105,8 +95,8 @@ TEST(MeshTest, DuplicateFaceIsNonManifold) {
 
 // Two closed boxes sharing nothing are closed together.
 TEST(MeshTest, TwoComponentsAreClosed) {
-  TriMesh m = box(0.0f, 1.0f);
-  const TriMesh b = box(2.0f, 3.0f);
+  TriMesh m = make_box(0.0f, 1.0f);
+  const TriMesh b = make_box(2.0f, 3.0f);
   for (const Tri& t : b.triangles) m.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
   m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
   EXPECT_TRUE(check_mesh(m).ok());
@@ -119,16 +109,16 @@ TEST(MeshTest, BadInputIsNamed) {
     const char* expected;
     const char* why;
   };
-  TriMesh out_of_range = box();
+  TriMesh out_of_range = make_box();
   out_of_range.triangles[3][2] = 99;
-  TriMesh nan = box();
+  TriMesh nan = make_box();
   nan.vertices[5][1] = std::numeric_limits<float>::quiet_NaN();
-  TriMesh repeated = box();
+  TriMesh repeated = make_box();
   repeated.triangles[2] = {1, 1, 3};
-  TriMesh collinear = box();
+  TriMesh collinear = make_box();
   collinear.vertices.push_back({0.5f, 0.0f, 0.0f});
   collinear.triangles.push_back({0, 8, 1});
-  TriMesh welded_repeat = box();  // triangle 2 is {1, 3, 7}: its corner 1 replaced by a copy of corner 3
+  TriMesh welded_repeat = make_box();  // triangle 2 is {1, 3, 7}: its corner 1 replaced by a copy of corner 3
   welded_repeat.vertices.push_back(welded_repeat.vertices[3]);
   welded_repeat.triangles[2][0] = 8;
   const Case cases[] = {
@@ -179,7 +169,7 @@ TEST(MeshTest, NormalizeToUnitCube) {
 
 // Refused placements: bad margins, empty, a point, non-finite.
 TEST(MeshTest, NormalizeRefusesBadInput) {
-  TriMesh m = box();
+  TriMesh m = make_box();
   EXPECT_THROW(normalize_to_unit_cube(m, -0.1), InputError);
   EXPECT_THROW(normalize_to_unit_cube(m, 0.5), InputError);
   EXPECT_THROW(normalize_to_unit_cube(m, std::numeric_limits<double>::quiet_NaN()), InputError);
@@ -189,7 +179,7 @@ TEST(MeshTest, NormalizeRefusesBadInput) {
   point.vertices = {{1.0f, 1.0f, 1.0f}, {1.0f, 1.0f, 1.0f}, {1.0f, 1.0f, 1.0f}};
   point.triangles = {{0, 1, 2}};
   EXPECT_THROW(normalize_to_unit_cube(point, 0.0), InputError);
-  TriMesh inf = box();
+  TriMesh inf = make_box();
   inf.vertices[0][0] = std::numeric_limits<float>::infinity();
   EXPECT_THROW(normalize_to_unit_cube(inf, 0.0), InputError);
 }
