@@ -202,6 +202,59 @@ TEST_F(LdiPeelTest, BoxEdgesOnTexelCentresFollowTheTieRule) {
   EXPECT_EQ(c.depth_violations, 0u) << "layer depths within the float + vertex-snap bound";
 }
 
+// Coplanar faces (the hard case): two closed boxes stacked along z, touching at z = 0.5, seen
+// along -z. The reference lists 4 crossings on a line through both (the shared plane twice); the
+// strict peel collapses the two equal depths into one layer, so GL has 3 layers there: an odd count
+// on a closed solid, exactly one layer per distinct reference depth.
+TEST_F(LdiPeelTest, CoplanarFacesCollapseIntoOneLayer) {
+  mesh::TriMesh m = box(0.25f, 0.75f, 0.25f, 0.75f, 0.5f, 0.75f);
+  const mesh::TriMesh lower = box(0.25f, 0.75f, 0.25f, 0.75f, 0.25f, 0.5f);
+  const auto base = static_cast<std::uint32_t>(m.vertices.size());
+  m.vertices.insert(m.vertices.end(), lower.vertices.begin(), lower.vertices.end());
+  for (mesh::Tri t : lower.triangles) m.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  const mesh::OrthoFrame frame = mesh::OrthoFrame::look_along({0, 0, -1});
+  const PeelResult r = peel_ldi(m, frame, {.width_px = 32, .height_px = 32, .max_layers = 8});
+  const OrthoMapping map = OrthoMapping::fit_unit_cube(frame, 32, 32);
+  const mesh::CrossingReference ref(m, frame);
+  int odd = 0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) {
+      std::vector<double> t = ref.crossing_depths(map.texel_line_point(x, y));
+      t.erase(std::unique(t.begin(), t.end()), t.end());
+      ASSERT_EQ(static_cast<std::size_t>(r.ldi.count(x, y)), t.size())
+          << "texel (" << x << ", " << y << "): one layer per distinct crossing depth";
+      if (r.ldi.count(x, y) == 3) {
+        ++odd;
+        EXPECT_EQ(r.ldi.depth(x, y, 1), 0.5f) << "the shared plane is one layer at depth 0.5";
+      }
+    }
+  EXPECT_EQ(odd, 16 * 16) << "every texel of the stacked boxes has 3 layers (odd)";
+}
+
+// Per pass, GL's counters: the same draw rasterizes the same fragments each pass, one per crossing
+// of a texel-centre line (no culling, no equal depths on these shapes), so a pass's fragment count
+// equals the LDI's total layer count; samples passed cover at least the texels holding layer k, and
+// the last pass writes nothing.
+TEST_F(LdiPeelTest, PassCountersMatchTheLayers) {
+  for (const char* shape : {"sphere", "nested", "coil"}) {
+    const PeelResult r = peel_ldi(placed(shape), mesh::OrthoFrame::look_along({1, 2, -3}),
+                                  {.width_px = 64, .height_px = 48, .max_layers = 64});
+    ASSERT_EQ(r.passes.size(), static_cast<std::size_t>(r.ldi.layer_count()) + 1) << shape;
+    std::uint64_t total = 0;
+    std::vector<std::uint64_t> texels_with(static_cast<std::size_t>(r.ldi.layer_count()) + 1, 0);
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 64; ++x) {
+        total += static_cast<std::uint64_t>(r.ldi.count(x, y));
+        for (int k = 0; k < r.ldi.count(x, y); ++k) ++texels_with[static_cast<std::size_t>(k)];
+      }
+    for (std::size_t k = 0; k < r.passes.size(); ++k) {
+      EXPECT_EQ(r.passes[k].fragments, total) << shape << " pass " << k << ": one fragment per crossing";
+      EXPECT_GE(r.passes[k].samples_passed, texels_with[k]) << shape << " pass " << k << ": layer k's texels";
+    }
+    EXPECT_EQ(r.passes.back().samples_passed, 0u) << shape << ": the last pass ends the peel";
+  }
+}
+
 // A shape deeper than max_layers is refused, naming the limit.
 TEST_F(LdiPeelTest, TooManyLayersIsRefused) {
   try {
