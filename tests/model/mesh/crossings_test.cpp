@@ -129,7 +129,7 @@ TEST(CrossingsTest, SharedHorizontalAndVerticalEdgesCountOnce) {
 }
 
 // Lines on the box's silhouette (its edges and corners seen along z) follow the tie rule: as if
-// moved by (+e, -e^2): the left (x = 0) and top (y = 1) sides count 2, the right and bottom 0,
+// moved by (+e, +e^2): the left (x = 0) and bottom (y = 0) sides count 2, the right and top 0,
 // never 1; the side faces, edge-on, count nothing.
 TEST(CrossingsTest, SilhouetteFollowsTheTieRule) {
   const CrossingReference ref(make_box(), OrthoFrame::look_along({0.0, 0.0, -1.0}));
@@ -140,8 +140,8 @@ TEST(CrossingsTest, SilhouetteFollowsTheTieRule) {
   };
   const Case cases[] = {
       {0.0, 0.5, 2, "left side: moved right, inside"},   {1.0, 0.5, 0, "right side: moved right, outside"},
-      {0.5, 1.0, 2, "top side: moved down, inside"},     {0.5, 0.0, 0, "bottom side: moved down, outside"},
-      {0.0, 1.0, 2, "top-left corner: inside"},          {0.0, 0.0, 0, "bottom-left corner: outside"},
+      {0.5, 1.0, 0, "top side: moved up, outside"},      {0.5, 0.0, 2, "bottom side: moved up, inside"},
+      {0.0, 1.0, 0, "top-left corner: outside"},         {0.0, 0.0, 2, "bottom-left corner: inside"},
       {1.0, 1.0, 0, "top-right corner: outside"},        {1.0, 0.0, 0, "bottom-right corner: outside"},
       {0.5, 0.5, 2, "centre, on the diagonals"},         {0.25, 0.5, 2, "interior"},
   };
@@ -221,9 +221,9 @@ TEST(CrossingsTest, EdgeOnAndSingleTriangleTies) {
   };
   const Case cases[] = {
       {0.0, 0.5, true, "left edge (runs down in CCW order)"},
-      {0.5, 0.0, false, "bottom edge (horizontal, rightward in CCW order)"},
+      {0.5, 0.0, true, "bottom edge (horizontal, rightward in CCW order)"},
       {0.5, 0.5, false, "hypotenuse (runs up in CCW order)"},
-      {0.0, 0.0, false, "lower-left corner"},
+      {0.0, 0.0, true, "lower-left corner"},
       {0.0, 1.0, false, "upper corner"},
       {0.2, 0.2, true, "interior"},
   };

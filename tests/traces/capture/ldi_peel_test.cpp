@@ -193,12 +193,11 @@ TEST_F(LdiPeelTest, CoilMatchesReference) { expect_agrees(placed("coil"), "coil"
 TEST_F(LdiPeelTest, BoxEdgesOnTexelCentresFollowTheTieRule) {
   const mesh::TriMesh m = box(8.5f / 64, 40.5f / 64, 10.5f / 64, 33.5f / 64, 0.25f, 0.75f);
   const Comparison c = compare(m, mesh::OrthoFrame::look_along({0, 0, -1}), 64, 64, "box on texel centres");
-  // GL covers columns 8..39 and rows 10..32 with two layers; rows 11..32 agree with the reference.
-  EXPECT_EQ(c.layers, 2u * 32u * 22u) << "two layers on the 32 x 22 texels both cover";
+  // GL covers columns 8..39 and rows 10..32 with two layers.
+  EXPECT_EQ(c.layers, 2u * 32u * 23u) << "two layers on the 32 x 23 texels both cover";
   EXPECT_EQ(c.count_mismatches_bottom_left, 0u) << "GL's ties follow a bottom-left rule (y up)";
-  // The reference's current top-left rule: exactly the two horizontal edges' rows differ. When the
-  // reference adopts GL's rule this count becomes 0 and this line must change with it.
-  EXPECT_EQ(c.count_mismatches, 64u) << "the reference's top-left rule differs from GL on rows 10 and 33 only";
+  // The reference follows the same rule (model/mesh/crossings.h): every texel agrees.
+  EXPECT_EQ(c.count_mismatches, 0u) << "the reference's tie rule is GL's";
   EXPECT_EQ(c.depth_violations, 0u) << "layer depths within the float + vertex-snap bound";
 }
 
