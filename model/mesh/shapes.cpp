@@ -140,9 +140,11 @@ TriMesh make_nested_shells(const NestedParams& p) {
   return m;
 }
 
-TriMesh make_box(float lo, float hi) {
+TriMesh make_box(float lo, float hi) { return make_box({lo, lo, lo}, {hi, hi, hi}); }
+
+TriMesh make_box(const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
   TriMesh m;
-  for (int i = 0; i < 8; ++i) m.vertices.push_back({i & 1 ? hi : lo, i & 2 ? hi : lo, i & 4 ? hi : lo});
+  for (int i = 0; i < 8; ++i) m.vertices.push_back({i & 1 ? hi[0] : lo[0], i & 2 ? hi[1] : lo[1], i & 4 ? hi[2] : lo[2]});
   constexpr std::uint32_t kFaces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
   for (const auto& f : kFaces) {
     m.triangles.push_back({f[0], f[1], f[2]});

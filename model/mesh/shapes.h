@@ -6,6 +6,8 @@
 // Model units are arbitrary: the capture places a shape with normalize_to_unit_cube (mesh.h).
 #pragma once
 
+#include <array>
+
 #include <optional>
 #include <span>
 #include <string_view>
@@ -61,6 +63,8 @@ TriMesh make_coil(const CoilParams& p = {});
 // triangles counter-clockwise seen from outside. The unit cube itself (the default) is the shape
 // that touches every face of the LDI's cube, and its edges fall on texel centres: the tie cases.
 TriMesh make_box(float lo = 0.0f, float hi = 1.0f);
+// The box [lo.x, hi.x] x [lo.y, hi.y] x [lo.z, hi.z], the same 12 triangles.
+TriMesh make_box(const std::array<float, 3>& lo, const std::array<float, 3>& hi);
 
 // The shape table (a capture's `--shape NAME [--shape-param N]`): one row per shape. `parameter`
 // names its one integer parameter ("" when it has none), with its default and limits.

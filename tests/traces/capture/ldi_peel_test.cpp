@@ -127,17 +127,7 @@ mesh::TriMesh placed(const char* shape, std::optional<int> parameter = std::null
 }
 
 // An axis-aligned box [x0, x1] x [y0, y1] x [z0, z1], outward counter-clockwise.
-mesh::TriMesh box(float x0, float x1, float y0, float y1, float z0, float z1) {
-  mesh::TriMesh m;
-  for (int c = 0; c < 8; ++c) m.vertices.push_back({c & 1 ? x1 : x0, c & 2 ? y1 : y0, c & 4 ? z1 : z0});
-  // Faces as corner quads (a, b, c, d) counter-clockwise seen from outside.
-  const std::uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    m.triangles.push_back({q[0], q[1], q[2]});
-    m.triangles.push_back({q[0], q[2], q[3]});
-  }
-  return m;
-}
+mesh::TriMesh box(float x0, float x1, float y0, float y1, float z0, float z1) { return mesh::make_box({x0, y0, z0}, {x1, y1, z1}); }
 
 class LdiPeelTest : public ::testing::Test {
  protected:
