@@ -56,6 +56,7 @@ enum class DrawRole : std::uint8_t {
   ShadowVolume = 10,  // a caster's stencil shadow volume (shadows): z-fail, two-sided, depth write off, depth clamp
   Litmap = 11,        // a scene object drawn from the light into a litmap, observer-hidden fragments discarded (shadows)
   ReceiverSplat = 12, // the observer's receivers as one-pixel points from the light into a litmap (shadows)
+  LdiPeel = 13,       // one depth-peeling pass of a shape into an LDI layer (ldi): orthographic, LEQUAL, strict test against the previous layer in the shader
 };
 
 // The culling technique a frame ran (ARCHITECTURE.md Table 2 modes).

@@ -13,6 +13,7 @@
 #include "model/common/error.h"
 #include "traces/format/bytes.h"
 #include "traces/format/codec.h"
+#include "traces/format/ldi_chunk.h"
 #include "traces/format/particles_chunk.h"
 #include "traces/format/shadows_chunk.h"
 
@@ -32,7 +33,7 @@ struct Registry {
 
 // The chunk types of the techniques this build knows, registered before anything else so that
 // every reader decodes them (a technique's own test types register later, at run time).
-std::vector<ChunkSpec> built_in_chunks() { return {particles_chunk_spec(), shadows_chunk_spec()}; }
+std::vector<ChunkSpec> built_in_chunks() { return {particles_chunk_spec(), shadows_chunk_spec(), ldi_image_chunk_spec(), ldi_tests_chunk_spec()}; }
 
 Registry& registry() {
   static Registry r{{}, built_in_chunks()};

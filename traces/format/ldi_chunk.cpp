@@ -1,0 +1,136 @@
+// The LDI technique's chunk descriptions; see ldi_chunk.h.
+#include "traces/format/ldi_chunk.h"
+
+#include <fmt/format.h>
+
+#include <string>
+#include <variant>
+
+namespace nbsim::trace {
+
+namespace {
+
+// Limits mirrored from model/ldi/ldi.h (kMaxSideTexels, kMaxLayers); the model checks the rest.
+constexpr std::uint64_t kMaxSide = 16384, kMaxLayers = 2048;
+
+const TechniqueField* field(const TechniqueRecord& r, std::string_view name) {
+  for (const TechniqueField& f : r.fields)
+    if (f.name == name) return &f;
+  return nullptr;
+}
+std::uint64_t u(const TechniqueRecord& r, std::string_view name) {
+  const TechniqueField* f = field(r, name);
+  return f ? std::get<std::uint64_t>(f->value) : 0;
+}
+std::int64_t i(const TechniqueRecord& r, std::string_view name) {
+  const TechniqueField* f = field(r, name);
+  return f ? std::get<std::int64_t>(f->value) : 0;
+}
+template <class T>
+std::size_t length(const TechniqueRecord& r, std::string_view name) {
+  const TechniqueField* f = field(r, name);
+  return f ? std::get<std::vector<T>>(f->value).size() : 0;
+}
+
+std::string image_rule(const TechniqueRecord& r) {
+  const std::uint64_t w = u(r, "width"), h = u(r, "height"), layers = u(r, "layer_count");
+  const std::uint64_t gh = u(r, "grid_h"), gv = u(r, "grid_v"), side = u(r, "comp_side");
+  if (w < 1 || w > kMaxSide || h < 1 || h > kMaxSide)
+    return fmt::format("the LDI is {}x{} texels; each side must be 1 to {}", w, h, kMaxSide);
+  if (layers > kMaxLayers) return fmt::format("layer_count is {}, above {}", layers, kMaxLayers);
+  if (gh < 1 || gv < 1 || gh > 1024 || gv > 1024) return fmt::format("the viewpoint grid is {}x{}; each side must be 1 to 1024", gh, gv);
+  if (u(r, "direction") >= gh * gv) return fmt::format("direction is {}, but the grid has {} directions", u(r, "direction"), gh * gv);
+  if (side > kMaxSide) return fmt::format("comp_side is {}, above {}", side, kMaxSide);
+  const std::size_t want_layers = static_cast<std::size_t>(layers * w * h);
+  if (length<float>(r, "layers") != want_layers)
+    return fmt::format("field 'layers' has {} values, but layer_count x width x height is {}", length<float>(r, "layers"), want_layers);
+  if (length<float>(r, "view") != 9) return fmt::format("field 'view' has {} values, not 9", length<float>(r, "view"));
+  if (length<float>(r, "rotation") != 9) return fmt::format("field 'rotation' has {} values, not 9", length<float>(r, "rotation"));
+  for (const char* name : {"candidate_d", "candidate_coverage"})
+    if (length<std::uint32_t>(r, name) != gh * gv)
+      return fmt::format("field '{}' has {} values, but the grid has {} directions", name, length<std::uint32_t>(r, name), gh * gv);
+  if (length<std::uint32_t>(r, "compressed") != 2 * side * side)
+    return fmt::format("field 'compressed' has {} values, but comp_side {} needs {}", length<std::uint32_t>(r, "compressed"), side,
+                       2 * side * side);
+  const std::int64_t cx = i(r, "crop_x"), cy = i(r, "crop_y"), cw = i(r, "crop_w"), ch = i(r, "crop_h");
+  if (cx < 0 || cy < 0 || cw < 0 || ch < 0 || cx + cw > static_cast<std::int64_t>(w) || cy + ch > static_cast<std::int64_t>(h))
+    return fmt::format("the crop ({}, {}, {}x{}) is not inside the {}x{} LDI", cx, cy, cw, ch, w, h);
+  return {};
+}
+
+std::string tests_rule(const TechniqueRecord& r) {
+  const std::uint64_t count = u(r, "count");
+  if (std::string problem = vector_lengths_problem(r, count, {"count", "epsilon"}, "test point"); !problem.empty()) return problem;
+  const TechniqueField* eps = field(r, "epsilon");
+  if (eps && !(std::get<double>(eps->value) >= 0.0 && std::get<double>(eps->value) < 1.0))
+    return fmt::format("epsilon is {}, not in [0, 1)", std::get<double>(eps->value));
+  for (const TechniqueField& f : r.fields) {
+    if (const auto* v = std::get_if<std::vector<std::uint32_t>>(&f.value)) {
+      const bool answer = f.name == "gl_inside_layers" || f.name == "gl_inside_ranges";
+      const std::uint32_t limit = f.name == "kind" ? kLdiPointKinds - 1 : answer ? 1u : 0xFFFFFFFFu;
+      for (std::size_t p = 0; p < v->size(); ++p)
+        if ((*v)[p] > limit) return fmt::format("field '{}' of test point {} is {}, above {}", f.name, p, (*v)[p], limit);
+    } else if (const auto* s = std::get_if<std::vector<std::int32_t>>(&f.value); s && f.name == "reference") {
+      for (std::size_t p = 0; p < s->size(); ++p)
+        if ((*s)[p] < kLdiNearSurface) return fmt::format("field 'reference' of test point {} is {}, below {}", p, (*s)[p], kLdiNearSurface);
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+ChunkSpec ldi_image_chunk_spec() {
+  ChunkSpec spec{
+      kLdiImageChunk,
+      "ldi",
+      "LdiImage",
+      {{"width", FieldKind::U32, "LDI width, texels (the peel's viewport)"},
+       {"height", FieldKind::U32, "LDI height, texels"},
+       {"layer_count", FieldKind::U32, "layers the peel found: the depth complexity d (the last, empty pass is not a layer)"},
+       {"grid_h", FieldKind::U32, "viewpoint grid: directions around the vertical axis (s_H)"},
+       {"grid_v", FieldKind::U32, "viewpoint grid: elevations (s_V)"},
+       {"direction", FieldKind::U32, "the chosen direction, v * grid_h + h: smallest d, then largest coverage, then lowest index"},
+       {"view", FieldKind::VecF32, "the chosen orthographic frame in the shape's unit cube: direction, right, up (3 each)"},
+       {"rotation", FieldKind::VecF32, "the shape's rotation this frame, column-major 3x3, applied before it is fitted into the unit cube"},
+       {"candidate_d", FieldKind::VecU32, "per direction: its depth complexity as GL measured it (most fragments on one texel)"},
+       {"candidate_coverage", FieldKind::VecU32, "per direction: texels with at least one fragment"},
+       {"layers", FieldKind::VecF32,
+        "the LDI as GL peeled it: layer_count layers of width x height linear depths in [0, 1], layer-major, y up, row-major; "
+        "+inf where the texel has no more layers"},
+       {"crop_x", FieldKind::I32, "GL's crop: the bounding rectangle of the texels with a layer, left texel"},
+       {"crop_y", FieldKind::I32, "bottom texel, y up"},
+       {"crop_w", FieldKind::I32, "width, texels (0: no layer anywhere)"},
+       {"crop_h", FieldKind::I32, "height, texels"},
+       {"comp_side", FieldKind::U32, "side w_c of GL's compressed RG32UI texture (model/ldi/compression.h)"},
+       {"comp_index", FieldKind::U32, "index-segment texels I = crop_w * crop_h"},
+       {"comp_ranges", FieldKind::U32, "range-segment texels R"},
+       {"compressed", FieldKind::VecU32, "GL's compressed texture read back: comp_side^2 texels, two channels each, row-major"}}};
+  spec.rule = image_rule;
+  return spec;
+}
+
+ChunkSpec ldi_tests_chunk_spec() {
+  ChunkSpec spec{
+      kLdiTestsChunk,
+      "ldi",
+      "LdiTests",
+      {{"count", FieldKind::U32, "test points (every vector below has this many elements)"},
+       {"epsilon", FieldKind::F64,
+        "the reference's near-surface distance, unit-cube units along the ray: a point nearer a surface is counted apart"},
+       {"kind", FieldKind::VecU32, "0 random, 1 crop boundary, 2 near a surface, 3 midway between layers"},
+       {"x", FieldKind::VecI32, "texel column of the full LDI (may lie outside the crop, or the LDI)"},
+       {"y", FieldKind::VecI32, "texel row, y up"},
+       {"z", FieldKind::VecF32, "linear depth of the point, [0, 1]"},
+       {"gl_inside_layers", FieldKind::VecU32, "GL's answer, uncompressed parity test on the cropped layers: 1 inside"},
+       {"gl_fetches_layers", FieldKind::VecU32, "layer texels that shader read"},
+       {"gl_inside_ranges", FieldKind::VecU32, "GL's answer, compressed parity test on the RG32UI texture: 1 inside"},
+       {"gl_fetches_ranges", FieldKind::VecU32, "texels that shader read (1 index + the ranges up to the answer)"},
+       {"reference", FieldKind::VecI32,
+        "the exact reference: surface crossings along the texel-centre ray beyond the point (odd: inside), from the mesh in "
+        "double precision; -1 within epsilon of a surface"}}};
+  spec.rule = tests_rule;
+  return spec;
+}
+
+}  // namespace nbsim::trace

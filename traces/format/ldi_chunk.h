@@ -1,0 +1,43 @@
+// The layered-depth-image technique's chunk types (Trapp & Doellner: depth peeling, viewpoint
+// selection, cropping, depth-range compression and the volumetric parity test). Per frame, one
+// LdiImage record (LDIL): the viewpoint GL chose among the grid's directions with every
+// direction's measured depth complexity and coverage, the LDI GL peeled (every layer as read back,
+// +inf where a texel has no more layers), GL's crop and GL's compressed RG32UI texture; and one
+// LdiTests record (LDIT): the frame's test points, GL's parity answers and fetch counts for both
+// readers, and the exact double-precision reference. Conventions are model/ldi/ (ldi.h,
+// compression.h, vpt.h); the peel passes themselves are the frame's draws of role ldi_peel, in
+// pass order. Built into the format library (technique_chunks.cpp registers it). The capture side
+// is traces/capture/ldi/.
+#pragma once
+
+#include <cstdint>
+
+#include "traces/format/records.h"
+#include "traces/format/technique_chunks.h"
+
+namespace nbsim::trace {
+
+inline constexpr std::uint32_t kLdiImageChunk = fourcc("LDIL");
+inline constexpr std::uint32_t kLdiTestsChunk = fourcc("LDIT");
+
+// What a test point was chosen to probe (LDIT field `kind`; fixed values: they are in files).
+enum class LdiPointKind : std::uint32_t {
+  Random = 0,        // uniform in the LDI's texels and depth [0, 1]
+  CropBoundary = 1,  // on a texel of the crop rectangle's border, or just outside it
+  NearSurface = 2,   // at a layer's depth or within a few ulps of it
+  Midway = 3,        // halfway between two consecutive layers of its texel (a clear answer)
+};
+inline constexpr std::uint32_t kLdiPointKinds = 4;
+
+// Reference value of a point within epsilon of a surface (LDIT field `reference`): counted apart.
+inline constexpr std::int32_t kLdiNearSurface = -1;
+
+// LdiImage's rule: layers has layer_count * width * height values, compressed 2 * side * side,
+// view 9, the candidate vectors grid_h * grid_v each with direction below that, the crop inside the
+// LDI, and layer_count, width, height, side within model/ldi's limits.
+ChunkSpec ldi_image_chunk_spec();
+// LdiTests' rule: every vector has `count` elements, kind below kLdiPointKinds, answers 0 or 1,
+// reference >= -1.
+ChunkSpec ldi_tests_chunk_spec();
+
+}  // namespace nbsim::trace
