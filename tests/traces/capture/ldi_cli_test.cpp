@@ -49,6 +49,8 @@ TEST(LdiCliTest, BadInputExitsTwoAndWritesNothing) {
   testing::expect_refused(kPrefix,
                           {{"--epsilon -1", "--epsilon '-1' is not a number in [0, 1)"},
                            {"--shape cube", "unknown shape 'cube'"},
+                           {"--shape sphere --mesh x.obj", "give --shape or --mesh, not both"},
+                           {"--mesh /nonexistent/x.obj", "/nonexistent/x.obj"},
                            {"--shape nested --shape-param 3 --max-layers 4", "more than max_layers = 4 layers"},
                            {"--max-layers 4096", "--max-layers 4096 is out of range"}},
                           o, out);
