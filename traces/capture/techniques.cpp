@@ -1,5 +1,6 @@
 // The technique table (technique.h): one row per technique. A new technique is a folder of its
 // own (traces/capture/<name>/, shaders/<name>/) and one row here.
+#include "traces/capture/ldi/ldi.h"
 #include "traces/capture/occlusion/occlusion_culling.h"
 #include "traces/capture/particles/particles.h"
 #include "traces/capture/shadows/shadows.h"
@@ -23,6 +24,11 @@ const std::vector<TechniqueRow>& technique_table() {
         "two N-buffers, with an infinite reference pass for the mask (N-buffer paper, 3.3 and 4.4)",
         shadows_options()},
        make_shadows},
+      {{"ldi",
+        "Layered depth images of a closed shape: viewpoint selection, depth peeling, crop, RG32UI depth-range compression and "
+        "the volumetric parity test with both readers against an exact reference (Trapp & Doellner)",
+        ldi_options()},
+       make_ldi},
   };
   return table;
 }

@@ -4,12 +4,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
 #include "model/common/error.h"
 #include "nbsim_shaders.h"
+#include "traces/capture/draw_recorder.h"
 #include "traces/capture/gl_program.h"
 
 namespace nbsim::capture {
@@ -21,14 +23,17 @@ double dot(const mesh::Vec3d& a, const mesh::Vec3d& b) { return a[0] * b[0] + a[
 struct PeelObjects {
   GLuint program = 0, vao = 0, vbo = 0, ebo = 0, ssbo = 0, query = 0, fbo = 0, depth = 0, array = 0;
   GLuint ping[2] = {0, 0};
+  bool keep = false;  // the array texture goes to the caller
+  GLint clip_origin = 0, clip_depth = 0;  // the clip control to restore (0: not changed)
   ~PeelObjects() {
+    if (clip_origin != 0) glClipControl(static_cast<GLenum>(clip_origin), static_cast<GLenum>(clip_depth));
     glDeleteProgram(program);
     glDeleteVertexArrays(1, &vao);
     GLuint buffers[] = {vbo, ebo, ssbo};
     glDeleteBuffers(3, buffers);
     glDeleteQueries(1, &query);
     glDeleteFramebuffers(1, &fbo);
-    GLuint textures[] = {depth, array, ping[0], ping[1]};
+    GLuint textures[] = {depth, keep ? 0u : array, ping[0], ping[1]};
     glDeleteTextures(4, textures);
   }
 };
@@ -69,7 +74,7 @@ std::array<double, 3> OrthoMapping::project(const mesh::Vec3d& p) const {
           linear_depth(dot(p, frame.direction))};
 }
 
-PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const PeelConfig& config) {
+PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const PeelConfig& config, DrawRecorder* recorder) {
   if (config.max_layers < 1 || config.max_layers > ldi::kMaxLayers)
     throw InputError(fmt::format("peel: max_layers {} outside [1, {}]", config.max_layers, ldi::kMaxLayers));
   const OrthoMapping map = OrthoMapping::fit_unit_cube(frame, config.width_px, config.height_px);
@@ -88,7 +93,7 @@ PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const
   PeelObjects o;
   o.program = link_program({compile_shader(GL_VERTEX_SHADER, shaders::ldi_peel_vert, "ldi/peel.vert"),
                             compile_shader(GL_FRAGMENT_SHADER, shaders::ldi_peel_frag, "ldi/peel.frag")},
-                           "ldi peel");
+                           "ldi peel", true);
   glCreateVertexArrays(1, &o.vao);
   glCreateBuffers(1, &o.vbo);
   glCreateBuffers(1, &o.ebo);
@@ -136,16 +141,23 @@ PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const
   // shape touching the cube's far face has fragments at exactly 1.0, which LESS would lose. A
   // fragment replacing one of equal depth writes the same colour, so the layer is the same.
   glDepthFunc(GL_LEQUAL);
+  glGetIntegerv(GL_CLIP_ORIGIN, &o.clip_origin);
+  glGetIntegerv(GL_CLIP_DEPTH_MODE, &o.clip_depth);
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);  // window depth = the linear depth (peel.vert)
   glDepthMask(GL_TRUE);
   glColorMaski(0, GL_TRUE, GL_FALSE, GL_FALSE, GL_FALSE);
   glUseProgram(o.program);
   glBindVertexArray(o.vao);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, o.ssbo);
-  const GLint slot_loc = glGetUniformLocation(o.program, "pass_slot");
+  if (recorder)
+    recorder->bind();
+  else
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, o.ssbo);
+  const GLint slot_loc = glGetUniformLocation(o.program, "draw_slot");
   const GLint first_loc = glGetUniformLocation(o.program, "first_pass");
   glUniform1i(glGetUniformLocation(o.program, "previous_layer"), 0);
 
   std::vector<std::uint64_t> samples;
+  std::uint64_t depth_checked = 0, depth_mismatches = 0;
   int layers = 0;
   for (int pass = 0; pass < max_passes; ++pass) {
     const GLuint target = o.ping[pass % 2], previous = o.ping[(pass + 1) % 2];
@@ -157,16 +169,44 @@ PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const
     const float far_depth = 1.0f;
     glClearNamedFramebufferfv(o.fbo, GL_DEPTH, 0, &far_depth);
     glBindTextureUnit(0, previous);
-    glUniform1ui(slot_loc, static_cast<GLuint>(pass));
     glUniform1i(first_loc, pass == 0 ? 1 : 0);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
-    glBeginQuery(GL_SAMPLES_PASSED, o.query);
-    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.triangles.size() * 3), GL_UNSIGNED_INT, nullptr);
-    glEndQuery(GL_SAMPLES_PASSED);
     GLuint64 passed = 0;
-    glGetQueryObjectui64v(o.query, GL_QUERY_RESULT, &passed);
+    if (recorder) {
+      scene::DrawRecord d;
+      d.role = scene::DrawRole::LdiPeel;
+      d.state.func = scene::DepthFunc::Lequal;
+      d.state.test = true;
+      d.state.write = true;
+      d.state.cull = scene::CullFace::None;
+      d.state.clip = scene::ClipControl::ZeroToOne;
+      d.discards = pass > 0;
+      const std::size_t slot = recorder->begin_draw(std::move(d), m.triangles.size() * 3);
+      glUniform1ui(slot_loc, static_cast<GLuint>(slot));
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.triangles.size() * 3), GL_UNSIGNED_INT, nullptr);
+      recorder->end_draw();
+      passed = recorder->samples_passed(slot);
+    } else {
+      glUniform1ui(slot_loc, static_cast<GLuint>(pass));
+      glBeginQuery(GL_SAMPLES_PASSED, o.query);
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.triangles.size() * 3), GL_UNSIGNED_INT, nullptr);
+      glEndQuery(GL_SAMPLES_PASSED);
+      glGetQueryObjectui64v(o.query, GL_QUERY_RESULT, &passed);
+    }
     samples.push_back(passed);
     if (passed == 0) break;
+    if (config.verify_depth_buffer) {
+      // The depth attachment against the layer just written, bit for bit, where the layer is valid.
+      glFinish();
+      std::vector<float> zb(static_cast<std::size_t>(w) * h), layer(zb.size());
+      glGetTextureImage(o.depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, static_cast<GLsizei>(zb.size() * 4), zb.data());
+      glGetTextureImage(target, 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(layer.size() * 4), layer.data());
+      for (std::size_t i = 0; i < zb.size(); ++i) {
+        if (!std::isfinite(layer[i])) continue;
+        ++depth_checked;
+        if (std::bit_cast<std::uint32_t>(layer[i]) != std::bit_cast<std::uint32_t>(zb[i])) ++depth_mismatches;
+      }
+    }
     if (pass == config.max_layers)
       throw InputError(fmt::format("peel: the shape has more than max_layers = {} layers", config.max_layers));
     glCopyImageSubData(target, GL_TEXTURE_2D, 0, 0, 0, 0, o.array, GL_TEXTURE_2D_ARRAY, 0, 0, 0, pass, w, h, 1);
@@ -177,7 +217,7 @@ PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
 
   std::vector<std::uint32_t> fragments(samples.size());
-  glGetNamedBufferSubData(o.ssbo, 0, static_cast<GLsizeiptr>(fragments.size() * 4), fragments.data());
+  if (!recorder) glGetNamedBufferSubData(o.ssbo, 0, static_cast<GLsizeiptr>(fragments.size() * 4), fragments.data());
   std::vector<float> depths(static_cast<std::size_t>(w) * h * layers);
   if (layers > 0)
     glGetTextureSubImage(o.array, 0, 0, 0, 0, w, h, layers, GL_RED, GL_FLOAT,
@@ -186,6 +226,12 @@ PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const
 
   PeelResult r{ldi::Ldi(w, h, layers, std::move(depths)), {}};
   for (std::size_t i = 0; i < samples.size(); ++i) r.passes.push_back({fragments[i], samples[i]});
+  r.depth_buffer_checked = depth_checked;
+  r.depth_buffer_mismatches = depth_mismatches;
+  if (config.keep_gl_layers) {
+    o.keep = true;
+    r.gl_layers = o.array;
+  }
   return r;
 }
 

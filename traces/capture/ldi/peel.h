@@ -12,6 +12,13 @@
 // depth is (t - t0) / (t1 - t0). The capture projects the vertices in double and rounds once to
 // float; GL then snaps them to its 1/256-pixel grid.
 //
+// Depth on GL (so that a model can replay the passes bit-exactly): during the peel the clip
+// control is (LOWER_LEFT, ZERO_TO_ONE) and the vertex stage emits gl_Position = (ndc x, ndc y,
+// linear depth, 1), so GL's window depth IS the linear depth; the layer written is gl_FragCoord.z
+// (no gl_FragDepth write), the depth buffer (DEPTH_COMPONENT32F, cleared to 1.0 each pass) is
+// tested with LEQUAL, and the strict test against the previous layer uses the same gl_FragCoord.z.
+// The previous clip control is restored afterwards.
+//
 // Duplicate and coplanar faces: the test against the previous layer is strict (depth > previous),
 // so surfaces at equal float depth at a texel collapse into ONE layer, where the exact reference
 // lists one crossing per face. A shape with a duplicated face therefore shows an odd layer count
@@ -51,6 +58,12 @@ struct PeelConfig {
   // Most layers the peel stores (tunable; at most ldi::kMaxLayers). A shape needing more is refused
   // with an InputError naming this limit.
   int max_layers = 64;
+  // Read the depth attachment back after every pass that wrote a layer and compare it with the
+  // layer (PeelResult::depth_buffer_mismatches): the check that gl_FragCoord.z is the depth-tested
+  // z. For tests (a read-back per pass).
+  bool verify_depth_buffer = false;
+  // Keep GL's layered texture for further GL passes (crop, compression): PeelResult::gl_layers.
+  bool keep_gl_layers = false;
 };
 
 // One peel pass's GL counters.
@@ -64,11 +77,23 @@ struct PeelResult {
   // Every pass run, including the last one that wrote nothing (which ends the peel); so
   // passes.size() == ldi.layer_count() + 1.
   std::vector<PeelPass> passes;
+  // With verify_depth_buffer: texels (over all passes that wrote a layer) where the layer's bits and
+  // the depth buffer's differ, among those where the layer is valid; and how many were compared.
+  std::uint64_t depth_buffer_mismatches = 0, depth_buffer_checked = 0;
+  // With keep_gl_layers: the GL_TEXTURE_2D_ARRAY (R32F, width x height x max_layers, +inf past the
+  // layers) holding the LDI; the caller owns it (glDeleteTextures). 0 otherwise.
+  std::uint32_t gl_layers = 0;
 };
 
+class DrawRecorder;
+
 // Peels the mesh (vertices in the unit cube; not checked for closedness here: see mesh.h's
-// require_closed) on the current GL context. No face culling. Throws InputError for a bad config or
+// require_closed) on the current GL context. No face culling. With a recorder, every pass (the last,
+// empty one included) is recorded as a draw of role LdiPeel with its clip positions (transform
+// feedback) and counters; the passes' `fragments` are then 0 here and come with the records
+// (DrawRecorder::collect), while `samples_passed` is filled either way. Throws InputError for a bad config or
 // when more than max_layers layers exist (naming max_layers), std::runtime_error for a GL failure.
-PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const PeelConfig& config);
+PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const PeelConfig& config,
+                    DrawRecorder* recorder = nullptr);
 
 }  // namespace nbsim::capture
