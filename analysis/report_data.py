@@ -570,3 +570,99 @@ def headline_shadows(label, rows, reading):
                      f"{r['build_texels_per_frame']:,.0f} | {r['lookups_per_frame']:,.0f} | {r['cycles_per_frame']:,.0f} | "
                      f"{r['mask_diff']:,}, {r['mask_diff_infinite']:,} |")
     return "\n".join(lines + [""] + [f"- {s}" for s in reading])
+
+
+# ------------------------------------------------------------------------------ layered depth images
+LDI_NEED = ["shape", "ldi_size", "vertices", "d_min", "d_max", "layers", "m_crop", "m_comp", "points", "classified",
+            "near_surface", "misclassified_layers", "misclassified_ranges", "fetches_per_test_layers",
+            "fetches_per_test_ranges"]
+LDI_OPTIONAL_NUMBERS = ["c_ratio", "ms_viewpoint", "ms_peel", "ms_crop", "ms_compress", "triangles",
+                        "paper_c_ratio", "gl_parity_mismatches", "classified_anywhere", "misclassified_anywhere",
+                        "fetches_anywhere_layers", "fetches_anywhere_ranges"]
+# The paper's Table 1 rows we can set beside ours (Trapp & Doellner 2008, 1024x1024 LDIs): only the
+# numbers the issue quotes; the rest of their table was not at hand. Fixed by the paper.
+PAPER_LDI = {"sphere": ("Sphere, 994 vertices, d = 2", 1.78), "nested": ("Hebe, d up to 18", 0.32)}
+
+
+def load_ldi(path):
+    """The rows of ldi.json (nbsim ldi table1 --out: one object per shape and LDI size), checked; BadInput otherwise."""
+    t = load_rows(path, "nbsim ldi table1", LDI_NEED, ["shape"], LDI_NEED[1:] + LDI_OPTIONAL_NUMBERS)
+    for i, r in enumerate(t):
+        if r["ldi_size"] <= 0 or r["points"] < 0 or r["classified"] < 0 or r["classified"] > r["points"]:
+            raise BadInput(f"{path}: rows[{i}]: ldi_size must be above 0 and classified within [0, points]")
+        if r["misclassified_layers"] > r["classified"] or r["misclassified_ranges"] > r["classified"]:
+            raise BadInput(f"{path}: rows[{i}]: more points misclassified than classified")
+    return t
+
+
+def ldi_rows(rows):
+    """The rows by shape (as given, first appearance) and LDI size, each with the misclassification rates of both
+    readers (over the classified points; None without any) and the paper's ratio where it has one."""
+    shapes = list(dict.fromkeys(r["shape"] for r in rows))
+    out = []
+    for r in sorted(rows, key=lambda r: (shapes.index(r["shape"]), r["ldi_size"])):
+        rr = dict(r)
+        n = r["classified"]
+        rr["error_layers"] = r["misclassified_layers"] / n if n else None
+        rr["error_ranges"] = r["misclassified_ranges"] / n if n else None
+        na = r.get("classified_anywhere")
+        rr["error_anywhere"] = r["misclassified_anywhere"] / na if na and r.get("misclassified_anywhere") is not None else None
+        base = r["shape"].split(":")[0]
+        paper = PAPER_LDI.get(base)
+        rr["paper_text"] = paper[0] if paper else ""
+        rr["paper_c_ratio"] = r.get("paper_c_ratio", paper[1] if paper else None)
+        out.append(rr)
+    return out
+
+
+def ldi_reading(rows):
+    """What the LDI table shows, as plain sentences computed from its rows."""
+    out = []
+    lossless = [r for r in rows if r["error_layers"] is not None and r["misclassified_layers"] != r["misclassified_ranges"]]
+    if lossless:
+        out.append("THE READERS DISAGREE in " + ", ".join(f"{r['shape']} {r['ldi_size']}" for r in lossless) +
+                   ": compression is lossless, so both must misclassify the same points.")
+    else:
+        out.append(f"Both readers misclassify the same number of points in every row ({len(rows)} rows): the compression "
+                   "is lossless, so it changes the cost of a test, not its answer.")
+    bad_gl = [r for r in rows if r.get("gl_parity_mismatches")]
+    if bad_gl:
+        out.append("GL AND THE MODEL DISAGREE on " + ", ".join(f"{r['shape']} {r['ldi_size']} ({r['gl_parity_mismatches']:,})"
+                                                              for r in bad_gl) + " parity answers.")
+    for shape in dict.fromkeys(r["shape"] for r in rows):
+        g = [r for r in rows if r["shape"] == shape and r["error_layers"] is not None]
+        if not g:
+            continue
+        lo, hi = g[0], g[-1]
+        s = (f"{shape}: misclassified {pct(lo['error_layers'], 2)} of its test points at {lo['ldi_size']}² "
+             + (f"and {pct(hi['error_layers'], 2)} at {hi['ldi_size']}²" if hi is not lo else "")
+             + ("" if lo.get("error_anywhere") is None else
+                f" (uniform points anywhere in their texel: {pct(lo['error_anywhere'], 2)}"
+                + (f" falling to {pct(hi['error_anywhere'], 2)})" if hi is not lo and hi.get("error_anywhere") is not None else ")"))
+             + f"; a test reads {hi['fetches_per_test_layers']:.2f} layer texels uncompressed against "
+             f"{hi['fetches_per_test_ranges']:.2f} texels compressed")
+        if hi.get("c_ratio") is not None:
+            s += f", C_ratio {hi['c_ratio']:.2f}"
+            if hi.get("paper_c_ratio") is not None:
+                s += f" (the paper's {hi['paper_text']}: {hi['paper_c_ratio']:.2f})"
+        out.append(s + ".")
+    return out
+
+
+def headline_ldi(label, rows, reading):
+    """The LDI Table 1 reproduction and misclassification, as Markdown."""
+    lines = [f"Layered depth images ({label}): Table 1 beside the paper's ratios, and the parity test's misclassification "
+             "against the exact reference",
+             "",
+             "| shape | LDI | vertices | d_min/d_max | M_crop | M_comp | C_ratio | paper | misclassified | anywhere in the texel | fetches/test (layers, ranges) | ms viewpoint/peel/crop/compress |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    ms = lambda r, k: "-" if r.get(k) is None else f"{r[k]:,.1f}"  # noqa: E731
+    for r in rows:
+        lines.append(f"| {r['shape']} | {r['ldi_size']} | {r['vertices']:,} | {r['d_min']}/{r['d_max']} | {r['m_crop']:,} | "
+                     f"{r['m_comp']:,} | {'-' if r.get('c_ratio') is None else format(r['c_ratio'], '.3f')} | "
+                     f"{'-' if r.get('paper_c_ratio') is None else format(r['paper_c_ratio'], '.2f')} | "
+                     f"{pct(r['error_layers'], 2)} of {r['classified']:,} | "
+                     f"{pct(r.get('error_anywhere'), 2)} | "
+                     f"{r['fetches_per_test_layers']:.2f}, {r['fetches_per_test_ranges']:.2f} | "
+                     f"{ms(r, 'ms_viewpoint')}/{ms(r, 'ms_peel')}/{ms(r, 'ms_crop')}/{ms(r, 'ms_compress')} |")
+    return "\n".join(lines + [""] + [f"- {s}" for s in reading])

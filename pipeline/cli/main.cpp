@@ -94,6 +94,7 @@ int main(int argc, char** argv) {
   cli::add_model_commands(app, action);
   cli::add_explore_command(app, action);
   cli::add_report_command(app, action);
+  cli::add_ldi_commands(app, action);
   cli::add_trace_commands(app, action);
   try {
     app.parse(argc, argv);

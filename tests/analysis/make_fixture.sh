@@ -1,7 +1,7 @@
 #!/bin/sh
 # Regenerates tests/analysis/fixture/, the input folder of analysis/report.py's tests, from real nbsim
 # outputs on the small samples (city_small_oq.nbt, and city_small_nb_reversed.nbt for a second trace
-# in two sweeps) on four tiny particles captures and nine tiny shadows captures. Big files are trimmed to what the report reads.
+# in two sweeps) on four tiny particles captures, nine tiny shadows captures and a small `nbsim ldi table1`. Big files are trimmed to what the report reads.
 # About a minute on 2 cores.
 # Usage: tests/analysis/make_fixture.sh [NBSIM]   (default: build/pipeline/nbsim; run from anywhere)
 set -eu
@@ -84,6 +84,10 @@ mkdir -p "$out/shadows"
  done &&
  "$nbsim" shadows shadows_*_*.nbt --out shadows >/dev/null)
 cp "$tmp/shadows/shadows.json" "$out/shadows/"
+
+# Layered depth images: Table 1 and the parity test's accuracy, two shapes at two small sides.
+"$nbsim" ldi table1 --shapes sphere,nested:3 --sizes 32,64 --points 512 --out "$out/ldi" >/dev/null
+rm -f "$out/ldi/ldi.csv"
 
 du -sh "$out"
 echo "wrote $out"

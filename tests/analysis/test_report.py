@@ -142,7 +142,23 @@ class FixtureReport(unittest.TestCase):
         self.assertIn("Particles (particles_none, particles_center, particles_nb, particles_hiz)", last,
                       "the particles table follows the sweeps (scripts/demo ends on it and the shadows table)")
         self.assertIn("Shadows (9 traces of boxes, terrain, city)", last.split("Particles (")[1],
-                      "the shadows table is the last block, after the particles table")
+                      "the shadows table follows the particles table")
+        self.assertIn("Layered depth images (2 shapes, 4 LDIs)", last.split("Shadows (")[1],
+                      "the LDI table is the last block, after the shadows table")
+
+    def test_ldi_section_from_nbsim_ldi_table1(self):
+        # ldi/ldi.json (nbsim ldi table1 --out): its rows in the table and CSV copy, the plot, the paper's sphere row
+        rows = json.loads((FIXTURE / "ldi" / "ldi.json").read_text())
+        self.assertIn("ldi/ldi.json", self.html, "the page names its input")
+        with open(self.dir / "report" / "ldi.csv") as f:
+            table = list(csv.DictReader(f))
+        self.assertEqual([(t["shape"], int(t["ldi_size"])) for t in table], [(r["shape"], r["ldi_size"]) for r in rows])
+        for t, r in zip(table, rows):
+            self.assertEqual(int(t["m_comp"]), r["m_comp"], "memory is nbsim's own")
+            if r["shape"] == "sphere":
+                self.assertEqual(float(t["paper_c_ratio"]), 1.78)
+        png_size(self.dir / "report" / "ldi.png")
+        self.assertIn("C_ratio", (self.dir / "report" / "headline.md").read_text())
 
     def test_particles_section_per_mode_beside_the_paper(self):
         # particles/particles.json: one row per mode beside the paper's 256 N and N, its CSV copy, and a
@@ -208,7 +224,7 @@ class FixtureReport(unittest.TestCase):
         self.assertIn("shadows.png", self.html)
         png_size(self.dir / "report" / "shadows.png")
         text = (self.dir / "report" / "headline.md").read_text()
-        block = text.split("Shadows (")[1]
+        block = text.split("Shadows (")[1].split("Layered depth images (")[0]
         lines = [line for line in block.splitlines() if line.startswith("| ") and not line.startswith("| scene")]
         self.assertEqual(len(lines), 9, block)
         self.assertIn("| city | clamped | 64 |", block)
@@ -520,6 +536,37 @@ class ShadowsReading(unittest.TestCase):
         self.assertNotIn("clamping cuts", self.reading([r]))
 
 
+def ldi_row(shape, size, **kw):
+    """An ldi.json row (nbsim ldi table1 --out): 4,096 points, 96 near a surface; kw overrides."""
+    r = {"shape": shape, "ldi_size": size, "vertices": 994, "triangles": 1984, "d_min": 2, "d_max": 4, "layers": 2,
+         "direction": 0, "m_crop": 2 * size * size, "m_comp": 3 * size * size, "c_ratio": 1.5, "ms_viewpoint": 120.0,
+         "ms_peel": 30.0, "ms_crop": 1.0, "ms_compress": 2.0, "points": 4096, "classified": 4000, "near_surface": 96,
+         "misclassified_layers": 40 * 64 // size, "misclassified_ranges": 40 * 64 // size,
+         "fetches_per_test_layers": 1.5, "fetches_per_test_ranges": 1.8, "gl_parity_mismatches": 0}
+    r.update(kw)
+    return r
+
+
+class LdiReading(unittest.TestCase):
+    """The LDI section's reading follows the rows it is given, not fixed text."""
+
+    def reading(self, rows):
+        return " ".join(report_data.ldi_reading(report_data.ldi_rows(rows)))
+
+    def test_rates_and_the_paper(self):
+        text = self.reading([ldi_row("sphere", 256), ldi_row("sphere", 64)])
+        self.assertIn("Both readers misclassify the same number of points in every row (2 rows)", text)
+        self.assertIn("sphere: misclassified 1.00% of its test points at 64² and 0.25% at 256²", text, "sorted by size")
+        self.assertIn("C_ratio 1.50 (the paper's Sphere, 994 vertices, d = 2: 1.78)", text)
+        self.assertNotIn("the paper's", self.reading([ldi_row("knot", 64)]), "no paper row for the knot")
+
+    def test_disagreements_are_named(self):
+        text = self.reading([ldi_row("knot", 128, misclassified_ranges=3), ldi_row("coil", 64, gl_parity_mismatches=7)])
+        self.assertIn("THE READERS DISAGREE in knot 128", text)
+        self.assertIn("GL AND THE MODEL DISAGREE on coil 64 (7)", text)
+        self.assertNotIn("Both readers misclassify", text)
+
+
 class ParticlesReading(unittest.TestCase):
     """The particles section's reading follows the rows it is given, not fixed text."""
 
@@ -715,6 +762,26 @@ class MissingAndBroken(unittest.TestCase):
             (self.dir / "shadows.json").write_text(bad)
             rc, _, err = run_report(self.dir)
             self.assertBroken(rc, err, "shadows.json")
+            self.assertIn(says, err, bad)
+
+    def test_ldi_json_of_nbsim_ldi_out_dir(self):
+        # DIR/ldi.json (nbsim ldi table1 --out DIR) renders alone with its plot; a malformed one exits 2 naming the file
+        (self.dir / "ldi.json").write_text(json.dumps([ldi_row("sphere", 64), ldi_row("sphere", 128), ldi_row("knot", 64)]))
+        rc, out, err = run_report(self.dir)
+        self.assertEqual(rc, 0, err)
+        self.assertIn("1 sections", out)
+        self.assertIn("Layered depth images (2 shapes, 3 LDIs)", (self.dir / "report" / "headline.md").read_text())
+        png_size(self.dir / "report" / "ldi.png")
+        with open(self.dir / "report" / "ldi.csv") as f:
+            self.assertEqual(len(list(csv.DictReader(f))), 3)
+        for bad, says in [("[]", "non-empty JSON list"), (json.dumps([{"shape": "sphere"}]), "lacks ldi_size"),
+                          (json.dumps([ldi_row("sphere", 64, m_crop="big")]), "rows[0].m_crop is not a number"),
+                          (json.dumps([ldi_row("sphere", 64, classified=5000)]), "classified within [0, points]"),
+                          (json.dumps([ldi_row("sphere", 64, misclassified_layers=4001)]), "more points misclassified"),
+                          ("[{", "broken JSON")]:
+            (self.dir / "ldi.json").write_text(bad)
+            rc, _, err = run_report(self.dir)
+            self.assertBroken(rc, err, "ldi.json")
             self.assertIn(says, err, bad)
 
     def test_help(self):
