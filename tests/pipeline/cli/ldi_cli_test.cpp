@@ -33,6 +33,7 @@ TEST(LdiTable1CliTest, RowsPerShapeAndSide) {
     EXPECT_EQ(row.at("layers"), sphere ? 2 : 4) << "d of a sphere and of two nested shells";
     EXPECT_EQ(row.at("d_min"), row.at("layers")) << "the chosen direction has the smallest d";
     EXPECT_EQ(row.at("readers_disagree"), 0) << "compression is lossless";
+    EXPECT_EQ(row.at("gl_parity_mismatches"), 0) << "the model's parity test on GL's LDI is GL's, fetches included";
     EXPECT_EQ(row.at("misclassified_layers"), row.at("misclassified_ranges"));
     EXPECT_EQ(row.at("points"), 300);
     EXPECT_EQ(row.at("uniform_points"), 300);
