@@ -226,7 +226,15 @@ LdiFrameCounts run_frame(const scene::Frame& f, PeelReplay& peel) {
     k.peel_pass_mismatches += p.fragments != d.gl.fragments || p.samples != d.gl.samples_passed ? 1 : 0;
     k.passes.push_back(p);
   }
-  const Ldi model = peel.ldi();
+  // The model's layers break ldi.h's rules only if the rasterizer interpolates a depth outside
+  // [0, 1] (clip positions outside the zero-to-one range with depth clamp on): the trace's fault.
+  const Ldi model = [&] {
+    try {
+      return peel.ldi();
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("frame {}: the model's peel of the recorded draws is not an LDI: {}", frame, e.what()));
+    }
+  }();
   k.layers = model.layer_count();
   k.gl_layers = gl.layer_count;
   const int layers = std::max(k.layers, k.gl_layers);

@@ -139,12 +139,13 @@ TEST(PeelReplayTest, CurvedShapesMatchTheReferenceWithinTolerance) {
         }
         for (std::size_t k = 0; k < d.size(); ++k) depth_mismatches += std::fabs(l.depth(x, y, static_cast<int>(k)) - (d[k] + 1.0)) > 1e-5 ? 1 : 0;
       }
+    RecordProperty(m == &sphere ? "sphere_count_mismatches" : "nested_count_mismatches", count_mismatches);
+    RecordProperty(m == &sphere ? "sphere_covered" : "nested_covered", covered);
     EXPECT_GT(covered, 100);
     EXPECT_LE(count_mismatches, covered * 3 / 100) << "texels whose layer count differs from the reference";
     EXPECT_EQ(depth_mismatches, 0);
     EXPECT_EQ(l.depth_complexity(), deepest) << "the model's d is the reference's";
   }
-  EXPECT_EQ(mesh::make_nested_shells({3, 15, 24}).triangles.empty(), false);
 }
 
 // A box touching the cube's far face: its back face is at depth exactly 1.0, which passes LEQUAL
