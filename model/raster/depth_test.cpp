@@ -4,6 +4,8 @@
 #include <bit>
 #include <cmath>
 
+#include "model/common/error.h"
+
 namespace nbsim::raster {
 
 namespace {
@@ -30,6 +32,40 @@ void run_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint
   k.written += written;
 }
 
+// The peel's path (DepthState::peel_layer or passed_mask set): the strict compare against the
+// previous layer, then the depth test; one pixel at a time (a peel is not the hot path).
+void run_peel_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint16_t mask, const DepthState& state,
+                    bool fused, DepthFormat format, DepthCounters& k) {
+  for (unsigned m = mask; m != 0; m &= m - 1) {
+    const int i = std::countr_zero(m);
+    const int px = x + (i & 3), py = y + (i >> 2);
+    const std::size_t at = static_cast<std::size_t>(py) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(px);
+    const float interpolated = plane.at(px, py, fused);
+    if (state.peel_layer) {
+      ++k.peel_reads;
+      if (!(interpolated > state.peel_layer->texels[at])) {  // strict; NaN and +inf layers drop the fragment
+        ++k.peel_discarded;
+        continue;
+      }
+    }
+    if (!state.test) {
+      ++k.passed;
+      if (state.passed_mask) (*state.passed_mask)[at] = 1;
+      continue;
+    }
+    ++k.depth_tests;
+    const float z = stored_depth(format, interpolated);
+    float& stored = img.texels[at];
+    if (!depth_passes(state.func, z, stored)) continue;
+    ++k.passed;
+    if (state.passed_mask) (*state.passed_mask)[at] = 1;
+    if (state.write) {
+      stored = z;
+      ++k.written;
+    }
+  }
+}
+
 }  // namespace
 
 std::optional<DepthFormat> parse_depth_format(std::string_view n) noexcept {
@@ -53,6 +89,8 @@ DepthCounters& DepthCounters::operator+=(const DepthCounters& o) {
   passed += o.passed;
   written += o.written;
   blocks += o.blocks;
+  peel_reads += o.peel_reads;
+  peel_discarded += o.peel_discarded;
   return *this;
 }
 
@@ -65,6 +103,12 @@ void EarlyDepthTest::test_block(const DepthPlane& plane, int x, int y, std::uint
   const auto n = static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(mask)));
   k.fragments += n;
   k.blocks += 1;
+  if (state.peel_layer || state.passed_mask) {
+    NBSIM_CHECK(!state.peel_layer || state.peel_layer->texels.size() == buffer_->texels.size(), "peel layer of another size");
+    NBSIM_CHECK(!state.passed_mask || state.passed_mask->size() == buffer_->texels.size(), "passed mask of another size");
+    run_peel_block(*buffer_, plane, x, y, mask, state, fused_, format_, k);
+    return;
+  }
   if (!state.test) {
     k.passed += n;
     return;

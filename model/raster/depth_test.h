@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 #include "model/common/depth.h"
 #include "model/raster/setup.h"
@@ -70,6 +71,15 @@ struct DepthState {
   DepthFunc func = DepthFunc::Less;
   bool test = true;   // GL_DEPTH_TEST
   bool write = true;  // glDepthMask
+  // Depth peeling (layered depth images, model/ldi): when set, a second compare before the depth
+  // test, as a peel's fragment shader makes it: a fragment whose interpolated depth is not strictly
+  // greater than `peel_layer` at its pixel (same size as the buffer; +inf where there is no
+  // previous layer, which drops every fragment there) is discarded: counted in `fragments` and
+  // `peel_reads`, never depth tested, never in `passed`. Null (the default): no peel compare.
+  const DepthImage* peel_layer = nullptr;
+  // When set (a vector of buffer-size bytes), the pixels where a sample passed the depth test are
+  // set to 1 (never cleared here): which texels a peel pass wrote, even at the clear value 1.0.
+  std::vector<std::uint8_t>* passed_mask = nullptr;
 };
 
 // Per-draw counters of the depth test (added to, never reset, by the unit).
@@ -79,6 +89,8 @@ struct DepthCounters {
   std::uint64_t passed = 0;       // GL_SAMPLES_PASSED
   std::uint64_t written = 0;      // depth values stored
   std::uint64_t blocks = 0;       // 4x4 blocks with at least one fragment
+  std::uint64_t peel_reads = 0;      // previous-layer reads of the peel compare (DepthState::peel_layer)
+  std::uint64_t peel_discarded = 0;  // fragments the peel compare discarded (not strictly behind the layer)
   DepthCounters& operator+=(const DepthCounters& o);
 };
 

@@ -71,6 +71,7 @@ void DepthStencilTest::test_block(const DepthPlane& plane, bool front_facing, in
     return;
   }
   if (mask == 0) return;
+  NBSIM_CHECK(!ds.peel_layer && !ds.passed_mask, "the peel compare is not modelled with the stencil test on");
   const auto n = static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(mask)));
   dk.fragments += n;
   dk.blocks += 1;

@@ -21,6 +21,7 @@
 #include "model/cp/unit.h"
 #include "model/cull/unit.h"
 #include "model/depth/unit.h"
+#include "model/ldi/unit.h"
 #include "model/geometry/unit.h"
 #include "model/memory/memory.h"
 #include "model/particles/unit.h"
@@ -40,6 +41,7 @@ struct GpuConfig {
   cull::CullUnitConfig cull;
   particles::ParticlesUnitConfig particles;
   shadows::ShadowsUnitConfig shadows;
+  ldi::LdiUnitConfig ldi;
   // The query-structure instances (programs.h structure_instances()) by name, one config each
   // (keys "<name>.<field>"): "nbuffer" and "hiz" for occlusion culling's modes.
   std::map<std::string, nbuffer::NBufferUnitConfig, std::less<>> nbuffers;
@@ -51,7 +53,7 @@ struct GpuConfig {
   int quantum_cycles = 0;
 
   // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.", "particles.",
-  // "shadows.", "nbuffer.", "hiz.", "gpu.").
+  // "shadows.", "ldi.", "nbuffer.", "hiz.", "gpu.").
   static void describe(config::Schema& s, GpuConfig& c);
   // Throws InputError naming the key when a unit's value is out of its limits or inconsistent
   // (the checks the units make when they are built, for a config checked before any run).

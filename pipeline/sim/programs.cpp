@@ -152,7 +152,19 @@ Program shadows(const ProgramContext& c) {
   return p;
 }
 
-constexpr std::array<ProgramRow, 3> kPrograms = {{
+// Layered depth images (Trapp & Doellner): the peel replayed at the LDI's size (LDIL) with its own
+// depth buffer and the strict compare against the previous layer, the model's LDI cropped and
+// compressed and compared with GL's, and the parity test at GL's test points (LDIT).
+Program ldi(const ProgramContext& c) {
+  require_no_cull_mode(c, "an ldi trace peels and tests its own shape");
+  Program p;
+  auto unit = std::make_unique<ldi::LdiUnit>("ldi", c.registry, c.config.ldi, c.memory, c.config.depth.fused_interpolation);
+  p.frames = unit.get();
+  p.unit = std::move(unit);
+  return p;
+}
+
+constexpr std::array<ProgramRow, 4> kPrograms = {{
     {"occlusion_culling",
      "occlusion culling of a scene's objects (cull.mode: trace replays the recorded draws; none, oq, oq_hier, nb, "
      "nb_hier, hiz_tile, hiz_pyramid cull every candidate again)",
@@ -166,6 +178,11 @@ constexpr std::array<ProgramRow, 3> kPrograms = {{
      "rasterized with the stencil test, a min and a max N-buffer built over GL's litmaps and queried per caster, the "
      "decisions and the shadow mask compared with GL's",
      shadows},
+    {"ldi",
+     "layered depth images and the volumetric parity test: GL's peel passes replayed at the LDI's size with the strict "
+     "compare against the previous layer, the model's LDI, crop and compressed texture compared with GL's, and the parity "
+     "test (uncompressed and compressed) at GL's test points against GL's answers and the exact reference",
+     ldi},
 }};
 
 constexpr std::array<StructureInstance, 4> kInstances = {{

@@ -33,6 +33,12 @@ constexpr std::array<const char*, 19> kShadowsFrameCounts = {
     "lookups",     "build_texels",    "litmap_reprojections", "receiver_splats", "volume_draws", "fill", "gl_fill",
     "stencil_tests", "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches"};
 
+// The ldi program's counters in run.json's per-frame values (differences at frame ends).
+constexpr std::array<const char*, 16> kLdiFrameCounts = {
+    "peel_passes", "peel_fragments", "gl_peel_fragments", "peel_samples", "gl_peel_samples", "peel_pass_mismatches", "layers",
+    "gl_layers", "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "test_points", "parity_mismatches_layers",
+    "parity_mismatches_ranges", "misclassified_layers", "misclassified_ranges"};
+
 // A statistic of a group's values (0 when the group has none of that name).
 std::uint64_t stat(const nlohmann::ordered_json& group, const char* name) {
   const auto it = group.find(name);
@@ -155,6 +161,11 @@ class Collector : public depth::ResultSink {
       for (const char* name : kShadowsFrameCounts) pf[name] = stat(now, name) - stat(last_shadows_, name);
       last_shadows_ = now;
     }
+    if (const stats::Group* g = registry_.find("gpu.ldi")) {
+      const nlohmann::ordered_json now = g->values();
+      for (const char* name : kLdiFrameCounts) pf[name] = stat(now, name) - stat(last_ldi_, name);
+      last_ldi_ = now;
+    }
     per_frame_.push_back(std::move(pf));
     last_cycle_ = cycle;
     for (const auto& d : w.frame->draws)
@@ -182,6 +193,7 @@ class Collector : public depth::ResultSink {
   nlohmann::ordered_json last_cull_ = nlohmann::ordered_json::object();  // gpu.cull at the last frame end
   nlohmann::ordered_json last_particles_ = nlohmann::ordered_json::object();  // gpu.particles at the last frame end
   nlohmann::ordered_json last_shadows_ = nlohmann::ordered_json::object();    // gpu.shadows at the last frame end
+  nlohmann::ordered_json last_ldi_ = nlohmann::ordered_json::object();        // gpu.ldi at the last frame end
   std::ofstream draws_, frames_;
   FrameTotals frame_;
   std::uint64_t last_cycle_ = 0;
@@ -316,6 +328,46 @@ nlohmann::ordered_json shadows_summary(const nlohmann::ordered_json& p, std::uin
   return j;
 }
 
+// The ldi program's run totals (summary "ldi"), from its statistics; the per-frame values are
+// run.json's frames. Rates are null when nothing was classified; cycles are the program's own
+// (peel and parity tests), cycles_total the run's.
+nlohmann::ordered_json ldi_summary(const nlohmann::ordered_json& p, const nlohmann::ordered_json& memory, std::uint64_t cycles) {
+  nlohmann::ordered_json j;
+  for (const char* name : {"frames", "peel_passes", "peel_fragments", "gl_peel_fragments", "peel_samples", "gl_peel_samples",
+                           "peel_reads", "peel_discarded", "peel_pass_mismatches", "layers", "gl_layers", "layer_count_mismatches",
+                           "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "m_crop", "m_comp", "test_points",
+                           "parity_mismatches_layers", "parity_mismatches_ranges", "fetch_mismatches_layers",
+                           "fetch_mismatches_ranges", "fetches_layers", "fetches_ranges", "gl_fetches_layers", "gl_fetches_ranges",
+                           "misclassified_layers", "misclassified_ranges", "classified_points", "near_surface_points"})
+    j[name] = stat(p, name);
+  const std::uint64_t classified = stat(p, "classified_points");
+  const auto rate = [classified](std::uint64_t v) {
+    return classified ? nlohmann::ordered_json(static_cast<double>(v) / static_cast<double>(classified)) : nlohmann::ordered_json(nullptr);
+  };
+  j["misclassification_rate_layers"] = rate(stat(p, "misclassified_layers"));
+  j["misclassification_rate_ranges"] = rate(stat(p, "misclassified_ranges"));
+  const std::uint64_t m_crop = stat(p, "m_crop");
+  j["c_ratio"] = m_crop ? nlohmann::ordered_json(static_cast<double>(stat(p, "m_comp")) / static_cast<double>(m_crop))
+                        : nlohmann::ordered_json(nullptr);
+  nlohmann::ordered_json kinds = nlohmann::ordered_json::object();
+  for (const char* kind : {"random", "crop_boundary", "near_surface", "midway"}) {
+    const std::string k(kind);
+    kinds[k] = {{"points", stat(p, ("points_" + k).c_str())},
+                {"classified", stat(p, ("classified_" + k).c_str())},
+                {"misclassified_layers", stat(p, ("misclassified_layers_" + k).c_str())},
+                {"misclassified_ranges", stat(p, ("misclassified_ranges_" + k).c_str())}};
+  }
+  j["by_kind"] = kinds;
+  j["peel_cycles"] = stat(p, "peel_cycles");
+  j["vpt_cycles"] = stat(p, "vpt_cycles");
+  j["cycles"] = stat(p, "peel_cycles") + stat(p, "vpt_cycles");
+  j["cycles_total"] = cycles;
+  j["memory_bytes"] = stat(memory, "bytes_ldi");
+  j["peel_bytes"] = stat(p, "peel_bytes");
+  j["vpt_bytes"] = stat(p, "vpt_bytes");
+  return j;
+}
+
 double rel(std::uint64_t a, std::uint64_t b) {
   if (b == 0) return a == 0 ? 0.0 : 1.0;
   return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
@@ -330,7 +382,12 @@ bool ReplaySummary::within_thresholds() const {
   const bool draws_ok = draws == 0 || static_cast<double>(draws_exact) >= 0.99 * static_cast<double>(draws);
   const bool depth_ok = depth_pixels == 0 || static_cast<double>(depth_pixels_matching) >= 0.9999 * static_cast<double>(depth_pixels);
   const bool stencil_ok = stencil_pixels_matching == stencil_pixels;
-  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok && stencil_ok;
+  // An ldi trace's peel is the program's own replay of GL's peel draws: its fragments and samples
+  // against GL's counters under the same thresholds.
+  const auto counter = [this](const char* name) { return ldi.value(name, std::uint64_t{0}); };
+  const bool ldi_ok = ldi.is_null() || (rel(counter("peel_fragments"), counter("gl_peel_fragments")) <= 1e-4 &&
+                                        rel(counter("peel_samples"), counter("gl_peel_samples")) <= 1e-4);
+  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok && stencil_ok && ldi_ok;
 }
 
 nlohmann::ordered_json ReplaySummary::to_json() const {
@@ -367,6 +424,7 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   if (!cull.is_null()) j["cull"] = cull;
   if (!particles.is_null()) j["particles"] = particles;
   if (!shadows.is_null()) j["shadows"] = shadows;
+  if (!ldi.is_null()) j["ldi"] = ldi;
   return j;
 }
 
@@ -476,6 +534,14 @@ ReplaySummary replay(const ReplayOptions& o) {
                            {"gl_culled", pf.value("gl_culled", std::uint64_t{0})}, {"mask_diff", pf.value("mask_diff", std::uint64_t{0})},
                            {"mask_diff_infinite", pf.value("mask_diff_infinite", std::uint64_t{0})}, {"cycles", pf["cycles"]}});
     s.shadows["per_frame"] = per_frame;
+  }
+
+  if (s.stats.contains("gpu.ldi")) {
+    s.ldi = ldi_summary(s.stats["gpu.ldi"], s.stats.contains("gpu.memory") ? s.stats["gpu.memory"] : nlohmann::ordered_json::object(),
+                        sink.last_frame_cycle());
+    for (const char* key : {"shape", "seed"})
+      for (const auto& [k, v] : tr.properties())
+        if (k == key) s.ldi[key] = v;
   }
 
   if (o.out) {

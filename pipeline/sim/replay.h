@@ -72,6 +72,10 @@ struct ReplaySummary {
   // Shadows traces: totals, per-frame averages and per-frame values of the shadows program
   // (shadows_summary in replay.cpp), the header's shadow_mode and scene; null otherwise.
   nlohmann::ordered_json shadows;
+  // LDI traces: totals of the ldi program (ldi_summary in replay.cpp: the peel against GL's
+  // counters, the LDI, crop and compressed texture against GL's, the parity tests against GL's
+  // answers and the exact reference, cycles and memory), the header's shape; null otherwise.
+  nlohmann::ordered_json ldi;
 
   double fragment_error() const;  // |model - gl| / gl over all draws
   double passed_error() const;
