@@ -55,7 +55,9 @@ PeelReplay::PeelReplay(int width, int height, bool fused_interpolation)
       depth_(path_config(width, height, fused_interpolation).width_px, height, 1.0f),
       previous_(width, height, kInvalidDepth),
       written_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0),
-      path_(path_config(width, height, fused_interpolation), depth_) {}
+      path_(path_config(width, height, fused_interpolation), depth_) {
+  path_.set_reuse_rasterization(true);  // every pass draws the same mesh: its blocks are walked once a frame
+}
 
 void PeelReplay::begin_frame() {
   layers_.clear();

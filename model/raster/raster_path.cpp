@@ -1,6 +1,7 @@
 // RasterPath: geometry -> setup -> rasterizer -> stencil and early depth test for one draw; see raster_path.h.
 #include "model/raster/raster_path.h"
 
+#include <cstring>
 #include <string>
 
 #include "model/common/error.h"
@@ -52,16 +53,48 @@ RasterPath::RasterPath(const RasterPathConfig& config, DepthImage& depth, Stenci
       own_stencil_(stencil ? nullptr : std::make_unique<StencilImage>(check_size(config, depth).width, depth.height, 0)),
       test_(check_size(config, depth), stencil ? *stencil : *own_stencil_, config.fused_interpolation, config.depth_format) {}
 
+namespace {
+
+bool same_state(const geometry::GeometryState& a, const geometry::GeometryState& b) noexcept {
+  return a.clip == b.clip && a.face.cull == b.face.cull && a.face.front_ccw == b.face.front_ccw && a.depth_clamp == b.depth_clamp;
+}
+
+bool same_positions(std::span<const geometry::ClipPosition> a, const std::vector<geometry::ClipPosition>& b) noexcept {
+  // Bit-identical (a NaN equals itself here, -0.0 differs from +0.0): memcmp of the floats.
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(geometry::ClipPosition)) == 0);
+}
+
+}  // namespace
+
 DrawCounters RasterPath::draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state) {
   DrawCounters k;
+  if (reuse_ && cached_ && same_state(state.geometry, cached_state_) && same_positions(clip_positions, cached_positions_)) {
+    k.geometry = cached_geometry_, k.setup = cached_setup_, k.tiles = cached_tiles_;
+    for (const CachedBlock& b : cached_blocks_)
+      test_.test_block(cached_planes_[b.triangle], cached_front_[b.triangle] != 0, b.x, b.y, b.mask, state.depth, state.stencil,
+                       k.depth, k.stencil);
+    return k;
+  }
   triangles_.clear();
   geometry_.process(clip_positions, state.geometry, triangles_, k.geometry);
+  if (reuse_) {
+    cached_planes_.clear(), cached_front_.clear(), cached_blocks_.clear();
+  }
   SetupTriangle t;
   for (const geometry::WindowTriangle& w : triangles_) {
     if (setup_.setup(w, state.geometry.face, t, k.setup) != SetupResult::Accepted) continue;
+    const auto triangle = static_cast<std::uint32_t>(cached_planes_.size());
+    if (reuse_) cached_planes_.push_back(t.depth), cached_front_.push_back(t.front_facing ? 1 : 0);
     rasterizer_.rasterize(t, k.tiles, [&](int x, int y, std::uint16_t mask) {
+      if (reuse_) cached_blocks_.push_back({x, y, mask, triangle});
       test_.test_block(t.depth, t.front_facing, x, y, mask, state.depth, state.stencil, k.depth, k.stencil);
     });
+  }
+  if (reuse_) {
+    cached_ = true;
+    cached_positions_.assign(clip_positions.begin(), clip_positions.end());
+    cached_state_ = state.geometry;
+    cached_geometry_ = k.geometry, cached_setup_ = k.setup, cached_tiles_ = k.tiles;
   }
   return k;
 }
@@ -69,6 +102,7 @@ DrawCounters RasterPath::draw(std::span<const geometry::ClipPosition> clip_posit
 DrawCounters RasterPath::draw_points(std::span<const geometry::ClipPosition> clip_positions,
                                      std::span<const float> point_sizes, const DrawState& state) {
   DrawCounters k;
+  cached_ = false;
   points_.clear();
   geometry_.process_points(clip_positions, point_sizes, state.geometry, points_, k.geometry);
   SetupTriangle t;

@@ -59,6 +59,16 @@ class RasterPath {
   DrawCounters draw_points(std::span<const geometry::ClipPosition> clip_positions, std::span<const float> point_sizes,
                            const DrawState& state);
 
+  // Rasterization reuse, a host-speed option (counts never depend on it): when on, a triangle draw
+  // whose clip positions and geometry state are bit-identical to the previous triangle draw's skips
+  // clipping, setup and the tile walk and runs the depth (and stencil) tests over the previous
+  // draw's blocks again, in the same order, with the same geometry, setup and tile counters. The
+  // depth passes of a peel draw one mesh per pass. Off by default; a points draw forgets the cache.
+  void set_reuse_rasterization(bool on) noexcept {
+    reuse_ = on;
+    cached_ = false;
+  }
+
   const RasterPathConfig& config() const noexcept { return config_; }
   DepthImage& depth() noexcept { return test_.depth(); }
   StencilImage& stencil() noexcept { return test_.stencil(); }
@@ -74,6 +84,22 @@ class RasterPath {
   DepthStencilTest test_;
   std::vector<geometry::WindowTriangle> triangles_;  // reused from draw to draw
   std::vector<geometry::WindowPoint> points_;        // likewise
+  // The previous triangle draw's rasterization (set_reuse_rasterization): its inputs, counters,
+  // each accepted triangle's depth plane and facing, and its blocks in rasterization order.
+  struct CachedBlock {
+    std::int32_t x, y;
+    std::uint16_t mask;
+    std::uint32_t triangle;
+  };
+  bool reuse_ = false, cached_ = false;
+  std::vector<geometry::ClipPosition> cached_positions_;
+  geometry::GeometryState cached_state_;
+  geometry::GeometryCounters cached_geometry_;
+  SetupCounters cached_setup_;
+  TileCounters cached_tiles_;
+  std::vector<DepthPlane> cached_planes_;
+  std::vector<std::uint8_t> cached_front_;
+  std::vector<CachedBlock> cached_blocks_;
 };
 
 }  // namespace nbsim::raster

@@ -25,6 +25,7 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
   c.technique = o.technique;
   c.scene = o.scene.empty() ? "city" : o.scene;
   const bool particles = o.technique == "particles";
+  const bool ldi = o.technique == "ldi";
   if (c.scene != "city" && o.technique != "shadows")
     throw InputError(fmt::format("--scene {}: {} benches the city only (the other scenes are the shadows technique's)", c.scene,
                                  o.technique));
@@ -45,6 +46,14 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
       throw InputError(fmt::format("--mode '{}' is not a shadows mode (infinite, culled, clamped)", mode));
     c.path = "fly";
     c.options = {{"shadow-mode", mode}, {"levels-every", "0"}};
+  } else if (ldi) {
+    // The LDI work does not look at the observer: the smallest scene the capture accepts.
+    if (!mode.empty()) throw InputError("--mode is not an ldi option (the shape is --shape)");
+    mode = o.shape.empty() ? "knot" : o.shape;
+    c.scene = "boxes";
+    c.path = "fly";
+    c.width = c.height = 8;
+    c.options = {{"boxes", "0"}, {"shape", mode}, {"ldi-size", std::to_string(o.ldi_size)}};
   } else {
     throw InputError(fmt::format("--technique '{}' is not one of {}", o.technique, fmt::join(kReplayBenchTechniques, ", ")));
   }
@@ -73,6 +82,7 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
     j["sprite"] = o.sprite;
   }
   if (o.technique == "shadows") j["scene"] = c.scene;
+  if (ldi) j["ldi_size"] = o.ldi_size;
   j["draws"] = s.draws;
   j["gl_ms"] = cap.gl_ms;
   j["replay_ms"] = s.host_seconds * 1e3;
@@ -89,6 +99,7 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
     sh.erase("per_frame");
     j["shadows_summary"] = std::move(sh);
   }
+  if (ldi && !s.ldi.is_null()) j["ldi_summary"] = s.ldi;
   return j;
 }
 

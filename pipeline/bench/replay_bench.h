@@ -2,7 +2,8 @@
 // the GL technique passes) and replays the same trace through the SystemC model in the same run,
 // so the ratio of the two compares like with like on this machine, now. Techniques: occlusion
 // culling (the city walk), particles (scene, partial N-buffer or Hi-Z build, culled sprites) and
-// shadows (observer depth, litmaps, min and max N-buffers, the mode's stencil shadow volumes).
+// shadows (observer depth, litmaps, min and max N-buffers, the mode's stencil shadow volumes) and
+// layered depth images (viewpoint selection, the peel, crop, compression and the parity tests).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -24,15 +25,19 @@ struct ReplayBenchOptions {
   // The scene (city, or for shadows also terrain and boxes); empty: city. Shadows fly over it (the
   // terrain and the boxes have no streets to walk).
   std::string scene;
+  // The ldi technique: the shape (model/mesh/shapes.h's table; empty: knot) and the LDI's side.
+  std::string shape;
+  int ldi_size = 256;
 };
 
 // The technique names the bench accepts (the capture's plug-in names).
-inline constexpr const char* kReplayBenchTechniques[] = {"occlusion_culling", "particles", "shadows"};
+inline constexpr const char* kReplayBenchTechniques[] = {"occlusion_culling", "particles", "shadows", "ldi"};
 
 // One JSON object: technique, frames, gl_ms (llvmpipe, technique passes), replay_ms, ratio replay/gl,
 // depth tests and cycles per host second, and whether the comparison stayed within thresholds;
 // for particles also the particle count, sprite and the replay's particles summary; for shadows
-// the scene and the replay's shadows summary when the replay has one. Throws
+// the scene and the replay's shadows summary when the replay has one; for ldi the shape, the LDI's
+// side and the replay's ldi summary. Throws
 // InputError for an unknown technique or mode, or options the capture refuses.
 nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& options);
 

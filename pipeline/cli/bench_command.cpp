@@ -112,19 +112,26 @@ void add_bench_commands(CLI::App& app, Action& action) {
     rep->add_option("--scene", ro->scene, "Scene: city (default); shadows also terrain or boxes (flown over)");
     rep->add_option("--particles", ro->particles, "Particles a frame (technique particles)")->capture_default_str();
     rep->add_option("--sprite", ro->sprite, "Sprite size: 16, 24 or atten (technique particles)")->capture_default_str();
+    rep->add_option("--shape", ro->shape, "Shape peeled (technique ldi; default knot): sphere, knot, nested, coil, box");
+    rep->add_option("--ldi-size", ro->ldi_size, "LDI side, texels (technique ldi)")->check(CLI::Range(1, 4096))->capture_default_str();
     rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes; particles: scene, partial N-buffer or Hi-Z\n"
                 "build and the culled particle draws, not the reference pass), replay_ms (the SystemC model), ratio\n"
                 "replay/gl, depth_tests_per_s and cycles_per_s of the model, measured in the same run; for particles\n"
                 "also particles_summary (the replay's particles totals), for shadows shadows_summary (fill, casters\n"
                 "culled, mask pixels differing, N-buffer cost). Shadows: gl_ms spans the observer's depth, the litmaps,\n"
                 "both N-buffers, the CPU's per-caster work and the volumes, not the reference pass; the model replays\n"
-                "the observer and volume draws and builds both N-buffers, and takes the litmaps as GL made them.");
+                "the observer and volume draws and builds both N-buffers, and takes the litmaps as GL made them.\n"
+                "Ldi: gl_ms spans viewpoint selection, the peel, crop, compression and GL's parity tests (not the exact\n"
+                "reference on the CPU); the model replays the peel passes, crops, compresses and runs both parity tests;\n"
+                "--size is ignored (the LDI is --ldi-size square).");
     rep->callback([&action, ro] {
       action = [ro] {
         parse_size(ro->size, "--size");
         if (ro->technique != "particles" && (ro->particles != bench::ReplayBenchOptions{}.particles ||
                                              ro->sprite != bench::ReplayBenchOptions{}.sprite))
           throw InputError("--particles and --sprite need --technique particles");
+        if (ro->technique != "ldi" && (!ro->shape.empty() || ro->ldi_size != bench::ReplayBenchOptions{}.ldi_size))
+          throw InputError("--shape and --ldi-size need --technique ldi");
         fmt::print("{}\n", bench::run_replay_bench(*ro).dump());
         return 0;
       };

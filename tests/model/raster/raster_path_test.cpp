@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "model/common/depth.h"
@@ -14,6 +15,7 @@ namespace {
 
 using geometry::ClipControl;
 using geometry::ClipPosition;
+using geometry::CullFace;
 
 // A draw into a cleared buffer passes everywhere; the same draw again ties: LESS rejects every
 // fragment, LEQUAL passes every one. Reversed Z (GREATER, clear 0) behaves the same way.
@@ -37,6 +39,43 @@ TEST(RasterPathTest, RepeatedDrawTiesAtEqualDepth) {
     st.depth.func = reversed ? DepthFunc::Gequal : DepthFunc::Lequal;
     st.depth.write = false;
     EXPECT_EQ(path.draw(quad, st).depth.passed, first.depth.fragments) << "non-strict test passes ties";
+  }
+}
+
+// Rasterization reuse (set_reuse_rasterization) changes no count and no depth: a sequence of draws
+// (the same triangles again, then moved ones, then the first again, under other depth funcs) gives
+// the same counters and buffer with it on as off; a moved vertex or another face state is not reused.
+TEST(RasterPathTest, ReuseOfTheRasterizationChangesNothing) {
+  std::vector<ClipPosition> a;
+  for (int i = 0; i < 40; ++i) {  // overlapping triangles of varied depth
+    const float x = -0.9f + 0.04f * i, z = 0.1f + 0.02f * (i % 7);
+    a.insert(a.end(), {{x, -0.8f, z, 1}, {x + 0.5f, -0.5f + 0.01f * i, z + 0.3f, 1}, {x + 0.1f, 0.7f, 0.9f - z, 1}});
+  }
+  std::vector<ClipPosition> b = a;
+  b[5][0] = std::nextafter(b[5][0], 1.0f);  // one ulp: not the same draw
+  struct Step {
+    const std::vector<ClipPosition>* positions;
+    DepthFunc func;
+    CullFace cull;
+  };
+  const Step steps[] = {{&a, DepthFunc::Lequal, CullFace::None}, {&a, DepthFunc::Less, CullFace::None},
+                        {&b, DepthFunc::Lequal, CullFace::None}, {&a, DepthFunc::Greater, CullFace::None},
+                        {&a, DepthFunc::Lequal, CullFace::Back}, {&a, DepthFunc::Always, CullFace::Back}};
+  DepthImage off(80, 72, 1.0f), on(80, 72, 1.0f);
+  RasterPath plain({80, 72, 85, true, true}, off), reusing({80, 72, 85, true, true}, on);
+  reusing.set_reuse_rasterization(true);
+  for (const Step& st : steps) {
+    DrawState ds;
+    ds.geometry.face.cull = st.cull;
+    ds.depth.func = st.func;
+    const DrawCounters p = plain.draw(*st.positions, ds), r = reusing.draw(*st.positions, ds);
+    EXPECT_EQ(r.geometry.prims_out, p.geometry.prims_out);
+    EXPECT_EQ(r.setup.culled, p.setup.culled);
+    EXPECT_EQ(r.tiles.blocks16_partial, p.tiles.blocks16_partial);
+    EXPECT_EQ(r.depth.fragments, p.depth.fragments);
+    EXPECT_EQ(r.depth.passed, p.depth.passed);
+    EXPECT_EQ(r.depth.written, p.depth.written);
+    ASSERT_EQ(on.texels, off.texels) << "the buffers after each draw are the same";
   }
 }
 

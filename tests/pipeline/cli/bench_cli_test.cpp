@@ -1,4 +1,4 @@
-// BenchReplayCliTest: `nbsim bench replay` from the outside, for particles and shadows: one JSON
+// BenchReplayCliTest: `nbsim bench replay` from the outside, for particles, shadows and ldi: one JSON
 // object with llvmpipe's time, the model's replay time and their ratio, measured in the same run
 // (the ratio is printed and recorded, never asserted: it depends on the machine), and bad
 // arguments refused with exit 2.
@@ -69,7 +69,32 @@ TEST(BenchReplayCliTest, BadArgumentsExitTwo) {
                            {"--mode hiz", "--mode 'hiz' is not an occlusion_culling mode"},
                            {"--particles 500", "--particles and --sprite need --technique particles"},
                            {"--technique particles --particles 0", "--particles 0 is out of range"},
-                           {"--technique particles --sprite 32", "--sprite '32' is not one of 16, 24, atten"}});
+                           {"--technique particles --sprite 32", "--sprite '32' is not one of 16, 24, atten"},
+                           {"--shape knot", "--shape and --ldi-size need --technique ldi"},
+                           {"--technique ldi --mode nb", "--mode is not an ldi option"},
+                           {"--technique ldi --shape teapot", "teapot"},
+                           {"--technique ldi --ldi-size 0", "--ldi-size"}});
+}
+
+// A small LDI capture (the knot at 64x64) replayed in the same run: the peel passes' fragments and
+// samples equal GL's, and the model's parity answers GL's (within_thresholds covers both).
+TEST(BenchReplayCliTest, LdiRatioPrinted) {
+  const CliResult r = run_nbsim("bench replay --technique ldi --frames 2 --ldi-size 64");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("technique"), "ldi");
+  EXPECT_EQ(j.at("mode"), "knot") << "the ldi bench's default shape";
+  EXPECT_EQ(j.at("ldi_size"), 64);
+  EXPECT_TRUE(j.at("within_thresholds").get<bool>());
+  const nlohmann::json& s = j.at("ldi_summary");
+  EXPECT_EQ(s.at("peel_fragments"), s.at("gl_peel_fragments"));
+  EXPECT_EQ(s.at("peel_samples"), s.at("gl_peel_samples"));
+  EXPECT_EQ(s.at("parity_mismatches_layers"), 0);
+  EXPECT_EQ(s.at("parity_mismatches_ranges"), 0);
+  const std::string ratio = std::to_string(j.at("ratio").get<double>());
+  ::testing::Test::RecordProperty("ldi_replay_ratio", ratio);
+  std::printf("bench replay ldi knot 64x64, 2 frames: ratio %s (gl %.1f ms, replay %.1f ms)\n", ratio.c_str(),
+              j.at("gl_ms").get<double>(), j.at("replay_ms").get<double>());
 }
 
 }  // namespace
