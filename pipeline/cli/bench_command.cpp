@@ -112,7 +112,7 @@ void add_bench_commands(CLI::App& app, Action& action) {
     rep->add_option("--scene", ro->scene, "Scene: city (default); shadows also terrain or boxes (flown over)");
     rep->add_option("--particles", ro->particles, "Particles a frame (technique particles)")->capture_default_str();
     rep->add_option("--sprite", ro->sprite, "Sprite size: 16, 24 or atten (technique particles)")->capture_default_str();
-    rep->add_option("--shape", ro->shape, "Shape peeled (technique ldi; default knot): sphere, knot, nested, coil, box");
+    rep->add_option("--shape", ro->shape, "Shape peeled (technique ldi; default knot): sphere, knot, nested, coil");
     rep->add_option("--ldi-size", ro->ldi_size, "LDI side, texels (technique ldi)")->check(CLI::Range(1, 4096))->capture_default_str();
     rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes; particles: scene, partial N-buffer or Hi-Z\n"
                 "build and the culled particle draws, not the reference pass), replay_ms (the SystemC model), ratio\n"

@@ -335,7 +335,7 @@ void add_ldi_commands(CLI::App& app, Action& action) {
   auto* t = ldi->add_subcommand(
       "table1", "Table 1 on llvmpipe: viewpoint selection, peel, crop and compression per shape and LDI side, and the parity "
                 "test's misclassification against the exact reference");
-  t->add_option("--shapes", a->shapes, "Procedural shapes, NAME or NAME:PARAMETER (model/mesh/shapes.h: sphere, knot, nested:K, coil:T, box)")
+  t->add_option("--shapes", a->shapes, "Procedural shapes, NAME or NAME:PARAMETER (model/mesh/shapes.h: sphere, knot, nested:K, coil:T)")
       ->delimiter(',')
       ->capture_default_str();
   t->add_option("--mesh", a->meshes, "A closed mesh file (any format assimp reads); repeat for more");
