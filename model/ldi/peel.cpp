@@ -98,18 +98,6 @@ PeelPassCounts PeelReplay::pass(std::span<const geometry::ClipPosition> clip_pos
 
 Ldi PeelReplay::ldi() const { return Ldi(width_, height_, layer_count_, layers_); }
 
-raster::DrawState draw_state(const scene::DepthState& t) {
-  raster::DrawState s;
-  s.geometry.clip = static_cast<geometry::ClipControl>(t.clip);
-  s.geometry.face.cull = static_cast<geometry::CullFace>(t.cull);
-  s.geometry.face.front_ccw = t.front_ccw;
-  s.geometry.depth_clamp = t.depth_clamp;
-  s.depth.func = static_cast<raster::DepthFunc>(t.func);
-  s.depth.test = t.test;
-  s.depth.write = t.write;
-  return s;
-}
-
 namespace {
 
 const scene::TechniqueRecord& image_record(const scene::Frame& f) {

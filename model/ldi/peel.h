@@ -77,9 +77,8 @@ class PeelReplay {
   bool ended_ = false;
 };
 
-// The raster state of a recorded draw (its depth func, test, write, cull, winding, clip control,
-// depth clamp), the stencil test off.
-raster::DrawState draw_state(const scene::DepthState& s);
+// The raster state of a recorded draw (model/raster/raster_path.h).
+using raster::draw_state;
 
 // GL's LDI image of a frame (LDIL), checked: InputError naming the frame and the problem (a missing
 // record or field, sizes that do not match, NaN or out-of-range depths, a crop outside the LDI).

@@ -66,6 +66,18 @@ bool same_positions(std::span<const geometry::ClipPosition> a, const std::vector
 
 }  // namespace
 
+DrawState draw_state(const scene::DepthState& t) {
+  DrawState s;
+  s.geometry.clip = static_cast<geometry::ClipControl>(t.clip);
+  s.geometry.face.cull = static_cast<geometry::CullFace>(t.cull);
+  s.geometry.face.front_ccw = t.front_ccw;
+  s.geometry.depth_clamp = t.depth_clamp;
+  s.depth.func = static_cast<DepthFunc>(t.func);
+  s.depth.test = t.test;
+  s.depth.write = t.write;
+  return s;
+}
+
 DrawCounters RasterPath::draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state) {
   DrawCounters k;
   if (reuse_ && cached_ && same_state(state.geometry, cached_state_) && same_positions(clip_positions, cached_positions_)) {

@@ -15,6 +15,7 @@
 #include "model/raster/rasterizer.h"
 #include "model/raster/setup.h"
 #include "model/raster/stencil_test.h"
+#include "model/scene/frame.h"
 
 namespace nbsim::raster {
 
@@ -33,6 +34,10 @@ struct DrawState {
   DepthState depth;
   StencilState stencil;  // test off: the stencil buffer is not touched
 };
+
+// The path's state for a recorded draw (its depth func, test, write, cull, winding, clip control
+// and depth clamp; the stencil test off).
+DrawState draw_state(const scene::DepthState& recorded);
 
 // Everything counted for one draw (or summed over many).
 struct DrawCounters {

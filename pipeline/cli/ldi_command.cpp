@@ -157,19 +157,9 @@ nlohmann::ordered_json measure(const Shape& shape, int size, const Table1Args& a
   check(pts.x, pts.y, pts.z, gl);
   check(ux, uy, uz, uniform);
 
-  std::uint64_t near = 0, wrong_layers = 0, wrong_ranges = 0, fetch_layers = 0, fetch_ranges = 0, disagree = 0;
-  for (std::size_t p = 0; p < reference.size(); ++p) {
-    fetch_layers += gl.fetches_layers[p];
-    fetch_ranges += gl.fetches_ranges[p];
-    disagree += gl.inside_layers[p] != gl.inside_ranges[p];
-    if (reference[p] < 0) {
-      ++near;
-      continue;
-    }
-    const std::uint32_t inside = static_cast<std::uint32_t>(reference[p]) & 1u;
-    wrong_layers += gl.inside_layers[p] != inside;
-    wrong_ranges += gl.inside_ranges[p] != inside;
-  }
+  const capture::VptScore score = capture::score_vpt(gl, reference);
+  const std::uint64_t near = score.near_surface, wrong_layers = score.wrong_layers, wrong_ranges = score.wrong_ranges,
+                      fetch_layers = score.fetches_layers, fetch_ranges = score.fetches_ranges, disagree = score.readers_disagree;
   std::uint32_t d_min = 0, d_max = 0;
   for (std::size_t i = 0; i < b.candidate_d.size(); ++i) {
     d_min = i == 0 ? b.candidate_d[i] : std::min(d_min, b.candidate_d[i]);

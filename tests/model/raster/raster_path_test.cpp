@@ -48,8 +48,8 @@ TEST(RasterPathTest, RepeatedDrawTiesAtEqualDepth) {
 TEST(RasterPathTest, ReuseOfTheRasterizationChangesNothing) {
   std::vector<ClipPosition> a;
   for (int i = 0; i < 40; ++i) {  // overlapping triangles of varied depth
-    const float x = -0.9f + 0.04f * i, z = 0.1f + 0.02f * (i % 7);
-    a.insert(a.end(), {{x, -0.8f, z, 1}, {x + 0.5f, -0.5f + 0.01f * i, z + 0.3f, 1}, {x + 0.1f, 0.7f, 0.9f - z, 1}});
+    const float fi = static_cast<float>(i), x = -0.9f + 0.04f * fi, z = 0.1f + 0.02f * static_cast<float>(i % 7);
+    a.insert(a.end(), {{x, -0.8f, z, 1}, {x + 0.5f, -0.5f + 0.01f * fi, z + 0.3f, 1}, {x + 0.1f, 0.7f, 0.9f - z, 1}});
   }
   std::vector<ClipPosition> b = a;
   b[5][0] = std::nextafter(b[5][0], 1.0f);  // one ulp: not the same draw

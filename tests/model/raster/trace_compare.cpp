@@ -36,18 +36,6 @@ void compare_depth(const DepthImage& model, const trace::DepthSnapshot& gl, doub
 
 }  // namespace
 
-raster::DrawState draw_state(const trace::DepthState& t) {
-  raster::DrawState s;
-  s.geometry.clip = static_cast<geometry::ClipControl>(t.clip);
-  s.geometry.face.cull = static_cast<geometry::CullFace>(t.cull);
-  s.geometry.face.front_ccw = t.front_ccw;
-  s.geometry.depth_clamp = t.depth_clamp;
-  s.depth.func = static_cast<raster::DepthFunc>(t.func);
-  s.depth.test = t.test;
-  s.depth.write = t.write;
-  return s;
-}
-
 bool CompareSummary::within_thresholds() const {
   const auto rel = [](std::uint64_t a, std::uint64_t b) {
     return b == 0 ? (a == 0 ? 0.0 : 1.0)

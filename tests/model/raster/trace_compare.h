@@ -67,7 +67,7 @@ CompareSummary compare_trace(const std::filesystem::path& trace, const CompareOp
 // One JSON object with the summary's numbers (no mismatch list).
 std::string to_json(const CompareSummary& s);
 
-// The model's draw state for a trace record.
-raster::DrawState draw_state(const trace::DepthState& s);
+// The model's draw state for a trace record (model/raster/raster_path.h).
+using raster::draw_state;
 
 }  // namespace nbsim::raster_compare

@@ -365,4 +365,21 @@ GlVptAnswers gl_vpt(const LdiBuild& b, const std::vector<std::int32_t>& x, const
   return a;
 }
 
+VptScore score_vpt(const GlVptAnswers& gl, const std::vector<std::int32_t>& reference) {
+  VptScore v;
+  for (std::size_t p = 0; p < reference.size(); ++p) {
+    v.fetches_layers += gl.fetches_layers[p];
+    v.fetches_ranges += gl.fetches_ranges[p];
+    v.readers_disagree += gl.inside_layers[p] != gl.inside_ranges[p];
+    if (reference[p] < 0) {
+      ++v.near_surface;
+      continue;
+    }
+    const std::uint32_t inside = static_cast<std::uint32_t>(reference[p]) & 1u;
+    v.wrong_layers += gl.inside_layers[p] != inside;
+    v.wrong_ranges += gl.inside_ranges[p] != inside;
+  }
+  return v;
+}
+
 }  // namespace nbsim::capture

@@ -77,4 +77,15 @@ struct GlVptAnswers {
 GlVptAnswers gl_vpt(const LdiBuild& b, const std::vector<std::int32_t>& x, const std::vector<std::int32_t>& y,
                     const std::vector<float>& z);
 
+// GL's answers scored against the exact reference (test_points.h: crossings beyond each point, odd:
+// inside; kLdiNearSurface: counted apart), and the fetches both readers made.
+struct VptScore {
+  std::uint64_t near_surface = 0;     // points with reference -1, not classified
+  std::uint64_t wrong_layers = 0;     // classified points the uncompressed reader answers wrongly
+  std::uint64_t wrong_ranges = 0;     // likewise, the compressed reader
+  std::uint64_t readers_disagree = 0; // points where the readers' answers differ (0: compression is lossless)
+  std::uint64_t fetches_layers = 0, fetches_ranges = 0;
+};
+VptScore score_vpt(const GlVptAnswers& gl, const std::vector<std::int32_t>& reference);
+
 }  // namespace nbsim::capture

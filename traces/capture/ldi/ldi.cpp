@@ -176,19 +176,10 @@ class Ldi final : public Technique {
     const mesh::CrossingReference ref(m, b.map.frame);
     std::vector<std::int32_t> reference = reference_crossings(ref, b.map, pts, epsilon_);
 
-    std::uint64_t near = 0, wrong_layers = 0, wrong_ranges = 0, disagree = 0, fetch_layers = 0, fetch_ranges = 0, fragments = 0;
-    for (std::size_t p = 0; p < reference.size(); ++p) {
-      fetch_layers += gl.fetches_layers[p];
-      fetch_ranges += gl.fetches_ranges[p];
-      disagree += gl.inside_layers[p] != gl.inside_ranges[p];
-      if (reference[p] < 0) {
-        ++near;
-        continue;
-      }
-      const std::uint32_t inside = static_cast<std::uint32_t>(reference[p]) & 1u;
-      wrong_layers += gl.inside_layers[p] != inside;
-      wrong_ranges += gl.inside_ranges[p] != inside;
-    }
+    const VptScore score = score_vpt(gl, reference);
+    const std::uint64_t near = score.near_surface, wrong_layers = score.wrong_layers, wrong_ranges = score.wrong_ranges,
+                        disagree = score.readers_disagree, fetch_layers = score.fetches_layers, fetch_ranges = score.fetches_ranges;
+    std::uint64_t fragments = 0;
     for (const scene::DrawRecord& d : f.draws) fragments += d.gl.fragments;
 
     const auto& fr = b.map.frame;
