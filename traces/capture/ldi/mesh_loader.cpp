@@ -172,8 +172,10 @@ mesh::TriMesh load_mesh(const std::string& path, const MeshLoadLimits& limits) {
   if (!got.empty() && got[0] == 'E') throw InputError(got.substr(1));
   std::uint64_t counts[2] = {0, 0};
   if (got.size() < 1 + sizeof counts || got[0] != 'M')
-    throw InputError(fmt::format("mesh file '{}' does not load: the reader stopped without an answer (exit status {})", path,
-                                 WIFEXITED(status) ? WEXITSTATUS(status) : -1));
+    // (A sanitizer build's handler turns a crash into exit status 1.)
+    throw InputError(fmt::format("mesh file '{}' does not load: assimp crashed or stopped reading it (its process exited with "
+                                 "status {} without an answer)",
+                                 path, WIFEXITED(status) ? WEXITSTATUS(status) : -1));
   std::memcpy(counts, got.data() + 1, sizeof counts);
   const std::uint64_t need = 1 + sizeof counts + counts[0] * sizeof(mesh::Vec3f) + counts[1] * sizeof(mesh::Tri);
   if (counts[0] > got.size() || counts[1] > got.size() || got.size() != need)
