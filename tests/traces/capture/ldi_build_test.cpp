@@ -23,7 +23,7 @@
 #include "traces/capture/ldi/build.h"
 #include "traces/capture/ldi/test_points.h"
 #include "traces/format/ldi_chunk.h"
-#include "traces/gl/context.h"
+#include "tests/common/gl_context_suite.h"
 
 namespace nbsim::capture {
 namespace {
@@ -45,15 +45,7 @@ mesh::TriMesh stacked_boxes() {
   return a;
 }
 
-class LdiBuildTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { context_ = new gl::Context(); }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
-  static inline gl::Context* context_ = nullptr;
-};
+class LdiBuildTest : public testing::GlContextSuite {};
 
 struct Case {
   const char* what;

@@ -16,7 +16,7 @@
 #include "model/mesh/crossings.h"
 #include "model/mesh/shapes.h"
 #include "traces/capture/ldi/peel.h"
-#include "traces/gl/context.h"
+#include "tests/common/gl_context_suite.h"
 
 namespace nbsim::capture {
 namespace {
@@ -129,15 +129,7 @@ mesh::TriMesh placed(const char* shape, std::optional<int> parameter = std::null
 // An axis-aligned box [x0, x1] x [y0, y1] x [z0, z1], outward counter-clockwise.
 mesh::TriMesh box(float x0, float x1, float y0, float y1, float z0, float z1) { return mesh::make_box({x0, y0, z0}, {x1, y1, z1}); }
 
-class LdiPeelTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { context_ = new gl::Context(); }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
-  static inline gl::Context* context_ = nullptr;
-};
+class LdiPeelTest : public testing::GlContextSuite {};
 
 std::vector<mesh::OrthoFrame> directions() {
   return {mesh::OrthoFrame::look_along({0, 0, -1}),  mesh::OrthoFrame::look_along({1, 0, 0}),
