@@ -8,9 +8,9 @@ namespace nbsim::scene {
 namespace {
 
 // One name table per enum, indexed by the enum's fixed value.
-constexpr std::array<std::string_view, 14> kRoleNames = {"occluder",      "bounds_query", "node_query",    "nbuffer_build", "nbuffer_query",
+constexpr std::array<std::string_view, 15> kRoleNames = {"occluder",      "bounds_query", "node_query",    "nbuffer_build", "nbuffer_query",
                                                          "visible",       "id_buffer",    "scene",         "particles",     "hiz_build",
-                                                         "shadow_volume", "litmap",       "receiver_splat", "ldi_peel"};
+                                                         "shadow_volume", "litmap",       "receiver_splat", "ldi_peel", "relief_box"};
 constexpr std::array<std::string_view, 2> kDepthWhichNames = {"after_occluders", "final"};
 constexpr std::array<std::string_view, 8> kDepthFuncNames = {"never",   "less",     "equal",  "lequal",
                                                              "greater", "notequal", "gequal", "always"};

@@ -57,6 +57,7 @@ enum class DrawRole : std::uint8_t {
   Litmap = 11,        // a scene object drawn from the light into a litmap, observer-hidden fragments discarded (shadows)
   ReceiverSplat = 12, // the observer's receivers as one-pixel points from the light into a litmap (shadows)
   LdiPeel = 13,       // one depth-peeling pass of a shape into an LDI layer (ldi): orthographic, LEQUAL, strict test against the previous layer in the shader
+  ReliefBox = 14,     // a relief box drawn with one ray-walk method (relief): early fragment tests, depth write off, every fragment casts its ray, a miss discards
 };
 
 // The culling technique a frame ran (ARCHITECTURE.md Table 2 modes).

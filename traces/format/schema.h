@@ -62,7 +62,7 @@ struct Element {
 // come from the model's one name table per enum (to_string).
 template <class E> struct EnumInfo;
 template <> struct EnumInfo<TestMode> { static constexpr const char* name = "TestMode"; static constexpr unsigned max = 4; };
-template <> struct EnumInfo<DrawRole> { static constexpr const char* name = "DrawRole"; static constexpr unsigned max = 13; };
+template <> struct EnumInfo<DrawRole> { static constexpr const char* name = "DrawRole"; static constexpr unsigned max = 14; };
 template <> struct EnumInfo<DepthFunc> { static constexpr const char* name = "DepthFunc"; static constexpr unsigned max = 7; };
 template <> struct EnumInfo<CullFace> { static constexpr const char* name = "CullFace"; static constexpr unsigned max = 3; };
 template <> struct EnumInfo<ClipControl> { static constexpr const char* name = "ClipControl"; static constexpr unsigned max = 1; };

@@ -1,0 +1,2 @@
+// See heightfield.h.
+#include "model/relief/heightfield.h"

@@ -1,0 +1,2 @@
+// See radius.h.
+#include "model/relief/radius.h"

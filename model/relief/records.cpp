@@ -1,0 +1,2 @@
+// See records.h.
+#include "model/relief/records.h"

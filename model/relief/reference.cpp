@@ -1,0 +1,2 @@
+// See reference.h.
+#include "model/relief/reference.h"

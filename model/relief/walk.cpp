@@ -1,0 +1,2 @@
+// See walk.h.
+#include "model/relief/walk.h"

@@ -1,0 +1,102 @@
+// The relief ray walks of one box fragment in float, operation for operation as the capture's
+// fragment shader runs them (shaders/relief/relief.frag: every expression there is `precise`, and
+// this file is built with -ffp-contract=off), so that the model's hits, lookups and steps equal
+// GL's bit for bit. heightfield.h states the conventions (texel space, cells, the zero border).
+//
+// The fragment's ray: origin o = the eye in texel space; direction d = (a * px + b * py) + c with
+// (px, py) the fragment's pixel centre in window coordinates (gl_FragCoord.xy) and a, b, c the
+// draw's ray frame (a perspective camera's rays are affine in the pixel centre). No varying is
+// interpolated, so nothing depends on the rasterizer's attribute setup. The box [0, N]^2 x [0, 1]
+// clips the ray to [t_in, t_out] (slabs; t_in >= 0); a ray that misses the box is a miss with no
+// lookups.
+//
+// Methods (Baboud & Decoret section 4, and the N-buffer paper's future work):
+// - binary: `linear_steps` equal steps from t_in to t_out until a point is below the surface, then
+//   `binary_steps` bisections; the hit is the bracket's lower (below) end. Wrong at grazing angles,
+//   across depth discontinuities and on thin peaks (a step jumps over them).
+// - exact: the cell walk from texel centreline to centreline (Amanatides-Woo over cells); in each
+//   cell the height above the surface at the cell's entry and exit, a hit when it is <= 0 at the
+//   entry or the exit, refined by `root_steps` bisections inside the cell. Misses a bilinear
+//   saddle the ray dips under and leaves within one cell (their Figure 3).
+// - robust: steps of the texel's safety radius (radius.h) with a bisection when a step ends below;
+//   where the radius is 0 (peaks), up to two cell steps of the full cell test (below).
+// - robust_clamp: the same, with a radius of 0 clamped to 1 (cheaper; a peak may be stepped over).
+// - nbuffer: empty-space skipping with the max N-buffer of the heightfield: from t, a span of 2^s
+//   texels of horizontal travel is skipped when the ray's lower end is above the N-buffer's
+//   maximum over the texels the span's surface depends on (one four-lookup query, covering.h's
+//   four-square covering); s grows by one after a skip and shrinks by one after a failed query; at
+//   s = 0 a failed query walks one cell with the full cell test. The full cell test is the exact
+//   walk's plus the dip: where the height above the surface is convex along the ray inside the
+//   cell, its minimum (the vertex of the quadratic through the entry, the middle and the exit) is
+//   tested too. So the N-buffer walk finds saddles the exact walk misses.
+// Lookups count every texel read the shader issues: 4 per surface height (binary, robust), 4 per
+// cell (its corners; exact, nbuffer, robust's cell steps), 1 per radius, 4 per N-buffer query.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+namespace nbsim::relief {
+
+// Fixed values (they are in files: RLFF's `method`).
+enum class Method : std::uint8_t { Binary = 0, Exact = 1, Robust = 2, RobustClamp = 3, NBuffer = 4 };
+inline constexpr int kMethods = 5;
+std::string_view to_string(Method m) noexcept;
+std::optional<Method> parse_method(std::string_view s) noexcept;
+inline constexpr std::array<Method, kMethods> kAllMethods = {Method::Binary, Method::Exact, Method::Robust, Method::RobustClamp,
+                                                             Method::NBuffer};
+
+// The tunables of the walks (the capture records them; the shader receives them as uniforms).
+struct WalkParams {
+  int linear_steps = 16;  // binary: 1 to 1024
+  int binary_steps = 8;   // binary and robust: bisections after the bracket, 0 to 32
+  int root_steps = 16;    // exact, nbuffer and robust's cell steps: bisections inside a cell, 0 to 32
+};
+
+// The draw's ray frame (float, as the shader's uniforms).
+struct RayFrame {
+  std::array<float, 3> origin{};  // the eye, texel space
+  std::array<float, 3> a{}, b{}, c{};  // direction = (a * px + b * py) + c
+};
+
+// What the shader reads. Levels: `levels` planes of N * N (N-buffer, max), level-major.
+struct FieldView {
+  int size = 0;
+  std::span<const float> heights;  // N * N
+  std::span<const float> radius;   // N * N (robust methods), else may be empty
+  std::span<const float> nbuffer;  // levels * N * N (nbuffer), else may be empty
+  int levels = 0;
+};
+
+struct WalkResult {
+  bool hit = false;
+  float t = 0.0f;  // the hit's ray parameter (0 on a miss)
+  std::uint32_t lookups = 0, steps = 0, bisections = 0;
+  bool capped = false;  // the iteration cap ended the walk (counted a miss); never expected
+};
+
+// The texture a lookup reads (for the model's texel cache).
+enum class Texture : std::uint8_t { Height = 0, Radius = 1, NBuffer = 2 };
+// Called once per texel read, with the texture and the texel's index in it (virtual border texels
+// are reads too: index -1, served without memory).
+using LookupObserver = void (*)(void* context, Texture texture, std::int64_t index);
+
+// The ray of pixel centre (px, py) clipped to the box: false when it misses the box.
+struct FragmentRay {
+  std::array<float, 3> o{}, d{};
+  float t_in = 0.0f, t_out = 0.0f;
+};
+std::optional<FragmentRay> fragment_ray(const RayFrame& frame, int size, float px, float py);
+
+// One fragment's walk with `method`. `observer` (may be null) sees every lookup.
+WalkResult walk(Method method, const FieldView& field, const WalkParams& params, const FragmentRay& ray,
+                LookupObserver observer = nullptr, void* context = nullptr);
+
+// The iteration cap of every walk's main loop (a walk that reaches it is a capped miss).
+int walk_iteration_cap(int size) noexcept;
+
+}  // namespace nbsim::relief

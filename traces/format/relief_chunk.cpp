@@ -1,0 +1,2 @@
+// See relief_chunk.h.
+#include "traces/format/relief_chunk.h"
