@@ -1,0 +1,61 @@
+// The relief ray walks on GL (shaders/relief/relief.frag): a heightfield, its safety radius and the
+// max N-buffer GL builds from it (GlslNBuffer, each level a recorded nbuffer_build draw) as
+// textures, and one box draw per method into an own framebuffer (DEPTH_COMPONENT32F cleared to 1.0,
+// LESS with early fragment tests, depth writes off, back faces culled) whose fragment shader
+// writes every fragment's walk into an SSBO, read back as GlFragments. The model's twin is
+// model/relief/walk.h; ReliefGlWalkTest compares them fragment by fragment.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "model/relief/heightfield.h"
+#include "model/relief/radius.h"
+#include "model/relief/walk.h"
+#include "model/scene/frame.h"
+#include "traces/capture/draw_recorder.h"
+
+namespace nbsim::capture {
+
+// GL's walk of every fragment of one box draw (pixel order).
+struct GlFragments {
+  std::vector<std::uint32_t> pixel, hit, lookups, steps, bisections;
+  std::vector<float> t;
+};
+
+// A camera on the box: texel space to clip (column-major, float, as GL takes it) and the ray frame.
+struct ReliefView {
+  std::array<float, 16> texel_to_clip{};
+  relief::RayFrame ray;
+};
+
+class GlReliefWalker {
+ public:
+  // A width x height viewport.
+  GlReliefWalker(int width, int height);
+  ~GlReliefWalker();
+  GlReliefWalker(const GlReliefWalker&) = delete;
+  GlReliefWalker& operator=(const GlReliefWalker&) = delete;
+
+  // Uploads the field and its radius and builds the N-buffer on GL (its passes recorded with
+  // `recorder`). The radius may be empty (the robust methods then read 0 everywhere).
+  void set_field(const relief::Heightfield& field, const relief::SafetyRadius& radius, DrawRecorder& recorder);
+  // The N-buffer GL built, levels * N * N, level-major.
+  std::vector<float> levels() const;
+  int level_count() const noexcept;
+
+  // Clears the depth buffer (1.0).
+  void clear_depth();
+  // One box draw with `method`, recorded (role relief_box, the box's 36 vertices captured).
+  GlFragments draw(relief::Method method, const ReliefView& view, const relief::WalkParams& params, DrawRecorder& recorder);
+
+ private:
+  struct Objects;
+  std::unique_ptr<Objects> gl_;
+  int width_, height_;
+  int size_ = 0;
+};
+
+}  // namespace nbsim::capture
