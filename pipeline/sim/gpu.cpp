@@ -20,6 +20,7 @@ void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
   particles::ParticlesUnitConfig::describe(s, c.particles);
   shadows::ShadowsUnitConfig::describe(s, c.shadows);
   ldi::LdiUnitConfig::describe(s, c.ldi);
+  relief::ReliefUnitConfig::describe(s, c.relief);
   for (auto& [name, config] : c.nbuffers) nbuffer::NBufferUnitConfig::describe(s, config, name);
   for (auto& [name, config] : c.hiz) HiZUnitConfig::describe(s, config, name);
   s.add("gpu.fifo_depth", c.fifo_depth, "work items", "depth of the fifos between units", 1, 4096);
@@ -40,6 +41,7 @@ void GpuConfig::validate() const {
   for (const auto& [name, config] : nbuffers) config.validate();
   for (const auto& [name, config] : hiz) config.validate();
   ldi.validate();
+  relief.validate();
 }
 
 Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& c, int width_px, int height_px,

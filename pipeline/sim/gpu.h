@@ -22,6 +22,7 @@
 #include "model/cull/unit.h"
 #include "model/depth/unit.h"
 #include "model/ldi/unit.h"
+#include "model/relief/unit.h"
 #include "model/geometry/unit.h"
 #include "model/memory/memory.h"
 #include "model/particles/unit.h"
@@ -42,6 +43,7 @@ struct GpuConfig {
   particles::ParticlesUnitConfig particles;
   shadows::ShadowsUnitConfig shadows;
   ldi::LdiUnitConfig ldi;
+  relief::ReliefUnitConfig relief;
   // The query-structure instances (programs.h structure_instances()) by name, one config each
   // (keys "<name>.<field>"): "nbuffer" and "hiz" for occlusion culling's modes.
   std::map<std::string, nbuffer::NBufferUnitConfig, std::less<>> nbuffers;
@@ -53,7 +55,7 @@ struct GpuConfig {
   int quantum_cycles = 0;
 
   // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.", "particles.",
-  // "shadows.", "ldi.", "nbuffer.", "hiz.", "gpu.").
+  // "shadows.", "ldi.", "relief.", "nbuffer.", "hiz.", "gpu.").
   static void describe(config::Schema& s, GpuConfig& c);
   // Throws InputError naming the key when a unit's value is out of its limits or inconsistent
   // (the checks the units make when they are built, for a config checked before any run).

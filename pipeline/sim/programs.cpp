@@ -164,7 +164,27 @@ Program ldi(const ProgramContext& c) {
   return p;
 }
 
-constexpr std::array<ProgramRow, 4> kPrograms = {{
+// Relief textures (Baboud & Decoret) and the N-buffer walk: every relief_box draw rasterized with the
+// early depth test, each fragment's walk run with the draw's method and compared with GL's, and
+// scored against the exact reference.
+Program relief(const ProgramContext& c) {
+  require_no_cull_mode(c, "a relief trace walks its own rays");
+  double box_height = 0.0;
+  const std::string_view text = property(c, "relief_box_height", "relief");
+  try {
+    box_height = std::stod(std::string(text));
+  } catch (const std::exception&) {
+    throw InputError(fmt::format("the relief trace's relief_box_height '{}' is not a number", text));
+  }
+  Program p;
+  auto unit = std::make_unique<relief::ReliefUnit>("relief", c.registry, c.config.relief, c.memory, c.setup.width_px, c.setup.height_px,
+                                                   box_height, c.config.depth.fused_interpolation);
+  p.frames = unit.get();
+  p.unit = std::move(unit);
+  return p;
+}
+
+constexpr std::array<ProgramRow, 5> kPrograms = {{
     {"occlusion_culling",
      "occlusion culling of a scene's objects (cull.mode: trace replays the recorded draws; none, oq, oq_hier, nb, "
      "nb_hier, hiz_tile, hiz_pyramid cull every candidate again)",
@@ -183,6 +203,11 @@ constexpr std::array<ProgramRow, 4> kPrograms = {{
      "compare against the previous layer, the model's LDI, crop and compressed texture compared with GL's, and the parity "
      "test (uncompressed and compressed) at GL's test points against GL's answers and the exact reference",
      ldi},
+    {"relief",
+     "relief textures: every relief_box draw rasterized with the early depth test, each fragment's ray walk (binary, "
+     "exact, robust, robust_clamp or nbuffer, as the draw's RLFF says) run through the ray-walk unit and its texel cache, "
+     "compared with GL's per fragment and scored against the exact reference",
+     relief},
 }};
 
 constexpr std::array<StructureInstance, 4> kInstances = {{

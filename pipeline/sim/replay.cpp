@@ -9,6 +9,7 @@
 
 #include "model/common/error.h"
 #include "model/sim/kernel.h"
+#include "model/relief/walk.h"
 #include "model/sim/timeline.h"
 #include "traces/format/reader.h"
 
@@ -38,6 +39,10 @@ constexpr std::array<const char*, 16> kLdiFrameCounts = {
     "peel_passes", "peel_fragments", "gl_peel_fragments", "peel_samples", "gl_peel_samples", "peel_pass_mismatches", "layers",
     "gl_layers", "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "test_points", "parity_mismatches_layers",
     "parity_mismatches_ranges", "misclassified_layers", "misclassified_ranges"};
+
+// The relief program's counters in run.json's per-frame values, per method (differences at frame ends).
+constexpr std::array<const char*, 9> kReliefFrameCounts = {"fragments", "gl_fragments", "pixel_mismatches", "walk_mismatches",
+                                                            "lookups", "steps", "errors", "reference_hits", "cycles"};
 
 // A statistic of a group's values (0 when the group has none of that name).
 std::uint64_t stat(const nlohmann::ordered_json& group, const char* name) {
@@ -166,6 +171,19 @@ class Collector : public depth::ResultSink {
       for (const char* name : kLdiFrameCounts) pf[name] = stat(now, name) - stat(last_ldi_, name);
       last_ldi_ = now;
     }
+    if (const stats::Group* g = registry_.find("gpu.relief")) {
+      const nlohmann::ordered_json now = g->values();
+      nlohmann::ordered_json methods = nlohmann::ordered_json::object();
+      for (relief::Method m : relief::kAllMethods) {
+        const std::string prefix = std::string(relief::to_string(m)) + "_";
+        if (stat(now, (prefix + "draws").c_str()) == stat(last_relief_, (prefix + "draws").c_str())) continue;
+        nlohmann::ordered_json v;
+        for (const char* name : kReliefFrameCounts) v[name] = stat(now, (prefix + name).c_str()) - stat(last_relief_, (prefix + name).c_str());
+        methods[std::string(relief::to_string(m))] = v;
+      }
+      pf["relief"] = methods;
+      last_relief_ = now;
+    }
     per_frame_.push_back(std::move(pf));
     last_cycle_ = cycle;
     for (const auto& d : w.frame->draws)
@@ -194,6 +212,7 @@ class Collector : public depth::ResultSink {
   nlohmann::ordered_json last_particles_ = nlohmann::ordered_json::object();  // gpu.particles at the last frame end
   nlohmann::ordered_json last_shadows_ = nlohmann::ordered_json::object();    // gpu.shadows at the last frame end
   nlohmann::ordered_json last_ldi_ = nlohmann::ordered_json::object();        // gpu.ldi at the last frame end
+  nlohmann::ordered_json last_relief_ = nlohmann::ordered_json::object();     // gpu.relief at the last frame end
   std::ofstream draws_, frames_;
   FrameTotals frame_;
   std::uint64_t last_cycle_ = 0;
@@ -368,6 +387,41 @@ nlohmann::ordered_json ldi_summary(const nlohmann::ordered_json& p, const nlohma
   return j;
 }
 
+// The relief program's run totals (summary "relief"), from its statistics: per method its counts,
+// lookups and steps per fragment, cycles, and hit error against the exact reference.
+nlohmann::ordered_json relief_summary(const nlohmann::ordered_json& p, const nlohmann::ordered_json& memory, std::uint64_t cycles) {
+  nlohmann::ordered_json j;
+  for (const char* name : {"frames", "box_draws", "cache_hits", "cache_misses", "memory_bytes", "memory_stall_cycles", "cycles"}) j[name] = stat(p, name);
+  j["cycles_total"] = cycles;
+  j["channel_bytes"] = stat(memory, "bytes_relief");
+  nlohmann::ordered_json methods = nlohmann::ordered_json::object();
+  for (relief::Method m : relief::kAllMethods) {
+    const std::string prefix = std::string(relief::to_string(m)) + "_";
+    const auto v = [&](const char* name) { return stat(p, (prefix + name).c_str()); };
+    if (v("draws") == 0) continue;
+    nlohmann::ordered_json e;
+    for (const char* name : {"draws", "fragments", "gl_fragments", "samples", "gl_samples", "pixel_mismatches", "walk_mismatches", "lookups",
+                             "gl_lookups", "steps", "bisections", "hits", "capped", "reference_hits", "wrong_hit", "wrong_miss",
+                             "far_hit", "errors", "cycles", "cache_misses"})
+      e[name] = v(name);
+    const double fragments = static_cast<double>(v("fragments"));
+    const auto per = [fragments](std::uint64_t x) {
+      return fragments > 0 ? nlohmann::ordered_json(static_cast<double>(x) / fragments) : nlohmann::ordered_json(nullptr);
+    };
+    e["lookups_per_fragment"] = per(v("lookups"));
+    e["steps_per_fragment"] = per(v("steps"));
+    e["error_rate"] = per(v("errors"));
+    const std::uint64_t both = v("hits") - std::min(v("hits"), v("wrong_hit"));
+    e["mean_hit_distance"] = both ? nlohmann::ordered_json(static_cast<double>(v("distance_microtexels")) * 1e-6 / static_cast<double>(both))
+                                  : nlohmann::ordered_json(nullptr);
+    e["cycles_per_frame"] = stat(p, "frames") ? nlohmann::ordered_json(static_cast<double>(v("cycles")) / static_cast<double>(stat(p, "frames")))
+                                              : nlohmann::ordered_json(nullptr);
+    methods[std::string(relief::to_string(m))] = e;
+  }
+  j["methods"] = methods;
+  return j;
+}
+
 double rel(std::uint64_t a, std::uint64_t b) {
   if (b == 0) return a == 0 ? 0.0 : 1.0;
   return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
@@ -387,7 +441,13 @@ bool ReplaySummary::within_thresholds() const {
   const auto counter = [this](const char* name) { return ldi.value(name, std::uint64_t{0}); };
   const bool ldi_ok = ldi.is_null() || (rel(counter("peel_fragments"), counter("gl_peel_fragments")) <= 1e-4 &&
                                         rel(counter("peel_samples"), counter("gl_peel_samples")) <= 1e-4);
-  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok && stencil_ok && ldi_ok;
+  // A relief trace: every method's fragments, samples and walks equal GL's.
+  bool relief_ok = true;
+  if (!relief.is_null())
+    for (const auto& [name, m] : relief["methods"].items())
+      relief_ok = relief_ok && m.value("pixel_mismatches", 0) == 0 && m.value("walk_mismatches", 0) == 0 &&
+                  m.value("fragments", 0) == m.value("gl_fragments", 0) && m.value("samples", 0) == m.value("gl_samples", 0);
+  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok && stencil_ok && ldi_ok && relief_ok;
 }
 
 nlohmann::ordered_json ReplaySummary::to_json() const {
@@ -425,6 +485,7 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   if (!particles.is_null()) j["particles"] = particles;
   if (!shadows.is_null()) j["shadows"] = shadows;
   if (!ldi.is_null()) j["ldi"] = ldi;
+  if (!relief.is_null()) j["relief"] = relief;
   return j;
 }
 
@@ -542,6 +603,14 @@ ReplaySummary replay(const ReplayOptions& o) {
     for (const char* key : {"shape", "seed"})
       for (const auto& [k, v] : tr.properties())
         if (k == key) s.ldi[key] = v;
+  }
+
+  if (s.stats.contains("gpu.relief")) {
+    s.relief = relief_summary(s.stats["gpu.relief"], s.stats.contains("gpu.memory") ? s.stats["gpu.memory"] : nlohmann::ordered_json::object(),
+                              sink.last_frame_cycle());
+    for (const char* key : {"relief_field", "relief_field_size", "relief_box_height", "relief_angles"})
+      for (const auto& [k, v] : tr.properties())
+        if (k == key) s.relief[key] = v;
   }
 
   if (o.out) {

@@ -76,6 +76,8 @@ struct ReplaySummary {
   // counters, the LDI, crop and compressed texture against GL's, the parity tests against GL's
   // answers and the exact reference, cycles and memory), the header's shape; null otherwise.
   nlohmann::ordered_json ldi;
+  // Relief traces: totals of the relief program per method (relief_summary in replay.cpp).
+  nlohmann::ordered_json relief;
 
   double fragment_error() const;  // |model - gl| / gl over all draws
   double passed_error() const;

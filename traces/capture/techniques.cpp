@@ -3,6 +3,7 @@
 #include "traces/capture/ldi/ldi.h"
 #include "traces/capture/occlusion/occlusion_culling.h"
 #include "traces/capture/particles/particles.h"
+#include "traces/capture/relief/relief.h"
 #include "traces/capture/shadows/shadows.h"
 #include "traces/capture/technique.h"
 
@@ -29,6 +30,12 @@ const std::vector<TechniqueRow>& technique_table() {
         "the volumetric parity test with both readers against an exact reference (Trapp & Doellner)",
         ldi_options()},
        make_ldi},
+      {{"relief",
+        "Relief textures: a heightfield in a box, each fragment's ray walked by binary search, the exact cell walk, the "
+        "robust search with safety radii (two zero-radius variants) or the N-buffer empty-space walk, scored against an "
+        "exact reference (Baboud & Decoret; the N-buffer paper's future work)",
+        relief_options()},
+       make_relief},
   };
   return table;
 }

@@ -1,0 +1,116 @@
+// The relief program's plain core; see replay.h.
+#include "model/relief/replay.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "model/common/error.h"
+
+namespace nbsim::relief {
+
+namespace {
+
+raster::RasterPathConfig path_config(int width, int height, bool fused) {
+  if (width < 1 || width > 16384 || height < 1 || height > 16384)
+    throw InputError(fmt::format("the relief viewport is {}x{} pixels; each side must be 1 to 16384", width, height));
+  raster::RasterPathConfig c;
+  c.width_px = width;
+  c.height_px = height;
+  c.fused_interpolation = fused;
+  return c;
+}
+
+}  // namespace
+
+ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation)
+    : width_(width),
+      height_(height),
+      depth_(path_config(width, height, fused_interpolation).width_px, height, 1.0f),
+      passed_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0),
+      path_(path_config(width, height, fused_interpolation), depth_) {
+  path_.set_reuse_rasterization(true);  // every method draws the same box
+}
+
+ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double tolerance, double box_height, LookupObserver observer,
+                                          void* context, void (*draw_done)(void* context, const BoxDrawCounts& draw)) {
+  const GlReliefField gl = read_relief_field(f);
+  const std::uint64_t pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
+  const std::vector<GlReliefFragments> records = read_relief_fragments(f, pixels);
+  const FieldView view = gl.view();
+  ReliefFrameCounts out;
+  out.size = gl.field.size;
+  out.view_angle = gl.view_angle;
+
+  std::size_t next_record = 0;
+  for (const scene::DrawRecord& d : f.draws) {
+    if (d.role != scene::DrawRole::ReliefBox) continue;
+    if (d.topology != scene::Topology::Triangles || d.clip_positions.size() % 3 != 0)
+      throw InputError(fmt::format("frame {}: relief_box draw {} is not a list of triangles", f.begin.frame, d.index));
+    if (next_record >= records.size() || records[next_record].draw != d.index)
+      throw InputError(fmt::format("frame {}: relief_box draw {} has no ReliefFragments (RLFF) record in draw order", f.begin.frame, d.index));
+    const GlReliefFragments& r = records[next_record++];
+
+    std::fill(depth_.texels.begin(), depth_.texels.end(), 1.0f);
+    std::fill(passed_.begin(), passed_.end(), std::uint8_t{0});
+    raster::DrawState s = raster::draw_state(d.state);
+    s.depth.passed_mask = &passed_;
+    const raster::DrawCounters k = path_.draw(d.clip_positions, s);
+
+    BoxDrawCounts c;
+    c.method = r.method;
+    c.triangles = k.geometry.prims_out;
+    c.blocks = k.depth.blocks;
+    c.depth_tests = k.depth.depth_tests;
+    c.fragments = k.depth.passed;
+    c.gl_fragments = d.gl.fragments;
+    c.gl_samples = d.gl.samples_passed;
+    // The model's fragments (pixel order) against GL's, merged.
+    std::size_t g = 0;
+    for (std::uint32_t px = 0; px < pixels; ++px) {
+      const bool model = passed_[px] != 0;
+      while (g < r.pixel.size() && r.pixel[g] < px) ++c.pixel_mismatches, ++g;
+      const bool in_gl = g < r.pixel.size() && r.pixel[g] == px;
+      if (!model) {
+        if (in_gl) ++c.pixel_mismatches, ++g;
+        continue;
+      }
+      const float fx = static_cast<float>(px % static_cast<std::uint32_t>(width_)) + 0.5f;
+      const float fy = static_cast<float>(px / static_cast<std::uint32_t>(width_)) + 0.5f;
+      const std::optional<FragmentRay> ray = fragment_ray(gl.ray, gl.field.size, fx, fy);
+      WalkResult w;
+      if (ray) w = walk(r.method, view, gl.params, *ray, observer, context);
+      const std::uint32_t code = w.capped ? 2u : w.hit ? 1u : 0u;
+      c.lookups += w.lookups, c.steps += w.steps, c.bisections += w.bisections;
+      c.longest_walk = std::max<std::uint64_t>(c.longest_walk, w.lookups);
+      c.hits += code == 1u, c.capped += code == 2u, c.samples += code == 1u;
+      if (ray) {
+        const HitScore score = score_hit(gl.field, *ray, code == 1u, w.t, box_height, tolerance);
+        c.reference_hits += score.reference_hit;
+        c.wrong_hit += score.error == HitError::WrongHit;
+        c.wrong_miss += score.error == HitError::WrongMiss;
+        c.far_hit += score.error == HitError::FarHit;
+        if (code == 1u && score.reference_hit) c.distance_sum += score.distance;
+      }
+      if (!in_gl) {
+        ++c.pixel_mismatches;
+        continue;
+      }
+      c.gl_lookups += r.lookups[g];
+      const bool same = code == r.hit[g] && std::memcmp(&w.t, &r.t[g], sizeof(float)) == 0 && w.lookups == r.lookups[g] &&
+                        w.steps == r.steps[g] && w.bisections == r.bisections[g];
+      c.walk_mismatches += same ? 0 : 1;
+      ++g;
+    }
+    c.pixel_mismatches += r.pixel.size() - g;
+    if (draw_done) draw_done(context, c);
+    out.draws.push_back(c);
+  }
+  if (next_record != records.size())
+    throw InputError(fmt::format("frame {}: {} ReliefFragments (RLFF) records, but {} relief_box draws", f.begin.frame, records.size(),
+                                 next_record));
+  return out;
+}
+
+}  // namespace nbsim::relief

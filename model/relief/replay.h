@@ -1,0 +1,72 @@
+// The relief program's plain core (no SystemC; model/relief/unit.h wraps it with timing, the
+// heightfield texel cache and statistics). Per frame: GL's RLFH record (records.h: the heightfield,
+// its safety radius and GL's max N-buffer, checked against the model's own build) and, for every
+// relief_box draw in order with its RLFF record,
+//  1. the box's triangles through the model's raster path at the viewport's size, early depth test
+//     LESS against a depth buffer cleared to 1.0 with depth writes off (relief.frag's state): the
+//     fragments that run the walk (one a pixel: the box is convex and back faces are culled);
+//  2. every such fragment's walk (walk.h) with the draw's method, compared with GL's fragment by
+//     fragment: the same pixels, and the same hit, t (bits), lookups, steps and bisections;
+//  3. every walk scored against the exact reference (score.h): the method's hit error.
+// GL's counters of the draw: fragments (relief.frag counts after the early test) and samples passed
+// (fragments that were not discarded: the hits).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "model/common/depth.h"
+#include "model/raster/raster_path.h"
+#include "model/relief/records.h"
+#include "model/relief/score.h"
+#include "model/relief/walk.h"
+#include "model/scene/frame.h"
+
+namespace nbsim::relief {
+
+// One box draw's counts.
+struct BoxDrawCounts {
+  Method method = Method::Binary;
+  std::uint64_t triangles = 0, blocks = 0, depth_tests = 0;
+  std::uint64_t fragments = 0, gl_fragments = 0;  // the model's (after the early test) and GL's counter
+  std::uint64_t samples = 0, gl_samples = 0;      // the model's hits and GL_SAMPLES_PASSED
+  std::uint64_t pixel_mismatches = 0;  // pixels in the model's fragments or GL's RLFF but not both
+  std::uint64_t walk_mismatches = 0;   // fragments of both whose hit, t, lookups, steps or bisections differ
+  std::uint64_t lookups = 0, steps = 0, bisections = 0, hits = 0, capped = 0;
+  std::uint64_t gl_lookups = 0;
+  std::uint64_t longest_walk = 0;  // most lookups of one fragment
+  std::uint64_t reference_hits = 0, wrong_hit = 0, wrong_miss = 0, far_hit = 0;
+  std::uint64_t errors() const noexcept { return wrong_hit + wrong_miss + far_hit; }
+  double distance_sum = 0.0;  // texels between the hit and the reference's, summed over fragments where both hit
+};
+
+struct ReliefFrameCounts {
+  int size = 0;  // the heightfield's N
+  double view_angle = 0.0;
+  std::vector<BoxDrawCounts> draws;  // relief_box draws in order
+};
+
+class ReliefReplay {
+ public:
+  // The viewport (1 .. 16384 a side; InputError otherwise).
+  ReliefReplay(int width, int height, bool fused_interpolation = true);
+  ReliefReplay(const ReliefReplay&) = delete;
+  ReliefReplay& operator=(const ReliefReplay&) = delete;
+
+  // Runs the frame. `tolerance`: score.h's, texels; `box_height`: the box's height over its width
+  // (the trace header's relief_box_height). `observer` (may be null) sees every lookup of every walk;
+  // `draw_done` (may be null) is called after each box draw's walks with its counts.
+  // InputError naming the frame for a damaged record, a box draw without its RLFF or the reverse, or
+  // a box draw that is not triangles.
+  ReliefFrameCounts run_frame(const scene::Frame& f, double tolerance, double box_height, LookupObserver observer = nullptr,
+                              void* context = nullptr, void (*draw_done)(void* context, const BoxDrawCounts& draw) = nullptr);
+
+ private:
+  int width_, height_;
+  DepthImage depth_;
+  std::vector<std::uint8_t> passed_;
+  raster::RasterPath path_;
+};
+
+}  // namespace nbsim::relief

@@ -1,0 +1,318 @@
+// The `relief` capture technique; see relief.h.
+#include "traces/capture/relief/relief.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+#include "model/common/error.h"
+#include "model/relief/heightfield.h"
+#include "model/relief/radius.h"
+#include "model/relief/score.h"
+#include "model/relief/walk.h"
+#include "pipeline/io/image_io.h"
+#include "traces/capture/draw_recorder.h"
+#include "traces/capture/relief/gl_walk.h"
+#include "traces/capture/relief/view.h"
+#include "traces/format/relief_chunk.h"
+
+namespace nbsim::capture {
+namespace {
+
+const OptionSpec& field_option() {
+  static const OptionSpec spec =
+      text_option("field", "Procedural heightfield: fbm, walls, spikes, saddle or step (model/relief/heightfield.h)", "fbm");
+  return spec;
+}
+const OptionSpec& field_param_option() {
+  static const OptionSpec spec = integer_option(
+      "field-param", "The field's parameter (fbm: octaves, walls: spacing, spikes: count); 0 takes the field's default", 0, 0, 1 << 20);
+  return spec;
+}
+const OptionSpec& field_size_option() {
+  static const OptionSpec spec = integer_option("field-size", "Side N of the procedural heightfield, texels (2 to 1024)", 64, 1, 1 << 20);
+  return spec;
+}
+const OptionSpec& field_file_option() {
+  static const OptionSpec spec = text_option(
+      "field-file", "A square single-channel image (EXR, PNG, ... through OpenImageIO) of heights in [0, 1] instead of --field ('none': use --field)",
+      "none");
+  return spec;
+}
+const OptionSpec& radius_file_option() {
+  static const OptionSpec spec = text_option(
+      "radius-file", "A single-channel image of safety radii in texels for the field, checked against it ('none': computed)", "none");
+  return spec;
+}
+const OptionSpec& max_radius_option() {
+  static const OptionSpec spec = integer_option("max-radius", "Cap of the safety radius, texels", 16, 1, 255);
+  return spec;
+}
+const OptionSpec& methods_option() {
+  static const OptionSpec spec =
+      text_option("methods", "Walk methods, comma-separated: binary, exact, robust, robust_clamp, nbuffer (or all); one box draw each", "all");
+  return spec;
+}
+const OptionSpec& angles_option() {
+  static const OptionSpec spec = text_option(
+      "angles", "View angles from the box's up axis, degrees, comma-separated (0 head-on, 80 to 89 grazing); frame k takes angle k mod count",
+      "0,45,80,89");
+  return spec;
+}
+const OptionSpec& box_height_option() {
+  static const OptionSpec spec = text_option("box-height", "Height of the box over its width (the heightfield's 1.0)", "0.25");
+  return spec;
+}
+const OptionSpec& linear_steps_option() {
+  static const OptionSpec spec = integer_option("linear-steps", "binary: linear steps before the bisection", 16, 1, 1024);
+  return spec;
+}
+const OptionSpec& binary_steps_option() {
+  static const OptionSpec spec = integer_option("binary-steps", "binary and robust: bisections after the bracket", 8, 0, 32);
+  return spec;
+}
+const OptionSpec& root_steps_option() {
+  static const OptionSpec spec = integer_option("root-steps", "exact, nbuffer and robust's cell steps: bisections inside a cell", 16, 0, 32);
+  return spec;
+}
+const OptionSpec& tolerance_option() {
+  static const OptionSpec spec =
+      text_option("tolerance", "Hit error tolerance for the capture's own counts, texels (model/relief/score.h)", "0.25");
+  return spec;
+}
+
+double parse_number(const std::string& s, const char* option, double lo, double hi) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(s, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != s.size() || !(v >= lo && v <= hi)) throw InputError(fmt::format("--{} '{}' is not a number in [{}, {}]", option, s, lo, hi));
+  return v;
+}
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');) out.push_back(item);
+  return out;
+}
+
+std::vector<relief::Method> parse_methods(const std::string& s) {
+  if (s == "all") return {relief::kAllMethods.begin(), relief::kAllMethods.end()};
+  std::vector<relief::Method> out;
+  for (const std::string& name : split(s)) {
+    const std::optional<relief::Method> m = relief::parse_method(name);
+    if (!m) throw InputError(fmt::format("--methods: '{}' is not a method (binary, exact, robust, robust_clamp, nbuffer or all)", name));
+    out.push_back(*m);
+  }
+  if (out.empty()) throw InputError("--methods names no method");
+  return out;
+}
+
+std::vector<double> parse_angles(const std::string& s) {
+  std::vector<double> out;
+  for (const std::string& a : split(s)) out.push_back(parse_number(a, "angles", 0.0, 89.9));
+  if (out.empty()) throw InputError("--angles names no angle");
+  return out;
+}
+
+// A single-channel image as a square grid of floats, y up.
+relief::Heightfield read_square(const std::string& file, const char* what) {
+  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{} '{}' does not exist", what, file));
+  const DepthImage img = io::read_depth(file);
+  if (img.width != img.height)
+    throw InputError(fmt::format("{} '{}' is {}x{}; a heightfield is square", what, file, img.width, img.height));
+  relief::Heightfield f;
+  f.size = img.width;
+  f.heights = img.texels;
+  return f;
+}
+
+std::string join(const std::vector<double>& v) {
+  std::string s;
+  for (double a : v) s += (s.empty() ? "" : ",") + fmt::format("{}", a);
+  return s;
+}
+
+class Relief final : public Technique {
+ public:
+  explicit Relief(const TechniqueSetup& s) : width_(s.width), height_(s.height) {
+    const OptionValues& o = s.options;
+    seed_ = static_cast<std::uint64_t>(o.integer(seed_option()));
+    max_radius_ = static_cast<int>(o.integer(max_radius_option()));
+    const std::string file = o.text(field_file_option());
+    if (file != "none") {
+      if (o.has("field") || o.has("field-param") || o.has("field-size")) throw InputError("give --field or --field-file, not both");
+      field_ = read_square(file, "--field-file");
+      relief::check_heightfield(field_, fmt::format("the heightfield in '{}'", file));
+      description_ = "file:" + std::filesystem::path(file).filename().string();
+    } else {
+      const int n = static_cast<int>(o.integer(field_size_option()));
+      const int param = static_cast<int>(o.integer(field_param_option()));
+      field_ = relief::make_heightfield(o.text(field_option()), n, param, seed_);
+      description_ = fmt::format("{}:{} seed {}", o.text(field_option()), param, seed_);
+    }
+    const std::string radius_file = o.text(radius_file_option());
+    if (radius_file != "none") {
+      const relief::Heightfield r = read_square(radius_file, "--radius-file");
+      radius_ = {r.size, r.heights};
+      if (const std::string problem = relief::radius_problem(field_, radius_, max_radius_); !problem.empty())
+        throw InputError(fmt::format("--radius-file '{}' does not match the heightfield: {}", radius_file, problem));
+    } else {
+      radius_ = relief::safety_radius(field_, max_radius_);
+    }
+    methods_ = parse_methods(o.text(methods_option()));
+    angles_ = parse_angles(o.text(angles_option()));
+    box_height_ = parse_number(o.text(box_height_option()), "box-height", 1e-3, 16.0);
+    params_.linear_steps = static_cast<int>(o.integer(linear_steps_option()));
+    params_.binary_steps = static_cast<int>(o.integer(binary_steps_option()));
+    params_.root_steps = static_cast<int>(o.integer(root_steps_option()));
+    tolerance_ = parse_number(o.text(tolerance_option()), "tolerance", 0.0, 1e6);
+    walker_ = std::make_unique<GlReliefWalker>(width_, height_);
+  }
+
+  trace::Properties variant_properties() const override {
+    std::string methods;
+    for (relief::Method m : methods_) methods += (methods.empty() ? "" : ",") + std::string(relief::to_string(m));
+    return {{"relief_field", description_}, {"relief_methods", methods}};
+  }
+  trace::Properties setting_properties() const override {
+    return {{"relief_field_size", std::to_string(field_.size)},
+            {"relief_box_height", fmt::format("{}", box_height_)},
+            {"relief_angles", join(angles_)},
+            {"relief_max_radius", std::to_string(max_radius_)},
+            {"relief_linear_steps", std::to_string(params_.linear_steps)},
+            {"relief_binary_steps", std::to_string(params_.binary_steps)},
+            {"relief_root_steps", std::to_string(params_.root_steps)},
+            {"relief_seed", std::to_string(seed_)},
+            {"relief_view", "the box [0,1]^2 x [0,relief_box_height] seen from angle k mod count of relief_angles off its up axis, "
+                            "azimuth 37 + 61 k + 13 seed degrees, framing the box; rays rebuilt from gl_FragCoord (model/relief/walk.h)"},
+            {"observer", "unused: the relief technique views its box from its own camera; the scene, the camera path and the "
+                         "projection are ignored, --size is the viewport"}};
+  }
+
+  CapturedFrame render(std::uint32_t index, const CameraPose&) override {
+    CapturedFrame out;
+    scene::Frame& f = out.frame;
+    f.begin.frame = index;
+    f.begin.mode = scene::TestMode::None;
+    const double angle = angles_[index % angles_.size()];
+    const double azimuth = std::fmod(37.0 + 61.0 * index + 13.0 * static_cast<double>(seed_ % 1000), 360.0);
+    const ReliefCamera cam = relief_camera(field_.size, box_height_, angle, azimuth, width_, height_);
+    for (std::size_t k = 0; k < 16; ++k) {
+      f.begin.view[k] = static_cast<float>(cam.world_view[k]);
+      f.begin.proj[k] = static_cast<float>(cam.projection[k]);
+    }
+    for (std::size_t k = 0; k < 3; ++k) f.begin.eye[k] = static_cast<float>(cam.eye_world[k]);
+
+    const auto t0 = std::chrono::steady_clock::now();
+    recorder_.begin_frame(16 + methods_.size());
+    walker_->set_field(field_, radius_, recorder_);
+    const std::vector<float> levels = walker_->levels();
+    const relief::FieldView view{field_.size, field_.heights, radius_.radius, levels, walker_->level_count()};
+    std::vector<GlFragments> gl;
+    for (relief::Method m : methods_) {
+      walker_->clear_depth();
+      gl.push_back(walker_->draw(m, cam.view, params_, recorder_));
+    }
+    f.draws = recorder_.collect();
+    f.end.gl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+    trace::TechniqueRecord field;
+    field.type = trace::kReliefFieldChunk;
+    field.decoded = true;
+    const auto vec3 = [](const std::array<float, 3>& v) { return std::vector<float>(v.begin(), v.end()); };
+    field.fields = {{"size", static_cast<std::uint64_t>(field_.size)},
+                    {"levels", static_cast<std::uint64_t>(walker_->level_count())},
+                    {"max_radius", static_cast<std::uint64_t>(max_radius_)},
+                    {"field", description_},
+                    {"heights", field_.heights},
+                    {"radius", radius_.radius},
+                    {"nbuffer", levels},
+                    {"linear_steps", static_cast<std::uint64_t>(params_.linear_steps)},
+                    {"binary_steps", static_cast<std::uint64_t>(params_.binary_steps)},
+                    {"root_steps", static_cast<std::uint64_t>(params_.root_steps)},
+                    {"origin", vec3(cam.view.ray.origin)},
+                    {"ray_a", vec3(cam.view.ray.a)},
+                    {"ray_b", vec3(cam.view.ray.b)},
+                    {"ray_c", vec3(cam.view.ray.c)},
+                    {"view_angle", angle}};
+    f.technique_records.push_back(std::move(field));
+
+    // One RLFF a box draw, in draw order; the capture's own score of each method.
+    std::size_t box = 0;
+    for (const scene::DrawRecord& d : f.draws) {
+      if (d.role != scene::DrawRole::ReliefBox) continue;
+      const relief::Method m = methods_[box];
+      const GlFragments& g = gl[box++];
+      std::uint64_t errors = 0, lookups = 0, hits = 0;
+      for (std::size_t k = 0; k < g.pixel.size(); ++k) {
+        lookups += g.lookups[k];
+        hits += g.hit[k] == trace::kReliefHit;
+        const float px = static_cast<float>(g.pixel[k] % static_cast<std::uint32_t>(width_)) + 0.5f;
+        const float py = static_cast<float>(g.pixel[k] / static_cast<std::uint32_t>(width_)) + 0.5f;
+        if (const auto ray = relief::fragment_ray(cam.view.ray, field_.size, px, py))
+          errors += relief::score_hit(field_, *ray, g.hit[k] == trace::kReliefHit, g.t[k], box_height_, tolerance_).error !=
+                    relief::HitError::None;
+      }
+      const std::string name(relief::to_string(m));
+      counts_add(out, name + "_fragments", g.pixel.size());
+      counts_add(out, name + "_hits", hits);
+      counts_add(out, name + "_lookups", lookups);
+      counts_add(out, name + "_errors", errors);
+      trace::TechniqueRecord r;
+      r.type = trace::kReliefFragmentsChunk;
+      r.decoded = true;
+      r.fields = {{"draw", std::uint64_t{d.index}},
+                  {"method", static_cast<std::uint64_t>(m)},
+                  {"count", static_cast<std::uint64_t>(g.pixel.size())},
+                  {"pixel", g.pixel},
+                  {"hit", g.hit},
+                  {"t", g.t},
+                  {"lookups", g.lookups},
+                  {"steps", g.steps},
+                  {"bisections", g.bisections}};
+      f.technique_records.push_back(std::move(r));
+    }
+    f.end.frame = index;
+    f.end.draws = static_cast<std::uint32_t>(f.draws.size());
+    return out;
+  }
+
+ private:
+  static void counts_add(CapturedFrame& out, const std::string& name, std::uint64_t v) { out.counts.emplace_back(name, v); }
+
+  int width_, height_;
+  std::uint64_t seed_ = 1;
+  int max_radius_ = 16;
+  relief::Heightfield field_;
+  relief::SafetyRadius radius_;
+  std::string description_;
+  std::vector<relief::Method> methods_;
+  std::vector<double> angles_;
+  double box_height_ = 0.25, tolerance_ = relief::kDefaultHitTolerance;
+  relief::WalkParams params_;
+  DrawRecorder recorder_;
+  std::unique_ptr<GlReliefWalker> walker_;
+};
+
+}  // namespace
+
+const std::vector<OptionSpec>& relief_options() {
+  static const std::vector<OptionSpec> options = {field_option(),        field_param_option(), field_size_option(),   field_file_option(),
+                                                  radius_file_option(),  max_radius_option(),  methods_option(),      angles_option(),
+                                                  box_height_option(),   linear_steps_option(), binary_steps_option(), root_steps_option(),
+                                                  tolerance_option(),    seed_option()};
+  return options;
+}
+
+std::unique_ptr<Technique> make_relief(const TechniqueSetup& setup) { return std::make_unique<Relief>(setup); }
+
+}  // namespace nbsim::capture
