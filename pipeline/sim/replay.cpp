@@ -419,6 +419,20 @@ nlohmann::ordered_json relief_summary(const nlohmann::ordered_json& p, const nlo
     methods[std::string(relief::to_string(m))] = e;
   }
   j["methods"] = methods;
+  // Totals over the methods (the results row's metrics).
+  std::uint64_t fragments = 0, lookups = 0, errors = 0, walk_mismatches = 0, pixel_mismatches = 0;
+  for (const auto& [name, e] : methods.items()) {
+    fragments += e["fragments"].get<std::uint64_t>(), lookups += e["lookups"].get<std::uint64_t>();
+    errors += e["errors"].get<std::uint64_t>(), walk_mismatches += e["walk_mismatches"].get<std::uint64_t>();
+    pixel_mismatches += e["pixel_mismatches"].get<std::uint64_t>();
+  }
+  j["fragments"] = fragments;
+  j["lookups"] = lookups;
+  j["lookups_per_fragment"] = fragments ? nlohmann::ordered_json(static_cast<double>(lookups) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
+  j["errors"] = errors;
+  j["error_rate"] = fragments ? nlohmann::ordered_json(static_cast<double>(errors) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
+  j["walk_mismatches"] = walk_mismatches;
+  j["pixel_mismatches"] = pixel_mismatches;
   return j;
 }
 

@@ -16,6 +16,9 @@
 #include "model/relief/walk.h"
 #include "pipeline/io/image_io.h"
 #include "traces/capture/draw_recorder.h"
+#include "model/mesh/shapes.h"
+#include "traces/capture/ldi/mesh_loader.h"
+#include "traces/capture/relief/bake.h"
 #include "traces/capture/relief/gl_walk.h"
 #include "traces/capture/relief/view.h"
 #include "traces/format/relief_chunk.h"
@@ -40,6 +43,13 @@ const OptionSpec& field_size_option() {
 const OptionSpec& field_file_option() {
   static const OptionSpec spec = text_option(
       "field-file", "A square single-channel image (EXR, PNG, ... through OpenImageIO) of heights in [0, 1] instead of --field ('none': use --field)",
+      "none");
+  return spec;
+}
+const OptionSpec& field_mesh_option() {
+  static const OptionSpec spec = text_option(
+      "field-mesh", "Bake the heightfield from a mesh seen from above: a mesh file assimp reads, or shape:NAME[:PARAM] "
+                    "(model/mesh/shapes.h); --field-size texels a side ('none': use --field)",
       "none");
   return spec;
 }
@@ -148,7 +158,24 @@ class Relief final : public Technique {
     seed_ = static_cast<std::uint64_t>(o.integer(seed_option()));
     max_radius_ = static_cast<int>(o.integer(max_radius_option()));
     const std::string file = o.text(field_file_option());
-    if (file != "none") {
+    const std::string mesh_source = o.text(field_mesh_option());
+    if (file != "none" && mesh_source != "none") throw InputError("give --field-file or --field-mesh, not both");
+    if (mesh_source != "none") {
+      if (o.has("field") || o.has("field-param")) throw InputError("give --field or --field-mesh, not both");
+      mesh::TriMesh m;
+      if (mesh_source.rfind("shape:", 0) == 0) {
+        const std::string spec = mesh_source.substr(6);
+        const std::size_t colon = spec.find(':');
+        std::optional<int> param;
+        if (colon != std::string::npos) param = static_cast<int>(parse_number(spec.substr(colon + 1), "field-mesh", 1, 1000));
+        m = mesh::make_shape(spec.substr(0, colon), param);
+      } else {
+        m = load_mesh(mesh_source);
+      }
+      field_ = bake_heightfield(std::move(m), static_cast<int>(o.integer(field_size_option())));
+      relief::check_heightfield(field_, fmt::format("the heightfield baked from '{}'", mesh_source));
+      description_ = "mesh:" + std::filesystem::path(mesh_source).filename().string();
+    } else if (file != "none") {
       if (o.has("field") || o.has("field-param") || o.has("field-size")) throw InputError("give --field or --field-file, not both");
       field_ = read_square(file, "--field-file");
       relief::check_heightfield(field_, fmt::format("the heightfield in '{}'", file));
@@ -306,7 +333,7 @@ class Relief final : public Technique {
 }  // namespace
 
 const std::vector<OptionSpec>& relief_options() {
-  static const std::vector<OptionSpec> options = {field_option(),        field_param_option(), field_size_option(),   field_file_option(),
+  static const std::vector<OptionSpec> options = {field_option(),        field_param_option(), field_size_option(),   field_file_option(),  field_mesh_option(),
                                                   radius_file_option(),  max_radius_option(),  methods_option(),      angles_option(),
                                                   box_height_option(),   linear_steps_option(), binary_steps_option(), root_steps_option(),
                                                   tolerance_option(),    seed_option()};

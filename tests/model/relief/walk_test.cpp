@@ -1,0 +1,182 @@
+// ReliefWalkTest: the walks of model/relief/walk.h on the hard cases, each against the exact
+// reference (reference.h, score.h): the saddle of Baboud & Decoret's Figure 3 (the exact walk
+// misses it, the robust search and the N-buffer walk must not), a single-texel spike (radius 0), a 0
+// to 1 step seen at grazing angles, a long empty run (the N-buffer walk skips it in a few lookups),
+// and rays entering through the box's sides. The GL twin of every walk is ReliefGlWalkTest's.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "model/nbuffer/covering.h"
+#include "model/relief/heightfield.h"
+#include "model/relief/radius.h"
+#include "model/relief/reference.h"
+#include "model/relief/score.h"
+#include "model/relief/walk.h"
+
+namespace nbsim::relief {
+namespace {
+
+// A field with its radius and max N-buffer (brute force), and the views walk() reads.
+struct Setup {
+  Heightfield field;
+  SafetyRadius radius;
+  std::vector<float> levels;
+  int level_count = 0;
+
+  explicit Setup(Heightfield f, int max_radius = 16) : field(std::move(f)) {
+    radius = safety_radius(field, max_radius);
+    const int n = field.size;
+    level_count = nbuffer_level_count(n, n);
+    for (int l = 0; l < level_count; ++l)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          float m = 0.0f;
+          for (int j = y; j < std::min(n, y + (1 << l)); ++j)
+            for (int i = x; i < std::min(n, x + (1 << l)); ++i) m = std::max(m, field.at(i, j));
+          levels.push_back(m);
+        }
+  }
+  FieldView view() const { return {field.size, field.heights, radius.radius, levels, level_count}; }
+};
+
+// The ray from `o` along `d` (texel space) clipped to the box, as fragment_ray clips it.
+FragmentRay clipped(const Setup& s, std::array<float, 3> o, std::array<float, 3> d) {
+  FragmentRay r;
+  r.o = o;
+  r.d = d;
+  float tmin = 0.0f, tmax = 3.0e38f;
+  const float hi[3] = {static_cast<float>(s.field.size), static_cast<float>(s.field.size), 1.0f};
+  for (int k = 0; k < 3; ++k) {
+    if (d[k] == 0.0f) continue;
+    const float t1 = (0.0f - o[k]) / d[k], t2 = (hi[k] - o[k]) / d[k];
+    tmin = std::max(tmin, std::min(t1, t2));
+    tmax = std::min(tmax, std::max(t1, t2));
+  }
+  r.t_in = tmin;
+  r.t_out = tmax;
+  return r;
+}
+
+HitError error_of(const Setup& s, Method m, const FragmentRay& r, const WalkParams& p = {}) {
+  const WalkResult w = walk(m, s.view(), p, r);
+  EXPECT_FALSE(w.capped) << to_string(m);
+  return score_hit(s.field, r, w.hit, w.t, 1.0 / s.field.size, kDefaultHitTolerance).error;
+}
+
+TEST(ReliefWalkTest, SaddleOfFigure3) {
+  const Setup s(make_heightfield("saddle", 16, 0, 1));
+  // A horizontal ray at height 0.4 just off the saddle cell's diagonal: the height above the patch
+  // is positive where it enters and leaves the cell and negative in between.
+  const float m = 8.0f;
+  const FragmentRay r = clipped(s, {m - 0.5f - 4.0f, m - 0.5f - 4.0f + 0.05f, 0.4f}, {1.0f, 1.0f, 0.0f});
+  const std::array<double, 3> o = {r.o[0], r.o[1], r.o[2]}, d = {r.d[0], r.d[1], r.d[2]};
+  ASSERT_TRUE(reference_hit(s.field, o, d, r.t_in, r.t_out).hit);
+  EXPECT_EQ(error_of(s, Method::Exact, r), HitError::WrongMiss);  // their Figure 3
+  EXPECT_EQ(error_of(s, Method::NBuffer, r), HitError::None);
+  EXPECT_EQ(error_of(s, Method::Robust, r), HitError::None);
+}
+
+TEST(ReliefWalkTest, SingleTexelSpike) {
+  Heightfield f;
+  f.size = 16;
+  f.heights.assign(256, 0.1f);
+  f.heights[8 * 16 + 8] = 1.0f;
+  const Setup s(f);
+  EXPECT_EQ(s.radius.radius[8 * 16 + 8], 0.0f);  // a peak: radius 0
+  // Horizontal rays through the spike at heights near its tip and across its width.
+  WalkParams coarse;
+  coarse.linear_steps = 4;
+  int binary_errors = 0, clamp_errors = 0, checked = 0;
+  for (float z : {0.5f, 0.8f, 0.95f})
+    for (float y = 8.2f; y < 8.85f; y += 0.1f) {
+      const FragmentRay r = clipped(s, {0.0f, y, z}, {1.0f, 0.013f, 0.0f});
+      for (Method m : {Method::Exact, Method::NBuffer, Method::Robust}) EXPECT_EQ(error_of(s, m, r), HitError::None) << to_string(m) << " z " << z << " y " << y;
+      binary_errors += error_of(s, Method::Binary, r, coarse) != HitError::None;
+      clamp_errors += error_of(s, Method::RobustClamp, r) != HitError::None;
+      ++checked;
+    }
+  EXPECT_GT(binary_errors, 0) << "binary search with 4 linear steps should step over a one-texel spike";
+  RecordProperty("robust_clamp_errors", clamp_errors);
+  RecordProperty("checked", checked);
+}
+
+TEST(ReliefWalkTest, StepAtGrazingAngles) {
+  const Setup s(make_heightfield("step", 32, 0, 1));
+  // Rays from the low side toward the 0 to 1 step, 80 to 89 degrees off vertical.
+  int binary_errors = 0;
+  for (double angle = 80.0; angle <= 89.0; angle += 1.0)
+    for (float y = 3.3f; y < 29.0f; y += 2.9f) {
+      const double a = angle * M_PI / 180.0;
+      const std::array<float, 3> d = {static_cast<float>(std::sin(a) * 32.0), 0.11f, static_cast<float>(-std::cos(a))};
+      const FragmentRay r = clipped(s, {0.0f, y, 0.999f}, d);
+      for (Method m : {Method::Exact, Method::NBuffer, Method::Robust}) EXPECT_EQ(error_of(s, m, r), HitError::None) << to_string(m) << " at " << angle;
+      binary_errors += error_of(s, Method::Binary, r) != HitError::None;
+    }
+  RecordProperty("binary_errors", binary_errors);
+}
+
+TEST(ReliefWalkTest, LongEmptyRunIsSkipped) {
+  Heightfield f;
+  f.size = 256;
+  f.heights.assign(256 * 256, 0.0f);
+  for (int j = 120; j < 136; ++j)
+    for (int i = 240; i < 250; ++i) f.heights[static_cast<std::size_t>(j * 256 + i)] = 0.9f;
+  const Setup s(f);
+  const FragmentRay r = clipped(s, {0.0f, 128.3f, 0.5f}, {1.0f, 0.0001f, 0.0f});
+  const WalkResult exact = walk(Method::Exact, s.view(), {}, r);
+  const WalkResult nb = walk(Method::NBuffer, s.view(), {}, r);
+  ASSERT_TRUE(exact.hit);
+  ASSERT_TRUE(nb.hit);
+  EXPECT_FLOAT_EQ(exact.t, nb.t);
+  EXPECT_LT(nb.lookups * 10, exact.lookups) << "nbuffer " << nb.lookups << " exact " << exact.lookups;
+  EXPECT_EQ(error_of(s, Method::NBuffer, r), HitError::None);
+}
+
+TEST(ReliefWalkTest, RaysThroughTheSides) {
+  const Setup s(make_heightfield("fbm", 32, 0, 3));
+  // Enters through a side (x = 0) below the border's height 0... so above it, then climbs out
+  // through the top: a miss for every method and the reference.
+  const FragmentRay up = clipped(s, {-1.0f, 16.2f, 0.02f}, {1.0f, 0.01f, 0.5f});
+  for (Method m : kAllMethods) EXPECT_EQ(error_of(s, m, up), HitError::None) << to_string(m);
+  // Enters through a side where the surface is higher than the ray: the side wall is a hit at t_in
+  // for every method... the surface at x = 0 is 0 (the zero border), so enter one texel in instead
+  // from the top and leave through the far side.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int k = 0; k < 200; ++k) {
+    const float y = 1.0f + 30.0f * u(rng), z = u(rng);
+    const FragmentRay r = clipped(s, {-0.5f, y, z}, {1.0f, 0.2f * (u(rng) - 0.5f), 0.05f * (u(rng) - 0.5f)});
+    for (Method m : {Method::Exact, Method::NBuffer}) {
+      const HitError e = error_of(s, m, r);
+      EXPECT_TRUE(e == HitError::None || (m == Method::Exact && e == HitError::WrongMiss)) << to_string(m) << " ray " << k;
+    }
+  }
+}
+
+TEST(ReliefWalkTest, ExactMethodsAgreeWithTheReferenceOnRandomRays) {
+  const Setup s(make_heightfield("fbm", 64, 0, 11));
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int nbuffer_errors = 0, robust_errors = 0, exact_misses = 0, rays = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const std::array<float, 3> o = {64.0f * u(rng), 64.0f * u(rng), 1.2f};
+    const std::array<float, 3> d = {40.0f * (u(rng) - 0.5f), 40.0f * (u(rng) - 0.5f), -0.2f - u(rng)};
+    const FragmentRay r = clipped(s, o, d);
+    if (!(r.t_in <= r.t_out)) continue;
+    ++rays;
+    nbuffer_errors += error_of(s, Method::NBuffer, r) != HitError::None;
+    robust_errors += error_of(s, Method::Robust, r) != HitError::None;
+    const HitError e = error_of(s, Method::Exact, r);
+    exact_misses += e == HitError::WrongMiss;
+    EXPECT_TRUE(e == HitError::None || e == HitError::WrongMiss) << "the exact walk errs only by missing saddles, ray " << k;
+  }
+  EXPECT_GT(rays, 2000);
+  EXPECT_EQ(nbuffer_errors, 0);
+  EXPECT_EQ(robust_errors, 0);
+  RecordProperty("exact_saddle_misses", exact_misses);
+}
+
+}  // namespace
+}  // namespace nbsim::relief

@@ -1,0 +1,19 @@
+// Heightfields baked from a mesh on GL (the "heightfields baked from meshes"): the mesh,
+// fitted into the unit cube (model/mesh/mesh.h normalize_to_unit_cube, margin 0) and shrunk in x and
+// y to leave a one-texel ring at height 0, is rendered orthographically from above into an N x N
+// DEPTH_COMPONENT32F target (clip control ZERO_TO_ONE, window depth = 1 - height, LESS against 1.0,
+// no culling); a texel's height is 1 - its depth where a fragment landed, 0 elsewhere: the upper
+// envelope of the mesh sampled at texel centres, as GL's rasterizer samples it.
+#pragma once
+
+#include <string>
+
+#include "model/mesh/mesh.h"
+#include "model/relief/heightfield.h"
+
+namespace nbsim::capture {
+
+// The GL context must be current. Throws InputError for an unusable mesh or size.
+relief::Heightfield bake_heightfield(mesh::TriMesh m, int size);
+
+}  // namespace nbsim::capture
