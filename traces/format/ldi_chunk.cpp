@@ -13,22 +13,17 @@ namespace {
 // Limits mirrored from model/ldi/ldi.h (kMaxSideTexels, kMaxLayers); the model checks the rest.
 constexpr std::uint64_t kMaxSide = 16384, kMaxLayers = 2048;
 
-const TechniqueField* field(const TechniqueRecord& r, std::string_view name) {
-  for (const TechniqueField& f : r.fields)
-    if (f.name == name) return &f;
-  return nullptr;
-}
 std::uint64_t u(const TechniqueRecord& r, std::string_view name) {
-  const TechniqueField* f = field(r, name);
+  const TechniqueField* f = find_field(r, name);
   return f ? std::get<std::uint64_t>(f->value) : 0;
 }
 std::int64_t i(const TechniqueRecord& r, std::string_view name) {
-  const TechniqueField* f = field(r, name);
+  const TechniqueField* f = find_field(r, name);
   return f ? std::get<std::int64_t>(f->value) : 0;
 }
 template <class T>
 std::size_t length(const TechniqueRecord& r, std::string_view name) {
-  const TechniqueField* f = field(r, name);
+  const TechniqueField* f = find_field(r, name);
   return f ? std::get<std::vector<T>>(f->value).size() : 0;
 }
 
@@ -61,7 +56,7 @@ std::string image_rule(const TechniqueRecord& r) {
 std::string tests_rule(const TechniqueRecord& r) {
   const std::uint64_t count = u(r, "count");
   if (std::string problem = vector_lengths_problem(r, count, {"count", "epsilon"}, "test point"); !problem.empty()) return problem;
-  const TechniqueField* eps = field(r, "epsilon");
+  const TechniqueField* eps = find_field(r, "epsilon");
   if (eps && !(std::get<double>(eps->value) >= 0.0 && std::get<double>(eps->value) < 1.0))
     return fmt::format("epsilon is {}, not in [0, 1)", std::get<double>(eps->value));
   for (const TechniqueField& f : r.fields) {

@@ -1,2 +1,145 @@
-// See relief_chunk.h.
+// The relief technique's chunk descriptions; see relief_chunk.h.
 #include "traces/format/relief_chunk.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <string>
+#include <variant>
+
+#include "model/nbuffer/covering.h"
+#include "model/relief/heightfield.h"
+#include "model/relief/walk.h"
+
+namespace nbsim::trace {
+
+namespace {
+
+// Limits fixed by the design, as relief_chunk.h and model/relief (radius.h, walk.h WalkParams)
+// state them; the size limits are model/relief/heightfield.h's.
+constexpr std::uint64_t kMaxRadiusLimit = 255, kMaxLinearSteps = 1024, kMaxBisections = 32;
+
+std::uint64_t u(const TechniqueRecord& r, std::string_view name) {
+  const TechniqueField* f = find_field(r, name);
+  return f ? std::get<std::uint64_t>(f->value) : 0;
+}
+const std::vector<float>& floats(const TechniqueRecord& r, std::string_view name) {
+  static const std::vector<float> none;
+  const TechniqueField* f = find_field(r, name);
+  return f ? std::get<std::vector<float>>(f->value) : none;
+}
+
+// Why `name` does not hold `want` values none of which is NaN, or empty.
+std::string float_vector_problem(const TechniqueRecord& r, std::string_view name, std::uint64_t want, std::string_view why) {
+  const std::vector<float>& v = floats(r, name);
+  if (v.size() != want) return fmt::format("field '{}' has {} values, but {} is {}", name, v.size(), why, want);
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (std::isnan(v[k])) return fmt::format("field '{}' has NaN at index {}", name, k);
+  return {};
+}
+
+std::string field_rule(const TechniqueRecord& r) {
+  const std::uint64_t n = u(r, "size"), levels = u(r, "levels"), max_radius = u(r, "max_radius");
+  if (n < static_cast<std::uint64_t>(relief::kMinSize) || n > static_cast<std::uint64_t>(relief::kMaxSize))
+    return fmt::format("size is {}, not {} to {}", n, relief::kMinSize, relief::kMaxSize);
+  const int side = static_cast<int>(n);
+  const std::uint64_t want_levels = static_cast<std::uint64_t>(nbuffer_level_count(side, side));
+  if (levels != want_levels) return fmt::format("levels is {}, but a {}x{} N-buffer has {}", levels, n, n, want_levels);
+  if (max_radius < 1 || max_radius > kMaxRadiusLimit) return fmt::format("max_radius is {}, not 1 to {}", max_radius, kMaxRadiusLimit);
+  const struct {
+    const char* name;
+    std::uint64_t lo, hi;
+  } tunables[] = {{"linear_steps", 1, kMaxLinearSteps}, {"binary_steps", 0, kMaxBisections}, {"root_steps", 0, kMaxBisections}};
+  for (const auto& t : tunables)
+    if (u(r, t.name) < t.lo || u(r, t.name) > t.hi) return fmt::format("{} is {}, not {} to {}", t.name, u(r, t.name), t.lo, t.hi);
+  const std::uint64_t texels = n * n;
+  const std::string texels_why = fmt::format("size x size ({}x{})", n, n);
+  for (const char* name : {"heights", "radius"})
+    if (std::string p = float_vector_problem(r, name, texels, texels_why); !p.empty()) return p;
+  if (std::string p = float_vector_problem(r, "nbuffer", levels * texels, fmt::format("levels x size x size ({}x{}x{})", levels, n, n));
+      !p.empty())
+    return p;
+  for (const char* name : {"origin", "ray_a", "ray_b", "ray_c"})
+    if (std::string p = float_vector_problem(r, name, 3, "a vector's length"); !p.empty()) return p;
+  const std::vector<float>& heights = floats(r, "heights");
+  for (std::size_t k = 0; k < heights.size(); ++k)
+    if (!(heights[k] >= 0.0f && heights[k] <= 1.0f))
+      return fmt::format("height of texel ({}, {}) is {}, outside [0, 1]", k % n, k / n, heights[k]);
+  const std::vector<float>& radius = floats(r, "radius");
+  for (std::size_t k = 0; k < radius.size(); ++k)
+    if (!(radius[k] >= 0.0f && radius[k] <= static_cast<float>(max_radius)) || radius[k] != std::floor(radius[k]))
+      return fmt::format("radius of texel ({}, {}) is {}, not a whole number in [0, {}]", k % n, k / n, radius[k], max_radius);
+  return {};
+}
+
+std::string fragments_rule(const TechniqueRecord& r) {
+  if (std::string p = vector_lengths_problem(r, u(r, "count"), {"draw", "method", "count"}, "fragment"); !p.empty()) return p;
+  if (u(r, "method") >= static_cast<std::uint64_t>(relief::kMethods))
+    return fmt::format("method is {}, above {}", u(r, "method"), relief::kMethods - 1);
+  for (const TechniqueField& f : r.fields) {
+    if (f.name == "hit") {
+      const auto& v = std::get<std::vector<std::uint32_t>>(f.value);
+      for (std::size_t k = 0; k < v.size(); ++k)
+        if (v[k] > kReliefCapped) return fmt::format("field 'hit' of fragment {} is {}, above {}", k, v[k], kReliefCapped);
+    } else if (f.name == "pixel") {
+      const auto& v = std::get<std::vector<std::uint32_t>>(f.value);
+      for (std::size_t k = 1; k < v.size(); ++k)
+        if (v[k] <= v[k - 1])
+          return fmt::format("field 'pixel' is not strictly increasing: fragment {} is pixel {}, after {}", k, v[k], v[k - 1]);
+    } else if (f.name == "t") {
+      const auto& v = std::get<std::vector<float>>(f.value);
+      for (std::size_t k = 0; k < v.size(); ++k)
+        if (std::isnan(v[k])) return fmt::format("field 't' of fragment {} is NaN", k);
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+ChunkSpec relief_field_chunk_spec() {
+  ChunkSpec spec{
+      kReliefFieldChunk,
+      "relief",
+      "ReliefField",
+      {{"size", FieldKind::U32, "N: the heightfield is N x N texels, 2 to 1024"},
+       {"levels", FieldKind::U32, "levels of the max N-buffer: nbuffer_level_count(N, N) = ceil(log2 N), at least 1"},
+       {"max_radius", FieldKind::U32, "the cap of the safety radius, texels, 1 to 255"},
+       {"field", FieldKind::String, "what the heightfield is: a generator and its arguments (\"fbm:6 seed 7\") or a file name"},
+       {"heights", FieldKind::VecF32, "the heightfield: N x N heights in [0, 1], y up, row-major (model/relief/heightfield.h)"},
+       {"radius", FieldKind::VecF32, "the safety radius GL's walks read: N x N whole texels in [0, max_radius], y up, row-major"},
+       {"nbuffer", FieldKind::VecF32,
+        "the max N-buffer of the heights as GL built it: levels planes of N x N, level-major, y up, row-major; level 0 is the heights"},
+       {"linear_steps", FieldKind::U32, "binary: equal steps from the box entry to its exit, 1 to 1024"},
+       {"binary_steps", FieldKind::U32, "binary and robust: bisections after the bracket, 0 to 32"},
+       {"root_steps", FieldKind::U32, "exact, nbuffer and robust's cell steps: bisections inside a cell, 0 to 32"},
+       {"origin", FieldKind::VecF32, "the ray frame (model/relief/walk.h): the eye in texel space, x, y, z"},
+       {"ray_a", FieldKind::VecF32,
+        "the ray frame: a fragment's ray direction is (ray_a * px + ray_b * py) + ray_c, (px, py) its pixel centre in window "
+        "coordinates; ray_a: x, y, z, texel space per pixel of px"},
+       {"ray_b", FieldKind::VecF32, "x, y, z, texel space per pixel of py"},
+       {"ray_c", FieldKind::VecF32, "x, y, z, texel space"},
+       {"view_angle", FieldKind::F64, "degrees between the view direction and the box's up axis (for reports)"}}};
+  spec.rule = field_rule;
+  return spec;
+}
+
+ChunkSpec relief_fragments_chunk_spec() {
+  ChunkSpec spec{
+      kReliefFragmentsChunk,
+      "relief",
+      "ReliefFragments",
+      {{"draw", FieldKind::U32, "the index in the frame of the relief_box draw these fragments are of"},
+       {"method", FieldKind::U32, "the walk that draw ran: 0 binary, 1 exact, 2 robust, 3 robust_clamp, 4 nbuffer"},
+       {"count", FieldKind::U32, "fragments the shader ran, after the early depth test (every vector below has this many)"},
+       {"pixel", FieldKind::VecU32, "the fragment's pixel, y * width + x of the viewport, strictly increasing"},
+       {"hit", FieldKind::VecU32, "GL's answer: 0 miss (discarded), 1 hit, 2 capped (the walk reached its iteration cap: a miss)"},
+       {"t", FieldKind::VecF32, "the hit's ray parameter, 0 on a miss"},
+       {"lookups", FieldKind::VecU32, "texel reads the walk issued (model/relief/walk.h counts them)"},
+       {"steps", FieldKind::VecU32, "steps the walk took"},
+       {"bisections", FieldKind::VecU32, "bisections the walk took"}}};
+  spec.rule = fragments_rule;
+  return spec;
+}
+
+}  // namespace nbsim::trace

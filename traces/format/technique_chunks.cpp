@@ -15,6 +15,7 @@
 #include "traces/format/codec.h"
 #include "traces/format/ldi_chunk.h"
 #include "traces/format/particles_chunk.h"
+#include "traces/format/relief_chunk.h"
 #include "traces/format/shadows_chunk.h"
 
 namespace nbsim::trace {
@@ -33,7 +34,10 @@ struct Registry {
 
 // The chunk types of the techniques this build knows, registered before anything else so that
 // every reader decodes them (a technique's own test types register later, at run time).
-std::vector<ChunkSpec> built_in_chunks() { return {particles_chunk_spec(), shadows_chunk_spec(), ldi_image_chunk_spec(), ldi_tests_chunk_spec()}; }
+std::vector<ChunkSpec> built_in_chunks() {
+  return {particles_chunk_spec(), shadows_chunk_spec(),      ldi_image_chunk_spec(),
+          ldi_tests_chunk_spec(), relief_field_chunk_spec(), relief_fragments_chunk_spec()};
+}
 
 Registry& registry() {
   static Registry r{{}, built_in_chunks()};
@@ -162,6 +166,12 @@ std::string technique_table(const ChunkSpec& spec) {
     t += fmt::format("| {} | {} | `{}` | {} |\n", i + 1, kind_name(spec.fields[i].kind), spec.fields[i].name,
                      spec.fields[i].meaning);
   return t;
+}
+
+const TechniqueField* find_field(const TechniqueRecord& record, std::string_view name) {
+  for (const TechniqueField& f : record.fields)
+    if (f.name == name) return &f;
+  return nullptr;
 }
 
 std::string vector_lengths_problem(const TechniqueRecord& record, std::uint64_t count, std::initializer_list<std::string_view> scalars,

@@ -38,6 +38,9 @@ struct ChunkSpec {
   std::string (*rule)(const TechniqueRecord& record) = nullptr;
 };
 
+// For a spec's rule: the field `name` of `record`, or nullptr.
+const TechniqueField* find_field(const TechniqueRecord& record, std::string_view name);
+
 // For a spec's rule: why a vector field of `record` (other than the fields named in `scalars`) does
 // not have `count` elements ("field 'x' has 2 elements, but count is 3 (one a particle)", with
 // `one_a` = "particle"), or empty when every one has.
