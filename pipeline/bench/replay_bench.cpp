@@ -54,6 +54,13 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
     c.path = "fly";
     c.width = c.height = 8;
     c.options = {{"boxes", "0"}, {"shape", mode}, {"ldi-size", std::to_string(o.ldi_size)}};
+  } else if (o.technique == "relief") {
+    // The relief box is seen from its own camera: the smallest scene the capture accepts.
+    if (!mode.empty()) throw InputError("--mode is not a relief option (the heightfield is --field)");
+    mode = o.field.empty() ? "fbm" : o.field;
+    c.scene = "boxes";
+    c.path = "fly";
+    c.options = {{"boxes", "0"}, {"field", mode}, {"field-size", std::to_string(o.field_size)}};
   } else {
     throw InputError(fmt::format("--technique '{}' is not one of {}", o.technique, fmt::join(kReplayBenchTechniques, ", ")));
   }
@@ -100,6 +107,10 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
     j["shadows_summary"] = std::move(sh);
   }
   if (ldi && !s.ldi.is_null()) j["ldi_summary"] = s.ldi;
+  if (o.technique == "relief") {
+    j["field_size"] = o.field_size;
+    if (!s.relief.is_null()) j["relief_summary"] = s.relief;
+  }
   return j;
 }
 

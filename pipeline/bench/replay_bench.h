@@ -28,10 +28,14 @@ struct ReplayBenchOptions {
   // The ldi technique: the shape (model/mesh/shapes.h's table; empty: knot) and the LDI's side.
   std::string shape;
   int ldi_size = 256;
+  // The relief technique: the heightfield kind (model/relief/heightfield.h; empty: fbm) and its side;
+  // --size is the viewport, every method a box draw a frame, the frames cycling 0, 45, 80, 89 degrees.
+  std::string field;
+  int field_size = 128;
 };
 
 // The technique names the bench accepts (the capture's plug-in names).
-inline constexpr const char* kReplayBenchTechniques[] = {"occlusion_culling", "particles", "shadows", "ldi"};
+inline constexpr const char* kReplayBenchTechniques[] = {"occlusion_culling", "particles", "shadows", "ldi", "relief"};
 
 // One JSON object: technique, frames, gl_ms (llvmpipe, technique passes), replay_ms, ratio replay/gl,
 // depth tests and cycles per host second, and whether the comparison stayed within thresholds;

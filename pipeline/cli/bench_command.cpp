@@ -114,6 +114,10 @@ void add_bench_commands(CLI::App& app, Action& action) {
     rep->add_option("--sprite", ro->sprite, "Sprite size: 16, 24 or atten (technique particles)")->capture_default_str();
     rep->add_option("--shape", ro->shape, "Shape peeled (technique ldi; default knot): sphere, knot, nested, coil");
     rep->add_option("--ldi-size", ro->ldi_size, "LDI side, texels (technique ldi)")->check(CLI::Range(1, 4096))->capture_default_str();
+    rep->add_option("--field", ro->field, "Heightfield (technique relief; default fbm): fbm, walls, spikes, saddle, step");
+    rep->add_option("--field-size", ro->field_size, "Heightfield side, texels (technique relief)")
+        ->check(CLI::Range(2, 1024))
+        ->capture_default_str();
     rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes; particles: scene, partial N-buffer or Hi-Z\n"
                 "build and the culled particle draws, not the reference pass), replay_ms (the SystemC model), ratio\n"
                 "replay/gl, depth_tests_per_s and cycles_per_s of the model, measured in the same run; for particles\n"
@@ -123,7 +127,10 @@ void add_bench_commands(CLI::App& app, Action& action) {
                 "the observer and volume draws and builds both N-buffers, and takes the litmaps as GL made them.\n"
                 "Ldi: gl_ms spans viewpoint selection, the peel, crop, compression and GL's parity tests (not the exact\n"
                 "reference on the CPU); the model replays the peel passes, crops, compresses and runs both parity tests;\n"
-                "--size is ignored (the LDI is --ldi-size square).");
+                "--size is ignored (the LDI is --ldi-size square).\n"
+                "Relief: gl_ms spans the N-buffer build and every method's box draw with its per-fragment read-back (not\n"
+                "the exact reference on the CPU); the model rasterizes each box draw and walks every fragment's ray with\n"
+                "the texel cache and the exact reference's scoring; --size is the viewport.");
     rep->callback([&action, ro] {
       action = [ro] {
         parse_size(ro->size, "--size");
@@ -132,6 +139,8 @@ void add_bench_commands(CLI::App& app, Action& action) {
           throw InputError("--particles and --sprite need --technique particles");
         if (ro->technique != "ldi" && (!ro->shape.empty() || ro->ldi_size != bench::ReplayBenchOptions{}.ldi_size))
           throw InputError("--shape and --ldi-size need --technique ldi");
+        if (ro->technique != "relief" && (!ro->field.empty() || ro->field_size != bench::ReplayBenchOptions{}.field_size))
+          throw InputError("--field and --field-size need --technique relief");
         fmt::print("{}\n", bench::run_replay_bench(*ro).dump());
         return 0;
       };

@@ -186,6 +186,7 @@ class Relief final : public Technique {
       field_ = relief::make_heightfield(o.text(field_option()), n, param, seed_);
       description_ = fmt::format("{}:{} seed {}", o.text(field_option()), param, seed_);
     }
+    for (float& h : field_.heights) h += 0.0f;  // -0.0 becomes +0.0: one zero, so GL's max and the model's agree bit for bit
     const std::string radius_file = o.text(radius_file_option());
     if (radius_file != "none") {
       const relief::Heightfield r = read_square(radius_file, "--radius-file");
