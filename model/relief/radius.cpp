@@ -8,14 +8,16 @@
 // cell. So the first s where m starts to decrease is found per cell in closed form: at the cell's
 // entry when phi < 0 there and gamma >= 0, else where gamma s^2 = alpha - g(0). The cells come
 // from a walk over the cell grid (Amanatides & Woo) that crosses planar ground in jumps (CellMap
-// below), so that a flat floor costs a few steps instead of 2 per texel. A concave start (gamma < 0
+// below), so that a flat floor costs a few steps instead of 2 per texel, and a start point inside
+// a wide plane needs no walk at all. A concave start (gamma < 0
 // in the first cell; every cell with a twist, C != 0, has concave directions) gives r = 0: a ray
 // just under the patch's tangent enters and leaves it within any distance. So on a twisted field
 // (fbm: almost every cell) the radius is 0 almost everywhere.
 //
 // Start points: the samples x samples grid of each texel's square (corners included); a grid point
 // on a square's edge is shared by its neighbours, so its result is cached. Per direction, the walk
-// stops at the texel's current minimum (whole texels): a direction can only lower it.
+// stops at the texel's current minimum (whole texels): a direction can only lower it. Directions
+// go in bit-reversed order (opposite sides of the circle first), so failing ones come early.
 #include "model/relief/radius.h"
 
 #include <algorithm>
@@ -97,30 +99,56 @@ struct CellMap {
   }
 };
 
+// floor for the cell coordinates of a walk (well inside int range): a truncation, no libm call.
+int floor_int(double x) noexcept {
+  const int t = static_cast<int>(x);
+  return t - (t > x);
+}
+
+// A horizontal direction with what the cell walk needs of it.
+struct Direction {
+  double dx = 0.0, dy = 0.0;
+  double inv_dx = 0.0, inv_dy = 0.0;    // 1 / d (infinite for 0)
+  double delta_x = 0.0, delta_y = 0.0;  // the distance between two x (y) boundaries: |1 / d|
+  int step_i = 0, step_j = 0;           // +1 or -1
+
+  Direction(double x, double y) : dx(x), dy(y) {
+    const double inf = std::numeric_limits<double>::infinity();
+    inv_dx = dx != 0.0 ? 1.0 / dx : inf;
+    inv_dy = dy != 0.0 ? 1.0 / dy : inf;
+    delta_x = std::abs(inv_dx);
+    delta_y = std::abs(inv_dy);
+    step_i = dx > 0.0 ? 1 : -1;
+    step_j = dy > 0.0 ? 1 : -1;
+  }
+};
+
 // The point's radius: min over directions of the first s where the slope from the start
 // decreases, in whole texels, at most `limit`.
 int point_radius(const Heightfield& field, const CellMap& cells, double px, double py, int limit,
-                 const std::vector<std::array<double, 2>>& dirs) {
+                 const std::vector<Direction>& dirs) {
   const double g0 = surface_height(field, px, py);
   const double x0 = px - 0.5, y0 = py - 0.5;  // cell space: cell (ci, cj) is [ci, ci + 1] x [cj, cj + 1]
+  // On a plane reaching past the limit in every direction (a walk of `limit` texels from a point
+  // of the cell ends at most limit + 1 cells away), every profile is a line: phi = 0 throughout.
+  if (cells.at(floor_int(x0), floor_int(y0)).plane >= limit + 2) return limit;
   const double inf = std::numeric_limits<double>::infinity();
   int best = limit;
-  for (const auto& [dx, dy] : dirs) {
+  for (const Direction& dir : dirs) {
     if (best == 0) break;
-    const int step_i = dx > 0.0 ? 1 : -1, step_j = dy > 0.0 ? 1 : -1;
-    const double delta_x = dx != 0.0 ? 1.0 / std::abs(dx) : inf, delta_y = dy != 0.0 ? 1.0 / std::abs(dy) : inf;
+    const double dx = dir.dx, dy = dir.dy;
     int ci = 0, cj = 0;
     double next_x = inf, next_y = inf;
     // Amanatides-Woo set-up at distance s; a point on a boundary, heading to the lower side, is in
     // the lower cell.
     auto enter = [&](double s) {
       const double x = x0 + s * dx, y = y0 + s * dy;
-      ci = static_cast<int>(std::floor(x));
-      cj = static_cast<int>(std::floor(y));
+      ci = floor_int(x);
+      cj = floor_int(y);
       if (dx < 0.0 && ci == x) --ci;
       if (dy < 0.0 && cj == y) --cj;
-      next_x = dx > 0.0 ? (ci + 1 - x0) / dx : dx < 0.0 ? (ci - x0) / dx : inf;
-      next_y = dy > 0.0 ? (cj + 1 - y0) / dy : dy < 0.0 ? (cj - y0) / dy : inf;
+      next_x = dx > 0.0 ? (ci + 1 - x0) * dir.inv_dx : dx < 0.0 ? (ci - x0) * dir.inv_dx : inf;
+      next_y = dy > 0.0 ? (cj + 1 - y0) * dir.inv_dy : dy < 0.0 ? (cj - y0) * dir.inv_dy : inf;
     };
     enter(0.0);
     const double end = best;
@@ -159,10 +187,10 @@ int point_radius(const Heightfield& field, const CellMap& cells, double px, doub
       }
       if (sb >= end) break;
       sa = sb;  // written without branches: which axis steps is the loop's unpredictable choice
-      ci += along_x ? step_i : 0;
-      cj += along_x ? 0 : step_j;
-      next_x += along_x ? delta_x : 0.0;
-      next_y += along_x ? 0.0 : delta_y;
+      ci += along_x ? dir.step_i : 0;
+      cj += along_x ? 0 : dir.step_j;
+      next_x += along_x ? dir.delta_x : 0.0;
+      next_y += along_x ? 0.0 : dir.delta_y;
     }
   }
   return best;
@@ -181,18 +209,16 @@ SafetyRadius safety_radius(const Heightfield& field, int max_radius, int directi
   // so the walks in the other directions stop early too. The minimum does not depend on the order.
   int bits = 0;
   while ((1 << bits) < directions) ++bits;
-  std::vector<std::array<double, 2>> dirs;
+  std::vector<Direction> dirs;
   for (int r = 0; r < (1 << bits); ++r) {
     int k = 0;
     for (int b = 0; b < bits; ++b) k |= ((r >> b) & 1) << (bits - 1 - b);
     if (k >= directions) continue;
     const double angle = 2.0 * std::numbers::pi * k / directions;
-    dirs.push_back({std::cos(angle), std::sin(angle)});
+    // The axis directions exactly (cos(pi / 2) is 6e-17, not 0): a walk along a boundary stays on it.
+    const auto exact = [](double c) { return std::abs(c) < 1e-15 ? 0.0 : c; };
+    dirs.emplace_back(exact(std::cos(angle)), exact(std::sin(angle)));
   }
-  // The axis directions exactly (cos(pi / 2) is 6e-17, not 0): a walk along a boundary stays on it.
-  for (auto& d : dirs)
-    for (double& c : d)
-      if (std::abs(c) < 1e-15) c = 0.0;
 
   const CellMap cells(field, max_radius);
   // Grid point (gx, gy) is (gx / per, gy / per); texel (i, j) uses gx in [i per, (i + 1) per].
@@ -215,20 +241,13 @@ SafetyRadius safety_radius(const Heightfield& field, int max_radius, int directi
   r.radius.resize(static_cast<std::size_t>(n) * static_cast<std::size_t>(n));
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < n; ++i) {
-      // Two rounds: every point up to 1 texel first (most zeros, a concave start or a ridge beside
-      // the square, show there), then every point up to the texel's minimum.
       int m = max_radius;
-      for (const int round_limit : {1, max_radius}) {
-        for (const auto& [a, b] : order) {
-          if (m == 0) break;
-          const int gx = i * per + a, gy = j * per + b, limit = std::min(m, round_limit);
-          Cached& c = cache[static_cast<std::size_t>(gy) * grid + gx];
-          if (c.limit < limit)
-            c = {point_radius(field, cells, static_cast<double>(gx) / per, static_cast<double>(gy) / per, limit, dirs), limit};
-          // The result is the point's r when below its limit, else only a bound r >= limit, which
-          // lowers nothing.
-          if (c.value < c.limit) m = std::min(m, c.value);
-        }
+      for (const auto& [a, b] : order) {
+        if (m == 0) break;
+        const int gx = i * per + a, gy = j * per + b;
+        Cached& c = cache[static_cast<std::size_t>(gy) * grid + gx];
+        if (c.limit < m) c = {point_radius(field, cells, static_cast<double>(gx) / per, static_cast<double>(gy) / per, m, dirs), m};
+        m = std::min(m, c.value);  // c.value = min(r, c.limit) with c.limit >= m
       }
       r.radius[static_cast<std::size_t>(j) * n + i] = static_cast<float>(m);
     }
