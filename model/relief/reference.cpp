@@ -1,2 +1,126 @@
-// See reference.h.
+// The exact reference of a relief ray (reference.h; heightfield.h's conventions), in double: the
+// ground truth the walks (walk.h) and the capture's hits are scored against.
+//
+// The ray's horizontal projection is cut at every cell boundary it crosses (x or y = k + 0.5, k in
+// [-1, N]); between two consecutive cuts it stays in one cell, found from the piece's midpoint, so
+// corners, axis-parallel rays (even one running along a boundary: the surface is continuous there)
+// and vertical rays (one piece) need no special case. In a cell, with s = t - ta from the piece's
+// start, the height above the bilinear patch is the quadratic f(s) = a s^2 + b s + c. Its first
+// root on [0, L] is searched on the monotone pieces of f (split at its vertex), in order: a piece
+// whose end is <= 0 holds a root, found with the cancellation-free formula (q = -(b + sign(b)
+// sqrt(b^2 - 4ac)) / 2, roots q / a and c / q) and checked to lie in the piece (else bisection);
+// an end value within kTouch above 0 is a touch (a tangent, or a graze on a cell boundary).
 #include "model/relief/reference.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "model/common/error.h"
+
+namespace nbsim::relief {
+namespace {
+
+// Tunable: an end or vertex of f this close above the surface (height units) is a touch, a hit.
+// Far above double rounding of heights in [0, 1] (~1e-16), far below anything a walk resolves.
+constexpr double kTouch = 1e-12;
+
+struct Quadratic {
+  double a, b, c;
+  double operator()(double s) const noexcept { return (a * s + b) * s + c; }
+};
+
+// The root of q in [lo, hi], where q(lo) > 0 >= q(hi) and q is monotone on [lo, hi].
+double root_in(const Quadratic& q, double lo, double hi) noexcept {
+  const double slack = 1e-12 * (1.0 + std::abs(hi));
+  auto inside = [&](double s) { return std::isfinite(s) && s >= lo - slack && s <= hi + slack; };
+  double best = std::numeric_limits<double>::quiet_NaN();
+  if (q.a == 0.0) {
+    if (q.b != 0.0) best = -q.c / q.b;
+  } else {
+    const double disc = std::max(0.0, q.b * q.b - 4.0 * q.a * q.c);
+    const double w = -0.5 * (q.b + std::copysign(std::sqrt(disc), q.b));
+    const double r1 = w / q.a;
+    const double r2 = w != 0.0 ? q.c / w : std::numeric_limits<double>::quiet_NaN();
+    if (inside(r1)) best = r1;
+    if (inside(r2) && (!inside(best) || r2 < best)) best = r2;
+  }
+  if (inside(best)) return std::clamp(best, lo, hi);
+  // Rounding put the formula's roots outside the bracket: bisect it down to adjacent doubles.
+  for (int k = 0; k < 200; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid <= lo || mid >= hi) break;
+    (q(mid) > 0.0 ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+// The first s in [0, length] where q <= 0 or touches 0 (q(0) > 0 is known), or NaN.
+double first_root(const Quadratic& q, double length) noexcept {
+  double cuts[3] = {0.0, length, length};
+  int count = 2;
+  if (q.a != 0.0) {
+    const double vertex = -q.b / (2.0 * q.a);
+    if (vertex > 0.0 && vertex < length) {
+      cuts[1] = vertex;
+      count = 3;
+    }
+  }
+  for (int k = 0; k + 1 < count; ++k) {
+    const double lo = cuts[k], hi = cuts[k + 1];
+    const double fhi = q(hi);
+    if (fhi <= 0.0) return q(lo) <= 0.0 ? lo : root_in(q, lo, hi);
+    if (fhi <= kTouch) return hi;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+ReferenceHit reference_hit(const Heightfield& field, const std::array<double, 3>& origin, const std::array<double, 3>& direction,
+                           double t_enter, double t_exit) {
+  NBSIM_CHECK(std::isfinite(t_enter) && std::isfinite(t_exit) && t_enter <= t_exit,
+              fmt::format("reference_hit needs a finite interval with t_enter <= t_exit, got [{}, {}]", t_enter, t_exit));
+  const auto [ox, oy, oz] = origin;
+  const auto [dx, dy, dz] = direction;
+  if (oz + t_enter * dz - surface_height(field, ox + t_enter * dx, oy + t_enter * dy) <= 0.0) return {true, t_enter};
+
+  // The cuts: every t in (t_enter, t_exit) where x or y crosses a cell boundary k + 0.5, k in
+  // [-1, N] (beyond the outermost boundaries every texel is virtual and the surface is 0).
+  std::vector<double> cuts{t_enter};
+  const int n = field.size;
+  auto add_crossings = [&](double o, double d) {
+    if (d == 0.0) return;
+    const double a = o + t_enter * d - 0.5, b = o + t_exit * d - 0.5;
+    const double first = std::max(std::ceil(std::min(a, b)), -1.0), last = std::min(std::floor(std::max(a, b)), static_cast<double>(n));
+    for (double k = first; k <= last; k += 1.0) {
+      const double t = (k + 0.5 - o) / d;
+      if (t > t_enter && t < t_exit) cuts.push_back(t);
+    }
+  };
+  add_crossings(ox, dx);
+  add_crossings(oy, dy);
+  std::sort(cuts.begin() + 1, cuts.end());
+  cuts.push_back(t_exit);
+
+  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double ta = cuts[k], tb = cuts[k + 1];
+    if (!(tb > ta)) continue;  // a corner (its neighbours cover it), or t_enter == t_exit (checked above)
+    const double tm = 0.5 * (ta + tb);
+    const double cx = std::clamp(ox + tm * dx - 0.5, -2.0, n + 1.0), cy = std::clamp(oy + tm * dy - 0.5, -2.0, n + 1.0);
+    const int ci = static_cast<int>(std::floor(cx)), cj = static_cast<int>(std::floor(cy));
+    const double h00 = field.at(ci, cj), h10 = field.at(ci + 1, cj), h01 = field.at(ci, cj + 1), h11 = field.at(ci + 1, cj + 1);
+    const double A = h10 - h00, B = h01 - h00, C = h00 - h10 - h01 + h11;
+    // The patch h(u, v) = h00 + A u + B v + C u v along u = ua + s dx, v = va + s dy.
+    const double ua = ox + ta * dx - (ci + 0.5), va = oy + ta * dy - (cj + 0.5);
+    const Quadratic f{-C * dx * dy, dz - (A * dx + B * dy + C * (ua * dy + va * dx)), oz + ta * dz - (h00 + A * ua + B * va + C * ua * va)};
+    if (f.c <= 0.0) return {true, ta};  // only by rounding: the previous piece ended a hair above
+    if (const double s = first_root(f, tb - ta); !std::isnan(s)) return {true, std::min(ta + s, tb)};
+  }
+  return {};
+}
+
+}  // namespace nbsim::relief
