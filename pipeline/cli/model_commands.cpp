@@ -273,7 +273,8 @@ void add_model_commands(CLI::App& app, Action& action) {
     mo->add_options(cmd);
     cmd->footer("Exit 0 only within the thresholds: total fragment and passed-sample error at most 0.01%, at least 99%\n"
                 "of draws exact, at least 99.99% of depth pixels within 1e-6 of GL's snapshots, every stencil pixel equal to a\n"
-                "frame's 'stencil' image when it has one; exit 1 otherwise.");
+                "frame's 'stencil' image when it has one, and (relief traces) every method's fragments, hits and per-fragment\n"
+                "walks equal to GL's; exit 1 otherwise.");
     cmd->callback([&action, trace, json, mo] {
       action = [trace, json, mo] {
         pipeline::ReplayOptions o;
@@ -317,6 +318,15 @@ void add_model_commands(CLI::App& app, Action& action) {
                        l["test_points"].get<std::uint64_t>(), l["parity_mismatches_layers"].get<std::uint64_t>(),
                        l["parity_mismatches_ranges"].get<std::uint64_t>(), l["misclassified_layers"].get<std::uint64_t>(),
                        l["misclassified_ranges"].get<std::uint64_t>(), l["classified_points"].get<std::uint64_t>());
+          }
+          if (!s.relief.is_null()) {
+            for (const auto& [name, m] : s.relief["methods"].items())
+              fmt::print("  relief {:<13} fragments model {} GL {}, hits model {} GL {}, walks differing {}, pixels differing {}, "
+                         "{:.2f} lookups/fragment, hit errors {}\n",
+                         name, m["fragments"].get<std::uint64_t>(), m["gl_fragments"].get<std::uint64_t>(), m["samples"].get<std::uint64_t>(),
+                         m["gl_samples"].get<std::uint64_t>(), m["walk_mismatches"].get<std::uint64_t>(),
+                         m["pixel_mismatches"].get<std::uint64_t>(), m["lookups_per_fragment"].is_number() ? m["lookups_per_fragment"].get<double>() : 0.0,
+                         m["errors"].get<std::uint64_t>());
           }
           fmt::print("  {}\n", s.within_thresholds() ? "within the thresholds" : "OUTSIDE the thresholds");
         }

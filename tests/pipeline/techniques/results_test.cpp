@@ -205,6 +205,11 @@ nlohmann::json real_run(const std::string& technique) {
     const CliResult c = run_nbsim("capture ldi --scene boxes --boxes 0 --path fly --size 8x8 --frames 2 --shape sphere --ldi-size 32 "
                                   "--grid 2x2 --points 256 -o " + trace);
     EXPECT_EQ(c.status, 0) << c.out << c.err;
+  } else if (technique == "relief") {
+    trace = scratch("relief.nbt").string();
+    const CliResult c = run_nbsim("capture relief --scene boxes --boxes 0 --path fly --size 48x48 --frames 2 --field fbm "
+                                  "--field-size 16 --angles 30,85 -o " + trace);
+    EXPECT_EQ(c.status, 0) << c.out << c.err;
   } else {
     ADD_FAILURE() << technique << ": no real run.json to check its row against (add its trace to real_run)";
     return nlohmann::json();
