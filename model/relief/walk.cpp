@@ -329,7 +329,7 @@ std::optional<FragmentRay> fragment_ray(const RayFrame& frame, int size, float p
     const auto kk = static_cast<std::size_t>(k);
     ray.d[kk] = (frame.a[kk] * px + frame.b[kk] * py) + frame.c[kk];
   }
-  float tmin = 0.0f, tmax = kFar;
+  float tmin = 0.0f, tmax = kFar, t_floor = kFar;
   const float hi[3] = {static_cast<float>(size), static_cast<float>(size), 1.0f};
   for (int k = 0; k < 3; ++k) {
     const auto kk = static_cast<std::size_t>(k);
@@ -341,10 +341,12 @@ std::optional<FragmentRay> fragment_ray(const RayFrame& frame, int size, float p
     const float t1 = (0.0f - o) / d, t2 = (hi[k] - o) / d;
     tmin = std::max(tmin, std::min(t1, t2));
     tmax = std::min(tmax, std::max(t1, t2));
+    if (k == 2 && d < 0.0f) t_floor = t1;
   }
   if (!(tmin <= tmax)) return std::nullopt;
   ray.t_in = tmin;
   ray.t_out = tmax;
+  ray.floor_exit = t_floor == tmax;
   return ray;
 }
 
@@ -364,6 +366,7 @@ WalkResult walk(Method method, const FieldView& field, const WalkParams& params,
       case Method::NBuffer: walk_nbuffer(r, params, ray, w, cap); break;
     }
   }
+  if (!w.hit && !w.capped && ray.floor_exit) set_hit(w, ray.t_out);
   if (w.capped) w.hit = false, w.t = 0.0f;
   w.lookups = r.lookups;
   return w;

@@ -29,6 +29,7 @@
 //   walk's plus the dip: where the height above the surface is convex along the ray inside the
 //   cell, its minimum (the vertex of the quadratic through the entry, the middle and the exit) is
 //   tested too. So the N-buffer walk finds saddles the exact walk misses.
+// A ray that leaves through the box's floor and found no hit before hits at t_out (FragmentRay).
 // Lookups count every texel read the shader issues: 4 per surface height (binary, robust), 4 per
 // cell (its corners; exact, nbuffer, robust's cell steps), 1 per radius, 4 per N-buffer query.
 #pragma once
@@ -89,6 +90,10 @@ using LookupObserver = void (*)(void* context, Texture texture, std::int64_t ind
 struct FragmentRay {
   std::array<float, 3> o{}, d{};
   float t_in = 0.0f, t_out = 0.0f;
+  // The ray leaves the box through its floor (z = 0): the floor is the closed surface's bottom, so a
+  // walk that finds nothing before t_out hits there (every method; the twin of a height-0 floor that
+  // float rounding would leave a hair above the ray's end).
+  bool floor_exit = false;
 };
 std::optional<FragmentRay> fragment_ray(const RayFrame& frame, int size, float px, float py);
 

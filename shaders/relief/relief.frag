@@ -22,6 +22,7 @@ layout(location = 0) out uint hit_mask;
 const float kFar = 3.0e38;
 precise vec3 o, d;
 precise float t_in, t_out;
+bool floor_exit = false;
 uint lookups = 0u, steps = 0u, bisections = 0u;
 bool capped = false;
 
@@ -263,7 +264,7 @@ bool fragment_ray(float px, float py) {
   d.x = (ray_a.x * px + ray_b.x * py) + ray_c.x;
   d.y = (ray_a.y * px + ray_b.y * py) + ray_c.y;
   d.z = (ray_a.z * px + ray_b.z * py) + ray_c.z;
-  precise float tmin = 0.0, tmax = kFar;
+  precise float tmin = 0.0, tmax = kFar, t_floor = kFar;
   for (int k = 0; k < 3; ++k) {
     precise float oo = o[k], dd = d[k];
     precise float hi = k < 2 ? float(size) : 1.0;
@@ -275,10 +276,12 @@ bool fragment_ray(float px, float py) {
     precise float t2 = (hi - oo) / dd;
     tmin = max(tmin, min(t1, t2));
     tmax = min(tmax, max(t1, t2));
+    if (k == 2 && dd < 0.0) t_floor = t1;
   }
   if (!(tmin <= tmax)) return false;
   t_in = tmin;
   t_out = tmax;
+  floor_exit = t_floor == tmax;
   return true;
 }
 
@@ -295,6 +298,7 @@ void main() {
     else if (method == 2) hit_t = walk_robust(false, cap);
     else if (method == 3) hit_t = walk_robust(true, cap);
     else hit_t = walk_nbuffer(cap);
+    if (!capped && hit_t < 0.0 && floor_exit) hit_t = t_out;
     code = capped ? 2u : (hit_t >= 0.0 ? 1u : 0u);
   }
   results[6u * pixel + 0u] = 1u;
