@@ -88,32 +88,41 @@ void write(const std::filesystem::path& file, int width, int height, int channel
 
 std::string openimageio_version() { return load_backend().openimageio_version; }
 
-DepthImage read_depth(const std::filesystem::path& file) {
+namespace {
+
+// A single-channel 2D image, y up, every value as read; `what` names the file's kind in messages.
+DepthImage read_single_channel(const std::filesystem::path& file, const char* what, bool depth_range) {
   const std::string name = file.string();
-  if (!std::filesystem::exists(file)) throw InputError(fmt::format("depth file '{}' does not exist", name));
+  if (!std::filesystem::exists(file)) throw InputError(fmt::format("{} '{}' does not exist", what, name));
   backend::FloatImage in;
   if (const std::string error = load_backend().read(name, in); !error.empty())
-    throw InputError(fmt::format("depth file '{}' {}", name, error));
+    throw InputError(fmt::format("{} '{}' {}", what, name, error));
   if (in.channels != 1)
-    throw InputError(fmt::format("depth file '{}' has {} channels; a depth image has exactly one", name, in.channels));
+    throw InputError(fmt::format("{} '{}' has {} channels; it must have exactly one", what, name, in.channels));
   if (in.width < 1 || in.height < 1 || in.depth > 1)
-    throw InputError(fmt::format("depth file '{}' is not a 2D image of at least 1x1 pixels", name));
+    throw InputError(fmt::format("{} '{}' is not a 2D image of at least 1x1 pixels", what, name));
   const int w = in.width, h = in.height;
   DepthImage img(w, h, 0.0f);
   for (int r = 0; r < h; ++r) {
     const int y = h - 1 - r;
     for (int x = 0; x < w; ++x) {
       const float v = in.pixels[static_cast<std::size_t>(r) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
-      if (!std::isfinite(v) || v < 0.0f || v > 1.0f) {
-        const char* what = std::isnan(v) ? "NaN" : std::isinf(v) ? "an infinite depth" : "a depth outside [0, 1]";
-        throw InputError(fmt::format("depth file '{}' holds {} ({}) at pixel ({}, {}) (y up; file row {}, column {})",
-                                     name, what, v, x, y, r, x));
+      if (depth_range && (!std::isfinite(v) || v < 0.0f || v > 1.0f)) {
+        const char* kind = std::isnan(v) ? "NaN" : std::isinf(v) ? "an infinite depth" : "a depth outside [0, 1]";
+        throw InputError(fmt::format("{} '{}' holds {} ({}) at pixel ({}, {}) (y up; file row {}, column {})", what, name, kind, v, x,
+                                     y, r, x));
       }
       img.at(x, y) = v;
     }
   }
   return img;
 }
+
+}  // namespace
+
+DepthImage read_depth(const std::filesystem::path& file) { return read_single_channel(file, "depth file", true); }
+
+DepthImage read_values(const std::filesystem::path& file) { return read_single_channel(file, "image file", false); }
 
 void write_depth(const DepthImage& image, const std::filesystem::path& file) {
   write(file, image.width, image.height, 1, backend::PixelType::Float,

@@ -18,6 +18,10 @@ namespace nbsim::io {
 // (naming the first bad pixel, in y-up pixel coordinates and in file row order).
 DepthImage read_depth(const std::filesystem::path& file);
 
+// Reads a single-channel image of any values (NaN and infinities included: the caller checks them),
+// e.g. a relief heightfield or safety-radius file. InputError naming the file as read_depth.
+DepthImage read_values(const std::filesystem::path& file);
+
 // Writes a float image as a single-channel 32-bit float file (EXR: channel "Z").
 void write_depth(const DepthImage& image, const std::filesystem::path& file);
 

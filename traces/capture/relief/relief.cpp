@@ -136,7 +136,7 @@ std::vector<double> parse_angles(const std::string& s) {
 // A single-channel image as a square grid of floats, y up.
 relief::Heightfield read_square(const std::string& file, const char* what) {
   if (!std::filesystem::exists(file)) throw InputError(fmt::format("{} '{}' does not exist", what, file));
-  const DepthImage img = io::read_depth(file);
+  const DepthImage img = io::read_values(file);
   if (img.width != img.height)
     throw InputError(fmt::format("{} '{}' is {}x{}; a heightfield is square", what, file, img.width, img.height));
   relief::Heightfield f;
