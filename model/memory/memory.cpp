@@ -32,6 +32,14 @@ Cache::Cache(CacheConfig c) : c_(c) {
   NBSIM_CHECK(c.size_bytes >= 0 && c.line_bytes > 0 && c.ways > 0, "cache config not validated");
   sets_ = static_cast<std::uint64_t>(c.size_bytes) / static_cast<std::uint64_t>(c.line_bytes * c.ways);
   lines_.assign(sets_ * static_cast<std::uint64_t>(c.ways), Line{});
+  // Powers of two (the usual sizes) index with a shift and a mask instead of two divisions.
+  const auto line = static_cast<std::uint64_t>(c.line_bytes);
+  if ((line & (line - 1)) == 0 && sets_ > 0 && (sets_ & (sets_ - 1)) == 0) {
+    line_shift_ = 0;
+    while ((std::uint64_t{1} << line_shift_) < line) ++line_shift_;
+    set_mask_ = sets_ - 1;
+    pow2_ = true;
+  }
 }
 
 Cache::Result Cache::access(std::uint64_t address, bool write) {
@@ -40,8 +48,8 @@ Cache::Result Cache::access(std::uint64_t address, bool write) {
     ++misses_;
     return r;
   }
-  const std::uint64_t line = address / static_cast<std::uint64_t>(c_.line_bytes);
-  const std::uint64_t set = line % sets_;
+  const std::uint64_t line = pow2_ ? address >> line_shift_ : address / static_cast<std::uint64_t>(c_.line_bytes);
+  const std::uint64_t set = pow2_ ? line & set_mask_ : line % sets_;
   Line* ways = &lines_[set * static_cast<std::uint64_t>(c_.ways)];
   ++clock_;
   Line* victim = ways;

@@ -67,6 +67,9 @@ class Cache {
   };
   CacheConfig c_;
   std::uint64_t sets_ = 0;
+  bool pow2_ = false;  // line size and set count powers of two: shift and mask
+  int line_shift_ = 0;
+  std::uint64_t set_mask_ = 0;
   std::vector<Line> lines_;
   std::uint64_t clock_ = 0;
   std::uint64_t hits_ = 0, misses_ = 0, writebacks_ = 0;

@@ -39,6 +39,8 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   const std::uint64_t pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
   const std::vector<GlReliefFragments> records = read_relief_fragments(f, pixels);
   const FieldView view = gl.view();
+  reference_.resize(pixels);
+  referenced_.assign(pixels, 0);
   ReliefFrameCounts out;
   out.size = gl.field.size;
   out.view_angle = gl.view_angle;
@@ -86,7 +88,8 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       c.longest_walk = std::max<std::uint64_t>(c.longest_walk, w.lookups);
       c.hits += code == 1u, c.capped += code == 2u, c.samples += code == 1u;
       if (ray) {
-        const HitScore score = score_hit(gl.field, *ray, code == 1u, w.t, box_height, tolerance);
+        if (!referenced_[px]) reference_[px] = reference_of(gl.field, *ray), referenced_[px] = 1;
+        const HitScore score = score_against(reference_[px], *ray, gl.field.size, code == 1u, w.t, box_height, tolerance);
         c.reference_hits += score.reference_hit;
         c.wrong_hit += score.error == HitError::WrongHit;
         c.wrong_miss += score.error == HitError::WrongMiss;

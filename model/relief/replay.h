@@ -66,6 +66,10 @@ class ReliefReplay {
   int width_, height_;
   DepthImage depth_;
   std::vector<std::uint8_t> passed_;
+  // The frame's references by pixel (the methods' draws share the frame's rays): computed at the
+  // first draw that walks the pixel.
+  std::vector<ReferenceHit> reference_;
+  std::vector<std::uint8_t> referenced_;
   raster::RasterPath path_;
 };
 

@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "model/relief/heightfield.h"
+#include "model/relief/reference.h"
 #include "model/relief/walk.h"
 
 namespace nbsim::relief {
@@ -24,6 +25,12 @@ struct HitScore {
 };
 
 HitScore score_hit(const Heightfield& field, const FragmentRay& ray, bool hit, float t, double box_height, double tolerance);
+
+// The two halves of score_hit, for a caller that scores several walks of one ray (the methods of a
+// frame share their rays): the reference of the ray, then a walk's score against it.
+ReferenceHit reference_of(const Heightfield& field, const FragmentRay& ray);
+HitScore score_against(const ReferenceHit& reference, const FragmentRay& ray, int size, bool hit, float t, double box_height,
+                       double tolerance);
 
 // The default tolerance, texels (a quarter texel: the exact methods land within 1e-3).
 inline constexpr double kDefaultHitTolerance = 0.25;
