@@ -13,6 +13,7 @@ marks). The inputs, and the nbsim commands that write them:
   DIR/particles/particles.json       nbsim particles TRACE... --out DIR/particles  (or DIR/particles.json: --out DIR)
   DIR/shadows/shadows.json           nbsim shadows TRACE... --out DIR/shadows  (or DIR/shadows.json: --out DIR)
   DIR/ldi/ldi.json                   nbsim ldi table1 --out DIR/ldi  (or DIR/ldi.json: --out DIR)
+  DIR/relief/relief.json             nbsim relief TRACE... --out DIR/relief  (or DIR/relief.json: --out DIR)
 The data side (reading, Pareto marks, labels, headline.md) is in report_data.py; plot helpers in
 report_plots.py. Every section whose inputs exist is rendered; the page names the inputs the others were missing.
 Exit 0 when at least one section rendered; 2 when DIR does not exist or holds nothing usable, or when
@@ -30,7 +31,7 @@ sys.dont_write_bytecode = True  # no __pycache__ next to the scripts
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 # report_plots first: it selects matplotlib's headless backend before pyplot loads.
 from report_plots import (DPI, FIGSIZE, MAX_LABELLED_POINTS, THOUSANDS, freeze_layout, mode_style,  # noqa: E402
-                          place_labels, spans_decades)
+                          place_labels, relief_style, spans_decades)
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
@@ -41,6 +42,8 @@ from report_data import (FIDELITY_KNOBS, NUMERIC, BadInput, Missing, fmt, headli
                          headline_shadows, headline_sweep, headline_table2, kib_key, load_particles, load_shadows,
                          particles_reading, particles_rows, shadows_reading, shadows_rows,
                          headline_ldi, ldi_reading, ldi_rows, load_ldi, technique_results,
+                         RELIEF_LISTS, headline_relief, load_relief, relief_lookups_by_field,
+                         relief_paper_rows, relief_ranking, relief_reading,
                          load_json, mark_pareto, number, pct, read_csv, short_label, sorted_modes, table2_ratios,
                          trace_name)
 
@@ -524,6 +527,138 @@ class Report:
                             "are the LDI sides. Read off: how fast the error falls with resolution and what the "
                             "compressed reader saves per test."))
 
+    # ------------------------------------------------------------------------------ relief textures
+    def relief_path(self):
+        return self.technique_table_path("relief")
+
+    def relief(self):
+        path = self.relief_path()
+        if path is None:
+            raise Missing(["relief/relief.json"])
+        doc = load_relief(path)
+        self.used(path, "relief")
+        rows = doc["rows"]
+        ranking = relief_ranking(doc)
+        paper = relief_paper_rows(doc["paper"])
+        reading = relief_reading(doc, ranking, paper)
+        fields = list(dict.fromkeys(r["field"] for r in rows))
+        sizes = sorted({r["field_size"] for r in rows})
+        at = [f"{n}²" for n in sizes]
+        label = (f"{len({r['trace'] for r in rows})} traces: {len(fields)} heightfields at "
+                 f"{' and '.join([', '.join(at[:-1]), at[-1]] if len(at) > 1 else at)}, "
+                 f"{len({r['frame'] for r in rows})} view angles each")
+        self.headline_last.append(headline_relief(label, ranking, reading))
+        with open(self.out / "relief_rows.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(RELIEF_LISTS["rows"][0]), extrasaction="ignore")
+            w.writeheader()
+            w.writerows(rows)
+        num = lambda d: (lambda v: "-" if v is None else f"{v:,.{d}f}")  # noqa: E731
+        mismatched = lambda r: r["walk_mismatches"] or r["pixel_mismatches"] or r["fragments_unlike_gl"]  # noqa: E731
+        for r in ranking:
+            r["pareto_mark"] = "yes (front)" if r["pareto"] else "no"
+        rank_tab = self.table(
+            "relief_ranking",
+            [("method", "method", None), ("cycles/box draw (mean)", "cycles_per_frame", num(0)),
+             ("lookups/fragment", "lookups_per_fragment", num(2)), ("steps/fragment", "steps_per_fragment", num(2)),
+             ("fragments", "fragments", None), ("hit errors", "errors", None),
+             ("hit error", "error_rate", lambda v: pct(v, 3)), ("Pareto", "pareto_mark", None),
+             ("walks differing from GL's", "walk_mismatches", None),
+             ("pixels differing from GL's", "pixel_mismatches", None),
+             ("fragments unlike GL's count", "fragments_unlike_gl", None)],
+            ranking, row_class=lambda r: "bad" if mismatched(r) else "pareto" if r["pareto"] else "")
+        nve = doc["nbuffer_vs_exact"]
+        nve_tab = self.table(
+            "relief_nbuffer_vs_exact",
+            [("heightfield", "field", None), ("size", "field_size", None),
+             ("exact: lookups/fragment", "exact_lookups_per_fragment", num(2)),
+             ("N-buffer: lookups/fragment", "nbuffer_lookups_per_fragment", num(2)),
+             ("N-buffer / exact", "lookup_ratio", num(3)), ("exact: hit errors", "exact_errors", None),
+             ("N-buffer: hit errors", "nbuffer_errors", None), ("extra errors", "extra_errors", None)],
+            nve, row_class=lambda r: "bad" if (r["extra_errors"] or 0) > 0 else "") if nve else \
+            "<p>No heightfield has both an exact and an N-buffer walk.</p>"
+        paper_tab = self.table(
+            "relief_paper",
+            [("size", "field_size", None), ("method", "method", None), ("paper (Hz)", "paper_hz", num(0)),
+             ("paper's rank (fastest first)", "paper_rank", None),
+             ("ours: cycles/box draw (fbm)", "cycles_per_frame", num(0)),
+             ("ours: lookups/fragment (fbm)", "lookups_per_fragment", num(2)),
+             ("our rank (fewest cycles first)", "our_rank", None)], paper) if paper else \
+            "<p>relief.json holds no paper rows.</p>"
+        nve_reading = [s for s in reading if s.startswith("The N-buffer walk")]
+        paper_reading = [s for s in reading if s.startswith("The paper ranks")]
+        lead = [s for s in reading if s not in nve_reading + paper_reading]
+
+        # left: cost against error, one point per method (the ranking), the Pareto front as a step line;
+        # right: lookups per fragment per heightfield (field and size) and method, over every view angle
+        fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True,
+                                     gridspec_kw={"width_ratios": [2, 3]})
+        for r in ranking:
+            c, mk = relief_style(r["method"])
+            ax.scatter([r["cycles_per_frame"]], [100 * r["error_rate"]], s=60, marker=mk, color=c,
+                       edgecolors="black" if r["pareto"] else c, linewidths=1.2 if r["pareto"] else 0.5, zorder=3)
+        front = sorted((r for r in ranking if r["pareto"]), key=lambda r: r["cycles_per_frame"])
+        if front:  # the step line runs on to the dearest method: what lies on or above it is dominated
+            dearest = max(r["cycles_per_frame"] for r in ranking)
+            ax.plot([r["cycles_per_frame"] for r in front] + [dearest],
+                    [100 * r["error_rate"] for r in front] + [100 * front[-1]["error_rate"]],
+                    drawstyle="steps-post", color="#b2182b", lw=1.2, alpha=0.7, zorder=1,
+                    label=f"Pareto front ({', '.join(r['method'] for r in front)})")
+        bad = [r for r in ranking if mismatched(r)]
+        if bad:
+            ax.scatter([r["cycles_per_frame"] for r in bad], [100 * r["error_rate"] for r in bad], s=140, marker="x",
+                       color="red", zorder=4, label="walks or pixels unlike GL's")
+        ax.xaxis.set_major_formatter(THOUSANDS)
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
+        ax.set_xlabel("modelled cycles per box draw (mean over the frames)")
+        ax.set_ylabel("hit error (% of fragments, against the exact reference)")
+        ax.set_title("Cost against hit error, per method", fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.margins(x=0.2, y=0.15)
+        if front or bad:
+            ax.legend(fontsize=7, loc="upper left")
+        lookups = relief_lookups_by_field(rows)
+        methods = [r["method"] for r in ranking]
+        x = np.arange(len(lookups))
+        wd = 0.8 / max(len(methods), 1)
+        for j, m in enumerate(methods):
+            c, _ = relief_style(m)
+            bx.bar(x - 0.4 + wd * (j + 0.5), [v.get(m) or np.nan for v in lookups.values()], wd, color=c, label=m)
+        bx.set_xticks(x, [f"{f.replace(' ', chr(10), 1)}\n{n}²" for f, n in lookups], fontsize=7)
+        bx.set_xlabel("heightfield and size")
+        bx.set_ylabel("lookups per fragment")
+        bx.set_title("Lookups per fragment, per heightfield and method", fontsize=10)
+        bx.grid(axis="y", alpha=0.3)
+        bx.legend(fontsize=7, ncols=len(methods), loc="upper left", title="method, cheapest first", title_fontsize=7)
+        bx.set_ylim(0, max([v for d in lookups.values() for v in d.values() if v is not None] + [1]) * 1.2)
+        fig.suptitle("Relief textures: the walks' cost and hit error")
+        freeze_layout(fig)
+        place_labels(ax, [r["cycles_per_frame"] for r in ranking], [100 * r["error_rate"] for r in ranking],
+                     methods, [relief_style(m)[0] for m in methods], fontsize=8)
+        img = self.save(fig, "relief.png")
+        settings = doc["settings"]
+        setting_text = ("settings: <code>" + html.escape(" ".join(settings)) + "</code>") if settings else \
+            "the model's default settings"
+        loud = lambda s: (f'<b class="bad">{html.escape(s)}</b>' if s.startswith("GL AND THE MODEL DISAGREE")  # noqa: E731
+                          else html.escape(s))
+        items = lambda ss: "<ul>" + "".join(f"<li>{loud(s)}</li>" for s in ss) + "</ul>"  # noqa: E731
+        return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim relief TRACE... --out</code>: each relief trace, one "
+                "heightfield at one size with a frame per view angle and a box draw per method, replayed in the model "
+                f"with {setting_text}). Cycles: a method's box draw in the model, the mean over the frames; lookups and "
+                "steps: heightfield texels read and walk steps per fragment; hit errors: fragments whose hit or miss "
+                "differs from the exact reference beyond <code>relief.hit_tolerance_texels</code>. Walks and pixels "
+                "differing: the model's against GL's; any is a bug (rows in red). Every row (trace, view angle, "
+                'method) is in <a href="relief_rows.csv">relief_rows.csv</a>.</p>'
+                "<p><b>What it shows</b> (computed from relief.json):</p>" + items(lead) +
+                self.figure(img, "Left: one point per method, x = modelled cycles per box draw, y = hit error; the "
+                            "Pareto-optimal methods (no other is as cheap and as accurate, and better in one) are "
+                            "outlined and joined by the front; red crosses would mark methods whose walks or pixels are "
+                            "not GL's. Right: lookups per fragment per heightfield and size, one bar per method. Read "
+                            "off: the cheapest method for an accepted hit error, and on which heightfields the N-buffer "
+                            "walk saves lookups over the exact walk.") +
+                "<h3>Ranking: cycles against hit error</h3>" + rank_tab +
+                "<h3>The N-buffer walk against the exact walk, per heightfield</h3>" + items(nve_reading) + nve_tab +
+                "<h3>The paper's Table 1 beside ours</h3>" + items(paper_reading) + paper_tab)
+
     # ------------------------------------------------------------------------------ shadows
     def shadows_path(self):
         return self.technique_table_path("shadows")
@@ -966,6 +1101,8 @@ def main(argv):
             rep.shadows_path() or root / "shadows" / "shadows.json")
     rep.run("ldi", "Layered depth images: Table 1 and the parity test's misclassification", rep.ldi,
             rep.ldi_path() or root / "ldi" / "ldi.json")
+    rep.run("relief", "Relief textures: the methods' cost against hit error, the N-buffer walk, the paper's Table 1",
+            rep.relief, rep.relief_path() or root / "relief" / "relief.json")
     dirs = rep.sweep_dirs()
     if not dirs:
         rep.missing.append(("Sweeps (architecture exploration)", ["sweeps/NAME/results.csv"]))
@@ -981,7 +1118,7 @@ def main(argv):
             pass
         print(f"report: nothing usable in {a.dir}: looked for table1.jsonl, figure4_map.csv, table2/table2.json, "
               "table2/MODE/run.json, particles/particles.json, particles.json, shadows/shadows.json, shadows.json, ldi/ldi.json, ldi.json, "
-              "sweeps/NAME/results.csv, results.csv", file=sys.stderr)
+              "relief/relief.json, relief.json, sweeps/NAME/results.csv, results.csv", file=sys.stderr)
         return 2
     rep.write_html()
     print(f"report: wrote {rep.out / 'index.html'} ({rendered} sections"

@@ -320,19 +320,30 @@ def load_rows(path, command, need, strings, numbers):
     t = load_json(path)
     if not isinstance(t, list) or not t:
         raise BadInput(f"{path}: expected a non-empty JSON list of rows ({command} --out)")
+    return check_rows(path, "rows", t, need, strings, numbers)
+
+
+def check_rows(path, name, t, need, strings, numbers, counts=()):
+    """The list `name` of the file `path`: objects with the keys `need`, `strings` of them strings, `numbers`
+    (when present and not null) numbers and `counts` whole numbers not below 0; BadInput naming the file
+    and the row otherwise."""
     for i, r in enumerate(t):
         if not isinstance(r, dict):
-            raise BadInput(f"{path}: rows[{i}] is not an object")
+            raise BadInput(f"{path}: {name}[{i}] is not an object")
         lacking = [k for k in need if k not in r]
         if lacking:
-            raise BadInput(f"{path}: rows[{i}] lacks {', '.join(lacking)}")
+            raise BadInput(f"{path}: {name}[{i}] lacks {', '.join(lacking)}")
         for k in strings:
             if not isinstance(r[k], str):
-                raise BadInput(f"{path}: rows[{i}].{k} is not a string: {r[k]!r}")
+                raise BadInput(f"{path}: {name}[{i}].{k} is not a string: {r[k]!r}")
         for k in numbers:
             v = r.get(k)
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
-                raise BadInput(f"{path}: rows[{i}].{k} is not a number: {v!r}")
+                raise BadInput(f"{path}: {name}[{i}].{k} is not a number: {v!r}")
+        for k in counts:
+            v = r[k]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0 or v != int(v):
+                raise BadInput(f"{path}: {name}[{i}].{k} must be a count (a whole number not below 0), not {v!r}")
     return t
 
 
@@ -665,4 +676,227 @@ def headline_ldi(label, rows, reading):
                      f"{pct(r.get('error_anywhere'), 2)} | "
                      f"{r['fetches_per_test_layers']:.2f}, {r['fetches_per_test_ranges']:.2f} | "
                      f"{ms(r, 'ms_viewpoint')}/{ms(r, 'ms_peel')}/{ms(r, 'ms_crop')}/{ms(r, 'ms_compress')} |")
+    return "\n".join(lines + [""] + [f"- {s}" for s in reading])
+
+
+# ------------------------------------------------------------------------------------ relief textures
+RELIEF_METHODS = ["binary", "exact", "robust", "robust_clamp", "nbuffer"]
+# relief.json (nbsim relief TRACE... --out; pipeline/techniques/relief_table.h): an object of these lists. Per
+# list: the keys each row must hold, those of them that are strings, numbers (null allowed: a ratio over no
+# fragment, a paper row we have no rows for) and counts (whole numbers not below 0).
+RELIEF_LISTS = {
+    "rows": (["trace", "field", "field_size", "frame", "angle", "method", "fragments", "gl_fragments", "lookups",
+              "steps", "errors", "reference_hits", "cycles", "pixel_mismatches", "walk_mismatches",
+              "lookups_per_fragment", "steps_per_fragment", "error_rate"],
+             ["trace", "field", "method"], ["angle", "lookups_per_fragment", "steps_per_fragment", "error_rate"],
+             ["field_size", "frame", "fragments", "gl_fragments", "lookups", "steps", "errors", "reference_hits",
+              "cycles", "pixel_mismatches", "walk_mismatches"]),
+    "ranking": (["method", "fragments", "lookups_per_fragment", "steps_per_fragment", "cycles_per_frame", "errors",
+                 "error_rate", "pareto"],
+                ["method"], ["lookups_per_fragment", "steps_per_fragment", "cycles_per_frame", "error_rate"],
+                ["fragments", "errors"]),
+    "nbuffer_vs_exact": (["field", "field_size", "exact_lookups_per_fragment", "nbuffer_lookups_per_fragment",
+                          "lookup_ratio", "exact_errors", "nbuffer_errors", "extra_errors"],
+                         ["field"], ["exact_lookups_per_fragment", "nbuffer_lookups_per_fragment", "lookup_ratio",
+                                     "extra_errors"],
+                         ["field_size", "exact_errors", "nbuffer_errors"]),
+    "paper": (["method", "field_size", "paper_hz", "cycles_per_frame", "lookups_per_fragment"],
+              ["method"], ["paper_hz", "cycles_per_frame", "lookups_per_fragment"], ["field_size"]),
+}
+# Where the paper's numbers come from (relief_table.cpp holds them): Baboud & Decoret, "Rendering geometry
+# with relief textures", Graphics Interface 2006, Table 1, terrain on a GeForce 6800 GT.
+RELIEF_PAPER = "Baboud & Décoret 2006, Table 1: the terrain on a GeForce 6800 GT"
+# How many places a reading names before it says "and N more" (readability).
+RELIEF_NAMED = 6
+
+
+def load_relief(path):
+    """relief.json (nbsim relief TRACE... --out), checked; BadInput naming the file and the row otherwise."""
+    doc = load_json(path)
+    if not isinstance(doc, dict):
+        raise BadInput(f"{path}: expected an object with settings, rows, ranking, nbuffer_vs_exact and paper "
+                       "(nbsim relief --out)")
+    lacking = [k for k in ["settings"] + list(RELIEF_LISTS) if k not in doc]
+    if lacking:
+        raise BadInput(f"{path}: lacks {', '.join(lacking)} (nbsim relief --out writes them all)")
+    if not isinstance(doc["settings"], list) or not all(isinstance(s, str) for s in doc["settings"]):
+        raise BadInput(f"{path}: settings is not a list of strings: {doc['settings']!r}")
+    for name, (need, strings, numbers, counts) in RELIEF_LISTS.items():
+        t = doc[name]
+        if not isinstance(t, list) or (name in ("rows", "ranking") and not t):
+            raise BadInput(f"{path}: {name} is not a{' non-empty' if name in ('rows', 'ranking') else ''} list")
+        check_rows(path, name, t, need, strings, numbers, counts)
+    for i, r in enumerate(doc["rows"]):
+        if r["errors"] > r["fragments"] or r["reference_hits"] > r["fragments"]:
+            raise BadInput(f"{path}: rows[{i}]: errors and reference_hits must be within [0, fragments]")
+    for i, r in enumerate(doc["ranking"]):
+        if not isinstance(r["pareto"], bool):
+            raise BadInput(f"{path}: ranking[{i}].pareto is not true or false: {r['pareto']!r}")
+        if r["cycles_per_frame"] is None or r["error_rate"] is None or r["cycles_per_frame"] < 0 or r["error_rate"] < 0:
+            raise BadInput(f"{path}: ranking[{i}]: cycles_per_frame and error_rate must be numbers not below 0")
+    for i, r in enumerate(doc["paper"]):
+        if r["paper_hz"] is None or r["paper_hz"] <= 0:
+            raise BadInput(f"{path}: paper[{i}].paper_hz must be above 0, not {r['paper_hz']!r}")
+    return doc
+
+
+def _named(items):
+    """At most RELIEF_NAMED of the items, comma-separated, then how many more."""
+    more = len(items) - RELIEF_NAMED
+    return ", ".join(items[:RELIEF_NAMED]) + (f" and {more} more" if more > 0 else "")
+
+
+def _rows(rows):
+    return f"{len(rows)} row{'' if len(rows) == 1 else 's'}"
+
+
+def relief_heightfield(field, size):
+    return f"{field} at {size}²"
+
+
+def relief_ranking(doc):
+    """The ranking (cheapest first, as nbsim wrote it), each method with its rows' walks and pixels differing
+    from GL's and fragment counts unlike GL's (summed over its rows)."""
+    out = []
+    for r in doc["ranking"]:
+        rr = dict(r)
+        mine = [x for x in doc["rows"] if x["method"] == r["method"]]
+        rr["walk_mismatches"] = sum(x["walk_mismatches"] for x in mine)
+        rr["pixel_mismatches"] = sum(x["pixel_mismatches"] for x in mine)
+        rr["fragments_unlike_gl"] = sum(abs(x["fragments"] - x["gl_fragments"]) for x in mine)
+        out.append(rr)
+    return out
+
+
+def relief_lookups_by_field(rows):
+    """Lookups per fragment per heightfield (field and size, in the order first met) and method, over every view
+    angle: {(field, size): {method: lookups per fragment, or None without fragments}}."""
+    sums = {}
+    for r in rows:
+        s = sums.setdefault((r["field"], r["field_size"]), {}).setdefault(r["method"], [0, 0])
+        s[0] += r["lookups"]
+        s[1] += r["fragments"]
+    return {k: {m: (lk / n if n else None) for m, (lk, n) in v.items()} for k, v in sums.items()}
+
+
+def relief_paper_rows(paper):
+    """The paper's rows by size and method, each with its rank among the methods of its size: the paper's by frame
+    rate (highest first) and ours by cycles per box draw (fewest first; None where we have no rows)."""
+    out = []
+    for size in sorted({r["field_size"] for r in paper}):
+        g = sorted((dict(r) for r in paper if r["field_size"] == size),
+                   key=lambda r: (_order(RELIEF_METHODS, r["method"]), r["method"]))
+        for r in g:
+            r["paper_rank"] = 1 + sum(1 for o in g if o["paper_hz"] > r["paper_hz"])
+            ours = r["cycles_per_frame"]
+            r["our_rank"] = None if ours is None else \
+                1 + sum(1 for o in g if o["cycles_per_frame"] is not None and o["cycles_per_frame"] < ours)
+        out += g
+    return out
+
+
+def _ordered(rows, key, rank, unit, spec):
+    """'a, b = c (1, 2, 2 unit)': methods in the order of `rank` (1 first), ties joined by '='."""
+    g = sorted(rows, key=lambda r: (r[rank], _order(RELIEF_METHODS, r["method"])))
+    names = g[0]["method"]
+    for a, b in zip(g, g[1:]):
+        names += (" = " if a[rank] == b[rank] else ", ") + b["method"]
+    return f"{names} ({', '.join(format(r[key], spec) for r in g)} {unit})"
+
+
+def relief_reading(doc, ranking, paper_rows):
+    """What the relief section shows, as plain sentences computed from relief.json."""
+    rows, out = doc["rows"], []
+    walks = [r for r in rows if r["walk_mismatches"] > 0]
+    pixels = [r for r in rows if r["pixel_mismatches"] > 0]
+    frags = [r for r in rows if r["fragments"] != r["gl_fragments"]]
+    where = lambda r: f"{trace_name(r['trace'])} frame {r['frame']} {r['method']}"  # noqa: E731
+    if walks or pixels or frags:
+        parts = []
+        if walks:
+            parts.append(f"walks differing from GL's in {_rows(walks)} ("
+                         + _named([f"{where(r)}: {r['walk_mismatches']:,}" for r in walks]) + ")")
+        if pixels:
+            parts.append(f"pixels differing from GL's in {_rows(pixels)} ("
+                         + _named([f"{where(r)}: {r['pixel_mismatches']:,}" for r in pixels]) + ")")
+        if frags:
+            parts.append(f"fragment counts unlike GL's in {_rows(frags)} ("
+                         + _named([f"{where(r)}: {r['fragments']:,} against {r['gl_fragments']:,}" for r in frags]) + ")")
+        out.append("GL AND THE MODEL DISAGREE: " + "; ".join(parts) + ". The model's walk must be the shader's, "
+                   "fragment for fragment.")
+    else:
+        traces = len({r["trace"] for r in rows})
+        out.append(f"The model's walks and pixels are GL's in every row ({len(rows)} rows: {traces} traces, "
+                   f"{len({r['frame'] for r in rows})} view angles, {len({r['method'] for r in rows})} "
+                   "methods): 0 walks and 0 pixels differing, fragment counts equal.")
+    front = [r for r in ranking if r["pareto"]]
+    cheap = min(ranking, key=lambda r: r["cycles_per_frame"])
+    dear = max(ranking, key=lambda r: r["cycles_per_frame"])
+    s = "Pareto front of cycles per box draw against hit error: " + ", ".join(
+        f"{r['method']} ({r['cycles_per_frame']:,.0f} cycles, {pct(r['error_rate'], 3)} hit errors)" for r in front)
+    s += f". Cheapest: {cheap['method']}"
+    if dear is not cheap and cheap["cycles_per_frame"] > 0:
+        s += (f"; dearest: {dear['method']} ({dear['cycles_per_frame']:,.0f} cycles, "
+              f"{dear['cycles_per_frame'] / cheap['cycles_per_frame']:.2f} times)")
+    out.append(s + ".")
+    least = min(r["error_rate"] for r in ranking)
+    best = [r["method"] for r in ranking if r["error_rate"] == least]
+    worst = max(ranking, key=lambda r: r["error_rate"])
+    out.append(f"Fewest hit errors: {_modes(best)} ({pct(least, 3)} of the fragments)"
+               + ("" if worst["error_rate"] == least else f"; most: {worst['method']} ({worst['errors']:,} of "
+                  f"{worst['fragments']:,} fragments, {pct(worst['error_rate'], 3)})") + ".")
+    lk = [r for r in ranking if r["lookups_per_fragment"] is not None]
+    if lk:
+        few = min(lk, key=lambda r: r["lookups_per_fragment"])
+        if few is not cheap:
+            out.append(f"Fewest lookups per fragment: {few['method']} ({few['lookups_per_fragment']:.2f}, "
+                       f"{cell(few, 'steps_per_fragment', '.2f')} steps), yet {cheap['method']} costs fewer cycles "
+                       f"({cell(cheap, 'lookups_per_fragment', '.2f')} lookups, {cell(cheap, 'steps_per_fragment', '.2f')} "
+                       "steps per fragment): lookups alone do not set the cost.")
+    nve = [r for r in doc["nbuffer_vs_exact"] if r["lookup_ratio"] is not None]
+    if nve:
+        fewer = [r for r in nve if r["lookup_ratio"] < 1]
+        more = [relief_heightfield(r["field"], r["field_size"]) for r in nve if r["lookup_ratio"] > 1]
+        extra = [r for r in nve if (r["extra_errors"] or 0) > 0]
+        lo, hi = min(r["lookup_ratio"] for r in nve), max(r["lookup_ratio"] for r in nve)
+        s = (f"The N-buffer walk read fewer lookups per fragment than the exact walk on {len(fewer)} of {len(nve)} "
+             f"heightfields (N-buffer / exact {lo:.2f} to {hi:.2f}" + (f"; more on {_named(more)}" if more else "")
+             + "), with " + (f"extra hit errors on {len(extra)}: " + _named(
+                 [f"{relief_heightfield(r['field'], r['field_size'])} (+{r['extra_errors']:,})" for r in extra])
+                 if extra else "0 extra hit errors on any of them")
+             + f" (N-buffer {sum(r['nbuffer_errors'] for r in nve):,} errors, exact "
+             f"{sum(r['exact_errors'] for r in nve):,}).")
+        out.append(s)
+    if paper_rows:
+        orders, without = [], []
+        for size in dict.fromkeys(r["field_size"] for r in paper_rows):
+            g = [r for r in paper_rows if r["field_size"] == size]
+            ours = [r for r in g if r["our_rank"] is not None]
+            if len(ours) < 2:
+                without.append(f"{size}²")
+                continue
+            p = _ordered(ours, "paper_hz", "paper_rank", "Hz", ".0f")
+            o = _ordered(ours, "cycles_per_frame", "our_rank", "cycles", ",.0f")
+            same = [r["paper_rank"] for r in sorted(ours, key=lambda r: r["method"])] == \
+                [r["our_rank"] for r in sorted(ours, key=lambda r: r["method"])]
+            orders.append(f"At {size}², the paper: {p}; ours: {o}; {'the same order' if same else 'another order'}.")
+        s = (f"The paper ranks the methods by frame rate on a 2006 GPU ({RELIEF_PAPER}), fastest first; we rank them "
+             "by modelled cycles per box draw of the fbm heightfield (the paper's terrain), fewest first. ")
+        s += " ".join(orders) if orders else "We have no fbm rows at the paper's sizes."
+        if without and orders:
+            s += f" No fbm rows of ours at {_modes(without)}: the paper's alone."
+        out.append(s)
+    return out
+
+
+def headline_relief(label, ranking, reading):
+    """The relief methods' ranking (cycles against hit error) and its reading, as Markdown."""
+    lines = [f"Relief textures ({label}): methods ranked by modelled cycles per box draw against hit error",
+             "",
+             "| method | cycles/box draw | lookups/fragment | steps/fragment | hit errors | Pareto | walks, pixels differing from GL |",
+             "|---|---:|---:|---:|---:|---|---:|"]
+    for r in ranking:
+        lines.append(f"| {r['method']} | {r['cycles_per_frame']:,.0f} | {cell(r, 'lookups_per_fragment', '.2f')} | "
+                     f"{cell(r, 'steps_per_fragment', '.2f')} | {pct(r['error_rate'], 3)} ({r['errors']:,}) | "
+                     f"{'yes' if r['pareto'] else 'no'} | {r['walk_mismatches']:,}, {r['pixel_mismatches']:,} |")
     return "\n".join(lines + [""] + [f"- {s}" for s in reading])

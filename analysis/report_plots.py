@@ -20,9 +20,18 @@ MODE_STYLE = {  # colour, line style, marker: a hierarchical mode is the darker,
     "hiz_tile": ("#1b7837", "-", "^"), "hiz_pyramid": ("#a6dba0", "--", "v"),
 }
 
+RELIEF_STYLE = {  # colour, marker per relief method: the N-buffer walk red as the N-buffer modes, the others apart
+    "binary": ("#7f7f7f", "v"), "exact": ("#1f4e96", "s"), "robust": ("#1b7837", "^"),
+    "robust_clamp": ("#a6dba0", "D"), "nbuffer": ("#b2182b", "o"),
+}
+
 
 def mode_style(mode):
     return MODE_STYLE.get(mode, ("#555555", "-", "x"))
+
+
+def relief_style(method):
+    return RELIEF_STYLE.get(method, ("#555555", "x"))
 
 
 def spans_decades(values, decades=1.0):

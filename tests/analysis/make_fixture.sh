@@ -1,7 +1,8 @@
 #!/bin/sh
 # Regenerates tests/analysis/fixture/, the input folder of analysis/report.py's tests, from real nbsim
 # outputs on the small samples (city_small_oq.nbt, and city_small_nb_reversed.nbt for a second trace
-# in two sweeps) on four tiny particles captures, nine tiny shadows captures and a small `nbsim ldi table1`. Big files are trimmed to what the report reads.
+# in two sweeps) on four tiny particles captures, nine tiny shadows captures, a small `nbsim ldi table1` and ten tiny
+# relief captures (five heightfields at two sizes). Big files are trimmed to what the report reads.
 # About a minute on 2 cores.
 # Usage: tests/analysis/make_fixture.sh [NBSIM]   (default: build/pipeline/nbsim; run from anywhere)
 set -eu
@@ -88,6 +89,19 @@ cp "$tmp/shadows/shadows.json" "$out/shadows/"
 # Layered depth images: Table 1 and the parity test's accuracy, two shapes at two small sides.
 "$nbsim" ldi table1 --shapes sphere,nested:3 --sizes 32,64 --points 512 --out "$out/ldi" >/dev/null
 rm -f "$out/ldi/ldi.csv"
+
+# Relief textures: tiny captures (128x128, 4 frames: one per view angle) of each heightfield at 32 and 64 texels,
+# and the table nbsim relief writes (relief.json alone: relief.csv and the replays' folders are not read).
+# Their own folder, so that *.nbt is the ten relief traces alone (the rows name them as given: fbm_32.nbt ...).
+mkdir -p "$out/relief" "$tmp/relief_traces"
+(cd "$tmp/relief_traces" && for f in fbm walls spikes saddle step; do
+   for n in 32 64; do
+     "$nbsim" capture relief --scene boxes --boxes 0 --path fly --size 128x128 --frames 4 --field "$f" --field-size "$n" \
+       --seed 5 -o "${f}_$n.nbt" >/dev/null
+   done
+ done &&
+ "$nbsim" relief *.nbt --out "$tmp/relief" >/dev/null)
+cp "$tmp/relief/relief.json" "$out/relief/"
 
 du -sh "$out"
 echo "wrote $out"

@@ -144,7 +144,9 @@ class FixtureReport(unittest.TestCase):
         self.assertIn("Shadows (9 traces of boxes, terrain, city)", last.split("Particles (")[1],
                       "the shadows table follows the particles table")
         self.assertIn("Layered depth images (2 shapes, 4 LDIs)", last.split("Shadows (")[1],
-                      "the LDI table is the last block, after the shadows table")
+                      "the LDI table follows the shadows table")
+        self.assertIn("Relief textures (10 traces: 5 heightfields at 32² and 64², 4 view angles each)",
+                      last.split("Layered depth images (")[1], "the relief table is the last block, after the LDI table")
 
     def test_ldi_section_from_nbsim_ldi_table1(self):
         # ldi/ldi.json (nbsim ldi table1 --out): its rows in the table and CSV copy, the plot, the paper's sphere row
@@ -159,6 +161,53 @@ class FixtureReport(unittest.TestCase):
                 self.assertEqual(float(t["paper_c_ratio"]), 1.78)
         png_size(self.dir / "report" / "ldi.png")
         self.assertIn("C_ratio", (self.dir / "report" / "headline.md").read_text())
+
+    def test_relief_section_from_nbsim_relief(self):
+        # relief/relief.json (nbsim relief --out): the ranking, the N-buffer walk against the exact walk and the
+        # paper's table with their CSV copies, the plot, and readings whose numbers are the fixture's own
+        doc = json.loads((FIXTURE / "relief" / "relief.json").read_text())
+        self.assertIn("Relief textures: the methods&#x27; cost against hit error", self.html)
+        self.assertIn("relief/relief.json", self.html, "the page names its input")
+        png_size(self.dir / "report" / "relief.png")
+        self.assertIn('<img src="relief.png"', self.html)
+        with open(self.dir / "report" / "relief_ranking.csv") as f:
+            ranking = list(csv.DictReader(f))
+        self.assertEqual([r["method"] for r in ranking], [r["method"] for r in doc["ranking"]], "nbsim's order, cheapest first")
+        for t, r in zip(ranking, doc["ranking"]):
+            self.assertAlmostEqual(float(t["cycles_per_frame"]), r["cycles_per_frame"], msg="cycles are nbsim's own")
+            self.assertEqual(t["pareto_mark"], "yes (front)" if r["pareto"] else "no", f"{r['method']}: Pareto mark")
+            self.assertIn(f">{100 * r['error_rate']:.3f}%<", self.html, f"{r['method']}: hit error in %")
+        with open(self.dir / "report" / "relief_nbuffer_vs_exact.csv") as f:
+            self.assertEqual(len(list(csv.DictReader(f))), len(doc["nbuffer_vs_exact"]))
+        nve = doc["nbuffer_vs_exact"]
+        fewer = sum(1 for r in nve if r["lookup_ratio"] < 1)
+        extra = sum(1 for r in nve if r["extra_errors"] > 0)
+        self.assertGreater(fewer, 0, "the fixture's N-buffer walk saves lookups somewhere")
+        self.assertIn(f"The N-buffer walk read fewer lookups per fragment than the exact walk on {fewer} of {len(nve)} "
+                      "heightfields", self.html, "the count is the fixture's")
+        self.assertIn(f"with extra hit errors on {extra}:" if extra else "with 0 extra hit errors on any of them", self.html)
+        with open(self.dir / "report" / "relief_paper.csv") as f:
+            paper = list(csv.DictReader(f))
+        self.assertEqual(len(paper), len(doc["paper"]))
+        self.assertIn("ranks the methods by frame rate on a 2006 GPU", self.html)
+        for size in sorted({r["field_size"] for r in doc["paper"] if r["cycles_per_frame"] is not None}):
+            g = [r for r in doc["paper"] if r["field_size"] == size and r["cycles_per_frame"] is not None]
+            by_hz = ", ".join(r["method"] for r in sorted(g, key=lambda r: -r["paper_hz"]))
+            by_cycles = ", ".join(r["method"] for r in sorted(g, key=lambda r: r["cycles_per_frame"]))
+            self.assertIn(f"At {size}², the paper: {by_hz} (", self.html, f"the paper's order at {size}")
+            self.assertIn(f"; ours: {by_cycles} (", self.html, f"our order at {size}")
+        self.assertTrue(all(r["walk_mismatches"] == 0 and r["pixel_mismatches"] == 0 for r in doc["rows"]),
+                        "the fixture's walks are GL's")
+        self.assertIn(f"The model&#x27;s walks and pixels are GL&#x27;s in every row ({len(doc['rows'])} rows", self.html)
+        self.assertNotIn("GL AND THE MODEL DISAGREE", self.html)
+        with open(self.dir / "report" / "relief_rows.csv") as f:
+            self.assertEqual(len(list(csv.DictReader(f))), len(doc["rows"]), "every row in relief_rows.csv")
+        text = (self.dir / "report" / "headline.md").read_text()
+        block = text.split("Relief textures (")[1]
+        lines = [line for line in block.splitlines() if line.startswith("| ") and not line.startswith("| method")]
+        self.assertEqual(len(lines), len(doc["ranking"]), block)
+        front = [r["method"] for r in doc["ranking"] if r["pareto"]]
+        self.assertIn(f"Pareto front of cycles per box draw against hit error: {front[0]} (", block)
 
     def test_particles_section_per_mode_beside_the_paper(self):
         # particles/particles.json: one row per mode beside the paper's 256 N and N, its CSV copy, and a
@@ -567,6 +616,87 @@ class LdiReading(unittest.TestCase):
         self.assertNotIn("Both readers misclassify", text)
 
 
+def relief_row(field_size, method, **kw):
+    """A relief.json row (nbsim relief --out): the fbm heightfield at field_size, frame 0, 1,000 fragments; kw overrides."""
+    r = {"trace": f"fbm_{field_size}.nbt", "field": "fbm:0 seed 5", "field_size": field_size, "frame": 0, "angle": 0.0,
+         "method": method, "fragments": 1000, "gl_fragments": 1000, "lookups": 20000, "steps": 3000, "errors": 0,
+         "reference_hits": 800, "cycles": 10000, "pixel_mismatches": 0, "walk_mismatches": 0}
+    r.update(kw)
+    for k, n in (("lookups_per_fragment", "lookups"), ("steps_per_fragment", "steps"), ("error_rate", "errors")):
+        r.setdefault(k, r[n] / r["fragments"] if r["fragments"] else None)
+    return r
+
+
+def relief_doc(rows=None, ranking=None, nbuffer_vs_exact=None, paper=None):
+    """A relief.json (nbsim relief --out) of exact and nbuffer walks at 32 and 64, by default with the N-buffer walk
+    cheaper at 64 and the paper's Table 1 rows at 32 and 64."""
+    rows = rows if rows is not None else [relief_row(32, "exact"), relief_row(32, "nbuffer", lookups=25000),
+                                          relief_row(64, "exact", lookups=40000, errors=3),
+                                          relief_row(64, "nbuffer", lookups=30000)]
+    ranking = ranking if ranking is not None else [
+        {"method": "nbuffer", "fragments": 2000, "lookups_per_fragment": 27.5, "steps_per_fragment": 3.0,
+         "cycles_per_frame": 10000.0, "errors": 0, "error_rate": 0.0, "pareto": True},
+        {"method": "exact", "fragments": 2000, "lookups_per_fragment": 30.0, "steps_per_fragment": 3.0,
+         "cycles_per_frame": 12000.0, "errors": 3, "error_rate": 0.0015, "pareto": False}]
+    nve = nbuffer_vs_exact if nbuffer_vs_exact is not None else [
+        {"field": "fbm:0 seed 5", "field_size": 32, "exact_lookups_per_fragment": 20.0,
+         "nbuffer_lookups_per_fragment": 25.0, "lookup_ratio": 1.25, "exact_errors": 0, "nbuffer_errors": 0,
+         "extra_errors": 0},
+        {"field": "fbm:0 seed 5", "field_size": 64, "exact_lookups_per_fragment": 40.0,
+         "nbuffer_lookups_per_fragment": 30.0, "lookup_ratio": 0.75, "exact_errors": 3, "nbuffer_errors": 0,
+         "extra_errors": -3}]
+    paper = paper if paper is not None else [
+        {"method": m, "field_size": n, "paper_hz": hz, "cycles_per_frame": c, "lookups_per_fragment": None}
+        for m, n, hz, c in [("exact", 32, 115.0, 9000.0), ("robust", 32, 116.0, 9500.0),
+                            ("exact", 64, 87.0, 20000.0), ("robust", 64, 105.0, 15000.0),
+                            ("exact", 128, 58.0, None), ("robust", 128, 97.0, None)]]
+    return {"settings": [], "rows": rows, "ranking": ranking, "nbuffer_vs_exact": nve, "paper": paper}
+
+
+class ReliefReading(unittest.TestCase):
+    """The relief section's reading follows relief.json, not fixed text."""
+
+    def reading(self, doc):
+        return " ".join(report_data.relief_reading(doc, report_data.relief_ranking(doc),
+                                                   report_data.relief_paper_rows(doc["paper"])))
+
+    def test_front_nbuffer_against_exact_and_the_paper(self):
+        # the front, the N-buffer walk's lookups and errors per heightfield, and the two rankings per size
+        text = self.reading(relief_doc())
+        self.assertIn("The model's walks and pixels are GL's in every row (4 rows: 2 traces, 1 view angles, 2 methods)", text)
+        self.assertIn("Pareto front of cycles per box draw against hit error: nbuffer (10,000 cycles, 0.000% hit errors). "
+                      "Cheapest: nbuffer; dearest: exact (12,000 cycles, 1.20 times).", text)
+        self.assertIn("fewer lookups per fragment than the exact walk on 1 of 2 heightfields (N-buffer / exact 0.75 to "
+                      "1.25; more on fbm:0 seed 5 at 32²), with 0 extra hit errors on any of them (N-buffer 0 errors, "
+                      "exact 3)", text)
+        self.assertIn("At 32², the paper: robust, exact (116, 115 Hz); ours: exact, robust (9,000, 9,500 cycles); "
+                      "another order.", text)
+        self.assertIn("At 64², the paper: robust, exact (105, 87 Hz); ours: robust, exact (15,000, 20,000 cycles); "
+                      "the same order.", text)
+        self.assertIn("No fbm rows of ours at 128²", text)
+
+    def test_extra_errors_are_named(self):
+        # an N-buffer walk with more hit errors than the exact walk on a heightfield: said, with how many
+        doc = relief_doc()
+        doc["nbuffer_vs_exact"][1].update(nbuffer_errors=7, extra_errors=4)
+        text = self.reading(doc)
+        self.assertIn("with extra hit errors on 1: fbm:0 seed 5 at 64² (+4)", text)
+        self.assertNotIn("0 extra hit errors", text)
+
+    def test_disagreements_with_gl_are_loud(self):
+        # walks, pixels or fragment counts unlike GL's are named, and the all-clear sentence goes
+        doc = relief_doc()
+        doc["rows"][1].update(walk_mismatches=12)
+        doc["rows"][2].update(pixel_mismatches=3, gl_fragments=999)
+        text = self.reading(doc)
+        self.assertIn("GL AND THE MODEL DISAGREE: walks differing from GL's in 1 row (fbm_32 frame 0 nbuffer: 12); "
+                      "pixels differing from GL's in 1 row (fbm_64 frame 0 exact: 3); fragment counts unlike GL's in "
+                      "1 row (fbm_64 frame 0 exact: 1,000 against 999)", text)
+        self.assertNotIn("walks and pixels are GL's", text)
+        ranking = {r["method"]: r for r in report_data.relief_ranking(doc)}
+        self.assertEqual((ranking["nbuffer"]["walk_mismatches"], ranking["exact"]["pixel_mismatches"]), (12, 3))
+
+
 class ParticlesReading(unittest.TestCase):
     """The particles section's reading follows the rows it is given, not fixed text."""
 
@@ -646,7 +776,7 @@ class MissingAndBroken(unittest.TestCase):
         html = (self.dir / "report" / "index.html").read_text()
         self.assertIn("Table 1: N-buffer build cost", html)
         for missing in ["figure4_map.csv", "table2/table2.json", "sweeps/NAME/results.csv", "particles/particles.json",
-                        "shadows/shadows.json"]:
+                        "shadows/shadows.json", "ldi/ldi.json", "relief/relief.json"]:
             self.assertIn(missing, html, f"the page does not say {missing} is missing")
         self.assertIn("missing inputs", out)
 
@@ -782,6 +912,45 @@ class MissingAndBroken(unittest.TestCase):
             (self.dir / "ldi.json").write_text(bad)
             rc, _, err = run_report(self.dir)
             self.assertBroken(rc, err, "ldi.json")
+            self.assertIn(says, err, bad)
+
+    def test_relief_json_of_nbsim_relief_out_dir(self):
+        # DIR/relief.json (nbsim relief --out DIR) renders alone with its plot; a malformed one exits 2 naming the
+        # file and the row
+        good = relief_doc()
+        (self.dir / "relief.json").write_text(json.dumps(good))
+        rc, out, err = run_report(self.dir)
+        self.assertEqual(rc, 0, err)
+        self.assertIn("1 sections", out)
+        self.assertIn("Relief textures (2 traces: 1 heightfields at 32² and 64², 1 view angles each)",
+                      (self.dir / "report" / "headline.md").read_text())
+        png_size(self.dir / "report" / "relief.png")
+
+        def broken(change):
+            d = json.loads(json.dumps(good))
+            change(d)
+            return json.dumps(d)
+        for bad, says in [
+                (broken(lambda d: d["rows"][0].pop("method")), "rows[0] lacks method"),
+                (broken(lambda d: d["rows"][1].update(lookups=-5)), "rows[1].lookups must be a count"),
+                (broken(lambda d: d["rows"][0].update(cycles=1.5)), "rows[0].cycles must be a count"),
+                (broken(lambda d: d["rows"][0].update(errors=10 ** 6)), "rows[0]: errors and reference_hits"),
+                (broken(lambda d: d["rows"][0].update(lookups_per_fragment="many")),
+                 "rows[0].lookups_per_fragment is not a number"),
+                (broken(lambda d: d["ranking"][0].update(errors=-1)), "ranking[0].errors must be a count"),
+                (broken(lambda d: d["ranking"][1].update(pareto="yes")), "ranking[1].pareto is not true or false"),
+                (broken(lambda d: d["ranking"][0].update(cycles_per_frame=None)), "ranking[0]: cycles_per_frame and error_rate"),
+                (broken(lambda d: d["nbuffer_vs_exact"][0].update(nbuffer_errors=-2)),
+                 "nbuffer_vs_exact[0].nbuffer_errors must be a count"),
+                (broken(lambda d: d["paper"][0].update(paper_hz=0)), "paper[0].paper_hz must be above 0"),
+                (broken(lambda d: d["paper"][0].update(method=3)), "paper[0].method is not a string"),
+                (broken(lambda d: d.pop("paper")), "lacks paper"),
+                (broken(lambda d: d.update(rows=[])), "rows is not a non-empty list"),
+                (broken(lambda d: d.update(settings="x")), "settings is not a list of strings"),
+                ("[]", "expected an object"), ('{"rows": [', "broken JSON")]:
+            (self.dir / "relief.json").write_text(bad)
+            rc, _, err = run_report(self.dir)
+            self.assertBroken(rc, err, "relief.json")
             self.assertIn(says, err, bad)
 
     def test_help(self):
