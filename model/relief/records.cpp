@@ -139,6 +139,17 @@ GlReliefField read_relief_field(const scene::Frame& f) {
   g.ray.b = vec3(rec, "ray_b", frame);
   g.ray.c = vec3(rec, "ray_c", frame);
   g.view_angle = scalar<double>(rec, "view_angle", kFieldLabel, frame);
+  g.frustum_apex = scalar<double>(rec, "frustum_apex", kFieldLabel, frame);
+  if (!(g.frustum_apex >= 0.0 && g.frustum_apex <= 1e6))
+    throw InputError(fmt::format("frame {}: the {} record's frustum_apex is {}, not in [0, 1e6]", frame, kFieldLabel, g.frustum_apex));
+  g.ray.frustum = g.frustum_apex > 0.0;
+  const std::vector<float>& eye = float_vector(rec, "eye_h", g.ray.frustum ? 4 : 0, "a frustum's homogeneous eye (a box: none)", frame);
+  const std::vector<float>& q = float_vector(rec, "ray_q", g.ray.frustum ? 12 : 0, "a frustum's three 4-vectors (a box: none)", frame);
+  if (g.ray.frustum)
+    for (std::size_t k = 0; k < 4; ++k) {
+      g.ray.eye_h[k] = eye[k];
+      g.ray.qa[k] = q[k], g.ray.qb[k] = q[4 + k], g.ray.qc[k] = q[8 + k];
+    }
   return g;
 }
 

@@ -32,6 +32,7 @@ struct GlReliefField {
   WalkParams params;
   RayFrame ray;
   double view_angle = 0.0;
+  double frustum_apex = 0.0;  // 0: the box; the ray frame is a frustum's (ray.frustum) otherwise
 
   FieldView view() const;  // spans into this record
 };

@@ -324,10 +324,20 @@ int walk_iteration_cap(int size) noexcept { return 16 * (size + 2) + 64; }
 
 std::optional<FragmentRay> fragment_ray(const RayFrame& frame, int size, float px, float py) {
   FragmentRay ray;
-  ray.o = frame.origin;
-  for (int k = 0; k < 3; ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    ray.d[kk] = (frame.a[kk] * px + frame.b[kk] * py) + frame.c[kk];
+  if (frame.frustum) {
+    std::array<float, 4> q{};
+    for (std::size_t k = 0; k < 4; ++k) q[k] = (frame.qa[k] * px + frame.qb[k] * py) + frame.qc[k];
+    if (!(q[3] > 0.0f)) return std::nullopt;  // the near-plane point outside the frustum's w > 0 side
+    for (std::size_t k = 0; k < 3; ++k) {
+      ray.o[k] = q[k] / q[3];
+      ray.d[k] = frame.eye_h[3] * q[k] - q[3] * frame.eye_h[k];
+    }
+  } else {
+    ray.o = frame.origin;
+    for (int k = 0; k < 3; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      ray.d[kk] = (frame.a[kk] * px + frame.b[kk] * py) + frame.c[kk];
+    }
   }
   float tmin = 0.0f, tmax = kFar, t_floor = kFar;
   const float hi[3] = {static_cast<float>(size), static_cast<float>(size), 1.0f};

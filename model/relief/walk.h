@@ -59,9 +59,20 @@ struct WalkParams {
 };
 
 // The draw's ray frame (float, as the shader's uniforms).
+// A box: origin o = `origin`, direction d = (a * px + b * py) + c.
+// A reverse-perspective frustum (`frustum`): texel space is the frustum's projective image (the
+// frustum -> box map F, homogeneous), where rays stay straight lines. The fragment's near-plane point
+// in F's homogeneous coordinates is Q = (qa * px + qb * py) + qc and the eye's is E = eye_h; the ray
+// starts at o = Q.xyz / Q.w and runs along d = E.w * Q.xyz - Q.w * E.xyz (the derivative of the
+// image of q + s (q - eye) at s = 0, scaled by Q.w^2 > 0: forward whatever E.w's sign). Nothing
+// divides by E.w, so an eye on or near F's w = 0 plane (the apex's plane, where the eye's image
+// goes to infinity and every ray becomes parallel) needs no special case.
 struct RayFrame {
-  std::array<float, 3> origin{};  // the eye, texel space
-  std::array<float, 3> a{}, b{}, c{};  // direction = (a * px + b * py) + c
+  std::array<float, 3> origin{};  // the eye, texel space (a box)
+  std::array<float, 3> a{}, b{}, c{};  // direction = (a * px + b * py) + c (a box)
+  bool frustum = false;
+  std::array<float, 4> eye_h{};         // E (a frustum)
+  std::array<float, 4> qa{}, qb{}, qc{};  // Q = (qa * px + qb * py) + qc (a frustum)
 };
 
 // What the shader reads. Levels: `levels` planes of N * N (N-buffer, max), level-major.

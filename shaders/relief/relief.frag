@@ -17,6 +17,8 @@ uniform sampler2D radii;         // R32F, N x N (robust methods)
 uniform sampler2DArray levels;   // R32F, the heightfield's max N-buffer, one layer a level
 uniform int size, top_level, method, linear_steps, binary_steps, root_steps;
 uniform vec3 origin, ray_a, ray_b, ray_c;
+uniform bool frustum;
+uniform vec4 eye_h, ray_qa, ray_qb, ray_qc;
 layout(location = 0) out uint hit_mask;
 
 const float kFar = 3.0e38;
@@ -260,10 +262,25 @@ float walk_nbuffer(int cap) {
 
 // The ray of this pixel centre, clipped to the box (walk.cpp's fragment_ray): false on a miss.
 bool fragment_ray(float px, float py) {
-  o = origin;
-  d.x = (ray_a.x * px + ray_b.x * py) + ray_c.x;
-  d.y = (ray_a.y * px + ray_b.y * py) + ray_c.y;
-  d.z = (ray_a.z * px + ray_b.z * py) + ray_c.z;
+  if (frustum) {
+    precise vec4 q;
+    q.x = (ray_qa.x * px + ray_qb.x * py) + ray_qc.x;
+    q.y = (ray_qa.y * px + ray_qb.y * py) + ray_qc.y;
+    q.z = (ray_qa.z * px + ray_qb.z * py) + ray_qc.z;
+    q.w = (ray_qa.w * px + ray_qb.w * py) + ray_qc.w;
+    if (!(q.w > 0.0)) return false;
+    o.x = q.x / q.w;
+    o.y = q.y / q.w;
+    o.z = q.z / q.w;
+    d.x = eye_h.w * q.x - q.w * eye_h.x;
+    d.y = eye_h.w * q.y - q.w * eye_h.y;
+    d.z = eye_h.w * q.z - q.w * eye_h.z;
+  } else {
+    o = origin;
+    d.x = (ray_a.x * px + ray_b.x * py) + ray_c.x;
+    d.y = (ray_a.y * px + ray_b.y * py) + ray_c.y;
+    d.z = (ray_a.z * px + ray_b.z * py) + ray_c.z;
+  }
   precise float tmin = 0.0, tmax = kFar, t_floor = kFar;
   for (int k = 0; k < 3; ++k) {
     precise float oo = o[k], dd = d[k];

@@ -61,6 +61,14 @@ std::string field_rule(const TechniqueRecord& r) {
     return p;
   for (const char* name : {"origin", "ray_a", "ray_b", "ray_c"})
     if (std::string p = float_vector_problem(r, name, 3, "a vector's length"); !p.empty()) return p;
+  const TechniqueField* apex_field = find_field(r, "frustum_apex");
+  const double apex = apex_field ? std::get<double>(apex_field->value) : 0.0;
+  if (!(apex >= 0.0 && apex <= 1e6)) return fmt::format("frustum_apex is {}, not in [0, 1e6] (0: a box)", apex);
+  const bool frustum = apex > 0.0;
+  if (std::string p = float_vector_problem(r, "eye_h", frustum ? 4 : 0, frustum ? "a frustum's homogeneous eye" : "a box's"); !p.empty())
+    return p;
+  if (std::string p = float_vector_problem(r, "ray_q", frustum ? 12 : 0, frustum ? "a frustum's three 4-vectors" : "a box's"); !p.empty())
+    return p;
   const std::vector<float>& heights = floats(r, "heights");
   for (std::size_t k = 0; k < heights.size(); ++k)
     if (!(heights[k] >= 0.0f && heights[k] <= 1.0f))
@@ -119,7 +127,14 @@ ChunkSpec relief_field_chunk_spec() {
         "coordinates; ray_a: x, y, z, texel space per pixel of px"},
        {"ray_b", FieldKind::VecF32, "x, y, z, texel space per pixel of py"},
        {"ray_c", FieldKind::VecF32, "x, y, z, texel space"},
-       {"view_angle", FieldKind::F64, "degrees between the view direction and the box's up axis (for reports)"}}};
+       {"view_angle", FieldKind::F64, "degrees between the view direction and the box's up axis (for reports)"},
+       {"frustum_apex", FieldKind::F64,
+        "0: the box; above 0: a reverse-perspective frustum over the box's bottom face whose sides meet this many box heights "
+        "below it (traces/capture/relief/view.h); its rays come from eye_h and ray_q"},
+       {"eye_h", FieldKind::VecF32, "a frustum's ray frame (model/relief/walk.h): the eye in the frustum map's homogeneous coordinates, "
+                                    "x, y, z, w (a box: empty)"},
+       {"ray_q", FieldKind::VecF32,
+        "a frustum's ray frame: qa, qb, qc (4 each), the fragment's near-plane point Q = (qa * px + qb * py) + qc (a box: empty)"}}};
   spec.rule = field_rule;
   return spec;
 }

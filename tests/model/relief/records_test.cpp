@@ -62,7 +62,10 @@ scene::TechniqueRecord field_record() {
               field("ray_a", std::vector<float>{0.125f, 0.0f, 0.0f}),
               field("ray_b", std::vector<float>{0.0f, 0.125f, 0.0f}),
               field("ray_c", std::vector<float>{-0.5f, 1.0f, -1.0f}),
-              field("view_angle", 30.0)};
+              field("view_angle", 30.0),
+              field("frustum_apex", 0.0),
+              field("eye_h", std::vector<float>{}),
+              field("ray_q", std::vector<float>{})};
   return r;
 }
 

@@ -76,6 +76,8 @@ TEST(ReliefCliTest, HardCasesReplayExactly) {
       {"walls", "--field walls --field-size 32 --field-param 5 --angles 60"},
       {"fbm_head_on", "--field fbm --field-size 32 --angles 0"},
       {"shape", "--field-mesh shape:knot --field-size 40 --angles 70"},
+      {"frustum", "--field-mesh shape:sphere --field-size 32 --frustum 1.5 --angles 40"},
+      {"frustum_below", "--field fbm --field-size 24 --frustum 0.5 --angles 150"},
   };
   std::uint64_t exact_errors = 0;
   for (const Case& c : cases) {
@@ -133,7 +135,8 @@ TEST(ReliefCliTest, BadInputExitsTwoAndWritesNothing) {
                            {("--field-file " + spike_file.string() + " --radius-file " + radius_small.string()).c_str(),
                             "does not match the heightfield"},
                            {"--methods exact,fastest", "'fastest' is not a method"},
-                           {"--angles 95", "--angles '95'"},
+                           {"--angles 185", "--angles '185'"},
+                           {"--frustum -1", "--frustum '-1'"},
                            {"--box-height 0", "--box-height '0'"},
                            {"--field-mesh shape:cube", "cube"}},
                           o, out);

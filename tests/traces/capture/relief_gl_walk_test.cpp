@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <cmath>
 #include <random>
 
 #include "model/relief/walk.h"
@@ -95,6 +96,82 @@ TEST_F(ReliefGlWalkTest, EveryMethodMatchesTheModelBitForBit) {
       EXPECT_EQ(r.differing, 0u) << relief::to_string(m) << " at " << angle << " degrees, of " << r.fragments;
     }
   }
+  recorder.collect();
+}
+
+// The reverse-perspective frustum (apex one box height below the bottom face): the same walks with
+// rays from the projective ray frame, at views from above, grazing and from below.
+TEST_F(ReliefGlWalkTest, FrustumMatchesTheModelBitForBit) {
+  const int width = 64, height = 64, n = 16;
+  const relief::Heightfield field = random_field(n, 9, 0.1f);
+  relief::SafetyRadius radius{n, std::vector<float>(static_cast<std::size_t>(n * n), 0.0f)};
+  capture::DrawRecorder recorder;
+  recorder.begin_frame(8);
+  capture::GlReliefWalker gl(width, height);
+  gl.set_field(field, radius, recorder);
+  const std::vector<float> levels = gl.levels();
+  relief::FieldView fv{n, field.heights, radius.radius, levels, gl.level_count()};
+  for (double angle : {0.0, 50.0, 86.0, 130.0}) {
+    const capture::ReliefCamera cam = capture::relief_camera(n, 0.3, angle, 40.0, width, height, 1.0);
+    ASSERT_TRUE(cam.view.ray.frustum);
+    for (Method m : relief::kAllMethods) {
+      gl.clear_depth();
+      const Mismatch r = compare(gl.draw(m, cam.view, {}, recorder), m, fv, {}, cam.view, width);
+      EXPECT_GT(r.fragments, 200u) << angle;
+      EXPECT_EQ(r.differing, 0u) << relief::to_string(m) << " at " << angle << " degrees, of " << r.fragments;
+    }
+  }
+  recorder.collect();
+}
+
+// The hard case: the eye on the frustum's w = 0 plane (the apex's height), where its image in texel
+// space is at infinity and every ray parallel. The angle putting it there is found by bisection on
+// the camera itself; the walks stay finite, exact (bit for bit with GL) and keep their hits.
+TEST_F(ReliefGlWalkTest, EyeOnTheFrustumsApexPlane) {
+  const int width = 64, height = 64, n = 16;
+  const double box_height = 0.3, apex = 1.0;
+  const auto w_of = [&](double angle) { return capture::relief_camera(n, box_height, angle, 40.0, width, height, apex).view.ray.eye_h[3]; };
+  double lo = 90.0, hi = 179.0;  // the eye above the apex plane at 90 degrees, below it at 179
+  ASSERT_GT(w_of(lo), 0.0f);
+  ASSERT_LT(w_of(hi), 0.0f);
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (w_of(mid) > 0.0f ? lo : hi) = mid;
+  }
+  const capture::ReliefCamera cam = capture::relief_camera(n, box_height, lo, 40.0, width, height, apex);
+  const std::array<float, 4>& e = cam.view.ray.eye_h;
+  EXPECT_LT(std::abs(e[3]), 1e-4f * (std::abs(e[0]) + std::abs(e[1]) + std::abs(e[2]))) << "the eye is on the apex plane";
+  const relief::Heightfield field = random_field(n, 13, 0.0f);
+  relief::SafetyRadius radius{n, std::vector<float>(static_cast<std::size_t>(n * n), 0.0f)};
+  capture::DrawRecorder recorder;
+  recorder.begin_frame(8);
+  capture::GlReliefWalker gl(width, height);
+  gl.set_field(field, radius, recorder);
+  const std::vector<float> levels = gl.levels();
+  relief::FieldView fv{n, field.heights, radius.radius, levels, gl.level_count()};
+  for (Method m : relief::kAllMethods) {
+    gl.clear_depth();
+    const capture::GlFragments f = gl.draw(m, cam.view, {}, recorder);
+    const Mismatch r = compare(f, m, fv, {}, cam.view, width);
+    EXPECT_GT(r.fragments, 200u);
+    EXPECT_GT(r.hits, 100u);
+    EXPECT_EQ(r.differing, 0u) << relief::to_string(m);
+    for (float t : f.t) EXPECT_TRUE(std::isfinite(t));
+  }
+  // Every ray of this view is parallel in texel space (the eye's image is at infinity).
+  gl.clear_depth();
+  const capture::GlFragments f = gl.draw(Method::Exact, cam.view, {}, recorder);
+  ASSERT_GE(f.pixel.size(), 2u);
+  const auto centre = [&](std::size_t k, int axis) {
+    return static_cast<float>(axis == 0 ? f.pixel[k] % width : f.pixel[k] / width) + 0.5f;
+  };
+  const std::size_t last = f.pixel.size() - 1;
+  const auto r0 = relief::fragment_ray(cam.view.ray, n, centre(0, 0), centre(0, 1));
+  const auto r1 = relief::fragment_ray(cam.view.ray, n, centre(last, 0), centre(last, 1));
+  ASSERT_TRUE(r0 && r1);
+  const double cross = std::abs(double(r0->d[0]) * r1->d[1] - double(r0->d[1]) * r1->d[0]) /
+                       (std::hypot(r0->d[0], r0->d[1]) * std::hypot(r1->d[0], r1->d[1]));
+  EXPECT_LT(cross, 1e-3) << "the rays' horizontal directions are parallel";
   recorder.collect();
 }
 

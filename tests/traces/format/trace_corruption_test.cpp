@@ -834,6 +834,8 @@ TEST(TraceCorruptionTest, ReliefChunks) {
     std::vector<float> radius = std::vector<float>{1, 0, 0, 1, 2, 0, 0, 1, 3, 2, 0, 1, 3, 3, 2, 2};
     std::vector<float> nbuffer;  // the max N-buffer of the default heights, filled in below
     std::vector<float> origin{2.0f, -3.0f, 5.5f}, ray_a{0.125f, 0.0f, 0.0f}, ray_c{-0.5f, 1.0f, -1.0f};
+    double frustum_apex = 0.0;
+    std::vector<float> eye_h, ray_q;  // a box: none
   };
   Field good_field;
   {
@@ -855,6 +857,9 @@ TEST(TraceCorruptionTest, ReliefChunks) {
     o.counted_words(std::vector<float>{0.0f, 0.125f, 0.0f});  // ray_b
     o.counted_words(f.ray_c);
     o.f64(30.0);  // view_angle
+    o.f64(f.frustum_apex);
+    o.counted_words(f.eye_h);
+    o.counted_words(f.ray_q);
     return o.take();
   };
   struct Fragments {
@@ -951,6 +956,10 @@ TEST(TraceCorruptionTest, ReliefChunks) {
       {[](Field& f) { f.radius.push_back(0); }, "field 'radius' has 17 values, but size x size (4x4) is 16"},
       {[](Field& f) { f.nbuffer.resize(16); }, "field 'nbuffer' has 16 values, but levels x size x size (2x4x4) is 32"},
       {[](Field& f) { f.origin.pop_back(); }, "field 'origin' has 2 values, but a vector's length is 3"},
+      {[](Field& f) { f.frustum_apex = -1.0; }, "frustum_apex is -1"},
+      {[](Field& f) { f.frustum_apex = 2.0; }, "field 'eye_h' has 0 values, but a frustum's homogeneous eye is 4"},
+      {[](Field& f) { f.eye_h = {0, 0, 0, 1}; }, "field 'eye_h' has 4 values, but a box's is 0"},
+      {[](Field& f) { f.frustum_apex = 2.0, f.eye_h = {0, 0, 0, 1}, f.ray_q = {1, 2, 3}; }, "field 'ray_q' has 3 values"},
       {[](Field& f) { f.ray_a.push_back(1); }, "field 'ray_a' has 4 values"},
       {[](Field& f) { f.heights[5] = std::nanf(""); }, "field 'heights' has NaN at index 5"},
       {[](Field& f) { f.nbuffer[20] = std::nanf(""); }, "field 'nbuffer' has NaN at index 20"},

@@ -4,12 +4,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <vector>
 
 #include "model/common/error.h"
 #include "nbsim_shaders.h"
 #include "traces/capture/gl_program.h"
+#include "traces/capture/relief/view.h"
 
 namespace nbsim::capture {
 
@@ -29,7 +31,7 @@ struct BakeObjects {
 };
 }  // namespace
 
-relief::Heightfield bake_heightfield(mesh::TriMesh m, int size) {
+relief::Heightfield bake_heightfield(mesh::TriMesh m, int size, double box_height, double apex) {
   if (size < relief::kMinSize || size > relief::kMaxSize)
     throw InputError(fmt::format("a heightfield of size {} is not supported ({} to {})", size, relief::kMinSize, relief::kMaxSize));
   if (m.triangles.empty()) throw InputError("the mesh to bake has no triangles");
@@ -37,11 +39,15 @@ relief::Heightfield bake_heightfield(mesh::TriMesh m, int size) {
   const double n = size, inner = (n - 2.0) / n, border = 1.0 / n;
   std::vector<float> vertices;
   vertices.reserve(m.vertices.size() * 3);
+  const std::array<double, 16> map = frustum_map(size, box_height, apex);  // world -> texel space, column-major
   for (const mesh::Vec3f& p : m.vertices) {
-    const double x = border + inner * p[0], y = border + inner * p[1];
-    vertices.push_back(static_cast<float>(2.0 * x - 1.0));
-    vertices.push_back(static_cast<float>(2.0 * y - 1.0));
-    vertices.push_back(static_cast<float>(1.0 - p[2]));
+    const double w[4] = {border + inner * p[0], border + inner * p[1], box_height * p[2], 1.0};
+    double t[4] = {0, 0, 0, 0};
+    for (int row = 0; row < 4; ++row)
+      for (int col = 0; col < 4; ++col) t[row] += map[static_cast<std::size_t>(col * 4 + row)] * w[col];
+    vertices.push_back(static_cast<float>(2.0 * t[0] / t[3] / n - 1.0));
+    vertices.push_back(static_cast<float>(2.0 * t[1] / t[3] / n - 1.0));
+    vertices.push_back(static_cast<float>(1.0 - t[2] / t[3]));
   }
   BakeObjects o;
   o.program = link_program({compile_shader(GL_VERTEX_SHADER, shaders::ldi_peel_vert, "ldi/peel.vert"),

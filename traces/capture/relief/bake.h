@@ -13,7 +13,12 @@
 
 namespace nbsim::capture {
 
+// With apex > 0 the same mesh, placed in the world box [0, 1]^2 x [0, box_height] as above, is
+// baked in the reverse-perspective frustum of view.h (frustum_map): each vertex through the
+// projective map onto texel space, the height its texel-space z; triangles stay triangles under a
+// projective map, so GL's rasterization of the mapped triangles is the mesh's upper envelope along
+// the frustum's rays through its apex.
 // The GL context must be current. Throws InputError for an unusable mesh or size.
-relief::Heightfield bake_heightfield(mesh::TriMesh m, int size);
+relief::Heightfield bake_heightfield(mesh::TriMesh m, int size, double box_height = 1.0, double apex = 0.0);
 
 }  // namespace nbsim::capture

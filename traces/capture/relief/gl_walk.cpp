@@ -105,6 +105,7 @@ std::vector<float> GlReliefWalker::levels() const {
 }
 
 void GlReliefWalker::clear_depth() {
+  glDepthMask(GL_TRUE);  // a clear honours the depth write mask, which the box draws leave off
   const float far_depth = 1.0f;
   glClearNamedFramebufferfv(gl_->fbo, GL_DEPTH, 0, &far_depth);
 }
@@ -151,6 +152,11 @@ GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, 
   glUniform3fv(glGetUniformLocation(p, "ray_a"), 1, view.ray.a.data());
   glUniform3fv(glGetUniformLocation(p, "ray_b"), 1, view.ray.b.data());
   glUniform3fv(glGetUniformLocation(p, "ray_c"), 1, view.ray.c.data());
+  glUniform1i(glGetUniformLocation(p, "frustum"), view.ray.frustum ? 1 : 0);
+  glUniform4fv(glGetUniformLocation(p, "eye_h"), 1, view.ray.eye_h.data());
+  glUniform4fv(glGetUniformLocation(p, "ray_qa"), 1, view.ray.qa.data());
+  glUniform4fv(glGetUniformLocation(p, "ray_qb"), 1, view.ray.qb.data());
+  glUniform4fv(glGetUniformLocation(p, "ray_qc"), 1, view.ray.qc.data());
 
   scene::DrawRecord d;
   d.role = scene::DrawRole::ReliefBox;

@@ -69,7 +69,8 @@ const OptionSpec& methods_option() {
 }
 const OptionSpec& angles_option() {
   static const OptionSpec spec = text_option(
-      "angles", "View angles from the box's up axis, degrees, comma-separated (0 head-on, 80 to 89 grazing); frame k takes angle k mod count",
+      "angles", "View angles from the box's up axis, degrees, comma-separated (0 head-on from above, 80 to 89 grazing, up to 179.9 from "
+                "below); frame k takes angle k mod count",
       "0,45,80,89");
   return spec;
 }
@@ -87,6 +88,13 @@ const OptionSpec& binary_steps_option() {
 }
 const OptionSpec& root_steps_option() {
   static const OptionSpec spec = integer_option("root-steps", "exact, nbuffer and robust's cell steps: bisections inside a cell", 16, 0, 32);
+  return spec;
+}
+const OptionSpec& frustum_option() {
+  static const OptionSpec spec = text_option(
+      "frustum", "0: the box; A > 0: a reverse-perspective frustum over the box's bottom face, its apex A box heights below it "
+                 "(traces/capture/relief/view.h); a --field-mesh is baked along the frustum's rays",
+      "0");
   return spec;
 }
 const OptionSpec& tolerance_option() {
@@ -128,7 +136,7 @@ std::vector<relief::Method> parse_methods(const std::string& s) {
 
 std::vector<double> parse_angles(const std::string& s) {
   std::vector<double> out;
-  for (const std::string& a : split(s)) out.push_back(parse_number(a, "angles", 0.0, 89.9));
+  for (const std::string& a : split(s)) out.push_back(parse_number(a, "angles", 0.0, 179.9));
   if (out.empty()) throw InputError("--angles names no angle");
   return out;
 }
@@ -151,12 +159,22 @@ std::string join(const std::vector<double>& v) {
   return s;
 }
 
+// A frustum's qa, qb, qc in a row (RLFH ray_q), or nothing for a box.
+std::vector<float> ray_q(const relief::RayFrame& r) {
+  if (!r.frustum) return {};
+  std::vector<float> q;
+  for (const auto* v : {&r.qa, &r.qb, &r.qc}) q.insert(q.end(), v->begin(), v->end());
+  return q;
+}
+
 class Relief final : public Technique {
  public:
   explicit Relief(const TechniqueSetup& s) : width_(s.width), height_(s.height) {
     const OptionValues& o = s.options;
     seed_ = static_cast<std::uint64_t>(o.integer(seed_option()));
     max_radius_ = static_cast<int>(o.integer(max_radius_option()));
+    apex_ = parse_number(o.text(frustum_option()), "frustum", 0.0, 1e6);
+    box_height_ = parse_number(o.text(box_height_option()), "box-height", 1e-3, 16.0);
     const std::string file = o.text(field_file_option());
     const std::string mesh_source = o.text(field_mesh_option());
     if (file != "none" && mesh_source != "none") throw InputError("give --field-file or --field-mesh, not both");
@@ -172,7 +190,7 @@ class Relief final : public Technique {
       } else {
         m = load_mesh(mesh_source);
       }
-      field_ = bake_heightfield(std::move(m), static_cast<int>(o.integer(field_size_option())));
+      field_ = bake_heightfield(std::move(m), static_cast<int>(o.integer(field_size_option())), box_height_, apex_);
       relief::check_heightfield(field_, fmt::format("the heightfield baked from '{}'", mesh_source));
       description_ = "mesh:" + std::filesystem::path(mesh_source).filename().string();
     } else if (file != "none") {
@@ -198,7 +216,6 @@ class Relief final : public Technique {
     }
     methods_ = parse_methods(o.text(methods_option()));
     angles_ = parse_angles(o.text(angles_option()));
-    box_height_ = parse_number(o.text(box_height_option()), "box-height", 1e-3, 16.0);
     params_.linear_steps = static_cast<int>(o.integer(linear_steps_option()));
     params_.binary_steps = static_cast<int>(o.integer(binary_steps_option()));
     params_.root_steps = static_cast<int>(o.integer(root_steps_option()));
@@ -214,6 +231,7 @@ class Relief final : public Technique {
   trace::Properties setting_properties() const override {
     return {{"relief_field_size", std::to_string(field_.size)},
             {"relief_box_height", fmt::format("{}", box_height_)},
+            {"relief_frustum_apex", fmt::format("{}", apex_)},
             {"relief_angles", join(angles_)},
             {"relief_max_radius", std::to_string(max_radius_)},
             {"relief_linear_steps", std::to_string(params_.linear_steps)},
@@ -233,7 +251,7 @@ class Relief final : public Technique {
     f.begin.mode = scene::TestMode::None;
     const double angle = angles_[index % angles_.size()];
     const double azimuth = std::fmod(37.0 + 61.0 * index + 13.0 * static_cast<double>(seed_ % 1000), 360.0);
-    const ReliefCamera cam = relief_camera(field_.size, box_height_, angle, azimuth, width_, height_);
+    const ReliefCamera cam = relief_camera(field_.size, box_height_, angle, azimuth, width_, height_, apex_);
     for (std::size_t k = 0; k < 16; ++k) {
       f.begin.view[k] = static_cast<float>(cam.world_view[k]);
       f.begin.proj[k] = static_cast<float>(cam.projection[k]);
@@ -271,7 +289,11 @@ class Relief final : public Technique {
                     {"ray_a", vec3(cam.view.ray.a)},
                     {"ray_b", vec3(cam.view.ray.b)},
                     {"ray_c", vec3(cam.view.ray.c)},
-                    {"view_angle", angle}};
+                    {"view_angle", angle},
+                    {"frustum_apex", apex_},
+                    {"eye_h", cam.view.ray.frustum ? std::vector<float>(cam.view.ray.eye_h.begin(), cam.view.ray.eye_h.end())
+                                                   : std::vector<float>{}},
+                    {"ray_q", ray_q(cam.view.ray)}};
     f.technique_records.push_back(std::move(field));
 
     // One RLFF a box draw, in draw order; the capture's own score of each method.
@@ -325,7 +347,7 @@ class Relief final : public Technique {
   std::string description_;
   std::vector<relief::Method> methods_;
   std::vector<double> angles_;
-  double box_height_ = 0.25, tolerance_ = relief::kDefaultHitTolerance;
+  double box_height_ = 0.25, tolerance_ = relief::kDefaultHitTolerance, apex_ = 0.0;
   relief::WalkParams params_;
   DrawRecorder recorder_;
   std::unique_ptr<GlReliefWalker> walker_;
@@ -336,7 +358,7 @@ class Relief final : public Technique {
 const std::vector<OptionSpec>& relief_options() {
   static const std::vector<OptionSpec> options = {field_option(),        field_param_option(), field_size_option(),   field_file_option(),  field_mesh_option(),
                                                   radius_file_option(),  max_radius_option(),  methods_option(),      angles_option(),
-                                                  box_height_option(),   linear_steps_option(), binary_steps_option(), root_steps_option(),
+                                                  box_height_option(),   frustum_option(),     linear_steps_option(), binary_steps_option(), root_steps_option(),
                                                   tolerance_option(),    seed_option()};
   return options;
 }
