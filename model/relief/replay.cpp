@@ -46,7 +46,15 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   out.view_angle = gl.view_angle;
 
   std::size_t next_record = 0;
+  std::fill(depth_.texels.begin(), depth_.texels.end(), 1.0f);  // the frame's depth buffer: the scene's, then tested by the boxes
   for (const scene::DrawRecord& d : f.draws) {
+    if (d.role == scene::DrawRole::Scene) {  // boxes in a scene: its depth, drawn first
+      if (d.topology != scene::Topology::Triangles || d.clip_positions.size() % 3 != 0)
+        throw InputError(fmt::format("frame {}: scene draw {} is not a list of triangles", f.begin.frame, d.index));
+      out.scene_depth_tests += path_.draw(d.clip_positions, raster::draw_state(d.state)).depth.depth_tests;
+      ++out.scene_draws;
+      continue;
+    }
     if (d.role != scene::DrawRole::ReliefBox) continue;
     if (d.topology != scene::Topology::Triangles || d.clip_positions.size() % 3 != 0)
       throw InputError(fmt::format("frame {}: relief_box draw {} is not a list of triangles", f.begin.frame, d.index));
@@ -54,7 +62,6 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       throw InputError(fmt::format("frame {}: relief_box draw {} has no ReliefFragments (RLFF) record in draw order", f.begin.frame, d.index));
     const GlReliefFragments& r = records[next_record++];
 
-    std::fill(depth_.texels.begin(), depth_.texels.end(), 1.0f);
     std::fill(passed_.begin(), passed_.end(), std::uint8_t{0});
     raster::DrawState s = raster::draw_state(d.state);
     s.depth.passed_mask = &passed_;
@@ -66,6 +73,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     c.blocks = k.depth.blocks;
     c.depth_tests = k.depth.depth_tests;
     c.fragments = k.depth.passed;
+    c.rasterized = k.depth.fragments;
     c.gl_fragments = d.gl.fragments;
     c.gl_samples = d.gl.samples_passed;
     // The model's fragments (pixel order) against GL's, merged.

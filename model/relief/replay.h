@@ -3,8 +3,10 @@
 // its safety radius and GL's max N-buffer, checked against the model's own build) and, for every
 // relief_box draw in order with its RLFF record,
 //  1. the box's triangles through the model's raster path at the viewport's size, early depth test
-//     LESS against a depth buffer cleared to 1.0 with depth writes off (relief.frag's state): the
-//     fragments that run the walk (one a pixel: the box is convex and back faces are culled);
+//     LESS with depth writes off (relief.frag's state) against the frame's depth buffer: cleared to
+//     1.0 at the frame's start, then the frame's scene draws (role scene: boxes placed in the city)
+//     in order with their recorded state; the fragments that pass run the walk (one a pixel: the box
+//     is convex and back faces are culled);
 //  2. every such fragment's walk (walk.h) with the draw's method, compared with GL's fragment by
 //     fragment: the same pixels, and the same hit, t (bits), lookups, steps and bisections;
 //  3. every walk scored against the exact reference (score.h): the method's hit error.
@@ -30,6 +32,7 @@ struct BoxDrawCounts {
   Method method = Method::Binary;
   std::uint64_t triangles = 0, blocks = 0, depth_tests = 0;
   std::uint64_t fragments = 0, gl_fragments = 0;  // the model's (after the early test) and GL's counter
+  std::uint64_t rasterized = 0;                    // the model's fragments before the early test (hidden ones culled)
   std::uint64_t samples = 0, gl_samples = 0;      // the model's hits and GL_SAMPLES_PASSED
   std::uint64_t pixel_mismatches = 0;  // pixels in the model's fragments or GL's RLFF but not both
   std::uint64_t walk_mismatches = 0;   // fragments of both whose hit, t, lookups, steps or bisections differ
@@ -43,6 +46,7 @@ struct BoxDrawCounts {
 
 struct ReliefFrameCounts {
   int size = 0;  // the heightfield's N
+  std::uint64_t scene_draws = 0, scene_depth_tests = 0;  // a scene drawn before the boxes (placement city)
   double view_angle = 0.0;
   std::vector<BoxDrawCounts> draws;  // relief_box draws in order
 };

@@ -88,6 +88,8 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
       replay_(width, height, fused_interpolation),
       cache_(cache_config(config)),
       frames_(stats().counter("frames", "frames", "frames replayed")),
+      scene_draws_(stats().counter("scene_draws", "draws", "scene draws before the boxes (placement city)")),
+      scene_depth_tests_(stats().counter("scene_depth_tests", "tests", "depth tests of the scene draws (charged at relief.tests_per_cycle)")),
       box_draws_(stats().counter("box_draws", "draws", "relief_box draws replayed")),
       cache_hits_(stats().counter("cache_hits", "lookups", "lookups the texel cache served")),
       cache_misses_(stats().counter("cache_misses", "lookups", "lookups that missed the texel cache (a line read each)")),
@@ -105,6 +107,7 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
       return &stats().counter(p + name, unit, what + of);
     };
     c.draws = counter("draws", "draws", "box draws");
+    c.rasterized = counter("rasterized", "fragments", "the model's box fragments before the early depth test");
     c.fragments = counter("fragments", "fragments", "the model's fragments after the early depth test (the walks run)");
     c.gl_fragments = counter("gl_fragments", "fragments", "GL's fragment counter of the box draws (after the early test)");
     c.samples = counter("samples", "samples", "the model's hits (fragments kept)");
@@ -172,7 +175,7 @@ void ReliefUnit::account(const BoxDrawCounts& d) {
   cache_hits_ += draw_hits_;
   cache_misses_ += draw_misses_;
   ++box_draws_;
-  *c.draws += 1, *c.fragments += d.fragments, *c.gl_fragments += d.gl_fragments, *c.samples += d.samples, *c.gl_samples += d.gl_samples;
+  *c.draws += 1, *c.rasterized += d.rasterized, *c.fragments += d.fragments, *c.gl_fragments += d.gl_fragments, *c.samples += d.samples, *c.gl_samples += d.gl_samples;
   *c.pixel_mismatches += d.pixel_mismatches, *c.walk_mismatches += d.walk_mismatches;
   *c.lookups += d.lookups, *c.gl_lookups += d.gl_lookups, *c.steps += d.steps, *c.bisections += d.bisections;
   *c.hits += d.hits, *c.capped += d.capped, *c.reference_hits += d.reference_hits;
@@ -187,8 +190,18 @@ void ReliefUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Com
   cache_.invalidate();  // a frame's textures are its own
   last_line_ = ~std::uint64_t{0};
   draw_misses_ = draw_hits_ = 0;
-  replay_.run_frame(*f, config_.hit_tolerance_texels, box_height_, &ReliefUnit::on_lookup, this, &ReliefUnit::on_draw);
+  const ReliefFrameCounts k =
+      replay_.run_frame(*f, config_.hit_tolerance_texels, box_height_, &ReliefUnit::on_lookup, this, &ReliefUnit::on_draw);
   ++frames_;
+  // The scene's depth (placement city): its depth tests through the same test lanes, charged after
+  // the frame's box draws (the frame's total is what a sweep reads).
+  if (k.scene_draws) {
+    scene_draws_ += k.scene_draws;
+    scene_depth_tests_ += k.scene_depth_tests;
+    const std::uint64_t spent = ceil_div(static_cast<double>(k.scene_depth_tests), config_.tests_per_cycle);
+    work(spent);
+    cycles_ += spent;
+  }
 }
 
 }  // namespace nbsim::relief

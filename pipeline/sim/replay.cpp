@@ -391,7 +391,9 @@ nlohmann::ordered_json ldi_summary(const nlohmann::ordered_json& p, const nlohma
 // lookups and steps per fragment, cycles, and hit error against the exact reference.
 nlohmann::ordered_json relief_summary(const nlohmann::ordered_json& p, const nlohmann::ordered_json& memory, std::uint64_t cycles) {
   nlohmann::ordered_json j;
-  for (const char* name : {"frames", "box_draws", "cache_hits", "cache_misses", "memory_bytes", "memory_stall_cycles", "cycles"}) j[name] = stat(p, name);
+  for (const char* name : {"frames", "scene_draws", "scene_depth_tests", "box_draws", "cache_hits", "cache_misses", "memory_bytes",
+                           "memory_stall_cycles", "cycles"})
+    j[name] = stat(p, name);
   j["cycles_total"] = cycles;
   j["channel_bytes"] = stat(memory, "bytes_relief");
   nlohmann::ordered_json methods = nlohmann::ordered_json::object();
@@ -400,7 +402,7 @@ nlohmann::ordered_json relief_summary(const nlohmann::ordered_json& p, const nlo
     const auto v = [&](const char* name) { return stat(p, (prefix + name).c_str()); };
     if (v("draws") == 0) continue;
     nlohmann::ordered_json e;
-    for (const char* name : {"draws", "fragments", "gl_fragments", "samples", "gl_samples", "pixel_mismatches", "walk_mismatches", "lookups",
+    for (const char* name : {"draws", "rasterized", "fragments", "gl_fragments", "samples", "gl_samples", "pixel_mismatches", "walk_mismatches", "lookups",
                              "gl_lookups", "steps", "bisections", "hits", "capped", "reference_hits", "wrong_hit", "wrong_miss",
                              "far_hit", "errors", "cycles", "cache_misses"})
       e[name] = v(name);

@@ -89,6 +89,24 @@ TEST(ReliefCliTest, HardCasesReplayExactly) {
   fs::remove_all(dir);
 }
 
+// A box standing in the city, seen along the walk: the scene's depth is drawn first and the early
+// depth test culls the box's hidden fragments, in GL and in the model alike.
+TEST(ReliefCliTest, BoxInTheCity) {
+  const fs::path dir = testing::scratch_path("nbsim_relief_cli_city", "x").parent_path();
+  const fs::path trace = dir / "city.nbt";
+  const CliResult c = run_nbsim("capture relief --scene city --objects 800 --path walk --size 160x120 --frames 4 --placement city "
+                                "--field fbm --field-size 32 -o " + trace.string());
+  ASSERT_EQ(c.status, 0) << c.out << c.err;
+  const CliResult r = run_nbsim("compare --json " + trace.string());
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  const nlohmann::json relief = nlohmann::json::parse(r.out)["relief"];
+  expect_exact_replay(relief, "city");
+  EXPECT_GT(relief["scene_draws"].get<std::uint64_t>(), 100u);
+  const nlohmann::json& m = relief["methods"]["nbuffer"];
+  EXPECT_LT(m["fragments"].get<std::uint64_t>(), m["rasterized"].get<std::uint64_t>()) << "buildings hide part of the box";
+  fs::remove_all(dir);
+}
+
 TEST(ReliefCliTest, HeightfieldFileAndTable) {
   const fs::path dir = testing::scratch_path("nbsim_relief_cli_file", "x").parent_path();
   std::vector<float> h(40 * 40);
@@ -138,7 +156,11 @@ TEST(ReliefCliTest, BadInputExitsTwoAndWritesNothing) {
                            {"--angles 185", "--angles '185'"},
                            {"--frustum -1", "--frustum '-1'"},
                            {"--box-height 0", "--box-height '0'"},
-                           {"--field-mesh shape:cube", "cube"}},
+                           {"--field-mesh shape:cube", "cube"},
+                           {"--box-at 1,2,3", "--box-at needs --placement city"},
+                           {"--placement city --angles 10", "--angles is for --placement own"},
+                           {"--placement city --frustum 1", "takes the box, not a --frustum"},
+                           {"--placement city --box-at 1,2", "is not X,Z,SIZE"}},
                           o, out);
   fs::remove_all(out.parent_path());
 }

@@ -110,10 +110,11 @@ void GlReliefWalker::clear_depth() {
   glClearNamedFramebufferfv(gl_->fbo, GL_DEPTH, 0, &far_depth);
 }
 
-GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, const relief::WalkParams& params, DrawRecorder& recorder) {
+GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, const relief::WalkParams& params, DrawRecorder& recorder,
+                                 GLuint framebuffer) {
   NBSIM_CHECK(size_ > 0, "relief: draw before set_field");
   Objects& o = *gl_;
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, o.fbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer ? framebuffer : o.fbo);
   glViewport(0, 0, width_, height_);
   glDisable(GL_BLEND);
   glDisable(GL_SCISSOR_TEST);
@@ -124,7 +125,8 @@ GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, 
   glEnable(GL_CULL_FACE);
   glCullFace(GL_BACK);
   glFrontFace(GL_CCW);
-  glColorMaski(0, GL_TRUE, GL_FALSE, GL_FALSE, GL_FALSE);
+  if (framebuffer) glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  else glColorMaski(0, GL_TRUE, GL_FALSE, GL_FALSE, GL_FALSE);
   const std::uint32_t zero = 0;
   glClearNamedBufferData(o.results, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

@@ -48,8 +48,11 @@ class GlReliefWalker {
 
   // Clears the depth buffer (1.0).
   void clear_depth();
-  // One box draw with `method`, recorded (role relief_box, the box's 36 vertices captured).
-  GlFragments draw(relief::Method method, const ReliefView& view, const relief::WalkParams& params, DrawRecorder& recorder);
+  // One box draw with `method`, recorded (role relief_box, the box's 36 vertices captured), into the
+  // walker's own framebuffer or, when `framebuffer` is not 0, into that one (its depth attachment
+  // holds a scene drawn before, LESS; no colour is written there).
+  GlFragments draw(relief::Method method, const ReliefView& view, const relief::WalkParams& params, DrawRecorder& recorder,
+                   GLuint framebuffer = 0);
 
  private:
   struct Objects;

@@ -3,24 +3,32 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <sstream>
 #include <string>
 
 #include "model/common/error.h"
+#include "model/mesh/shapes.h"
 #include "model/relief/heightfield.h"
 #include "model/relief/radius.h"
 #include "model/relief/score.h"
 #include "model/relief/walk.h"
+#include "model/scene/visibility.h"
 #include "pipeline/io/image_io.h"
+#include "traces/capture/camera.h"
 #include "traces/capture/draw_recorder.h"
-#include "model/mesh/shapes.h"
 #include "traces/capture/ldi/mesh_loader.h"
 #include "traces/capture/relief/bake.h"
 #include "traces/capture/relief/gl_walk.h"
 #include "traces/capture/relief/view.h"
+#include "traces/capture/render_target.h"
+#include "traces/capture/scene_pass.h"
 #include "traces/format/relief_chunk.h"
 
 namespace nbsim::capture {
@@ -97,6 +105,20 @@ const OptionSpec& frustum_option() {
       "0");
   return spec;
 }
+const OptionSpec& placement_option() {
+  static const OptionSpec spec = choice_option(
+      "placement", "own: the box seen from its own camera (--angles); city: the box standing in the capture's scene, seen by the "
+                   "observer along --path, the scene drawn first (early depth tests cull the box's hidden fragments)",
+      "own", {"own", "city"});
+  return spec;
+}
+const OptionSpec& box_at_option() {
+  static const OptionSpec spec = text_option(
+      "box-at", "placement city: X,Z,SIZE in metres (the box's corner on the ground at y = 0 and its side; its height is "
+                "--box-height x SIZE), or 'auto': 40 m ahead of the first frame's eye, 16 m a side",
+      "auto");
+  return spec;
+}
 const OptionSpec& tolerance_option() {
   static const OptionSpec spec =
       text_option("tolerance", "Hit error tolerance for the capture's own counts, texels (model/relief/score.h)", "0.25");
@@ -169,8 +191,15 @@ std::vector<float> ray_q(const relief::RayFrame& r) {
 
 class Relief final : public Technique {
  public:
-  explicit Relief(const TechniqueSetup& s) : width_(s.width), height_(s.height) {
+  explicit Relief(const TechniqueSetup& s) : width_(s.width), height_(s.height), scene_(s.scene), projection_(s.projection) {
     const OptionValues& o = s.options;
+    city_ = o.text(placement_option()) == "city";
+    if (city_ && s.projection.reversed_z) throw InputError("--placement city: reversed Z is not supported (the box draws test LESS)");
+    // (Checked against the defaults, not for presence: a recorded command line spells every option out.)
+    if (!city_ && o.text(box_at_option()) != box_at_option().default_value) throw InputError("--box-at needs --placement city");
+    if (city_ && o.text(angles_option()) != angles_option().default_value)
+      throw InputError("--angles is for --placement own (in the city the observer's path views the box)");
+    box_at_ = o.text(box_at_option());
     seed_ = static_cast<std::uint64_t>(o.integer(seed_option()));
     max_radius_ = static_cast<int>(o.integer(max_radius_option()));
     apex_ = parse_number(o.text(frustum_option()), "frustum", 0.0, 1e6);
@@ -220,13 +249,18 @@ class Relief final : public Technique {
     params_.binary_steps = static_cast<int>(o.integer(binary_steps_option()));
     params_.root_steps = static_cast<int>(o.integer(root_steps_option()));
     tolerance_ = parse_number(o.text(tolerance_option()), "tolerance", 0.0, 1e6);
+    if (city_ && apex_ > 0.0) throw InputError("--placement city takes the box, not a --frustum");
     walker_ = std::make_unique<GlReliefWalker>(width_, height_);
+    if (city_) {
+      pass_ = std::make_unique<ScenePass>(scene_, false);
+      target_ = std::make_unique<RenderTarget>(width_, height_);
+    }
   }
 
   trace::Properties variant_properties() const override {
     std::string methods;
     for (relief::Method m : methods_) methods += (methods.empty() ? "" : ",") + std::string(relief::to_string(m));
-    return {{"relief_field", description_}, {"relief_methods", methods}};
+    return {{"relief_field", description_}, {"relief_methods", methods}, {"relief_placement", city_ ? "city" : "own"}};
   }
   trace::Properties setting_properties() const override {
     return {{"relief_field_size", std::to_string(field_.size)},
@@ -240,18 +274,31 @@ class Relief final : public Technique {
             {"relief_seed", std::to_string(seed_)},
             {"relief_view", "the box [0,1]^2 x [0,relief_box_height] seen from angle k mod count of relief_angles off its up axis, "
                             "azimuth 37 + 61 k + 13 seed degrees, framing the box; rays rebuilt from gl_FragCoord (model/relief/walk.h)"},
-            {"observer", "unused: the relief technique views its box from its own camera; the scene, the camera path and the "
-                         "projection are ignored, --size is the viewport"}};
+            {"observer", city_ ? "the box stands in the scene (relief_box_at); the observer's path and projection view it"
+                               : "unused: the relief technique views its box from its own camera; the scene, the camera path and "
+                                 "the projection are ignored, --size is the viewport"},
+            {"relief_box_at", box_at_}};
   }
 
-  CapturedFrame render(std::uint32_t index, const CameraPose&) override {
+  CapturedFrame render(std::uint32_t index, const CameraPose& pose) override {
     CapturedFrame out;
     scene::Frame& f = out.frame;
     f.begin.frame = index;
     f.begin.mode = scene::TestMode::None;
-    const double angle = angles_[index % angles_.size()];
-    const double azimuth = std::fmod(37.0 + 61.0 * index + 13.0 * static_cast<double>(seed_ % 1000), 360.0);
-    const ReliefCamera cam = relief_camera(field_.size, box_height_, angle, azimuth, width_, height_, apex_);
+    double angle = angles_[index % angles_.size()];
+    ReliefCamera cam;
+    if (city_) {
+      if (index == 0) place_box(pose);
+      const glm::mat4 view = view_matrix(pose), proj = projection_matrix(projection_, static_cast<double>(width_) / height_);
+      std::array<double, 16> v{}, p{};
+      for (std::size_t k = 0; k < 16; ++k) v[k] = glm::value_ptr(view)[k], p[k] = glm::value_ptr(proj)[k];
+      cam = relief_view(v, p, world_to_texel_, width_, height_);
+      const glm::dvec3 forward = glm::normalize(glm::dvec3(pose.target - pose.eye));
+      angle = glm::degrees(std::acos(std::clamp(-forward.y, -1.0, 1.0)));  // from the box's up axis (world y)
+    } else {
+      const double azimuth = std::fmod(37.0 + 61.0 * index + 13.0 * static_cast<double>(seed_ % 1000), 360.0);
+      cam = relief_camera(field_.size, box_height_, angle, azimuth, width_, height_, apex_);
+    }
     for (std::size_t k = 0; k < 16; ++k) {
       f.begin.view[k] = static_cast<float>(cam.world_view[k]);
       f.begin.proj[k] = static_cast<float>(cam.projection[k]);
@@ -259,16 +306,37 @@ class Relief final : public Technique {
     for (std::size_t k = 0; k < 3; ++k) f.begin.eye[k] = static_cast<float>(cam.eye_world[k]);
 
     const auto t0 = std::chrono::steady_clock::now();
-    recorder_.begin_frame(16 + methods_.size());
+    std::vector<std::uint32_t> in_frustum;
+    if (city_) {
+      const scene::FrameView fv = scene::FrameView::make(f.begin, width_, height_, projection_.near_m, 0.0, false, false);
+      in_frustum = scene::frustum_objects(scene_.scene, fv);
+    }
+    recorder_.begin_frame(16 + methods_.size() + in_frustum.size());
+    if (city_) {  // the scene's depth first: the box draws test against it
+      glBindFramebuffer(GL_FRAMEBUFFER, target_->framebuffer());
+      target_->clear_depth(false);
+      const glm::mat4 view = view_matrix(pose), proj = projection_matrix(projection_, static_cast<double>(width_) / height_);
+      pass_->begin(*target_, proj * view, false, recorder_);
+      for (std::uint32_t o : in_frustum) {
+        scene::DrawRecord d;
+        d.role = scene::DrawRole::Scene;
+        d.object = static_cast<std::int32_t>(o);
+        d.state = depth_state(false, true, true);
+        pass_->draw_object(recorder_, std::move(d), o);
+      }
+    }
     walker_->set_field(field_, radius_, recorder_);
     const std::vector<float> levels = walker_->levels();
     const relief::FieldView view{field_.size, field_.heights, radius_.radius, levels, walker_->level_count()};
     std::vector<GlFragments> gl;
-    for (relief::Method m : methods_) {
-      walker_->clear_depth();
-      gl.push_back(walker_->draw(m, cam.view, params_, recorder_));
-    }
+    if (!city_) walker_->clear_depth();
+    for (relief::Method m : methods_) gl.push_back(walker_->draw(m, cam.view, params_, recorder_, city_ ? target_->framebuffer() : 0));
     f.draws = recorder_.collect();
+    if (city_) {
+      std::memcpy(f.begin.view.data(), glm::value_ptr(view_matrix(pose)), 64);
+      std::memcpy(f.begin.proj.data(), glm::value_ptr(projection_matrix(projection_, static_cast<double>(width_) / height_)), 64);
+      f.begin.eye = {pose.eye.x, pose.eye.y, pose.eye.z};
+    }
     f.end.gl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
     trace::TechniqueRecord field;
@@ -337,6 +405,34 @@ class Relief final : public Technique {
   }
 
  private:
+  // The box in the city: from --box-at, or 40 m ahead of the first frame's eye on the ground, 16 m a
+  // side. Texel space to world: x -> X + x S / N, z (height) -> y = z H, y -> Z - y S / N (the
+  // mirror keeps the box's winding), H = box_height x S.
+  void place_box(const CameraPose& pose) {
+    double x0 = 0, z0 = 0, side = 16.0;
+    if (box_at_ == "auto") {
+      glm::dvec3 ahead(pose.target.x - pose.eye.x, 0.0, pose.target.z - pose.eye.z);
+      if (glm::length(ahead) < 1e-9) ahead = glm::dvec3(1, 0, 0);
+      const glm::dvec3 c = glm::dvec3(pose.eye) + 40.0 * glm::normalize(ahead);
+      x0 = c.x - side / 2, z0 = c.z + side / 2;
+    } else {
+      const std::vector<std::string> parts = split(box_at_);
+      if (parts.size() != 3) throw InputError(fmt::format("--box-at '{}' is not X,Z,SIZE", box_at_));
+      x0 = parse_number(parts[0], "box-at", -1e6, 1e6);
+      z0 = parse_number(parts[1], "box-at", -1e6, 1e6);
+      side = parse_number(parts[2], "box-at", 1e-3, 1e5);
+    }
+    const double n = field_.size, h = box_height_ * side;
+    glm::dmat4 to_world(0.0);  // [column][row]
+    to_world[0][0] = side / n;
+    to_world[2][1] = h;
+    to_world[1][2] = -side / n;
+    to_world[3] = glm::dvec4(x0, 0.0, z0, 1.0);
+    const glm::dmat4 f = glm::inverse(to_world);
+    for (std::size_t k = 0; k < 16; ++k) world_to_texel_[k] = glm::value_ptr(f)[k];
+    box_at_ = fmt::format("{},{},{}", x0, z0, side);
+  }
+
   static void counts_add(CapturedFrame& out, const std::string& name, std::uint64_t v) { out.counts.emplace_back(name, v); }
 
   int width_, height_;
@@ -349,6 +445,13 @@ class Relief final : public Technique {
   std::vector<double> angles_;
   double box_height_ = 0.25, tolerance_ = relief::kDefaultHitTolerance, apex_ = 0.0;
   relief::WalkParams params_;
+  const CaptureScene& scene_;
+  Projection projection_;
+  bool city_ = false;
+  std::string box_at_;
+  std::array<double, 16> world_to_texel_{};
+  std::unique_ptr<ScenePass> pass_;
+  std::unique_ptr<RenderTarget> target_;
   DrawRecorder recorder_;
   std::unique_ptr<GlReliefWalker> walker_;
 };
@@ -359,7 +462,7 @@ const std::vector<OptionSpec>& relief_options() {
   static const std::vector<OptionSpec> options = {field_option(),        field_param_option(), field_size_option(),   field_file_option(),  field_mesh_option(),
                                                   radius_file_option(),  max_radius_option(),  methods_option(),      angles_option(),
                                                   box_height_option(),   frustum_option(),     linear_steps_option(), binary_steps_option(), root_steps_option(),
-                                                  tolerance_option(),    seed_option()};
+                                                  tolerance_option(),    placement_option(),   box_at_option(),       seed_option()};
   return options;
 }
 

@@ -37,6 +37,18 @@ std::array<double, 16> frustum_map(int field_size, double box_height, double ape
   return out;
 }
 
+namespace {
+
+std::array<double, 16> to_array(const glm::dmat4& m) {
+  std::array<double, 16> out{};
+  std::copy(glm::value_ptr(m), glm::value_ptr(m) + 16, out.begin());
+  return out;
+}
+
+glm::dmat4 to_matrix(const std::array<double, 16>& a) { return glm::make_mat4(a.data()); }
+
+}  // namespace
+
 ReliefCamera relief_camera(int field_size, double box_height, double angle_deg, double azimuth_deg, int width, int height,
                            double apex) {
   const double th = glm::radians(angle_deg), ph = glm::radians(azimuth_deg);
@@ -60,16 +72,19 @@ ReliefCamera relief_camera(int field_size, double box_height, double angle_deg, 
   const double aspect = static_cast<double>(width) / height;
   const double fovy = 2.0 * std::asin(std::min(1.0, radius * 1.05 / distance)) * (aspect < 1.0 ? 1.0 / aspect : 1.0);
   const glm::dmat4 p = glm::perspective(fovy, aspect, distance - radius * 1.1, distance + radius * 1.1);
-  const glm::dmat4 to_clip = p * v * to_world;
-  const glm::dmat4 inv_pv = glm::inverse(p * v);
+  return relief_view(to_array(v), to_array(p), to_array(f), width, height);
+}
 
+ReliefCamera relief_view(const std::array<double, 16>& view, const std::array<double, 16>& projection,
+                         const std::array<double, 16>& world_to_texel, int width, int height) {
+  const glm::dmat4 v = to_matrix(view), p = to_matrix(projection), f = to_matrix(world_to_texel);
+  const glm::dmat4 to_clip = p * v * glm::inverse(f);
+  const glm::dmat4 inv_pv = glm::inverse(p * v);
+  const glm::dvec3 eye = glm::dvec3(glm::inverse(v)[3]);
   ReliefCamera c;
-  for (int col = 0; col < 4; ++col)
-    for (int row = 0; row < 4; ++row) {
-      c.view.texel_to_clip[static_cast<std::size_t>(col * 4 + row)] = static_cast<float>(to_clip[col][row]);
-      c.world_view[static_cast<std::size_t>(col * 4 + row)] = v[col][row];
-      c.projection[static_cast<std::size_t>(col * 4 + row)] = p[col][row];
-    }
+  for (std::size_t k = 0; k < 16; ++k) c.view.texel_to_clip[k] = static_cast<float>(glm::value_ptr(to_clip)[k]);
+  c.world_view = view;
+  c.projection = projection;
   c.eye_world = {eye.x, eye.y, eye.z};
   // The world point on the near plane through window point (px, py) (affine in (px, py)).
   const auto near_point = [&](double px, double py) {
@@ -77,7 +92,8 @@ ReliefCamera relief_camera(int field_size, double box_height, double angle_deg, 
     return glm::dvec3(w) / w.w;
   };
   relief::RayFrame& r = c.view.ray;
-  if (apex <= 0.0) {
+  const bool affine = f[0][3] == 0.0 && f[1][3] == 0.0 && f[2][3] == 0.0 && f[3][3] == 1.0;
+  if (affine) {
     const glm::dvec3 origin = glm::dvec3(f * glm::dvec4(eye, 1.0));
     const auto direction = [&](double px, double py) { return glm::dvec3(f * glm::dvec4(near_point(px, py) - eye, 0.0)); };
     const glm::dvec3 d0 = direction(0, 0), dx = direction(1, 0) - d0, dy = direction(0, 1) - d0;

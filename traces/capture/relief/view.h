@@ -27,4 +27,9 @@ std::array<double, 16> frustum_map(int field_size, double box_height, double ape
 ReliefCamera relief_camera(int field_size, double box_height, double angle_deg, double azimuth_deg, int width, int height,
                            double apex = 0.0);
 
+// Any camera (view and projection, column-major, as GL takes them) on a volume mapped onto texel
+// space by `world_to_texel` (column-major 4x4; affine: a box, its last row 0 0 0 1; else a frustum).
+ReliefCamera relief_view(const std::array<double, 16>& view, const std::array<double, 16>& projection,
+                         const std::array<double, 16>& world_to_texel, int width, int height);
+
 }  // namespace nbsim::capture
