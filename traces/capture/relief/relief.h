@@ -8,8 +8,11 @@
 // draws the box once (role relief_box, gl_walk.h); records: RLFH and one RLFF a draw
 // (traces/format/relief_chunk.h). The exact reference (model/relief/reference.h) scores GL's hits:
 // the capture's counts give each method's hit error.
-// The observer is not used: the scene, the camera path and the projection only satisfy the capture
-// driver (use `--scene boxes --boxes 0`); --size is the viewport.
+// --frustum A replaces the box by a reverse-perspective frustum (view.h). --placement city stands the
+// box in the capture's scene instead (--box-at), viewed by the observer along --path: the scene's
+// depth is drawn first (role scene) and the box draws' early depth test culls what it hides.
+// Otherwise the observer is not used: the scene, the camera path and the projection only satisfy the
+// capture driver (use `--scene boxes --boxes 0`); --size is the viewport.
 #pragma once
 
 #include <memory>
