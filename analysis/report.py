@@ -623,7 +623,8 @@ class Report:
         for j, m in enumerate(methods):
             c, _ = relief_style(m)
             bx.bar(x - 0.4 + wd * (j + 0.5), [v.get(m) or np.nan for v in lookups.values()], wd, color=c, label=m)
-        bx.set_xticks(x, [f"{f.replace(' ', chr(10), 1)}\n{n}²" for f, n in lookups], fontsize=7)
+        # The generator's name alone ("fbm:0 seed 5" -> "fbm"), its size under it: the full description is in the table.
+        bx.set_xticks(x, [f"{f.split(':')[0].split(' ')[0]}\n{n}²" for f, n in lookups], fontsize=7)
         bx.set_xlabel("heightfield and size")
         bx.set_ylabel("lookups per fragment")
         bx.set_title("Lookups per fragment, per heightfield and method", fontsize=10)
