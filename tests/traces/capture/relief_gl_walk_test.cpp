@@ -21,6 +21,27 @@ using relief::Method;
 
 class ReliefGlWalkTest : public testing::GlContextSuite {};
 
+// A 64x64 walker over a field with a zero radius everywhere, its N-buffer built on GL, and the view
+// the model's walks read.
+struct WalkerOver {
+  static constexpr int kSize = 64;
+  relief::Heightfield field;
+  relief::SafetyRadius radius;
+  capture::DrawRecorder recorder;
+  capture::GlReliefWalker gl{kSize, kSize};
+  std::vector<float> levels;
+  relief::FieldView fv;
+
+  explicit WalkerOver(relief::Heightfield f) : field(std::move(f)) {
+    radius = {field.size, std::vector<float>(field.heights.size(), 0.0f)};
+    recorder.begin_frame(8);
+    gl.set_field(field, radius, recorder);
+    levels = gl.levels();
+    fv = {field.size, field.heights, radius.radius, levels, gl.level_count()};
+  }
+  ~WalkerOver() { recorder.collect(); }
+};
+
 relief::Heightfield random_field(int n, std::uint64_t seed, float floor_height) {
   relief::Heightfield f;
   f.size = n;
@@ -102,15 +123,11 @@ TEST_F(ReliefGlWalkTest, EveryMethodMatchesTheModelBitForBit) {
 // The reverse-perspective frustum (apex one box height below the bottom face): the same walks with
 // rays from the projective ray frame, at views from above, grazing and from below.
 TEST_F(ReliefGlWalkTest, FrustumMatchesTheModelBitForBit) {
-  const int width = 64, height = 64, n = 16;
-  const relief::Heightfield field = random_field(n, 9, 0.1f);
-  relief::SafetyRadius radius{n, std::vector<float>(static_cast<std::size_t>(n * n), 0.0f)};
-  capture::DrawRecorder recorder;
-  recorder.begin_frame(8);
-  capture::GlReliefWalker gl(width, height);
-  gl.set_field(field, radius, recorder);
-  const std::vector<float> levels = gl.levels();
-  relief::FieldView fv{n, field.heights, radius.radius, levels, gl.level_count()};
+  const int width = WalkerOver::kSize, height = WalkerOver::kSize, n = 16;
+  WalkerOver w(random_field(n, 9, 0.1f));
+  capture::GlReliefWalker& gl = w.gl;
+  capture::DrawRecorder& recorder = w.recorder;
+  const relief::FieldView& fv = w.fv;
   for (double angle : {0.0, 50.0, 86.0, 130.0}) {
     const capture::ReliefCamera cam = capture::relief_camera(n, 0.3, angle, 40.0, width, height, 1.0);
     ASSERT_TRUE(cam.view.ray.frustum);
@@ -121,14 +138,13 @@ TEST_F(ReliefGlWalkTest, FrustumMatchesTheModelBitForBit) {
       EXPECT_EQ(r.differing, 0u) << relief::to_string(m) << " at " << angle << " degrees, of " << r.fragments;
     }
   }
-  recorder.collect();
 }
 
 // The hard case: the eye on the frustum's w = 0 plane (the apex's height), where its image in texel
 // space is at infinity and every ray parallel. The angle putting it there is found by bisection on
 // the camera itself; the walks stay finite, exact (bit for bit with GL) and keep their hits.
 TEST_F(ReliefGlWalkTest, EyeOnTheFrustumsApexPlane) {
-  const int width = 64, height = 64, n = 16;
+  const int width = WalkerOver::kSize, height = WalkerOver::kSize, n = 16;
   const double box_height = 0.3, apex = 1.0;
   const auto w_of = [&](double angle) { return capture::relief_camera(n, box_height, angle, 40.0, width, height, apex).view.ray.eye_h[3]; };
   double lo = 90.0, hi = 179.0;  // the eye above the apex plane at 90 degrees, below it at 179
@@ -141,14 +157,10 @@ TEST_F(ReliefGlWalkTest, EyeOnTheFrustumsApexPlane) {
   const capture::ReliefCamera cam = capture::relief_camera(n, box_height, lo, 40.0, width, height, apex);
   const std::array<float, 4>& e = cam.view.ray.eye_h;
   EXPECT_LT(std::abs(e[3]), 1e-4f * (std::abs(e[0]) + std::abs(e[1]) + std::abs(e[2]))) << "the eye is on the apex plane";
-  const relief::Heightfield field = random_field(n, 13, 0.0f);
-  relief::SafetyRadius radius{n, std::vector<float>(static_cast<std::size_t>(n * n), 0.0f)};
-  capture::DrawRecorder recorder;
-  recorder.begin_frame(8);
-  capture::GlReliefWalker gl(width, height);
-  gl.set_field(field, radius, recorder);
-  const std::vector<float> levels = gl.levels();
-  relief::FieldView fv{n, field.heights, radius.radius, levels, gl.level_count()};
+  WalkerOver w(random_field(n, 13, 0.0f));
+  capture::GlReliefWalker& gl = w.gl;
+  capture::DrawRecorder& recorder = w.recorder;
+  const relief::FieldView& fv = w.fv;
   for (Method m : relief::kAllMethods) {
     gl.clear_depth();
     const capture::GlFragments f = gl.draw(m, cam.view, {}, recorder);
@@ -172,7 +184,6 @@ TEST_F(ReliefGlWalkTest, EyeOnTheFrustumsApexPlane) {
   const double cross = std::abs(double(r0->d[0]) * r1->d[1] - double(r0->d[1]) * r1->d[0]) /
                        (std::hypot(r0->d[0], r0->d[1]) * std::hypot(r1->d[0], r1->d[1]));
   EXPECT_LT(cross, 1e-3) << "the rays' horizontal directions are parallel";
-  recorder.collect();
 }
 
 }  // namespace

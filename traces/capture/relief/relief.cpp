@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <glm/glm.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <sstream>
@@ -364,7 +365,9 @@ class Relief final : public Technique {
                     {"ray_q", ray_q(cam.view.ray)}};
     f.technique_records.push_back(std::move(field));
 
-    // One RLFF a box draw, in draw order; the capture's own score of each method.
+    // One RLFF a box draw, in draw order; the capture's own score of each method (the methods share
+    // the frame's rays: each pixel's reference is computed once).
+    std::map<std::uint32_t, relief::ReferenceHit> references;
     std::size_t box = 0;
     for (const scene::DrawRecord& d : f.draws) {
       if (d.role != scene::DrawRole::ReliefBox) continue;
@@ -376,9 +379,12 @@ class Relief final : public Technique {
         hits += g.hit[k] == trace::kReliefHit;
         const float px = static_cast<float>(g.pixel[k] % static_cast<std::uint32_t>(width_)) + 0.5f;
         const float py = static_cast<float>(g.pixel[k] / static_cast<std::uint32_t>(width_)) + 0.5f;
-        if (const auto ray = relief::fragment_ray(cam.view.ray, field_.size, px, py))
-          errors += relief::score_hit(field_, *ray, g.hit[k] == trace::kReliefHit, g.t[k], box_height_, tolerance_).error !=
-                    relief::HitError::None;
+        if (const auto ray = relief::fragment_ray(cam.view.ray, field_.size, px, py)) {
+          const auto [at, fresh] = references.try_emplace(g.pixel[k]);
+          if (fresh) at->second = relief::reference_of(field_, *ray);
+          errors += relief::score_against(at->second, *ray, field_.size, g.hit[k] == trace::kReliefHit, g.t[k], box_height_, tolerance_)
+                        .error != relief::HitError::None;
+        }
       }
       const std::string name(relief::to_string(m));
       counts_add(out, name + "_fragments", g.pixel.size());
