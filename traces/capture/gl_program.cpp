@@ -43,6 +43,20 @@ GLuint link_program(std::initializer_list<GLuint> shaders, const char* name, boo
   return p;
 }
 
+void make_triangle_vertex_array(std::span<const float> xyz, std::span<const std::uint32_t> indices, GLuint& vao, GLuint& vbo,
+                                GLuint& ebo) {
+  glCreateVertexArrays(1, &vao);
+  glCreateBuffers(1, &vbo);
+  glCreateBuffers(1, &ebo);
+  glNamedBufferStorage(vbo, static_cast<GLsizeiptr>(xyz.size_bytes()), xyz.data(), 0);
+  glNamedBufferStorage(ebo, static_cast<GLsizeiptr>(indices.size_bytes()), indices.data(), 0);
+  glVertexArrayVertexBuffer(vao, 0, vbo, 0, 3 * sizeof(float));
+  glVertexArrayElementBuffer(vao, ebo);
+  glEnableVertexArrayAttrib(vao, 0);
+  glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(vao, 0, 0);
+}
+
 std::string with_defines(const char* source, const std::string& defines) {
   std::string s(source);
   const auto eol = s.find('\n', s.find("#version"));

@@ -8,7 +8,9 @@
 #endif
 #include <GL/glcorearb.h>
 
+#include <cstdint>
 #include <initializer_list>
+#include <span>
 #include <string>
 
 namespace nbsim::capture {
@@ -21,6 +23,11 @@ GLuint compile_shader(GLenum type, const std::string& source, const char* name);
 // it (five floats a vertex, for GL_POINTS draws). Throws std::runtime_error with GL's log.
 GLuint link_program(std::initializer_list<GLuint> shaders, const char* name, bool capture_position = false,
                     bool capture_point_size = false);
+
+// A vertex array of indexed triangles: `xyz` three floats a vertex at attribute 0 (vao, vbo), and
+// `indices` three a triangle bound as its element buffer (ebo); the caller deletes the three.
+void make_triangle_vertex_array(std::span<const float> xyz, std::span<const std::uint32_t> indices, GLuint& vao, GLuint& vbo,
+                                GLuint& ebo);
 
 // `source` with `defines` inserted after its #version line.
 std::string with_defines(const char* source, const std::string& defines);

@@ -94,16 +94,9 @@ PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const
   o.program = link_program({compile_shader(GL_VERTEX_SHADER, shaders::ldi_peel_vert, "ldi/peel.vert"),
                             compile_shader(GL_FRAGMENT_SHADER, shaders::ldi_peel_frag, "ldi/peel.frag")},
                            "ldi peel", true);
-  glCreateVertexArrays(1, &o.vao);
-  glCreateBuffers(1, &o.vbo);
-  glCreateBuffers(1, &o.ebo);
-  glNamedBufferStorage(o.vbo, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)), vertices.data(), 0);
-  glNamedBufferStorage(o.ebo, static_cast<GLsizeiptr>(m.triangles.size() * sizeof(mesh::Tri)), m.triangles.data(), 0);
-  glVertexArrayVertexBuffer(o.vao, 0, o.vbo, 0, 3 * sizeof(float));
-  glVertexArrayElementBuffer(o.vao, o.ebo);
-  glEnableVertexArrayAttrib(o.vao, 0);
-  glVertexArrayAttribFormat(o.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(o.vao, 0, 0);
+  static_assert(sizeof(mesh::Tri) == 3 * sizeof(std::uint32_t));
+  make_triangle_vertex_array(vertices, {reinterpret_cast<const std::uint32_t*>(m.triangles.data()), m.triangles.size() * 3}, o.vao, o.vbo,
+                             o.ebo);
 
   // One fragment counter per pass, the last pass (which writes nothing) included.
   const int max_passes = config.max_layers + 1;
