@@ -8,7 +8,12 @@
 
 #include <fmt/format.h>
 
+#include <poll.h>
+
+#include <array>
 #include <cerrno>
+#include <chrono>
+#include <cstdlib>
 #include <csignal>
 #include <cstring>
 #include <deque>
@@ -75,6 +80,87 @@ ChildOutcome outcome_of(int status, const ChildJob& job) {
 }  // namespace
 
 std::filesystem::path self_executable() { return std::filesystem::read_symlink("/proc/self/exe"); }
+
+CommandResult run_command(const std::vector<std::string>& argv, double timeout_s) {
+  CommandResult r;
+  if (argv.empty()) return r;
+  int out_pipe[2], err_pipe[2];
+  if (pipe2(out_pipe, O_CLOEXEC) != 0) return r.err = std::strerror(errno), r;
+  if (pipe2(err_pipe, O_CLOEXEC) != 0) {
+    r.err = std::strerror(errno);
+    close(out_pipe[0]), close(out_pipe[1]);
+    return r;
+  }
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_adddup2(&fa, out_pipe[1], STDOUT_FILENO);
+  posix_spawn_file_actions_adddup2(&fa, err_pipe[1], STDERR_FILENO);
+  posix_spawn_file_actions_addopen(&fa, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  std::vector<std::string> args = argv;
+  std::vector<char*> cargs;
+  for (auto& a : args) cargs.push_back(a.data());
+  cargs.push_back(nullptr);
+  pid_t pid = -1;
+  const int rc = posix_spawnp(&pid, args[0].c_str(), &fa, nullptr, cargs.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  close(out_pipe[1]), close(err_pipe[1]);
+  if (rc != 0) {
+    close(out_pipe[0]), close(err_pipe[0]);
+    r.err = fmt::format("cannot start '{}': {}", argv[0], std::strerror(rc));
+    return r;
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  std::array<pollfd, 2> fds = {pollfd{out_pipe[0], POLLIN, 0}, pollfd{err_pipe[0], POLLIN, 0}};
+  std::array<std::string*, 2> sinks = {&r.out, &r.err};
+  bool timed_out = false;
+  std::array<char, 4096> buf;
+  while (fds[0].fd >= 0 || fds[1].fd >= 0) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
+    if (left <= 0) {
+      timed_out = true;
+      break;
+    }
+    const int n = poll(fds.data(), fds.size(), static_cast<int>(std::min<long long>(left, 1000)));
+    if (n < 0 && errno != EINTR) break;
+    for (std::size_t i = 0; i < fds.size(); ++i) {
+      if (fds[i].fd < 0 || !(fds[i].revents & (POLLIN | POLLHUP | POLLERR))) continue;
+      const ssize_t got = read(fds[i].fd, buf.data(), buf.size());
+      if (got > 0) {
+        sinks[i]->append(buf.data(), static_cast<std::size_t>(got));
+      } else if (got == 0 || errno != EINTR) {
+        close(fds[i].fd);
+        fds[i].fd = -1;
+      }
+    }
+  }
+  for (auto& f : fds)
+    if (f.fd >= 0) close(f.fd);
+  if (timed_out) kill(pid, SIGKILL);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (timed_out) {
+    r.err += fmt::format("{}'{}' did not answer within {:.0f} s", r.err.empty() ? "" : "\n", argv[0], timeout_s);
+    r.status = -1;
+  } else {
+    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  return r;
+}
+
+bool in_path(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  if (!path) return false;
+  const std::string p = path;
+  std::size_t start = 0;
+  while (start <= p.size()) {
+    const std::size_t end = std::min(p.find(':', start), p.size());
+    const std::filesystem::path dir = end > start ? std::filesystem::path(p.substr(start, end - start)) : std::filesystem::path(".");
+    if (access((dir / name).c_str(), X_OK) == 0 && std::filesystem::is_regular_file(dir / name)) return true;
+    start = end + 1;
+  }
+  return false;
+}
 
 std::string tail_lines(const std::filesystem::path& file, std::size_t max_lines) {
   std::ifstream in(file);

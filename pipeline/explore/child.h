@@ -33,6 +33,21 @@ std::filesystem::path self_executable();
 void run_children(const std::filesystem::path& exe, const std::vector<ChildJob>& jobs, int parallel,
                   const std::function<void(std::size_t, const ChildOutcome&)>& on_done);
 
+// A short command's result: its exit status (-1 when it could not start, was killed or timed out)
+// and what it wrote.
+struct CommandResult {
+  int status = -1;
+  std::string out, err;  // stdout and stderr; err says why when the command could not start or timed out
+};
+
+// Runs argv[0] (searched in PATH) with the given arguments, collecting stdout and stderr; kills it
+// and reports status -1 when it runs longer than `timeout_s` seconds. The Slurm engine's sbatch,
+// squeue, scancel and scontrol calls.
+CommandResult run_command(const std::vector<std::string>& argv, double timeout_s);
+
+// True when `name` is an executable file in one of PATH's folders.
+bool in_path(const std::string& name);
+
 // The last `max_lines` non-empty lines of a text file ("" when it cannot be read).
 std::string tail_lines(const std::filesystem::path& file, std::size_t max_lines);
 

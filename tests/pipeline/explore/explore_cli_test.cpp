@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tests/common/run_nbsim.h"
+#include "tests/pipeline/explore/read_csv.h"
 
 namespace {
 
@@ -20,6 +21,7 @@ namespace fs = std::filesystem;
 using nbsim::testing::CliResult;
 using nbsim::testing::has;
 using nbsim::testing::run_nbsim;
+using nbsim::testing::read_csv;
 
 fs::path scratch(const std::string& name) { return nbsim::testing::scratch_path("nbsim_explore", name); }
 
@@ -29,45 +31,6 @@ fs::path write_sweep(const std::string& name, const nlohmann::json& j) {
   const fs::path f = scratch(name);
   std::ofstream(f) << j.dump(2);
   return f;
-}
-
-// results.csv as rows of header -> cell (RFC 4180 quoting).
-std::vector<std::map<std::string, std::string>> read_csv(const fs::path& file, std::vector<std::string>* header_out = nullptr) {
-  std::ifstream in(file);
-  const std::string text((std::istreambuf_iterator<char>(in)), {});
-  std::vector<std::vector<std::string>> rows(1);
-  std::string field;
-  bool quoted = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char ch = text[i];
-    if (quoted) {
-      if (ch == '"' && i + 1 < text.size() && text[i + 1] == '"') field += '"', ++i;
-      else if (ch == '"') quoted = false;
-      else field += ch;
-    } else if (ch == '"') {
-      quoted = true;
-    } else if (ch == ',') {
-      rows.back().push_back(std::move(field));
-      field.clear();
-    } else if (ch == '\n') {
-      rows.back().push_back(std::move(field));
-      field.clear();
-      rows.emplace_back();
-    } else {
-      field += ch;
-    }
-  }
-  if (rows.back().empty()) rows.pop_back();
-  std::vector<std::map<std::string, std::string>> out;
-  if (rows.empty()) return out;
-  if (header_out) *header_out = rows[0];
-  for (std::size_t r = 1; r < rows.size(); ++r) {
-    EXPECT_EQ(rows[r].size(), rows[0].size()) << "row " << r << " has as many cells as the header";
-    std::map<std::string, std::string> m;
-    for (std::size_t c = 0; c < std::min(rows[r].size(), rows[0].size()); ++c) m[rows[0][c]] = rows[r][c];
-    out.push_back(std::move(m));
-  }
-  return out;
 }
 
 // Bad sweeps exit 2 naming the problem, and no point runs.
@@ -353,3 +316,48 @@ TEST(ExploreCliTest, ParticlesSweepWritesItsColumns) {
 }
 
 }  // namespace
+
+// `--point N|ID` runs one point into its folder and writes no shared file; `--collect` merges what
+// is there without running anything: the other points are "not_run" and the exit status is 1.
+// Resume across modes: a full run afterwards runs only the points --point did not.
+TEST(ExploreCliTest, PointAndCollect) {
+  const fs::path out = scratch("point_collect");
+  const fs::path f = write_sweep("point.json", {{"traces", {kSample}}, {"axes", {{"cull.mode", {"nb_hier"}}, {"nbuffer.format", {"f32", "u16"}}}}});
+  CliResult r = run_nbsim("explore " + f.string() + " --out " + out.string() + " --point 1");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "ran; wrote")) << r.out;
+  EXPECT_FALSE(fs::exists(out / "results.csv")) << "--point writes its folder only";
+  EXPECT_FALSE(fs::exists(out / "sweep.json"));
+
+  r = run_nbsim("explore " + f.string() + " --out " + out.string() + " --collect");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "2 points (0 of them references): 1 done, 0 failed, 1 not run (--collect: nothing run)")) << r.out;
+  auto rows = read_csv(out / "results.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("status"), "not_run");
+  EXPECT_EQ(rows[1].at("status"), "ok");
+  EXPECT_EQ(rows[1].at("nbuffer.format"), "u16") << "--point 1 is the second point of sweep.json";
+  EXPECT_FALSE(fs::exists(out / "points" / rows[0].at("point_id") / "run.json")) << "--collect runs nothing";
+
+  // The same point by id: done before, not run again.
+  r = run_nbsim("explore " + f.string() + " --out " + out.string() + " --point " + rows[1].at("point_id"));
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "was done before, not run again")) << r.out;
+
+  r = run_nbsim("explore " + f.string() + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "2 points (0 of them references): 1 run, 1 resumed, 0 failed")) << r.out;
+
+  for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+           {"--point 2", "--point 2: the sweep '" + f.string() + "' has 2 points (0 to 1"},
+           {"--point 0123456789abcdef", "no point of the sweep"},
+           {"--point 0 --collect", "run alone: give one of them"},
+           {"--partition p", "are options of --engine slurm"},
+           {"--engine slurm --jobs 2", "--jobs is an option of --engine local"},
+           {"--engine slurm --point 0", "leave out --engine slurm"},
+           {"--engine pbs", "--engine"}}) {
+    r = run_nbsim("explore " + f.string() + " --out " + out.string() + " " + args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.out << r.err;
+    EXPECT_TRUE(has(r.err, message)) << args << ": " << r.err;
+  }
+}
