@@ -288,7 +288,7 @@ void add_explore_command(CLI::App& app, Action& action) {
       ->check(CLI::IsMember({"local", "slurm"}))
       ->capture_default_str();
   cmd->add_option("--partition", o->partition, "--engine slurm: the partition to submit to (default: the cluster's default)");
-  cmd->add_option("--max-running", o->max_running, "--engine slurm: most tasks of the array running at a time (sbatch --array=...%M)")
+  cmd->add_option("--max-running", o->max_running, "--engine slurm: most tasks running at a time (sbatch --array=...%M; a sweep larger than the cluster's MaxArraySize is several arrays, run one after the other)")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--sbatch-arg", o->sbatch_args,
                   "--engine slurm: one more sbatch argument, repeatable, e.g. --sbatch-arg=--time=00:30:00 --sbatch-arg=--mem=2G")

@@ -282,6 +282,8 @@ SlurmReport run_points_slurm(const std::vector<Point>& points, const SlurmOption
                                      "--output=" + (slurm_dir / "%A_%a.out").string(),
                                      "--ntasks=1"};
     if (!o.partition.empty()) argv.push_back("--partition=" + o.partition);
+    // --max-running bounds each array: with more than one, each waits for the one before.
+    if (o.max_running > 0 && !report.jobs.empty()) argv.push_back("--dependency=afterany:" + report.jobs.back());
     argv.insert(argv.end(), o.sbatch_args.begin(), o.sbatch_args.end());
     argv.push_back(script.string());
     argv.push_back(std::to_string(offset));

@@ -252,6 +252,10 @@ TEST_F(SlurmCliTest, CtrlCCancelsTheArray) {
       },
       120);
   ASSERT_TRUE(one_done) << read_text(b.err_file);
+  // --max-running 1 holds across the two arrays (MaxArraySize 5): the second waits for the first.
+  const auto before = submitted_jobs(out);
+  ASSERT_EQ(before.size(), 2u);
+  EXPECT_TRUE(has(shell("squeue -h -j " + before[1] + " -o %E"), "afterany:" + before[0]));
   kill(b.pid, SIGINT);
   const int status = b.wait(120);
   const std::string text = read_text(b.out_file);
