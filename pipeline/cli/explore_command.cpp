@@ -131,6 +131,13 @@ void check_option_combinations(const ExploreOptions& o) {
   if (!slurm && (!o.partition.empty() || o.max_running > 0 || !o.sbatch_args.empty()))
     throw InputError("--partition, --max-running and --sbatch-arg are options of --engine slurm");
   if (slurm && o.jobs_set) throw InputError("--jobs is an option of --engine local; with --engine slurm, --max-running limits the tasks");
+  // sbatch arguments the engine sets itself: a user's value would break the task-to-point mapping.
+  for (const auto& a : o.sbatch_args) {
+    const std::string name = a.substr(0, a.find('='));
+    for (const char* own : {"--array", "-a", "--wrap", "--output", "-o", "--chdir", "-D", "--parsable", "--dependency", "-d"})
+      if (name == own || (std::string(own).size() == 2 && name.rfind(own, 0) == 0 && name.size() > 2 && name[1] != '-'))
+        throw InputError(fmt::format("--sbatch-arg '{}': nbsim sets {} itself (one array task per point, logs in DIR/slurm/)", a, own));
+  }
   const int modes = (o.dry_run ? 1 : 0) + (o.collect ? 1 : 0) + (o.point.empty() ? 0 : 1);
   if (modes > 1) throw InputError("--dry-run, --collect and --point each run alone: give one of them");
   if (slurm && (o.collect || !o.point.empty()))

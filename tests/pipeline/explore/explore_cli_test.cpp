@@ -355,7 +355,10 @@ TEST(ExploreCliTest, PointAndCollect) {
            {"--partition p", "are options of --engine slurm"},
            {"--engine slurm --jobs 2", "--jobs is an option of --engine local"},
            {"--engine slurm --point 0", "leave out --engine slurm"},
-           {"--engine pbs", "--engine"}}) {
+           {"--engine pbs", "--engine"},
+           {"--engine slurm --sbatch-arg=--array=0-3", "--sbatch-arg '--array=0-3': nbsim sets --array itself"},
+           {"--engine slurm --sbatch-arg=-o/tmp/x", "nbsim sets -o itself"},
+           {"--engine slurm --sbatch-arg=--chdir=/", "nbsim sets --chdir itself"}}) {
     r = run_nbsim("explore " + f.string() + " --out " + out.string() + " " + args);
     EXPECT_EQ(r.status, 2) << args << ": " << r.out << r.err;
     EXPECT_TRUE(has(r.err, message)) << args << ": " << r.err;
