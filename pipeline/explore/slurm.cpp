@@ -34,6 +34,10 @@ constexpr int kPollsBeforeGone = 3;
 // Tunable. squeue failing this long in a row ends the wait: the arrays may still run, and
 // `--collect` merges them later.
 constexpr double kSqueueGiveUpS = 300.0;
+// Tunable. A task that ended COMPLETED or FAILED before its run.json or error.txt shows here (a
+// network file system's attribute cache can lag behind the node that wrote them) is settled after
+// this long at the latest.
+constexpr double kOutcomeGraceS = 30.0;
 // Tunable. After a cancel, how long to wait for Slurm to report every task ended.
 constexpr double kCancelWaitS = 60.0;
 
@@ -64,6 +68,8 @@ struct Task {
   bool settled = false;
   bool failed = false;
   int polls_unlisted = 0;
+  // When the task ended without its outcome visible in the point folder yet.
+  std::optional<std::chrono::steady_clock::time_point> ended_unseen;
 };
 
 std::string task_name(const Task& t) { return fmt::format("{}_{}", t.job, t.index); }
@@ -340,7 +346,14 @@ SlurmReport run_points_slurm(const std::vector<Point>& points, const SlurmOption
         t.state = s->state.substr(0, s->state.find(' '));
         t.reason = s->reason;
         t.polls_unlisted = 0;
-        if (is_final_state(t.state)) settle(t, o, report.cancelled);
+        if (!is_final_state(t.state)) continue;
+        // COMPLETED leaves a run.json, FAILED (the point failed) an error.txt: wait a little for them.
+        const bool outcome_visible = point_done(o.out, *t.point) || (t.state != "COMPLETED" && t.state != "FAILED") ||
+                                     (t.state == "FAILED" && fs::exists(point_dir(o.out, *t.point) / "error.txt"));
+        if (!outcome_visible && !t.ended_unseen) t.ended_unseen = std::chrono::steady_clock::now();
+        if (outcome_visible ||
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - *t.ended_unseen).count() > kOutcomeGraceS)
+          settle(t, o, report.cancelled);
       }
       for (std::size_t i = 0; i < tasks.size(); ++i) {
         Task& t = tasks[i];
