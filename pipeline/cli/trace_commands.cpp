@@ -235,7 +235,7 @@ void write_frame(tr::TraceWriter& w, const tr::Frame& f, std::uint32_t number) {
 // Pass p renumbers frame n of the input as p * (last + 1) + n: the first pass keeps the input's
 // numbers, and every later one keeps its gaps and order.
 int run_repeat(const RepeatOptions& o) {
-  if (o.frames < 1) throw InputError(fmt::format("--frames {}: a trace repeated to fewer than 1 frame is empty", o.frames));
+  if (o.frames < 1) throw InputError(fmt::format("--frames {}: the new trace needs at least 1 frame", o.frames));
   {
     std::error_code ec;
     if (fs::exists(o.out, ec) && fs::equivalent(o.file, o.out, ec))
@@ -269,9 +269,12 @@ int run_repeat(const RepeatOptions& o) {
   std::erase_if(properties, [](const auto& kv) { return kv.first == "repeated_from"; });
   properties.emplace_back("repeated_from", fmt::format("{} ({} frames)", fs::path(o.file).filename().string(), input_frames));
 
-  std::uint64_t written = 0;
+  // As a capture does: the frames go to OUT.partial, renamed to OUT once the trace is whole, so a
+  // failure (a full disk) leaves no half-written trace and an existing OUT as it was.
+  const fs::path partial = fs::path(o.out + ".partial");
+  std::uint64_t written = 0, bytes = 0;
   try {
-    tr::TraceWriter w(fs::path(o.out), properties);
+    tr::TraceWriter w(partial, properties);
     for (std::uint64_t pass = 0; written < o.frames; ++pass) {
       tr::FrameReader frames{fs::path(o.file)};
       if (pass == 0 && frames.trace().scene()) w.write(*frames.trace().scene());
@@ -283,13 +286,17 @@ int run_repeat(const RepeatOptions& o) {
       }
     }
     w.close();
-    fmt::print("wrote {}: {} frames ({} passes over the {} frames of {}), {} bytes\n", o.out, written, passes, input_frames,
-               o.file, w.bytes_written());
+    bytes = w.bytes_written();
+    std::error_code ec;
+    fs::rename(partial, o.out, ec);
+    if (ec) throw InputError(fmt::format("cannot write trace '{}': {}", o.out, ec.message()));
   } catch (...) {
     std::error_code ec;
-    fs::remove(o.out, ec);  // no half-written trace left behind
+    fs::remove(partial, ec);
     throw;
   }
+  fmt::print("wrote {}: {} frames ({} passes over the {} frames of {}), {} bytes\n", o.out, written, passes, input_frames,
+             o.file, bytes);
   return 0;
 }
 
@@ -468,7 +475,7 @@ void add_trace_commands(CLI::App& app, Action& action) {
     auto o = std::make_shared<RepeatOptions>();
     cmd->add_option("FILE", o->file, "Trace file to repeat")->required();
     cmd->add_option("--frames", o->frames, "Frames the new trace holds (at least 1)")->required();
-    cmd->add_option("-o,--out", o->out, "The new trace file (replaced when it exists)")->required();
+    cmd->add_option("-o,--out", o->out, "The new trace file (replaced when it exists; written as OUT.partial until whole)")->required();
     cmd->footer("The input is checked whole first (as by 'nbsim trace verify'), then read again once per pass, one frame\n"
                 "at a time, so memory stays at one frame however many frames are written. Pass p numbers input frame n as\n"
                 "p * (last frame number + 1) + n. The header keeps the input's properties, with 'frames' set to N and\n"
