@@ -64,11 +64,11 @@ constexpr int kShortFrames = 100;
 constexpr int kLongFrames = 10000;
 
 // The bound on the long run's extra peak, KiB. Measured on this project's machines (Release): the
-// two peaks differ by less than 0.4 MiB either way (about 18 MiB each, replay 0.2 ms a frame). A
-// frame of the 64x64 capture decodes to about 40 KiB (two 16 KiB depth images, the draws), so
-// keeping anything of a frame's size adds 9,900 x 40 KiB = 390 MiB; keeping run.json's per-frame
+// two peaks differ by less than 0.4 MiB either way (about 17.7 MiB each, replay 0.2 ms a frame). A
+// frame of the 64x64 capture decodes to about 60 KiB (two 16 KiB depth images, the ID buffer, the draws), so
+// keeping anything of a frame's size adds 9,900 x 60 KiB = 580 MiB; keeping run.json's per-frame
 // objects in memory as nlohmann::ordered_json (what replay did before it streamed them, about
-// 600 bytes a frame) added 5.8 MB (18.1 MB at 100 frames, 23.9 MB at 10,000). 2 MiB fails any
+// 580 bytes a frame) added 5.5 MiB (17.7 MiB at 100 frames, 23.2 MiB at 10,000). 2 MiB fails any
 // growth above about 210 bytes a frame (2 MiB / 9,900 frames) and is five times the noise.
 constexpr long kBoundKib = 2048;
 
