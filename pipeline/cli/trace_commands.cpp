@@ -5,18 +5,24 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <optional>
 
 #include "model/common/error.h"
 #include "pipeline/cli/command.h"
 #include "pipeline/io/image_io.h"
+#include "pipeline/io/json_spill.h"
 #include "traces/format/codec.h"
 #include "traces/format/describe.h"
 #include "traces/format/reader.h"
+#include "traces/format/writer.h"
 
 namespace nbsim::cli {
 
@@ -73,18 +79,82 @@ FrameSummary summarize(const tr::Frame& f) {
 
 std::string mib(std::uint64_t bytes) { return fmt::format("{:.2f} MiB", static_cast<double>(bytes) / (1 << 20)); }
 
+// The per-frame part of `info`'s text output, kept in a temporary file until the totals that
+// precede it are known (the whole trace has been read), so that memory stays bounded.
+class SpilledText {
+ public:
+  SpilledText() : file_(std::tmpfile()) {
+    if (!file_) throw InputError(fmt::format("cannot create a temporary file for the frame summaries: {}", std::strerror(errno)));
+  }
+  ~SpilledText() { std::fclose(file_); }
+  SpilledText(const SpilledText&) = delete;
+  SpilledText& operator=(const SpilledText&) = delete;
+  std::FILE* file() noexcept { return file_; }
+  void copy_to(std::FILE* out) {
+    if (std::fflush(file_) != 0 || std::fseek(file_, 0, SEEK_SET) != 0)
+      throw InputError(fmt::format("cannot read back the frame summaries: {}", std::strerror(errno)));
+    char buf[1 << 16];
+    std::size_t n = 0;
+    while ((n = std::fread(buf, 1, sizeof buf, file_)) > 0) std::fwrite(buf, 1, n, out);
+    if (std::ferror(file_)) throw InputError("cannot read back the frame summaries");
+  }
+
+ private:
+  std::FILE* file_ = nullptr;
+};
+
+ojson frame_json(const FrameSummary& s) {
+  ojson o;
+  o["frame"] = s.frame;
+  o["mode"] = tr::to_string(s.mode);
+  o["draws"] = s.draws;
+  o["fragments"] = s.fragments;
+  o["samples_passed"] = s.samples_passed;
+  o["objects_visible"] = s.objects_visible ? ojson(*s.objects_visible) : ojson(nullptr);
+  o["covered_pixels"] = s.covered_pixels ? ojson(*s.covered_pixels) : ojson(nullptr);
+  o["gl_ms"] = s.gl_ms;
+  o["depth"] = s.depths;
+  o["levels"] = s.level_json;
+  // Version 2's records only when the frame has them (occlusion-culling summaries stay as they were).
+  if (!s.stencils.empty()) o["stencil"] = s.stencils;
+  if (s.light) o["light"] = true;
+  if (!s.technique_records.empty()) o["technique_records"] = s.technique_records;
+  o["offset"] = s.offset;
+  return o;
+}
+
+void print_frame_line(std::FILE* out, const FrameSummary& s) {
+  const std::string visible = s.objects_visible ? fmt::format("{}", *s.objects_visible) : std::string("?");
+  fmt::print(out, "  frame {} ({}): {} draws, {} GL fragments, {} samples passed, {} objects visible (ground truth)", s.frame,
+             tr::to_string(s.mode), s.draws, s.fragments, s.samples_passed, visible);
+  if (!s.depths.empty()) fmt::print(out, "; depth: {}", fmt::join(s.depths, ", "));
+  if (!s.level_text.empty()) fmt::print(out, "; N-buffer: {}", fmt::join(s.level_text, ", "));
+  if (!s.stencils.empty()) fmt::print(out, "; stencil: {}", fmt::join(s.stencils, ", "));
+  if (s.light) fmt::print(out, "; light camera");
+  if (!s.technique_records.empty()) fmt::print(out, "; technique records: {}", fmt::join(s.technique_records, ", "));
+  fmt::print(out, "\n");
+}
+
+// Streams: each frame's summary goes to a temporary file as the frame is read (the header lines
+// need the whole trace's chunk counts first), so memory is one frame however long the trace.
 int run_info(const std::string& file, bool json) {
   tr::FrameReader frames{fs::path(file)};
-  std::vector<FrameSummary> summaries;
-  while (const auto f = frames.next()) summaries.push_back(summarize(*f));
-  const tr::TraceReader& t = frames.trace();
-  const tr::TraceStats& st = t.stats();
-  std::uint64_t fragments = 0, samples = 0, draws = 0;
-  for (const FrameSummary& s : summaries) {
+  std::optional<io::SpilledJsonArray> frame_objects;
+  std::optional<SpilledText> frame_lines;
+  if (json) frame_objects.emplace();
+  else frame_lines.emplace();
+  std::uint64_t fragments = 0, samples = 0, draws = 0, count = 0;
+  while (const auto f = frames.next()) {
+    const FrameSummary s = summarize(*f);
     fragments += s.fragments;
     samples += s.samples_passed;
     draws += s.draws;
+    ++count;
+    if (json) frame_objects->push_back(frame_json(s));
+    else print_frame_line(frame_lines->file(), s);
   }
+  const tr::TraceReader& t = frames.trace();
+  const tr::TraceStats& st = t.stats();
 
   if (json) {
     ojson j;
@@ -102,29 +172,10 @@ int run_info(const std::string& file, bool json) {
       j["scene"] = {{"objects", sc->objects.size()}, {"bvh_nodes", sc->node_bounds.size()}};
     else
       j["scene"] = nullptr;
-    ojson fr = ojson::array();
-    for (const FrameSummary& s : summaries) {
-      ojson o;
-      o["frame"] = s.frame;
-      o["mode"] = tr::to_string(s.mode);
-      o["draws"] = s.draws;
-      o["fragments"] = s.fragments;
-      o["samples_passed"] = s.samples_passed;
-      o["objects_visible"] = s.objects_visible ? ojson(*s.objects_visible) : ojson(nullptr);
-      o["covered_pixels"] = s.covered_pixels ? ojson(*s.covered_pixels) : ojson(nullptr);
-      o["gl_ms"] = s.gl_ms;
-      o["depth"] = s.depths;
-      o["levels"] = s.level_json;
-      // Version 2's records only when the frame has them (occlusion-culling summaries stay as they were).
-      if (!s.stencils.empty()) o["stencil"] = s.stencils;
-      if (s.light) o["light"] = true;
-      if (!s.technique_records.empty()) o["technique_records"] = s.technique_records;
-      o["offset"] = s.offset;
-      fr.push_back(std::move(o));
-    }
-    j["frames"] = std::move(fr);
-    j["totals"] = {{"frames", summaries.size()}, {"draws", draws}, {"fragments", fragments}, {"samples_passed", samples}};
-    fmt::print("{}\n", j.dump(2));
+    j["frames"] = io::SpilledJsonArray::placeholder();
+    j["totals"] = {{"frames", count}, {"draws", draws}, {"fragments", fragments}, {"samples_passed", samples}};
+    std::fflush(stdout);
+    frame_objects->write_document(stdout, j);
     return 0;
   }
 
@@ -136,18 +187,9 @@ int run_info(const std::string& file, bool json) {
     fmt::print("scene: {} objects, {} BVH nodes\n", sc->objects.size(), sc->node_bounds.size());
   else
     fmt::print("scene: none recorded\n");
-  fmt::print("frames: {}\n", summaries.size());
-  for (const FrameSummary& s : summaries) {
-    const std::string visible = s.objects_visible ? fmt::format("{}", *s.objects_visible) : std::string("?");
-    fmt::print("  frame {} ({}): {} draws, {} GL fragments, {} samples passed, {} objects visible (ground truth)", s.frame,
-               tr::to_string(s.mode), s.draws, s.fragments, s.samples_passed, visible);
-    if (!s.depths.empty()) fmt::print("; depth: {}", fmt::join(s.depths, ", "));
-    if (!s.level_text.empty()) fmt::print("; N-buffer: {}", fmt::join(s.level_text, ", "));
-    if (!s.stencils.empty()) fmt::print("; stencil: {}", fmt::join(s.stencils, ", "));
-    if (s.light) fmt::print("; light camera");
-    if (!s.technique_records.empty()) fmt::print("; technique records: {}", fmt::join(s.technique_records, ", "));
-    fmt::print("\n");
-  }
+  fmt::print("frames: {}\n", count);
+  std::fflush(stdout);
+  frame_lines->copy_to(stdout);
   fmt::print("total: {} draws, {} GL fragments, {} samples passed\n", draws, fragments, samples);
   return 0;
 }
@@ -160,6 +202,101 @@ int run_verify(const std::string& file) {
   const tr::TraceStats& st = t.stats();
   fmt::print("{}: sound: format version {}, {} bytes, {} chunks, {} frames, {} draws, payload {} stored as {}\n", file,
              t.version(), t.file_bytes(), st.chunks, st.frames, st.draws, mib(st.raw_bytes), mib(st.stored_bytes));
+  return 0;
+}
+
+struct RepeatOptions {
+  std::string file;
+  std::uint64_t frames = 0;
+  std::string out;
+};
+
+// Writes one frame, renumbered, record by record (the writer batches the draws and checks the
+// format's rules again). Frame records come back in the FrameReader's grouping, which the format
+// allows in any order inside FRAM .. FEND.
+void write_frame(tr::TraceWriter& w, const tr::Frame& f, std::uint32_t number) {
+  tr::FrameBegin begin = f.begin;
+  begin.frame = number;
+  w.begin_frame(begin);
+  for (const tr::DrawRecord& d : f.draws) w.write(d);
+  for (const tr::DepthSnapshot& d : f.depths) w.write(d);
+  for (const tr::NBufferLevels& l : f.levels) w.write(l);
+  for (const tr::StencilSnapshot& s : f.stencils) w.write(s);
+  if (f.light) w.write_light(*f.light);
+  for (const tr::TechniqueRecord& t : f.technique_records) w.write(t);
+  if (f.truth) w.write(*f.truth);
+  tr::FrameEnd end = f.end;
+  end.frame = number;
+  w.end_frame(end);
+}
+
+// `nbsim trace repeat`: a long trace from a short one, for memory and speed measurements. The input
+// is read once a pass, one frame at a time (FrameReader), so memory stays at one frame whatever N.
+// Pass p renumbers frame n of the input as p * (last + 1) + n: the first pass keeps the input's
+// numbers, and every later one keeps its gaps and order.
+int run_repeat(const RepeatOptions& o) {
+  if (o.frames < 1) throw InputError(fmt::format("--frames {}: the new trace needs at least 1 frame", o.frames));
+  {
+    std::error_code ec;
+    if (fs::exists(o.out, ec) && fs::equivalent(o.file, o.out, ec))
+      throw InputError(fmt::format("--out '{}' is the input trace: write the long trace to another file", o.out));
+  }
+  // One pass over the input checks all of it (as `trace verify` does) before anything is written,
+  // and gives its frame count and last frame number.
+  std::uint64_t input_frames = 0;
+  std::uint32_t last = 0;
+  tr::Properties properties;
+  {
+    tr::FrameReader frames{fs::path(o.file)};
+    while (const auto f = frames.next()) {
+      ++input_frames;
+      last = f->begin.frame;
+    }
+    properties = frames.trace().properties();
+  }
+  if (input_frames == 0) throw InputError(fmt::format("trace '{}' has no frames to repeat", o.file));
+  const std::uint64_t period = std::uint64_t{last} + 1;
+  const std::uint64_t passes = (o.frames + input_frames - 1) / input_frames;
+  if ((passes - 1) * period + last > std::numeric_limits<std::uint32_t>::max())
+    throw InputError(fmt::format("--frames {}: the repeated frame numbers of '{}' (frames up to {}, repeated every {}) would "
+                                 "pass the format's largest frame number {}",
+                                 o.frames, o.file, last, period, std::numeric_limits<std::uint32_t>::max()));
+  // The header says what the file is: the frame count it now holds and where its frames came from.
+  bool has_frames = false;
+  for (auto& [k, v] : properties)
+    if (k == "frames") v = std::to_string(o.frames), has_frames = true;
+  if (!has_frames) properties.emplace_back("frames", std::to_string(o.frames));
+  std::erase_if(properties, [](const auto& kv) { return kv.first == "repeated_from"; });
+  properties.emplace_back("repeated_from", fmt::format("{} ({} frames)", fs::path(o.file).filename().string(), input_frames));
+
+  // As a capture does: the frames go to OUT.partial, renamed to OUT once the trace is whole, so a
+  // failure (a full disk) leaves no half-written trace and an existing OUT as it was.
+  const fs::path partial = fs::path(o.out + ".partial");
+  std::uint64_t written = 0, bytes = 0;
+  try {
+    tr::TraceWriter w(partial, properties);
+    for (std::uint64_t pass = 0; written < o.frames; ++pass) {
+      tr::FrameReader frames{fs::path(o.file)};
+      if (pass == 0 && frames.trace().scene()) w.write(*frames.trace().scene());
+      while (written < o.frames) {
+        const auto f = frames.next();
+        if (!f) break;
+        write_frame(w, *f, static_cast<std::uint32_t>(pass * period + f->begin.frame));
+        ++written;
+      }
+    }
+    w.close();
+    bytes = w.bytes_written();
+    std::error_code ec;
+    fs::rename(partial, o.out, ec);
+    if (ec) throw InputError(fmt::format("cannot write trace '{}': {}", o.out, ec.message()));
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(partial, ec);
+    throw;
+  }
+  fmt::print("wrote {}: {} frames ({} passes over the {} frames of {}), {} bytes\n", o.out, written, passes, input_frames,
+             o.file, bytes);
   return 0;
 }
 
@@ -332,6 +469,18 @@ void add_trace_commands(CLI::App& app, Action& action) {
     cmd->footer("Prints one summary line when the trace is sound. Otherwise prints the first problem, naming the chunk\n"
                 "(index and type) and its byte offset, and exits with status 2.");
     cmd->callback([&action, file] { action = [=] { return run_verify(*file); }; });
+  }
+  {
+    auto* cmd = tc->add_subcommand("repeat", "Write a long trace that repeats a trace's frames until it has N frames");
+    auto o = std::make_shared<RepeatOptions>();
+    cmd->add_option("FILE", o->file, "Trace file to repeat")->required();
+    cmd->add_option("--frames", o->frames, "Frames the new trace holds (at least 1)")->required();
+    cmd->add_option("-o,--out", o->out, "The new trace file (replaced when it exists; written as OUT.partial until whole)")->required();
+    cmd->footer("The input is checked whole first (as by 'nbsim trace verify'), then read again once per pass, one frame\n"
+                "at a time, so memory stays at one frame however many frames are written. Pass p numbers input frame n as\n"
+                "p * (last frame number + 1) + n. The header keeps the input's properties, with 'frames' set to N and\n"
+                "'repeated_from' naming the input. For memory and speed measurements of long traces (README).");
+    cmd->callback([&action, o] { action = [=] { return run_repeat(*o); }; });
   }
   {
     auto* cmd = tc->add_subcommand("format", "Print the record tables of the trace format (Markdown), from the records' one description");

@@ -3,7 +3,10 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <chrono>
+#include <cstdio>
+#include <cstring>
 #include <cmath>
 #include <fstream>
 
@@ -11,6 +14,7 @@
 #include "model/sim/kernel.h"
 #include "model/relief/walk.h"
 #include "model/sim/timeline.h"
+#include "pipeline/io/json_spill.h"
 #include "traces/format/reader.h"
 
 namespace nbsim::pipeline {
@@ -62,6 +66,7 @@ class Collector : public depth::ResultSink {
                 "model_passed,gl_passed,depth_tests,culled,lookups,done_cycle\n";
       frames_ << "frame,draws,model_fragments,gl_fragments,model_passed,gl_passed,depth_tests,depth_pixels_matching,"
                  "depth_pixels,end_cycle,cycles\n";
+      per_frame_.emplace();
     }
   }
 
@@ -184,7 +189,12 @@ class Collector : public depth::ResultSink {
       pf["relief"] = methods;
       last_relief_ = now;
     }
-    per_frame_.push_back(std::move(pf));
+    if (registry_.find("gpu.shadows"))
+      shadows_frames_.push_back({w.frame->begin.frame, pf.value("fill", std::uint64_t{0}), pf.value("reference_fill", std::uint64_t{0}),
+                                 pf.value("culled", std::uint64_t{0}), pf.value("gl_culled", std::uint64_t{0}),
+                                 pf.value("mask_diff", std::uint64_t{0}), pf.value("mask_diff_infinite", std::uint64_t{0}),
+                                 cycle - last_cycle_});
+    if (per_frame_) per_frame_->push_back(pf);
     last_cycle_ = cycle;
     for (const auto& d : w.frame->draws)
       if (d.clip_positions.empty()) ++s_.passes_not_replayed;
@@ -197,7 +207,18 @@ class Collector : public depth::ResultSink {
   std::uint64_t total_frames = 0;
   std::uint64_t visible_draws_passed_below_gl = 0;  // drawn candidates with fewer passed samples than GL's
   std::uint64_t last_frame_cycle() const noexcept { return last_cycle_; }
-  nlohmann::ordered_json per_frame_ = nlohmann::ordered_json::array();
+  void write_run_json(std::FILE* f, const nlohmann::ordered_json& run) { per_frame_->write_document(f, run); }
+  // run.json's "frames", one object a frame: spilled to a temporary file as each frame ends (a
+  // run with an output folder only), so that memory does not grow with the trace's length.
+  std::optional<io::SpilledJsonArray> per_frame_;
+  // The shadows summary's "per_frame" values (shadows traces only): 64 bytes a frame, the one
+  // per-frame record a replay keeps in memory, because ReplaySummary (`nbsim compare --json`)
+  // returns them (320 KiB at 5,000 frames).
+  struct ShadowsFrame {
+    std::uint32_t frame = 0;
+    std::uint64_t fill = 0, reference_fill = 0, culled = 0, gl_culled = 0, mask_diff = 0, mask_diff_infinite = 0, cycles = 0;
+  };
+  std::vector<ShadowsFrame> shadows_frames_;
 
  private:
   struct FrameTotals {
@@ -605,11 +626,10 @@ ReplaySummary replay(const ReplayOptions& o) {
     for (const auto& structure : gpu.program().structures) bytes += structure->storage_bytes();
     s.shadows["nbuffer_memory_bytes"] = bytes;  // both units' levels
     nlohmann::ordered_json per_frame = nlohmann::ordered_json::array();
-    for (const auto& pf : sink.per_frame_)
-      per_frame.push_back({{"frame", pf["frame"]}, {"fill", pf.value("fill", std::uint64_t{0})},
-                           {"reference_fill", pf.value("reference_fill", std::uint64_t{0})}, {"culled", pf.value("culled", std::uint64_t{0})},
-                           {"gl_culled", pf.value("gl_culled", std::uint64_t{0})}, {"mask_diff", pf.value("mask_diff", std::uint64_t{0})},
-                           {"mask_diff_infinite", pf.value("mask_diff_infinite", std::uint64_t{0})}, {"cycles", pf["cycles"]}});
+    for (const auto& pf : sink.shadows_frames_)
+      per_frame.push_back({{"frame", pf.frame}, {"fill", pf.fill}, {"reference_fill", pf.reference_fill}, {"culled", pf.culled},
+                           {"gl_culled", pf.gl_culled}, {"mask_diff", pf.mask_diff}, {"mask_diff_infinite", pf.mask_diff_infinite},
+                           {"cycles", pf.cycles}});
     s.shadows["per_frame"] = per_frame;
   }
 
@@ -640,9 +660,17 @@ ReplaySummary replay(const ReplayOptions& o) {
     run["summary"] = s.to_json();
     run["stats"] = s.stats;
     run["stats_described"] = registry.describe();
-    run["frames"] = sink.per_frame_;
-    const std::string text = run.dump(2) + "\n";  // before the file is opened: a failure leaves none
-    std::ofstream(*o.out / "run.json") << text;
+    run["frames"] = io::SpilledJsonArray::placeholder();  // the frames, streamed back from their temporary file
+    const std::filesystem::path path = *o.out / "run.json";
+    std::FILE* f = std::fopen(path.string().c_str(), "wb");
+    if (!f) throw InputError(fmt::format("cannot write '{}': {}", path.string(), std::strerror(errno)));
+    try {
+      sink.write_run_json(f, run);
+    } catch (...) {
+      std::fclose(f);
+      throw;
+    }
+    if (std::fclose(f) != 0) throw InputError(fmt::format("cannot write '{}': {}", path.string(), std::strerror(errno)));
   }
   outputs.keep();
   return s;
