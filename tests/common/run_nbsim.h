@@ -47,6 +47,17 @@ inline std::filesystem::path scratch_path(const std::string& prefix, const std::
   return dir / name;
 }
 
+// What a shell command writes on stdout (its exit status is not looked at).
+inline std::string shell_output(const std::string& cmd) {
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), static_cast<int>(buf.size()), p)) out += buf.data();
+  pclose(p);
+  return out;
+}
+
 inline bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace nbsim::testing

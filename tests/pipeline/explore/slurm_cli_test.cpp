@@ -33,6 +33,7 @@ extern "C" char** environ;
 namespace {
 
 namespace fs = std::filesystem;
+using nbsim::testing::shell_output;
 using nbsim::testing::CliResult;
 using nbsim::testing::has;
 using nbsim::testing::read_csv;
@@ -68,15 +69,6 @@ std::string read_text(const fs::path& f) {
   return {std::istreambuf_iterator<char>(in), {}};
 }
 
-std::string shell(const std::string& cmd) {
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) out += buf;
-  pclose(p);
-  return out;
-}
 
 // The array job ids one explore run submitted (OUT/slurm/*.jobs).
 std::vector<std::string> submitted_jobs(const fs::path& out) {
@@ -156,7 +148,7 @@ bool wait_until(Pred pred, double seconds) {
 
 // The states squeue lists for a job's tasks that have not ended ("" when none).
 std::string active_tasks(const std::string& job) {
-  const std::string all = shell("squeue -h -t all -r -j " + job + " -o '%i %T' 2>/dev/null");
+  const std::string all = shell_output("squeue -h -t all -r -j " + job + " -o '%i %T' 2>/dev/null");
   std::string active;
   std::istringstream in(all);
   for (std::string line; std::getline(in, line);)
@@ -255,7 +247,7 @@ TEST_F(SlurmCliTest, CtrlCCancelsTheArray) {
   // --max-running 1 holds across the two arrays (MaxArraySize 5): the second waits for the first.
   const auto before = submitted_jobs(out);
   ASSERT_EQ(before.size(), 2u);
-  EXPECT_TRUE(has(shell("squeue -h -j " + before[1] + " -o %E"), "afterany:" + before[0]));
+  EXPECT_TRUE(has(shell_output("squeue -h -j " + before[1] + " -o %E"), "afterany:" + before[0]));
   kill(b.pid, SIGINT);
   const int status = b.wait(120);
   const std::string text = read_text(b.out_file);
@@ -290,7 +282,7 @@ TEST_F(SlurmCliTest, CancelledFromOutsideRecorded) {
   ASSERT_GT(b.pid, 0);
   ASSERT_TRUE(wait_until([&] { return !submitted_jobs(out).empty(); }, 60)) << read_text(b.err_file);
   const std::string job = submitted_jobs(out)[0];
-  shell("scancel " + job);
+  shell_output("scancel " + job);
   const int status = b.wait(120);
   EXPECT_EQ(status, 1) << read_text(b.out_file) << read_text(b.err_file);
   const auto rows = read_csv(out / "results.csv");

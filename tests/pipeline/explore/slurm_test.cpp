@@ -11,21 +11,14 @@
 #include <unistd.h>
 
 #include "pipeline/explore/slurm.h"
+#include "tests/common/run_nbsim.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using nbsim::testing::shell_output;
 using namespace nbsim::explore;
 
-std::string run_shell(const std::string& cmd) {
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) out += buf;
-  pclose(p);
-  return out;
-}
 
 TEST(SlurmPiecesTest, SqueueLines) {
   auto s = parse_squeue_line("1234_17 RUNNING None");
@@ -65,7 +58,7 @@ TEST(SlurmPiecesTest, ArraySpecAndSbatchAnswer) {
 // Quoted text comes back unchanged through sh, whatever it holds.
 TEST(SlurmPiecesTest, ShellQuoteRoundTrips) {
   for (const std::string text : {"plain", "two words", "it's", "''", "$HOME `id` \\ \" ; & | *", "/path/with spaces/x.nbt", ""})
-    EXPECT_EQ(run_shell("printf %s " + shell_quote(text)), text) << text;
+    EXPECT_EQ(shell_output("printf %s " + shell_quote(text)), text) << text;
 }
 
 // The batch script picks line offset + task id + 1 of the task list and passes the point's id,
@@ -76,13 +69,13 @@ TEST(SlurmPiecesTest, BatchScriptPicksItsPoint) {
   const fs::path tasks = dir / "a dir" / "x.tasks", script = dir / "x.sh";
   std::ofstream(tasks) << "aaaa\nbbbb\ncccc\ndddd\n";
   std::ofstream(script) << batch_script(tasks, "/bin/echo", dir / "sweep's.json", dir / "out", {"--max-points", "7"});
-  EXPECT_EQ(run_shell("SLURM_ARRAY_TASK_ID=1 sh " + shell_quote(script.string()) + " 2"),
+  EXPECT_EQ(shell_output("SLURM_ARRAY_TASK_ID=1 sh " + shell_quote(script.string()) + " 2"),
             "explore " + (dir / "sweep's.json").string() + " --out " + (dir / "out").string() + " --point dddd --max-points 7\n");
-  EXPECT_EQ(run_shell("SLURM_ARRAY_TASK_ID=0 sh " + shell_quote(script.string()) + " 0 2>&1"),
+  EXPECT_EQ(shell_output("SLURM_ARRAY_TASK_ID=0 sh " + shell_quote(script.string()) + " 0 2>&1"),
             "explore " + (dir / "sweep's.json").string() + " --out " + (dir / "out").string() + " --point aaaa --max-points 7\n");
-  EXPECT_NE(run_shell("SLURM_ARRAY_TASK_ID=4 sh " + shell_quote(script.string()) + " 0 2>&1; echo status=$?").find("no point on line 5"),
+  EXPECT_NE(shell_output("SLURM_ARRAY_TASK_ID=4 sh " + shell_quote(script.string()) + " 0 2>&1; echo status=$?").find("no point on line 5"),
             std::string::npos);
-  EXPECT_NE(run_shell("sh " + shell_quote(script.string()) + " 0 2>&1; echo status=$?").find("not a Slurm array task"), std::string::npos);
+  EXPECT_NE(shell_output("sh " + shell_quote(script.string()) + " 0 2>&1; echo status=$?").find("not a Slurm array task"), std::string::npos);
   fs::remove_all(dir);
 }
 

@@ -59,7 +59,9 @@ void expect_exact_replay(const nlohmann::json& relief, const std::string& what) 
     EXPECT_EQ(m["walk_mismatches"], 0);
     EXPECT_EQ(m["pixel_mismatches"], 0);
     EXPECT_EQ(m["capped"], 0);
-    if (name == "nbuffer" || name == "robust") EXPECT_EQ(m["errors"], 0) << "the robust and N-buffer walks are exact";
+    if (name == "nbuffer" || name == "robust") {
+      EXPECT_EQ(m["errors"], 0) << "the robust and N-buffer walks are exact";
+    }
   }
 }
 
@@ -111,7 +113,7 @@ TEST(ReliefCliTest, HeightfieldFileAndTable) {
   const fs::path dir = testing::scratch_path("nbsim_relief_cli_file", "x").parent_path();
   std::vector<float> h(40 * 40);
   for (int j = 0; j < 40; ++j)
-    for (int i = 0; i < 40; ++i) h[static_cast<std::size_t>(j * 40 + i)] = 0.5f + 0.45f * std::sin(0.4f * i) * std::cos(0.3f * j);
+    for (int i = 0; i < 40; ++i) h[static_cast<std::size_t>(j * 40 + i)] = 0.5f + 0.45f * std::sin(0.4f * static_cast<float>(i)) * std::cos(0.3f * static_cast<float>(j));
   const fs::path field = write_pfm(dir / "waves.pfm", 40, 40, h);
   const fs::path trace = dir / "waves.nbt";
   expect_exact_replay(capture_and_compare(trace, "--field-file " + field.string() + " --angles 75"), "waves.pfm");
