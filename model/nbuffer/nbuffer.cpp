@@ -62,6 +62,28 @@ template <FarOp Op>
   else reduce_row<FarOp::Min>(a, b, out, x0, x1, width, s);
 }
 
+// What apply_row did to one row: texels rewritten, and the first and last of them.
+struct RowChange {
+  long long count = 0;
+  int first = 0, last = -1;
+};
+
+// Writes each row[x] that differs (!=) from out[x], x in [x0, x1). A count first, then a select
+// over the span from the first to the last difference: both vectorize, and a row without changes
+// (most rows near the top of a dirty rectangle's reach) is only read.
+[[gnu::target_clones("avx2", "default")]] RowChange apply_row(const float* __restrict row, float* __restrict out,
+                                                              int x0, int x1) noexcept {
+  RowChange c;
+  for (int x = x0; x < x1; ++x) c.count += out[x] != row[x];
+  if (c.count == 0) return c;
+  c.first = x0;
+  while (!(out[c.first] != row[c.first])) ++c.first;
+  c.last = x1 - 1;
+  while (!(out[c.last] != row[c.last])) --c.last;
+  for (int x = c.first; x <= c.last; ++x) out[x] = out[x] != row[x] ? row[x] : out[x];
+  return c;
+}
+
 void grow(Rect& box, int x, int y) noexcept {
   if (box.empty()) { box = {x, y, 1, 1}; return; }
   const int x0 = std::min(box.x, x), y0 = std::min(box.y, y);
@@ -215,19 +237,21 @@ UpdateStats NBuffer::update(const DepthImage& depth, const Rect& dirty) {
 
   // Level 0: copy the dirty pixels, note the bounding box of those that changed.
   Rect changed;
-  float* l0 = level_ptr(0);
+  std::vector<float> row(static_cast<std::size_t>(width_));
   for (int y = r.y; y < r.y1(); ++y) {
-    for (int x = r.x; x < r.x1(); ++x) {
-      const float v = quantize_toward_far(depth.at(x, y), config_.format, config_.op);
-      float& t = l0[static_cast<std::size_t>(y) * width_ + x];
-      if (t != v) { t = v; ++stats.texels_changed[0]; grow(changed, x, y); }
+    const float* in = depth.texels.data() + static_cast<std::size_t>(y) * width_;
+    if (config_.format != StorageFormat::F32) {
+      for (int x = r.x; x < r.x1(); ++x) row[static_cast<std::size_t>(x)] = quantize_toward_far(in[x], config_.format, config_.op);
+      in = row.data();
     }
+    const RowChange c = apply_row(in, level_ptr(0) + static_cast<std::size_t>(y) * width_, r.x, r.x1());
+    stats.texels_changed[0] += c.count;
+    if (c.count) { grow(changed, c.first, y); grow(changed, c.last, y); }
   }
   stats.texels_recomputed[0] = r.area();
 
   // Level i: a texel at (x, y) reads level i - 1 at x and x + s, y and y + s, so a change in box B
   // of level i - 1 reaches [B.x - s, B.x1) x [B.y - s, B.y1) of level i, clipped to the image.
-  std::vector<float> row(static_cast<std::size_t>(width_));
   for (int i = 1; i < levels_ && !changed.empty(); ++i) {
     const int s = 1 << (i - 1);
     const Rect reach = clip({changed.x - s, changed.y - s, changed.w + s, changed.h + s}, width_, height_);
@@ -238,14 +262,9 @@ UpdateStats NBuffer::update(const DepthImage& depth, const Rect& dirty) {
       const float* a = src + static_cast<std::size_t>(y) * width_;
       const float* b = y + s < height_ ? a + static_cast<std::size_t>(s) * width_ : nullptr;
       reduce_row(config_.op, a, b, row.data(), reach.x, reach.x1(), width_, s);
-      float* out = dst + static_cast<std::size_t>(y) * width_;
-      for (int x = reach.x; x < reach.x1(); ++x) {
-        if (out[x] != row[static_cast<std::size_t>(x)]) {
-          out[x] = row[static_cast<std::size_t>(x)];
-          ++stats.texels_changed[static_cast<std::size_t>(i)];
-          grow(changed, x, y);
-        }
-      }
+      const RowChange c = apply_row(row.data(), dst + static_cast<std::size_t>(y) * width_, reach.x, reach.x1());
+      stats.texels_changed[static_cast<std::size_t>(i)] += c.count;
+      if (c.count) { grow(changed, c.first, y); grow(changed, c.last, y); }
     }
     stats.texels_recomputed[static_cast<std::size_t>(i)] = reach.area();
   }
