@@ -70,7 +70,7 @@ struct RowChange {
 
 // Writes each row[x] that differs (!=) from out[x], x in [x0, x1). A count first, then a select
 // over the span from the first to the last difference: both vectorize, and a row without changes
-// (most rows near the top of a dirty rectangle's reach) is only read.
+// is only read.
 [[gnu::target_clones("avx2", "default")]] RowChange apply_row(const float* __restrict row, float* __restrict out,
                                                               int x0, int x1) noexcept {
   RowChange c;
@@ -123,10 +123,11 @@ namespace {
 // rows below (G = 4, or 2 when four do not fit a band), so that each horizontal pair
 // far(a[x], a[x + s]) is loaded and reduced once instead of twice, and (3) runs its row loops in
 // an AVX2 clone where the CPU has AVX2 (the default clone is the x86-64 baseline, SSE2; GCC picks
-// one at load time). AVX2 alone takes the 1024x1024 build from about 1.2 to about 0.9 copies.
-// The two constants are tunable: the fastest pair among band heights 32 to 128 rows and banded
-// steps 16 to "all", timed with `nbsim bench nbuffer --only build` at 1024x1024 on the project's
-// 2-core machines (1 MiB L2 per core, 32 MiB L3); neighbours differ by a few percent at most.
+// one at load time). With the levels' huge pages (allocate_level_storage) that takes 1024x1024 from
+// about 1.2-1.5 to about 0.8 times the level-by-level copy (README, Table 1, has the measurements).
+// The two constants are tunable: (64, 64) and the pairs (64, 16), (32, 32), (128, 64), (128, 128)
+// and (64, all) timed within the noise of one another with `nbsim bench nbuffer --only build` at
+// 1024x1024 on the project's shared 2-core machines (1 MiB L2 per core, 32 MiB L3).
 constexpr int build_band_rows = 64;      // rows per band
 constexpr int build_band_max_step = 64;  // levels with s <= this are banded; the others go plane by plane
 

@@ -31,7 +31,7 @@ struct NBufferConfig {
 
 // Memory for the levels. Buffers of 2 MiB and more start on a 2 MiB boundary and, on Linux, are
 // offered transparent huge pages (madvise), so that the build's ten-odd row streams, one to four
-// per level, do not miss the TLB at every row (about 10% of a 1024x1024 build); smaller ones start
+// per level, do not miss the TLB at every row (a fifth or more of a 1024x1024 build); smaller ones start
 // on a cache-line boundary, so that the build's vector stores never straddle two lines when rows
 // are a multiple of 16 texels.
 void* allocate_level_storage(std::size_t bytes);
