@@ -12,6 +12,14 @@
 #include <sys/mman.h>
 #endif
 
+// The hot row loops get an AVX2 clone next to the baseline one on x86-64 (GCC and Clang pick one
+// when the program loads); elsewhere they are compiled once, for the target.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define NBSIM_ROW_LOOP_CLONES [[gnu::target_clones("avx2", "default")]]
+#else
+#define NBSIM_ROW_LOOP_CLONES
+#endif
+
 namespace nbsim {
 
 namespace {
@@ -57,7 +65,7 @@ template <FarOp Op>
   }
 }
 
-[[gnu::target_clones("avx2", "default")]] void reduce_row(FarOp op, const float* a, const float* b, float* out, int x0, int x1, int width, int s) noexcept {
+NBSIM_ROW_LOOP_CLONES void reduce_row(FarOp op, const float* a, const float* b, float* out, int x0, int x1, int width, int s) noexcept {
   if (op == FarOp::Max) reduce_row<FarOp::Max>(a, b, out, x0, x1, width, s);
   else reduce_row<FarOp::Min>(a, b, out, x0, x1, width, s);
 }
@@ -71,7 +79,7 @@ struct RowChange {
 // Writes each row[x] that differs (!=) from out[x], x in [x0, x1). A count first, then a select
 // over the span from the first to the last difference: both vectorize, and a row without changes
 // is only read.
-[[gnu::target_clones("avx2", "default")]] RowChange apply_row(const float* __restrict row, float* __restrict out,
+NBSIM_ROW_LOOP_CLONES RowChange apply_row(const float* __restrict row, float* __restrict out,
                                                               int x0, int x1) noexcept {
   RowChange c;
   for (int x = x0; x < x1; ++x) c.count += out[x] != row[x];
@@ -163,7 +171,7 @@ template <FarOp Op>
     reduce_row<Op>(src + y * w, y + s < height ? src + (y + s) * w : nullptr, dst + y * w, 0, width, width, s);
 }
 
-[[gnu::target_clones("avx2", "default")]] void reduce_rows(FarOp op, const float* src, float* dst, int width,
+NBSIM_ROW_LOOP_CLONES void reduce_rows(FarOp op, const float* src, float* dst, int width,
                                                            int height, int s, int y0, int y1) noexcept {
   if (op == FarOp::Max) reduce_rows<FarOp::Max>(src, dst, width, height, s, y0, y1);
   else reduce_rows<FarOp::Min>(src, dst, width, height, s, y0, y1);
