@@ -79,8 +79,8 @@ struct RowChange {
 // Writes each row[x] that differs (!=) from out[x], x in [x0, x1). A count first, then a select
 // over the span from the first to the last difference: both vectorize, and a row without changes
 // is only read.
-NBSIM_ROW_LOOP_CLONES RowChange apply_row(const float* __restrict row, float* __restrict out,
-                                                              int x0, int x1) noexcept {
+NBSIM_ROW_LOOP_CLONES RowChange apply_row(const float* __restrict row, float* __restrict out, int x0,
+                                          int x1) noexcept {
   RowChange c;
   for (int x = x0; x < x1; ++x) c.count += out[x] != row[x];
   if (c.count == 0) return c;
@@ -125,13 +125,12 @@ NBuffer::NBuffer(const DepthImage& depth, NBufferConfig config) : NBuffer(depth.
 namespace {
 
 // Full builds (NBuffer::build). A level pass costs about what copying its plane costs plus its
-// arithmetic, and the two overlap poorly. So the build (1) runs level 0 and the levels above it
-// band by band, top down, so that the rows a level reads were written a moment ago and are still
-// in cache, (2) computes G rows y, y + s, ..., y + (G - 1) s of a level together from the G + 1
-// rows below (G = 4, or 2 when four do not fit a band), so that each horizontal pair
-// far(a[x], a[x + s]) is loaded and reduced once instead of twice, and (3) runs its row loops in
-// an AVX2 clone where the CPU has AVX2 (the default clone is the x86-64 baseline, SSE2; GCC picks
-// one at load time). With the levels' huge pages (allocate_level_storage) that takes 1024x1024 from
+// arithmetic, and the two overlap poorly. So the build (1) runs level 0 and the levels with steps
+// up to build_band_max_step band by band, top down, so that the rows a level reads were written a
+// moment ago and are still in cache, (2) computes G rows y, y + s, ..., y + (G - 1) s of a level
+// together from the G + 1 rows below (G = 4; 2 or single rows where four do not fit), so that each
+// horizontal pair far(a[x], a[x + s]) is loaded and reduced once instead of twice, and (3) runs its
+// row loops in an AVX2 clone where the CPU has AVX2 (NBSIM_ROW_LOOP_CLONES). With the levels' huge pages (allocate_level_storage) that takes 1024x1024 from
 // about 1.2-1.5 to about 0.8 times the level-by-level copy (README, Table 1, has the measurements).
 // The two constants are tunable: (64, 64) and the pairs (64, 16), (32, 32), (128, 64), (128, 128)
 // and (64, all) timed within the noise of one another with `nbsim bench nbuffer --only build` at
@@ -171,8 +170,8 @@ template <FarOp Op>
     reduce_row<Op>(src + y * w, y + s < height ? src + (y + s) * w : nullptr, dst + y * w, 0, width, width, s);
 }
 
-NBSIM_ROW_LOOP_CLONES void reduce_rows(FarOp op, const float* src, float* dst, int width,
-                                                           int height, int s, int y0, int y1) noexcept {
+NBSIM_ROW_LOOP_CLONES void reduce_rows(FarOp op, const float* src, float* dst, int width, int height, int s,
+                                       int y0, int y1) noexcept {
   if (op == FarOp::Max) reduce_rows<FarOp::Max>(src, dst, width, height, s, y0, y1);
   else reduce_rows<FarOp::Min>(src, dst, width, height, s, y0, y1);
 }
