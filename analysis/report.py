@@ -5,7 +5,8 @@ Usage: /usr/bin/python3 analysis/report.py DIR
 Reads only the CSV/JSON outputs found under DIR and writes DIR/report/index.html with its PNG plots,
 a CSV copy of every table, and DIR/report/<sweep>_pareto.csv (every row of the sweep plus its Pareto
 marks). The inputs, and the nbsim commands that write them:
-  DIR/table1.jsonl                   nbsim bench nbuffer --only build --json-out DIR/table1.jsonl
+  DIR/table1.jsonl                   nbsim bench nbuffer --only build --json-out DIR/table1.jsonl  (--only build,update
+                                     adds the incremental updates' table: texels/s, against a rebuild)
   DIR/figure4_map.csv                nbsim nbuffer coverage --size 256x256 --out DIR/figure4_map.png
   DIR/table2/table2.json             nbsim table2 TRACE --out DIR/table2  (and DIR/table2/MODE/run.json)
   DIR/sweeps/NAME/results.csv        nbsim explore SWEEP.json --out DIR/sweeps/NAME  (and sweep.json, technique_results.json)
@@ -22,6 +23,7 @@ an input is malformed (the message names the file; the other sections are still 
 import argparse
 import csv
 import html
+import io
 import math
 import os
 import sys
@@ -122,9 +124,9 @@ class Report:
         if not path.exists():
             raise Missing(["table1.jsonl"])
         try:
-            with open(path) as f:
-                rows = table1.read_rows(f)
-            t = table1.table_rows(rows)
+            text = path.read_text()
+            t = table1.table_rows(table1.read_rows(io.StringIO(text)))
+            updates = table1.update_table_rows(table1.read_update_rows(io.StringIO(text)))
         except (OSError, UnicodeDecodeError, ValueError) as e:
             raise BadInput(f"{path}: {e}") from e
         if not t:
@@ -153,6 +155,16 @@ class Report:
         ax.grid(axis="y", which="both", alpha=0.3)
         ax.legend(loc="upper left", fontsize=8)
         img = self.save(fig, "table1.png")
+        update_part = ""
+        if updates:  # present when the input came from --only build,update
+            ucols = [("size", "size", None), ("dirty rectangle", "dirty", None), ("update (ms)", "update_ms", None),
+                     ("texels recomputed", "texels_recomputed", None),
+                     ("texels/s", "texels_per_s", lambda v: "-" if v is None else f"{v / 1e6:.0f} M"),
+                     ("full rebuild (ms)", "rebuild_ms", None), ("update / rebuild", "ratio", lambda v: f"{v:.3g}")]
+            update_part = ("<p>Incremental updates (<code>nbsim bench nbuffer --only build,update</code>): an S x S "
+                           "rectangle in the middle of the image changes; texels recomputed over every level, and "
+                           "their rate, against a full rebuild in the same run.</p>" +
+                           self.table("table1_update", ucols, updates))
         worst = max(t, key=lambda r: r["ratio"])
         return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim bench nbuffer --only build</code>). "
                 "The copy baseline moves exactly the bytes a naive level-by-level build reads and writes; "
@@ -160,7 +172,8 @@ class Report:
                 f"build/copy (worst here: {worst['ratio']:.2f} at {worst['size']}).</p>" + tab +
                 self.figure(img, "Build time per size, log scale. Read off: how build time grows with the "
                             "number of texels (the paper's and ours), and the label above each red bar: the "
-                            "build's cost in units of a plain copy of the same bytes (1.0 would be as cheap as copying)."))
+                            "build's cost in units of a plain copy of the same bytes (1.0 would be as cheap as copying).") +
+                update_part)
 
     # ------------------------------------------------------------------------------ Figure 4
     def figure4(self):

@@ -2,12 +2,45 @@
 #include "model/nbuffer/nbuffer.h"
 
 #include <algorithm>
+#include <new>
 #include <numeric>
 #include <string>
 
 #include "model/common/error.h"
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+// The hot row loops get an AVX2 clone next to the baseline one on x86-64 (GCC and Clang pick one
+// when the program loads); elsewhere they are compiled once, for the target.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define NBSIM_ROW_LOOP_CLONES [[gnu::target_clones("avx2", "default")]]
+#else
+#define NBSIM_ROW_LOOP_CLONES
+#endif
+
 namespace nbsim {
+
+namespace {
+constexpr std::size_t huge_page_bytes = std::size_t{2} << 20;  // x86-64 transparent huge page. Fixed.
+constexpr std::size_t cache_line_bytes = 64;                    // x86-64 cache line. Fixed.
+
+std::align_val_t level_alignment(std::size_t bytes) noexcept {
+  return std::align_val_t{bytes >= huge_page_bytes ? huge_page_bytes : cache_line_bytes};
+}
+}  // namespace
+
+void* allocate_level_storage(std::size_t bytes) {
+  void* p = ::operator new(bytes, level_alignment(bytes));
+#if defined(MADV_HUGEPAGE)
+  // Advice only: where the kernel has no huge pages to give, the build is merely slower.
+  if (bytes >= huge_page_bytes) ::madvise(p, bytes / huge_page_bytes * huge_page_bytes, MADV_HUGEPAGE);
+#endif
+  return p;
+}
+
+void free_level_storage(void* p, std::size_t bytes) noexcept { ::operator delete(p, level_alignment(bytes)); }
 
 namespace {
 
@@ -21,7 +54,7 @@ inline float far2(float a, float b) noexcept {
 // null past the top edge): the farthest of a[x], a[x + s], b[x], b[x + s], skipping what lies
 // outside the image. Written as plain loops so that the compiler vectorizes them.
 template <FarOp Op>
-void reduce_row(const float* a, const float* b, float* out, int x0, int x1, int width, int s) noexcept {
+[[gnu::always_inline]] inline void reduce_row(const float* a, const float* b, float* out, int x0, int x1, int width, int s) noexcept {
   const int split = std::clamp(width - s, x0, x1);  // x < split has x + s inside the image
   if (b) {
     for (int x = x0; x < split; ++x) out[x] = far2<Op>(far2<Op>(a[x], a[x + s]), far2<Op>(b[x], b[x + s]));
@@ -32,9 +65,31 @@ void reduce_row(const float* a, const float* b, float* out, int x0, int x1, int 
   }
 }
 
-void reduce_row(FarOp op, const float* a, const float* b, float* out, int x0, int x1, int width, int s) noexcept {
+NBSIM_ROW_LOOP_CLONES void reduce_row(FarOp op, const float* a, const float* b, float* out, int x0, int x1, int width, int s) noexcept {
   if (op == FarOp::Max) reduce_row<FarOp::Max>(a, b, out, x0, x1, width, s);
   else reduce_row<FarOp::Min>(a, b, out, x0, x1, width, s);
+}
+
+// What apply_row did to one row: texels rewritten, and the first and last of them.
+struct RowChange {
+  long long count = 0;
+  int first = 0, last = -1;
+};
+
+// Writes each row[x] that differs (!=) from out[x], x in [x0, x1). A count first, then a select
+// over the span from the first to the last difference: both vectorize, and a row without changes
+// is only read.
+NBSIM_ROW_LOOP_CLONES RowChange apply_row(const float* __restrict row, float* __restrict out, int x0,
+                                          int x1) noexcept {
+  RowChange c;
+  for (int x = x0; x < x1; ++x) c.count += out[x] != row[x];
+  if (c.count == 0) return c;
+  c.first = x0;
+  while (!(out[c.first] != row[c.first])) ++c.first;
+  c.last = x1 - 1;
+  while (!(out[c.last] != row[c.last])) --c.last;
+  for (int x = c.first; x <= c.last; ++x) out[x] = out[x] != row[x] ? row[x] : out[x];
+  return c;
 }
 
 void grow(Rect& box, int x, int y) noexcept {
@@ -70,63 +125,53 @@ NBuffer::NBuffer(const DepthImage& depth, NBufferConfig config) : NBuffer(depth.
 namespace {
 
 // Full builds (NBuffer::build). A level pass costs about what copying its plane costs plus its
-// arithmetic, and the two overlap poorly. So the build (1) runs level 0 and the levels with small
-// steps band by band, top down, so that the rows a level reads were written a moment ago and are
-// still in L2, and (2) computes four rows y, y + s, y + 2s, y + 3s of a level together from the
-// five rows below, so that each horizontal pair far(a[x], a[x + s]) is loaded and reduced once
-// instead of twice. Together about 15% faster than level by level at 1024x1024.
-// The two constants are tunable: the fastest of the band heights (32 to 256 rows) and banded
-// steps (8 to 128) timed at 1024x1024 on the project's 2-core machines (1 MiB L2 per core).
-constexpr int build_band_rows = 64;      // rows per band: at 1024 px, the bands of the 3 planes in use fit L2
-constexpr int build_band_max_step = 16;  // levels with s <= this are banded; the others go plane by plane
-static_assert(4 * build_band_max_step <= build_band_rows, "a banded level's four-row groups must fit a band");
+// arithmetic, and the two overlap poorly. So the build (1) runs level 0 and the levels with steps
+// up to build_band_max_step band by band, top down, so that the rows a level reads were written a
+// moment ago and are still in cache, (2) computes G rows y, y + s, ..., y + (G - 1) s of a level
+// together from the G + 1 rows below (G = 4; 2 or single rows where four do not fit), so that each
+// horizontal pair far(a[x], a[x + s]) is loaded and reduced once instead of twice, and (3) runs its
+// row loops in an AVX2 clone where the CPU has AVX2 (NBSIM_ROW_LOOP_CLONES). With the levels' huge pages (allocate_level_storage) that takes 1024x1024 from
+// about 1.2-1.5 to about 0.8 times the level-by-level copy (README, Table 1, has the measurements).
+// The two constants are tunable: (64, 64) and the pairs (64, 16), (32, 32), (128, 64), (128, 128)
+// and (64, all) timed within the noise of one another with `nbsim bench nbuffer --only build` at
+// 1024x1024 on the project's shared 2-core machines (1 MiB L2 per core, 32 MiB L3).
+constexpr int build_band_rows = 64;      // rows per band
+constexpr int build_band_max_step = 64;  // levels with s <= this are banded; the others go plane by plane
 
-// Rows y, y + s, y + 2s, y + 3s of level i + 1 (`out`, rows `row_step` floats apart) from rows
-// y .. y + 4s of level i (`in`), all inside the image. Same reduction order as reduce_row, so the
+// Rows y, y + s, ..., y + (G - 1) s of level i + 1 (`out`, rows `row_step` floats apart) from rows
+// y .. y + G s of level i (`in`), all inside the image. Same reduction order as reduce_row, so the
 // results are bit-identical to it (signed zeros and NaNs included).
-template <FarOp Op>
-void reduce_four_rows(const float* __restrict in, float* __restrict out, std::ptrdiff_t row_step, int width,
-                      int s) noexcept {
+template <FarOp Op, int G>
+[[gnu::always_inline]] inline void reduce_row_group(const float* __restrict in, float* __restrict out,
+                                                     std::ptrdiff_t row_step, int width, int s) noexcept {
   const int split = std::clamp(width - s, 0, width);  // x < split has x + s inside the image
-  const float* __restrict i0 = in;
-  const float* __restrict i1 = in + row_step;
-  const float* __restrict i2 = in + 2 * row_step;
-  const float* __restrict i3 = in + 3 * row_step;
-  const float* __restrict i4 = in + 4 * row_step;
-  float* __restrict o0 = out;
-  float* __restrict o1 = out + row_step;
-  float* __restrict o2 = out + 2 * row_step;
-  float* __restrict o3 = out + 3 * row_step;
   for (int x = 0; x < split; ++x) {
-    const float h0 = far2<Op>(i0[x], i0[x + s]), h1 = far2<Op>(i1[x], i1[x + s]), h2 = far2<Op>(i2[x], i2[x + s]);
-    const float h3 = far2<Op>(i3[x], i3[x + s]), h4 = far2<Op>(i4[x], i4[x + s]);
-    o0[x] = far2<Op>(h0, h1);
-    o1[x] = far2<Op>(h1, h2);
-    o2[x] = far2<Op>(h2, h3);
-    o3[x] = far2<Op>(h3, h4);
+    float h[G + 1];
+    for (int k = 0; k <= G; ++k) h[k] = far2<Op>(in[k * row_step + x], in[k * row_step + x + s]);
+    for (int k = 0; k < G; ++k) out[k * row_step + x] = far2<Op>(h[k], h[k + 1]);
   }
-  for (int x = split; x < width; ++x) {
-    o0[x] = far2<Op>(i0[x], i1[x]);
-    o1[x] = far2<Op>(i1[x], i2[x]);
-    o2[x] = far2<Op>(i2[x], i3[x]);
-    o3[x] = far2<Op>(i3[x], i4[x]);
-  }
+  for (int x = split; x < width; ++x)
+    for (int k = 0; k < G; ++k) out[k * row_step + x] = far2<Op>(in[k * row_step + x], in[(k + 1) * row_step + x]);
 }
 
 // Rows [y0, y1) of a level with step s from the level below (`src`), whose rows [y0, height) must
-// be final. Four-row groups where their five source rows exist, single rows elsewhere.
+// be final. Groups of four rows, then of two, where their source rows exist; single rows elsewhere.
 template <FarOp Op>
-void reduce_rows(const float* src, float* dst, int width, int height, int s, int y0, int y1) noexcept {
+[[gnu::always_inline]] inline void reduce_rows(const float* src, float* dst, int width, int height, int s, int y0,
+                                               int y1) noexcept {
   const std::size_t w = static_cast<std::size_t>(width);
   const std::ptrdiff_t row_step = static_cast<std::ptrdiff_t>(s) * width;
   int y = y0;
   for (; y + 4 * s <= y1 && y + 5 * s <= height; y += 4 * s)
-    for (int r = y; r < y + s; ++r) reduce_four_rows<Op>(src + r * w, dst + r * w, row_step, width, s);
+    for (int r = y; r < y + s; ++r) reduce_row_group<Op, 4>(src + r * w, dst + r * w, row_step, width, s);
+  for (; y + 2 * s <= y1 && y + 3 * s <= height; y += 2 * s)
+    for (int r = y; r < y + s; ++r) reduce_row_group<Op, 2>(src + r * w, dst + r * w, row_step, width, s);
   for (; y < y1; ++y)
     reduce_row<Op>(src + y * w, y + s < height ? src + (y + s) * w : nullptr, dst + y * w, 0, width, width, s);
 }
 
-void reduce_rows(FarOp op, const float* src, float* dst, int width, int height, int s, int y0, int y1) noexcept {
+NBSIM_ROW_LOOP_CLONES void reduce_rows(FarOp op, const float* src, float* dst, int width, int height, int s,
+                                       int y0, int y1) noexcept {
   if (op == FarOp::Max) reduce_rows<FarOp::Max>(src, dst, width, height, s, y0, y1);
   else reduce_rows<FarOp::Min>(src, dst, width, height, s, y0, y1);
 }
@@ -200,19 +245,21 @@ UpdateStats NBuffer::update(const DepthImage& depth, const Rect& dirty) {
 
   // Level 0: copy the dirty pixels, note the bounding box of those that changed.
   Rect changed;
-  float* l0 = level_ptr(0);
+  std::vector<float> row(static_cast<std::size_t>(width_));
   for (int y = r.y; y < r.y1(); ++y) {
-    for (int x = r.x; x < r.x1(); ++x) {
-      const float v = quantize_toward_far(depth.at(x, y), config_.format, config_.op);
-      float& t = l0[static_cast<std::size_t>(y) * width_ + x];
-      if (t != v) { t = v; ++stats.texels_changed[0]; grow(changed, x, y); }
+    const float* in = depth.texels.data() + static_cast<std::size_t>(y) * width_;
+    if (config_.format != StorageFormat::F32) {
+      for (int x = r.x; x < r.x1(); ++x) row[static_cast<std::size_t>(x)] = quantize_toward_far(in[x], config_.format, config_.op);
+      in = row.data();
     }
+    const RowChange c = apply_row(in, level_ptr(0) + static_cast<std::size_t>(y) * width_, r.x, r.x1());
+    stats.texels_changed[0] += c.count;
+    if (c.count) { grow(changed, c.first, y); grow(changed, c.last, y); }
   }
   stats.texels_recomputed[0] = r.area();
 
   // Level i: a texel at (x, y) reads level i - 1 at x and x + s, y and y + s, so a change in box B
   // of level i - 1 reaches [B.x - s, B.x1) x [B.y - s, B.y1) of level i, clipped to the image.
-  std::vector<float> row(static_cast<std::size_t>(width_));
   for (int i = 1; i < levels_ && !changed.empty(); ++i) {
     const int s = 1 << (i - 1);
     const Rect reach = clip({changed.x - s, changed.y - s, changed.w + s, changed.h + s}, width_, height_);
@@ -223,14 +270,9 @@ UpdateStats NBuffer::update(const DepthImage& depth, const Rect& dirty) {
       const float* a = src + static_cast<std::size_t>(y) * width_;
       const float* b = y + s < height_ ? a + static_cast<std::size_t>(s) * width_ : nullptr;
       reduce_row(config_.op, a, b, row.data(), reach.x, reach.x1(), width_, s);
-      float* out = dst + static_cast<std::size_t>(y) * width_;
-      for (int x = reach.x; x < reach.x1(); ++x) {
-        if (out[x] != row[static_cast<std::size_t>(x)]) {
-          out[x] = row[static_cast<std::size_t>(x)];
-          ++stats.texels_changed[static_cast<std::size_t>(i)];
-          grow(changed, x, y);
-        }
-      }
+      const RowChange c = apply_row(row.data(), dst + static_cast<std::size_t>(y) * width_, reach.x, reach.x1());
+      stats.texels_changed[static_cast<std::size_t>(i)] += c.count;
+      if (c.count) { grow(changed, c.first, y); grow(changed, c.last, y); }
     }
     stats.texels_recomputed[static_cast<std::size_t>(i)] = reach.area();
   }

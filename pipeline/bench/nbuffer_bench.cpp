@@ -290,6 +290,7 @@ void run_update(const NBufferBenchOptions& options, const std::function<void(con
     line["rebuild_ms"] = sig4(rebuild_ms);
     line["ratio"] = sig4(update_ms / rebuild_ms);
     line["texels_recomputed"] = c->recomputed;
+    line["texels_per_s"] = std::llround(sig4(static_cast<double>(c->recomputed) / (update_ms * 1e-3)));
     emit(line);
   }
 }

@@ -9,19 +9,23 @@
 // Lines (nlohmann::ordered_json, in this key order):
 // - {"bench":"build","size":"WxH","levels":L,"build_ms":t,"copy_ms":c,"ratio":t/c}, one per size
 //   256x256, 512x512, 640x480, 1024x1024, depth = scenes::city_depth(W, H, 1).
-//   build_ms: NBuffer::build() of every level (F32, max) into an NBuffer allocated beforehand.
+//   build_ms: NBuffer::build() of every level (F32, max) into an NBuffer allocated beforehand (its
+//   levels in the N-buffer's own storage: 64-byte aligned, huge pages advised on Linux).
 //   copy_ms: the streaming-copy baseline, i.e. exactly the bytes a naive level-by-level build reads
 //   and writes: L - 1 memcpy's of a W*H float plane, plane i to plane i + 1 (i = 0 .. L-2), in one
-//   buffer of L planes. ratio < 1 means the build costs less than streaming its levels once.
+//   std::vector of L planes (default allocation). ratio < 1 means the build costs less than
+//   streaming its levels once.
 // - {"bench":"query","size":"1024x1024","method":m,"queries_per_s":q,"ratio_vs_four":r} for m in
 //   four (NBuffer four-square covering), one (one-square covering), hiz (HiZPyramid), brute (scan
 //   every level-0 pixel of the rectangle: the reference). 4096 pre-generated random rectangles,
 //   fixed seed, each side log-uniform in 1..512 px, placed uniformly inside the image.
 // - {"bench":"update","size":"1024x1024","dirty":"SxS","update_ms":u,"rebuild_ms":b,"ratio":u/b,
-//   "texels_recomputed":n} for S in 1, 8, 64, 256: NBuffer::update(depth, rect) for an S x S rect
-//   centred in the image whose depths are halved (nearer), alternating with the original depths so
-//   that every iteration changes the rect; rebuild_ms is a full NBuffer::build() in the same run;
-//   n is UpdateStats::total_recomputed() of one such update (all levels, level 0 included).
+//   "texels_recomputed":n,"texels_per_s":n/u} for S in 1, 8, 64, 256: NBuffer::update(depth, rect)
+//   for an S x S rect centred in the image whose depths are halved (nearer), alternating with the
+//   original depths so that every iteration changes the rect; rebuild_ms is a full NBuffer::build()
+//   in the same run; n is UpdateStats::total_recomputed() of one such update (all levels, level 0
+//   included) and texels_per_s is n divided by update_ms in seconds (a full build recomputes
+//   L * W * H texels in rebuild_ms, for comparison).
 #pragma once
 
 #include <nlohmann/json.hpp>

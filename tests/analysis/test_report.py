@@ -972,6 +972,41 @@ class Table1Input(unittest.TestCase):
         self.assertEqual(len(array), 1)
         self.assertEqual(table1.table_rows(array)[0]["paper_ms_2005_gpu"], 2.0)
 
+    def test_update_rows_and_their_rate(self):
+        # update lines are read apart from build lines; texels_per_s is taken as given, or derived when absent
+        import io
+        objs = [{"bench": "build", "size": "256x256", "levels": 8, "build_ms": 0.1, "copy_ms": 0.05, "ratio": 2.0},
+                {"bench": "update", "size": "1024x1024", "dirty": "8x8", "update_ms": 0.002, "rebuild_ms": 2.0,
+                 "ratio": 0.001, "texels_recomputed": 500, "texels_per_s": 250000000},
+                {"bench": "update", "size": "1024x1024", "dirty": "1x1", "update_ms": 0.0001, "rebuild_ms": 2.0,
+                 "ratio": 0.00005, "texels_recomputed": 5}]
+        text = "\n".join(json.dumps(o) for o in objs)
+        self.assertEqual(len(table1.read_rows(io.StringIO(text))), 1, "update lines are not build rows")
+        u = table1.update_table_rows(table1.read_update_rows(io.StringIO(text)))
+        self.assertEqual([r["dirty"] for r in u], ["8x8", "1x1"])
+        self.assertEqual(u[0]["texels_per_s"], 250000000.0)
+        self.assertAlmostEqual(u[1]["texels_per_s"], 5 / 0.0001e-3, delta=1.0, msg="derived: texels / update seconds")
+        with self.assertRaises(ValueError):
+            table1.update_table_rows([{"bench": "update", "size": "1x1", "dirty": "1x1", "update_ms": "x"}])
+
+    def test_report_shows_update_table_when_present(self):
+        # table1.jsonl with update lines (--only build,update): the Table 1 section adds the update table and its CSV
+        with tempfile.TemporaryDirectory() as tmp:
+            d = Path(tmp)
+            lines = [json.dumps(o) for o in json.loads((FIXTURE / "table1.jsonl").read_text())]
+            lines.append(json.dumps({"bench": "update", "size": "1024x1024", "dirty": "64x64", "update_ms": 0.03,
+                                     "rebuild_ms": 3.0, "ratio": 0.01, "texels_recomputed": 41471,
+                                     "texels_per_s": 1382000000}))
+            (d / "table1.jsonl").write_text("\n".join(lines) + "\n")
+            rc, _, err = run_report(d)
+            self.assertEqual(rc, 0, err)
+            html = (d / "report" / "index.html").read_text()
+            self.assertIn("texels/s", html)
+            self.assertIn("1382 M", html, "the update's rate in millions of texels per second")
+            rows = (d / "report" / "table1_update.csv").read_text().splitlines()
+            self.assertEqual(rows[0].split(",")[:2], ["size", "dirty"])
+            self.assertEqual(len(rows), 2, "one row per update line")
+
 
 if __name__ == "__main__":
     unittest.main()
