@@ -167,7 +167,8 @@ class Report:
                            self.table("table1_update", ucols, updates))
         worst = max(t, key=lambda r: r["ratio"])
         return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim bench nbuffer --only build</code>). "
-                "The copy baseline moves exactly the bytes a naive level-by-level build reads and writes; "
+                "The copy baseline moves exactly the bytes a naive level-by-level build reads and writes, in the same "
+                "kind of memory as the levels; "
                 "the paper's times are for its 2005 GPU, ours for one CPU core, so compare the shape, and "
                 f"build/copy (worst here: {worst['ratio']:.2f} at {worst['size']}).</p>" + tab +
                 self.figure(img, "Build time per size, log scale. Read off: how build time grows with the "

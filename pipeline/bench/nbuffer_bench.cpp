@@ -136,7 +136,7 @@ void run_build(const NBufferBenchOptions& options, const std::function<void(cons
     int w, h;
     DepthImage depth;
     NBuffer nb;
-    std::vector<float> planes;  // L planes of W*H floats for the copy baseline
+    std::vector<float, LevelAllocator<float>> planes;  // L planes of W*H floats for the copy baseline, in the levels' kind of memory
   };
   const std::pair<int, int> sizes[] = {{256, 256}, {512, 512}, {640, 480}, {1024, 1024}};
   std::vector<std::unique_ptr<Case>> cases;

@@ -13,8 +13,9 @@
 //   levels in the N-buffer's own storage: 64-byte aligned, huge pages advised on Linux).
 //   copy_ms: the streaming-copy baseline, i.e. exactly the bytes a naive level-by-level build reads
 //   and writes: L - 1 memcpy's of a W*H float plane, plane i to plane i + 1 (i = 0 .. L-2), in one
-//   std::vector of L planes (default allocation). ratio < 1 means the build costs less than
-//   streaming its levels once.
+//   buffer of L planes allocated as the levels are (LevelAllocator: the same alignment and pages,
+//   so that the ratio measures the build, not the memory). ratio < 1 means the build costs less
+//   than streaming its levels once.
 // - {"bench":"query","size":"1024x1024","method":m,"queries_per_s":q,"ratio_vs_four":r} for m in
 //   four (NBuffer four-square covering), one (one-square covering), hiz (HiZPyramid), brute (scan
 //   every level-0 pixel of the rectangle: the reference). 4096 pre-generated random rectangles,
