@@ -86,7 +86,7 @@ CheckedSweep check_sweep(const ExploreOptions& o) {
   s.spec = explore::parse_sweep(j, o.sweep, o.max_points);
   for (const auto& t : s.spec.traces) {
     try {
-      s.traces.emplace(t, explore::inspect_trace(t));
+      s.traces.emplace(t, explore::inspect_trace(t, o.point.empty()));  // --point writes no checksum: none read
     } catch (const InputError& e) {
       throw InputError(fmt::format("{}: traces: {}", o.sweep, e.what()));
     }

@@ -15,7 +15,7 @@ namespace nbsim::explore {
 
 namespace fs = std::filesystem;
 
-TraceFile inspect_trace(const std::string& as_written) {
+TraceFile inspect_trace(const std::string& as_written, bool checksum) {
   std::error_code ec;
   const fs::path p = fs::absolute(as_written, ec);
   if (ec || !fs::is_regular_file(p, ec)) throw InputError(fmt::format("trace '{}' does not exist or is not a file", as_written));
@@ -23,12 +23,12 @@ TraceFile inspect_trace(const std::string& as_written) {
   if (!in) throw InputError(fmt::format("trace '{}' cannot be read", as_written));
   uLong crc = crc32(0L, Z_NULL, 0);
   std::vector<char> buf(1 << 20);
-  while (in) {
+  while (checksum && in) {
     in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
     const auto n = in.gcount();
     if (n > 0) crc = crc32(crc, reinterpret_cast<const Bytef*>(buf.data()), static_cast<uInt>(n));
   }
-  TraceFile t{p, fmt::format("{:08x}", static_cast<std::uint32_t>(crc)), "", ""};
+  TraceFile t{p, checksum ? fmt::format("{:08x}", static_cast<std::uint32_t>(crc)) : std::string(), "", ""};
   try {
     const trace::TraceReader reader(p);
     if (const std::string* technique = reader.property("technique")) t.technique = *technique;

@@ -29,8 +29,9 @@ struct TraceFile {
 // reads its technique; throws InputError naming the file when it does not exist, cannot be read,
 // or cannot be opened as a trace (TraceReader: preamble, header and scene), so that a sweep over
 // a file that is not a trace is refused before any point runs. Damage after the header is found
-// by the replay: its points fail one by one in results.csv.
-TraceFile inspect_trace(const std::string& as_written);
+// by the replay: its points fail one by one in results.csv. Without `checksum` (one point run by
+// itself: each Slurm task), crc32 stays "" and the file is not read whole.
+TraceFile inspect_trace(const std::string& as_written, bool checksum = true);
 
 struct RunOptions {
   std::filesystem::path out;   // the sweep's folder
