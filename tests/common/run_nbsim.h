@@ -12,6 +12,8 @@
 #include <iterator>
 #include <string>
 
+#include "tests/common/scratch.h"
+
 namespace nbsim::testing {
 
 struct CliResult {
@@ -38,14 +40,6 @@ inline CliResult run_nbsim_env(const std::string& env, const std::string& args) 
 }
 
 inline CliResult run_nbsim(const std::string& args) { return run_nbsim_env("", args); }
-
-// A per-process scratch folder under the test temp dir: <prefix>_<pid>/<name>.
-inline std::filesystem::path scratch_path(const std::string& prefix, const std::string& name) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / (prefix + "_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
 
 // What a shell command writes on stdout (its exit status is not looked at).
 inline std::string shell_output(const std::string& cmd) {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "model/common/error.h"
+#include "tests/common/scratch.h"
 
 namespace nbsim::config {
 namespace {
@@ -102,8 +103,7 @@ TEST(JsonInputTest, ExcerptsBounded) {
 
 // Reading a file: a directory and a missing file are named as such, a whole file is read past NUL bytes.
 TEST(JsonInputTest, ReadsWholeFilesOnly) {
-  const fs::path dir = fs::temp_directory_path() / ("nbsim_json_input_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = nbsim::testing::scratch_dir("nbsim_json_input");
   try {
     read_input_file(dir.string(), "config file");
     ADD_FAILURE() << "a directory was read";

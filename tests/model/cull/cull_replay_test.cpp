@@ -24,7 +24,7 @@ std::string sample(const std::string& name) { return (std::filesystem::path(NBSI
 
 // Replays `trace` in `mode` into a fresh folder; returns run.json's cull summary.
 nlohmann::json replay_cull(const std::string& trace, const std::string& mode, const std::string& extra = "") {
-  const auto out = std::filesystem::temp_directory_path() / ("nbsim_cull_" + mode + "_" + std::to_string(::getpid()));
+  const auto out = nbsim::testing::scratch_path("nbsim_cull", mode);
   std::filesystem::remove_all(out);
   const auto r = run_nbsim("replay " + sample(trace) + " --set cull.mode=" + mode + " " + extra + " --out " + out.string());
   EXPECT_EQ(r.status, 0) << r.err;

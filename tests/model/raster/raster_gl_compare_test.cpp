@@ -12,6 +12,7 @@
 
 #include "tests/model/raster/trace_compare.h"
 #include "traces/capture/capture.h"
+#include "tests/common/scratch.h"
 
 namespace nbsim::raster_compare {
 namespace {
@@ -26,8 +27,7 @@ struct Capture {
 };
 
 CompareSummary capture_and_compare(const Capture& c) {
-  const fs::path dir = fs::temp_directory_path() / ("nbsim_raster_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = nbsim::testing::scratch_dir("nbsim_raster");
   const fs::path file = dir / (std::string(c.name) + ".nbtrace");
   capture::CaptureOptions o;
   o.width = 160;

@@ -17,6 +17,7 @@
 #include "model/common/error.h"
 #include "model/sim/timeline.h"
 #include "model/sim/unit.h"
+#include "tests/common/scratch.h"
 
 extern "C" int sc_main(int, char*[]) { return 1; }  // libsystemc's main() needs one; gtest's main runs
 
@@ -26,9 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("nbsim_timeline_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
+  return nbsim::testing::scratch_path("nbsim_timeline", name);
 }
 
 TimelineOptions options(std::optional<fs::path> json, std::optional<fs::path> vcd, std::uint64_t max_events = 1000) {

@@ -42,7 +42,9 @@ TEST(LdiTable1CliTest, RowsPerShapeAndSide) {
     EXPECT_NEAR(row.at("c_ratio").get<double>(), row.at("m_comp").get<double>() / row.at("m_crop").get<double>(), 1e-12);
     EXPECT_EQ(row.at("paper_c_ratio").is_null(), !sphere) << "the paper's sphere row sits beside ours";
     // a sphere's test reads its texel's first layer, and the second when the point lies behind the first
-    if (sphere) EXPECT_LE(row.at("fetches_per_test_layers").get<double>(), 2.0);
+    if (sphere) {
+      EXPECT_LE(row.at("fetches_per_test_layers").get<double>(), 2.0);
+    }
   }
   std::filesystem::remove_all(out);
 }

@@ -23,9 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("nbsim_cli_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
+  return nbsim::testing::scratch_path("nbsim_cli", name);
 }
 
 using nbsim::testing::CliResult;

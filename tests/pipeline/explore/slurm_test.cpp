@@ -64,7 +64,7 @@ TEST(SlurmPiecesTest, ShellQuoteRoundTrips) {
 // The batch script picks line offset + task id + 1 of the task list and passes the point's id,
 // the absolute paths and the extra arguments; a task beyond the list fails with a message.
 TEST(SlurmPiecesTest, BatchScriptPicksItsPoint) {
-  const fs::path dir = fs::temp_directory_path() / ("nbsim_slurm_pieces_" + std::to_string(::getpid()));
+  const fs::path dir = nbsim::testing::scratch_dir("nbsim_slurm_pieces");
   fs::create_directories(dir / "a dir");
   const fs::path tasks = dir / "a dir" / "x.tasks", script = dir / "x.sh";
   std::ofstream(tasks) << "aaaa\nbbbb\ncccc\ndddd\n";

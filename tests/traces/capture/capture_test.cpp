@@ -21,6 +21,7 @@
 #include "traces/capture/scenes.h"
 #include "traces/capture/technique.h"
 #include "traces/format/reader.h"
+#include "tests/common/scratch.h"
 
 namespace nbsim::capture {
 namespace {
@@ -161,7 +162,7 @@ TEST(CaptureTest, TraceFileChecksItself) {
     o.frames = 4;
     o.options = {{"objects", "800"}, {"seed", "5"}, {"mode", "nb"}, {"levels-every", "1"}};
     o.reversed_z = reversed;
-    const auto file = std::filesystem::path(::testing::TempDir()) / ("capture_" + std::to_string(::getpid()) + ".nbt");
+    const auto file = nbsim::testing::scratch_path("nbsim_capture", "capture.nbt");
     const CaptureSummary sum = capture(o, file.string());
     EXPECT_EQ(sum.frames, 4);
     EXPECT_EQ(sum.visible_not_rendered, 0u);
@@ -233,8 +234,8 @@ TEST(CaptureTest, EveryTechniqueRunsOnEverySceneAndPath) {
         o.frames = 2;
         for (const auto& spec : sc.info.options)
           if (spec.name == "objects") o.options.set("objects", "300");
-        const auto file = std::filesystem::path(::testing::TempDir()) /
-                          ("every_" + std::to_string(::getpid()) + "_" + t.info.name + "_" + sc.info.name + "_" + p.info.name + ".nbt");
+        const auto file =
+            nbsim::testing::scratch_path("nbsim_capture", "every_" + t.info.name + "_" + sc.info.name + "_" + p.info.name + ".nbt");
         CaptureSummary sum;
         try {
           sum = capture(o, file.string());
@@ -264,7 +265,7 @@ TEST(CaptureTest, EveryTechniqueRunsOnEverySceneAndPath) {
 // partial trace, for every technique: neither OUT nor its temporary OUT.partial exists after it,
 // and an OUT already there is left as it was.
 TEST(CaptureTest, FailedCaptureLeavesNoPartialFile) {
-  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / ("partial_" + std::to_string(::getpid()));
+  const std::filesystem::path dir = nbsim::testing::scratch_path("nbsim_capture", "partial");
   std::filesystem::create_directories(dir);
   for (const TechniqueRow& t : technique_table()) {
     SCOPED_TRACE(t.info.name);

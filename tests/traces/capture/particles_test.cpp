@@ -20,6 +20,7 @@
 #include "traces/capture/scenes.h"
 #include "traces/format/particles_chunk.h"
 #include "traces/format/reader.h"
+#include "tests/common/scratch.h"
 
 namespace nbsim::capture {
 namespace {
@@ -38,7 +39,7 @@ CaptureOptions small(const std::string& mode, const std::string& sprite = "16") 
 }
 
 fs::path scratch(const std::string& name) {
-  return fs::path(::testing::TempDir()) / ("particles_" + std::to_string(::getpid()) + "_" + name + ".nbt");
+  return nbsim::testing::scratch_path("nbsim_particles", name + ".nbt");
 }
 
 // The PRTC record's fields by name.

@@ -22,6 +22,7 @@
 #include "traces/capture/scenes.h"
 #include "traces/format/reader.h"
 #include "traces/format/shadows_chunk.h"
+#include "tests/common/scratch.h"
 
 namespace nbsim::capture {
 namespace {
@@ -29,7 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  return fs::path(::testing::TempDir()) / ("shadows_" + std::to_string(::getpid()) + "_" + name + ".nbt");
+  return nbsim::testing::scratch_path("nbsim_shadows", name + ".nbt");
 }
 
 // A small capture: 128x96, 2 frames of the flyover, litmaps of 128, small scenes.

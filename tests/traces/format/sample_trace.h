@@ -23,6 +23,7 @@
 #include "traces/format/reader.h"
 #include "traces/format/technique_chunks.h"
 #include "traces/format/writer.h"
+#include "tests/common/scratch.h"
 
 namespace nbsim::trace::testing {
 
@@ -30,9 +31,7 @@ namespace fs = std::filesystem;
 using Bytes = std::vector<std::uint8_t>;
 
 inline fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("nbsim_trace_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
+  return nbsim::testing::scratch_path("nbsim_trace", name);
 }
 
 inline Bytes read_file(const fs::path& p) {
