@@ -61,9 +61,10 @@ struct ExploreOptions {
   int max_running = 0;
   std::vector<std::string> sbatch_args;
   double poll_seconds = 2.0;
+  double cluster_timeout = 300.0;
   std::string point;  // --point N|ID
   bool collect = false;
-  bool max_points_set = false, jobs_set = false;
+  bool max_points_set = false, jobs_set = false, slurm_waits_set = false;
 };
 
 // Ctrl-C and SIGTERM while a Slurm sweep waits: the wait loop sees the flag and cancels the arrays.
@@ -128,8 +129,8 @@ void print_failures(const fs::path& out, const std::vector<explore::Point>& poin
 
 void check_option_combinations(const ExploreOptions& o) {
   const bool slurm = o.engine == "slurm";
-  if (!slurm && (!o.partition.empty() || o.max_running > 0 || !o.sbatch_args.empty()))
-    throw InputError("--partition, --max-running and --sbatch-arg are options of --engine slurm");
+  if (!slurm && (!o.partition.empty() || o.max_running > 0 || !o.sbatch_args.empty() || o.slurm_waits_set))
+    throw InputError("--partition, --max-running, --sbatch-arg, --poll-seconds and --cluster-timeout are options of --engine slurm");
   if (slurm && o.jobs_set) throw InputError("--jobs is an option of --engine local; with --engine slurm, --max-running limits the tasks");
   // sbatch arguments the engine sets itself: a user's value would break the task-to-point mapping.
   for (const auto& a : o.sbatch_args) {
@@ -224,6 +225,7 @@ int run_explore(const ExploreOptions& given) {
     so.sbatch_args = o.sbatch_args;
     if (o.max_points_set) so.task_args = {"--max-points", std::to_string(o.max_points)};
     so.poll_seconds = o.poll_seconds;
+    so.cluster_timeout_seconds = o.cluster_timeout;
     so.cluster = *cluster;
     std::vector<fs::path> shared = {out, fs::path(o.sweep), ro.exe};
     for (const auto& [name, t] : s.traces) shared.push_back(t.path);
@@ -303,6 +305,11 @@ void add_explore_command(CLI::App& app, Action& action) {
   cmd->add_option("--poll-seconds", o->poll_seconds, "--engine slurm: seconds between two looks at the tasks' states (squeue)")
       ->check(CLI::Range(0.1, 3600.0))
       ->capture_default_str();
+  cmd->add_option("--cluster-timeout", o->cluster_timeout,
+                  "--engine slurm: seconds squeue may fail in a row (a controller down or failing over) before the wait "
+                  "ends; the tasks not seen to end are recorded as failed, and --collect merges them once they have run")
+      ->check(CLI::Range(1.0, 7.0 * 86400.0))
+      ->capture_default_str();
   cmd->add_option("--point", o->point,
                   "Run one point only, N (its index in sweep.json, references included) or its id, into DIR/points/<id>/; "
                   "what each Slurm array task runs. Writes no shared file: --collect merges");
@@ -332,6 +339,7 @@ void add_explore_command(CLI::App& app, Action& action) {
   cmd->callback([&action, o, cmd] {
     o->max_points_set = cmd->count("--max-points") > 0;
     o->jobs_set = cmd->count("--jobs") > 0;
+    o->slurm_waits_set = cmd->count("--poll-seconds") + cmd->count("--cluster-timeout") > 0;
     action = [o] { return run_explore(*o); };
   });
 }

@@ -31,9 +31,6 @@ constexpr double kCommandTimeoutS = 120.0;
 // Tunable. A task that squeue stopped listing (MinJobAge after its end, 300 s by default, or a
 // purge) is settled from its point folder after this many polls without it.
 constexpr int kPollsBeforeGone = 3;
-// Tunable. squeue failing this long in a row ends the wait: the arrays may still run, and
-// `--collect` merges them later.
-constexpr double kSqueueGiveUpS = 300.0;
 // Tunable. A task that ended COMPLETED or FAILED before its run.json or error.txt shows here (a
 // network file system's attribute cache can lag behind the node that wrote them) is settled after
 // this long at the latest.
@@ -363,14 +360,14 @@ SlurmReport run_points_slurm(const std::vector<Point>& points, const SlurmOption
           settle(t, o, report.cancelled);
         }
       }
-    } else if (std::chrono::duration<double>(std::chrono::steady_clock::now() - last_answer).count() > kSqueueGiveUpS) {
+    } else if (std::chrono::duration<double>(std::chrono::steady_clock::now() - last_answer).count() > o.cluster_timeout_seconds) {
       for (Task& t : tasks)
         if (!t.settled) {
           t.settled = t.failed = true;
           write_text(point_dir(o.out, *t.point) / "error.txt",
                      fmt::format("squeue did not answer for {:.0f} s while Slurm task {} was {}: {}; run `nbsim explore ... "
                                  "--collect` once the array has ended\n",
-                                 kSqueueGiveUpS, task_name(t), t.state, first_lines(q.err, 2)));
+                                 o.cluster_timeout_seconds, task_name(t), t.state, first_lines(q.err, 2)));
         }
     }
     if (cancel_deadline && std::chrono::steady_clock::now() > *cancel_deadline) {

@@ -50,6 +50,7 @@ struct SlurmOptions {
   std::vector<std::string> sbatch_args;  // passed to sbatch as given
   std::vector<std::string> task_args;    // appended to each task's `nbsim explore ... --point ID`
   double poll_seconds = 2.0;             // between two squeue calls
+  double cluster_timeout_seconds = 300.0;  // squeue failing this long in a row ends the wait
   ClusterInfo cluster;
   std::function<void(const SlurmProgress&)> progress;  // after each poll
   std::function<bool()> cancel_requested;              // polled often; true: scancel and stop

@@ -2,9 +2,10 @@
 // slurmctld, slurmd started by the CTest fixture SlurmCluster: scripts/slurm-cluster, SLURM_CONF
 // in the environment). A sweep's merged results equal a local run's (host time aside) and resume
 // across engines; a failing point is recorded with the replay's own message; Ctrl-C cancels the
-// array and records the cancelled tasks; a task cancelled from outside is recorded; no sbatch, a
-// controller that does not answer, an SLURM_CONF that does not parse and a partition sbatch refuses
-// exit 2 before anything runs.
+// array and records the cancelled tasks; a task cancelled from outside is recorded; a controller
+// that dies mid-run ends the wait after --cluster-timeout with the tasks recorded, and a later run
+// finishes them; no sbatch, a controller that does not answer, an SLURM_CONF that does not parse
+// and a partition sbatch refuses exit 2 before anything runs.
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -292,6 +293,54 @@ TEST_F(SlurmCliTest, CancelledFromOutsideRecorded) {
     EXPECT_TRUE(has(row.at("error"), "Slurm task " + job + "_")) << row.at("error");
     EXPECT_TRUE(has(row.at("error"), "ended CANCELLED")) << row.at("error");
   }
+}
+
+// A second cluster of its own (the fixture's must live on): its controller is killed while the
+// tasks wait, squeue fails, and after --cluster-timeout the wait ends with exit status 1 and every
+// task recorded with what happened. A later run on a live cluster runs those points and finishes.
+TEST_F(SlurmCliTest, ControllerLostMidRun) {
+  const fs::path cluster = scratch("lost_cluster");
+  const std::string script = std::string(NBSIM_SOURCE_DIR) + "/scripts/slurm-cluster";
+  const std::string started =
+      shell_output("NBSIM_SLURM_MESSAGE_TIMEOUT=2 bash " + script + " start " + cluster.string() + " 2>&1; echo status=$?");
+  struct StopCluster {
+    std::string cmd;
+    ~StopCluster() { shell_output(cmd); }
+  } stop{"bash " + script + " stop " + cluster.string() + " 2>&1"};
+  ASSERT_TRUE(has(started, "status=0")) << started;
+  const std::string fixture_conf = slurm_conf();
+  ASSERT_EQ(setenv("SLURM_CONF", (cluster / "slurm.conf").c_str(), 1), 0);
+
+  const fs::path f = write_sweep("lost.json", {{"traces", {kSample}}, {"axes", {{"cull.mode", {"nb", "nb_hier"}}}}});
+  const fs::path out = scratch("lost");
+  // --hold keeps the tasks pending: the controller dies with both of them waiting.
+  Background b({"explore", f.string(), "--out", out.string(), "--engine", "slurm", "--sbatch-arg=--hold", "--poll-seconds", "0.3",
+                "--cluster-timeout", "2"},
+               "lost");
+  ASSERT_GT(b.pid, 0);
+  ASSERT_TRUE(wait_until([&] { return !submitted_jobs(out).empty(); }, 60)) << read_text(b.err_file);
+  const std::string pid = read_text(cluster / "slurmctld.pid");
+  ASSERT_FALSE(pid.empty());
+  kill(std::stoi(pid), SIGKILL);
+  const int status = b.wait(120);
+  const std::string text = read_text(b.out_file) + read_text(b.err_file);
+  EXPECT_EQ(status, 1) << text;
+  const std::string job = submitted_jobs(out)[0];
+  auto rows = read_csv(out / "results.csv");
+  ASSERT_EQ(rows.size(), 2u) << text;
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "failed");
+    EXPECT_TRUE(has(row.at("error"), "squeue did not answer for 2 s while Slurm task " + job + "_")) << row.at("error");
+    EXPECT_TRUE(has(row.at("error"), "--collect")) << row.at("error");
+  }
+
+  // The fixture's cluster stands for the controller come back: the recorded points run again.
+  ASSERT_EQ(setenv("SLURM_CONF", fixture_conf.c_str(), 1), 0);
+  const CliResult r = run_nbsim("explore " + f.string() + " --out " + out.string() + " --engine slurm --poll-seconds 0.3");
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "2 run, 0 resumed, 0 failed")) << r.out;
+  rows = read_csv(out / "results.csv");
+  for (const auto& row : rows) EXPECT_EQ(row.at("status"), "ok") << row.at("error");
 }
 
 // A free TCP port on the loopback (nothing listens on it once this returns).
