@@ -18,7 +18,7 @@ using testing::CliResult;
 using testing::run_nbsim;
 
 TEST(LdiTable1CliTest, RowsPerShapeAndSide) {
-  const std::filesystem::path out = std::filesystem::temp_directory_path() / "nbsim_ldi_table1_cli";
+  const std::filesystem::path out = nbsim::testing::scratch_path("nbsim_ldi_cli", "table1");
   std::filesystem::remove_all(out);
   const CliResult r = run_nbsim("ldi table1 --shapes sphere,nested:2 --sizes 32,48 --points 300 --json --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.err;
@@ -50,7 +50,7 @@ TEST(LdiTable1CliTest, RowsPerShapeAndSide) {
 }
 
 TEST(LdiTable1CliTest, BadArgumentsAreRefused) {
-  const std::filesystem::path open = std::filesystem::temp_directory_path() / "nbsim_ldi_table1_open.obj";
+  const std::filesystem::path open = nbsim::testing::scratch_path("nbsim_ldi_cli", "open.obj");
   std::ofstream(open) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n";  // a tetrahedron missing a face
   struct Row {
     std::string args, says;

@@ -13,6 +13,7 @@
 
 #include "model/common/error.h"
 #include "model/mesh/mesh.h"
+#include "tests/common/scratch.h"
 #include "traces/capture/ldi/mesh_loader.h"
 
 namespace nbsim::capture {
@@ -26,7 +27,7 @@ void skip_without(const std::string& file) {
 }
 
 std::string scratch_file(const std::string& name, const std::string& text) {
-  const std::filesystem::path p = std::filesystem::temp_directory_path() / ("nbsim_mesh_loader_" + name);
+  const std::filesystem::path p = nbsim::testing::scratch_path("nbsim_mesh_loader", name);
   std::ofstream(p) << text;
   return p.string();
 }
@@ -130,7 +131,6 @@ TEST(MeshLoaderTest, BadFilesAreRefused) {
     const std::string message = load_error(c.path);
     EXPECT_NE(message.find("mesh file '" + c.path + "'"), std::string::npos) << c.why << ": " << message;
     EXPECT_NE(message.find(c.reason), std::string::npos) << c.why << ": " << message;
-    if (c.path.starts_with(std::filesystem::temp_directory_path().string())) std::filesystem::remove(c.path);
   }
 }
 
