@@ -13,8 +13,9 @@
 #endif
 
 // The hot row loops get an AVX2 clone next to the baseline one on x86-64 (GCC and Clang pick one
-// when the program loads); elsewhere they are compiled once, for the target.
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+// when the program loads); elsewhere they are compiled once, for the target. NBSIM_BASELINE_ONLY
+// leaves the AVX2 clone out: the test binary nbuffer_baseline_tests runs the baseline loops so.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(NBSIM_BASELINE_ONLY)
 #define NBSIM_ROW_LOOP_CLONES [[gnu::target_clones("avx2", "default")]]
 #else
 #define NBSIM_ROW_LOOP_CLONES
