@@ -102,7 +102,7 @@ TEST(CullReplayTest, ModeNoneCullsNothing) {
 
 // An unknown culling mode is the user's error: a message and exit status 2.
 TEST(CullReplayTest, UnknownModeIsRefused) {
-  const auto r = run_nbsim("replay " + sample("city_small_oq.nbt") + " --set cull.mode=nbuffer --out /tmp/nbsim_cull_bad");
+  const auto r = run_nbsim("replay " + sample("city_small_oq.nbt") + " --set cull.mode=nbuffer --out " + nbsim::testing::scratch_path("nbsim_cull", "bad").string());
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(testing::has(r.err, "cull.mode")) << r.err;
 }
