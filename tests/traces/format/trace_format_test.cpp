@@ -456,7 +456,10 @@ TEST(TraceFormatTest, RefusesUnopenableFiles) {
 // Breaking the writer's order is a bug of the caller: it aborts with a message.
 TEST(TraceWriterDeathTest, AbortsOnMisuse) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
-  const fs::path f = scratch("misuse.nbtrace");
+  // The threadsafe style runs this body again in a child process that dies (no clean-up): the
+  // child inherits the path through the environment and writes into this process's scratch folder.
+  if (!std::getenv("NBSIM_MISUSE_TRACE")) ::setenv("NBSIM_MISUSE_TRACE", scratch("misuse.nbtrace").c_str(), 1);
+  const fs::path f = std::getenv("NBSIM_MISUSE_TRACE");
   EXPECT_DEATH(
       {
         TraceWriter w(f, {});
