@@ -76,9 +76,14 @@ std::string read(const std::string& path, FloatImage& image) try {
                          file_bytes, offset, w, h, pixel_bytes);
   }
   image.pixels.resize(static_cast<std::size_t>(w * h));
-  if (!in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+  // OpenImageIO's TIFF reader records a strip it fails to read as an error but still returns true
+  // (the pixels stay as they were: zeros), so its error state is checked too.
+  const bool decoded = in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, image.pixels.data());
+  if (!decoded || in->has_error()) {
+    image.pixels.clear();
     return fmt::format("cannot be read: {}",
                        reason(in->geterror(), "OpenImageIO cannot decode its pixel data (a truncated or damaged file?)"));
+  }
   in->close();
   return "";
 } catch (const std::exception& e) {

@@ -17,6 +17,7 @@
 
 #include "pipeline/io/image_io.h"
 #include "tests/common/run_nbsim.h"
+#include "tests/pipeline/io/tiff_builder.h"
 
 namespace {
 
@@ -256,6 +257,64 @@ TEST(NBufferCliTest, RefusesExrAttributePastTheFileEnd) {
   r = nbsim("nbuffer query --depth " + text.string() + " --rect 0,0,1,1");
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(has(r.err, "not a depth image format nbsim reads (OpenEXR, TIFF, PNG or PFM")) << r.err;
+}
+
+// fuzz_depth_image's third finding: a 230-byte TIFF declaring 11825x4 pixels in strips of 63008
+// rows, its one strip past the end of the file. OpenImageIO sized its read buffer by RowsPerStrip
+// (2.98 GB) and, when that fitted, returned zeros without an error: `nbuffer build` wrote 14
+// levels of 0.0 and exited 0. Now refused (exit 2, the file and the field named) before
+// OpenImageIO opens it, within a few hundred MB, and the output folder it asked for is not left.
+TEST(NBufferCliTest, RefusesTiffWhoseStripsDoNotFitTheFile) {
+  const fs::path f = finding_file("tiff_strip_past_end", "strip_past_end.tif");
+  const fs::path out = scratch("tiff_levels/deeper");
+  const CliResult r = nbsim("nbuffer build --depth " + f.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, f.string()) && has(r.err, "declares RowsPerStrip 63008 for an image of 4 rows")) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_FALSE(fs::exists(scratch("tiff_levels"))) << "a refused command removes the folders it created";
+}
+
+// TIFFs built byte by byte (tests/pipeline/io/tiff_builder.h) are real TIFFs to OpenImageIO: each
+// layout the precheck accepts reads back the pixel values written, and a compressed strip that
+// does not decode is refused (OpenImageIO's TIFF reader reports it only through its error state;
+// the pixels used to stay zero and the read succeed).
+TEST(NBufferCliTest, ReadsHandBuiltTiffsAndRefusesUndecodableStrips) {
+  using nbsim::testing::TiffBuilder;
+  // 4x3, file rows top-down: the far value 0.9 is in the file's first row, last column, so at
+  // (3, 2) with y up.
+  std::vector<float> px(12, 0.25f);
+  px[3] = 0.9f;
+  const auto write = [](const TiffBuilder& t, const std::string& name) {
+    const fs::path f = scratch(name);
+    const auto b = t.bytes();
+    std::ofstream(f, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+    return f;
+  };
+  const struct {
+    const char* name;
+    TiffBuilder tiff;
+  } rows[] = {
+      {"le.tif", TiffBuilder(4, 3, px)},
+      {"be.tif", TiffBuilder(4, 3, px).big_endian()},
+      {"big.tif", TiffBuilder(4, 3, px).bigtiff()},
+      {"strips.tif", TiffBuilder(4, 3, px).set(278, TiffBuilder::kShort, {1}).strips({{0, 16}, {16, 16}, {32, 16}})},
+      {"rows_above.tif", TiffBuilder(4, 3, px).set(278, TiffBuilder::kLong, {8})},
+  };
+  for (const auto& row : rows) {
+    const fs::path f = write(row.tiff, row.name);
+    const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 3,2,1,1 --rect 0,0,3,2");
+    ASSERT_EQ(r.status, 0) << row.name << ": " << r.err;
+    std::istringstream lines(r.out);
+    std::string a, b;
+    std::getline(lines, a), std::getline(lines, b);
+    EXPECT_FLOAT_EQ(nlohmann::json::parse(a)["value"].get<float>(), 0.9f) << row.name;
+    EXPECT_FLOAT_EQ(nlohmann::json::parse(b)["value"].get<float>(), 0.25f) << row.name;
+  }
+  const fs::path bad = write(TiffBuilder(4, 3, px).set(259, TiffBuilder::kShort, {8}), "not_deflate.tif");
+  const CliResult r = nbsim("nbuffer query --depth " + bad.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, bad.string()) && has(r.err, "cannot be read: ") && has(r.err, "Decoding error")) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
 // The OpenImageIO backend is loaded only when an image is touched: without it, a query on the

@@ -1,0 +1,126 @@
+// ImagePrecheckTest: pipeline/io/image_precheck.h on TIFF files built byte by byte: every layout a
+// writer produces is accepted, and every declared strip, tile, value array or buffer that does not
+// fit the file or the limits is refused with a reason naming the field (fuzz_depth_image found a
+// TIFF whose strip lay past the end of the file: it was read as zeros, after a 2.98 GB buffer).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "pipeline/io/image_precheck.h"
+#include "tests/common/scratch.h"
+#include "tests/pipeline/io/tiff_builder.h"
+
+namespace {
+
+using nbsim::testing::TiffBuilder;
+constexpr long long kSide = 16384, kPixels = 4096LL * 4096LL;
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+std::string check(const TiffBuilder& t) {
+  const auto path = nbsim::testing::scratch_path("nbsim_precheck", "t.tif");
+  const auto b = t.bytes();
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  const nbsim::io::ImagePrecheck p = nbsim::io::precheck_depth_file(path.string(), kSide, kPixels);
+  EXPECT_EQ(p.format, "tif");
+  return p.refusal;
+}
+
+// A w x h float image, 0.5 everywhere.
+TiffBuilder image(int w, int h) { return TiffBuilder(w, h, std::vector<float>(static_cast<std::size_t>(w * h), 0.5f)); }
+
+// Layouts writers produce: one strip, a strip a row, a last strip shorter than the others,
+// RowsPerStrip larger than the image (a few rows more, or 2^32 - 1, "one strip"), tiles (the
+// edge tiles hanging over the image), big-endian files and BigTIFF.
+TEST(ImagePrecheckTest, AcceptsWhatWritersWrite) {
+  EXPECT_EQ(check(image(4, 3)), "");
+  EXPECT_EQ(check(image(4, 3).set(278, TiffBuilder::kShort, {1}).strips({{0, 16}, {16, 16}, {32, 16}})), "");
+  EXPECT_EQ(check(image(4, 3).set(278, TiffBuilder::kLong, {2}).strips({{0, 32}, {32, 16}})), "");
+  EXPECT_EQ(check(image(4, 3).set(278, TiffBuilder::kLong, {8})), "");
+  EXPECT_EQ(check(image(4, 3).set(278, TiffBuilder::kLong, {0xFFFFFFFFu})), "");
+  EXPECT_EQ(check(image(4, 3).erase(278)), "") << "RowsPerStrip absent: one strip";
+  // 20x20 in 16x16 tiles: four tiles, each stored whole (16 * 16 * 4 bytes).
+  TiffBuilder tiled(20, 20, std::vector<float>(4 * 256, 0.5f));
+  tiled.erase(278).set(322, TiffBuilder::kShort, {16}).set(323, TiffBuilder::kShort, {16});
+  tiled.strips({{0, 1024}, {1024, 1024}, {2048, 1024}, {3072, 1024}}, true);
+  EXPECT_EQ(check(tiled), "");
+  EXPECT_EQ(check(image(4, 3).big_endian()), "");
+  EXPECT_EQ(check(image(4, 3).bigtiff()), "");
+  EXPECT_EQ(check(image(4, 3).bigtiff().big_endian().strips({{0, 48}})), "");
+  EXPECT_EQ(check(image(4, 3).set(259, TiffBuilder::kShort, {8}).strips({{0, 7}})), "")
+      << "a compressed strip may be shorter than its pixels (the decoder says if it is damaged)";
+}
+
+// The finding: 4 rows declared with 63008 rows a strip, 11825 pixels wide (OpenImageIO's read
+// buffer would be 63008 rows), and its one strip past the end of the file.
+TEST(ImagePrecheckTest, RefusesRowsPerStripThatWouldCostAHugeBuffer) {
+  TiffBuilder t(11825, 4, {});
+  t.set(278, TiffBuilder::kShort, {63008}).set(339, TiffBuilder::kShort, {1}).strips({{0, 39}});
+  const std::string e = check(t);
+  EXPECT_TRUE(has(e, "RowsPerStrip 63008 for an image of 4 rows") && has(e, "2842 MiB, above the 256 MiB limit")) << e;
+  // The same strip with 4 rows a strip: the strip past the end is what is refused.
+  t.set(278, TiffBuilder::kShort, {4});
+  const std::string e2 = check(t);
+  EXPECT_TRUE(has(e2, "is a damaged TIFF: strip 0 declares 39 bytes at offset") && has(e2, "past the end of the")) << e2;
+}
+
+// One row per case: what is broken, and the words the refusal must hold.
+TEST(ImagePrecheckTest, RefusesLayoutsThatDoNotFitTheFile) {
+  const struct {
+    const char* why;
+    TiffBuilder tiff;
+    const char* expect;
+  } rows[] = {
+      {"strip past the end", image(4, 3).strips({{1000, 48}}), "strip 0 declares 48 bytes at offset"},
+      {"strip count past the end", image(4, 3).strips({{0, 4800}}), "strip 0 declares 4800 bytes"},
+      {"uncompressed strip short of its rows", image(4, 3).strips({{0, 40}}),
+       "uncompressed strip 0 holds 40 bytes (StripByteCounts 0), fewer than the 48 bytes of its 3 rows"},
+      {"last strip short", image(4, 3).set(278, TiffBuilder::kShort, {2}).strips({{0, 32}, {32, 8}}),
+       "uncompressed strip 1 holds 8 bytes (StripByteCounts 1), fewer than the 16 bytes of its 1 row"},
+      {"too few strips", image(4, 3).set(278, TiffBuilder::kShort, {1}).strips({{0, 16}, {16, 16}}),
+       "its 4x3 image needs 3 strips, and it declares 2 StripOffsets and 2 StripByteCounts"},
+      {"no StripByteCounts", image(4, 3).erase(279), "needs 1 strip, and it declares 1 StripOffsets and 0 StripByteCounts"},
+      {"no StripOffsets", image(4, 3).erase(273), "declares 0 StripOffsets and 1 StripByteCounts"},
+      {"values past the end", image(4, 3).raw_entry(273, TiffBuilder::kLong, 3, 5000),
+       "StripOffsets at byte 70 declares 3 values of 4 bytes at offset 5000, past the end"},
+      {"value count past the end", image(4, 3).raw_entry(305, TiffBuilder::kLong, 0x40000000u, 8),
+       "tag 305 at byte 130 declares 1073741824 values of 4 bytes"},
+      {"first directory past the end", image(4, 3).first_directory_at(100000), "first directory's offset 100000 is outside"},
+      {"entries past the end", image(4, 3).entry_count(5000), "declares 5000 entries, past the end"},
+      {"no width", image(4, 3).erase(256), "has no ImageWidth"},
+      {"no length", image(4, 3).erase(257), "has no ImageLength"},
+      {"too wide", image(20000, 1).strips({{0, 80000}}), "declares 20000x1 pixels, above the depth image limit"},
+      {"zero rows a strip", image(4, 3).set(278, TiffBuilder::kShort, {0}), "declares 0 RowsPerStrip"},
+      {"no bits", image(4, 3).set(258, TiffBuilder::kShort, {0}), "declares 0 bits a sample"},
+      {"too many bits", image(4, 3).set(258, TiffBuilder::kShort, {65}), "declares 65 bits a sample"},
+      {"big-endian strip past the end", image(4, 3).big_endian().strips({{1000, 48}}), "strip 0 declares 48 bytes"},
+      {"BigTIFF strip past the end", image(4, 3).bigtiff().strips({{1000, 48}}), "strip 0 declares 48 bytes"},
+  };
+  for (const auto& row : rows) {
+    const std::string e = check(row.tiff);
+    EXPECT_TRUE(has(e, row.expect)) << row.why << ": " << e;
+  }
+}
+
+TEST(ImagePrecheckTest, RefusesTilesThatDoNotFit) {
+  const auto tiled = [](std::uint64_t tw, std::uint64_t tl) {
+    TiffBuilder t(20, 20, std::vector<float>(4 * 256, 0.5f));
+    t.erase(278).set(322, TiffBuilder::kLong, {tw}).set(323, TiffBuilder::kLong, {tl});
+    t.strips({{0, 1024}, {1024, 1024}, {2048, 1024}, {3072, 1024}}, true);
+    return t;
+  };
+  EXPECT_EQ(check(tiled(16, 16)), "");
+  std::string e = check(tiled(16, 16).strips({{0, 1024}, {1024, 1024}, {2048, 1024}, {9000, 1024}}, true));
+  EXPECT_TRUE(has(e, "tile 3 declares 1024 bytes at offset") && has(e, "(TileOffsets 3, TileByteCounts 3)")) << e;
+  e = check(tiled(16, 16).strips({{0, 1024}, {1024, 1024}, {2048, 1024}, {3072, 1000}}, true));
+  EXPECT_TRUE(has(e, "uncompressed tile 3 holds 1000 bytes (TileByteCounts 3), fewer than the 1024 bytes")) << e;
+  e = check(tiled(16, 8));
+  EXPECT_TRUE(has(e, "needs 6 tiles, and it declares 4 TileOffsets and 4 TileByteCounts")) << e;
+  e = check(tiled(0, 16));
+  EXPECT_TRUE(has(e, "without a TileWidth and a TileLength of at least 1")) << e;
+  e = check(tiled(65536, 16));
+  EXPECT_TRUE(has(e, "tiles of 65536x16 pixels, above the depth image limit")) << e;
+}
+
+}  // namespace
