@@ -104,6 +104,9 @@ std::string chunk_type_name(std::uint32_t type) {
 }
 
 std::uint32_t crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc) noexcept {
+  // zlib reads a null buffer as a request for the initial value and returns 0, whatever `crc`
+  // was: an empty payload (whose data() may be null) must leave the running CRC unchanged.
+  if (bytes.empty()) return crc;
   return static_cast<std::uint32_t>(::crc32_z(crc, bytes.data(), bytes.size()));
 }
 

@@ -518,6 +518,61 @@ TEST(TraceCorruptionTest, TechniqueChunks) {
   EXPECT_TRUE(has(e, "chunk 2 (0x01020304)") && has(e, "four printable characters")) << e;
 }
 
+// A chunk whose stored payload is empty: its CRC covers the chunk header alone, as the writer
+// computes it (zlib's CRC of an empty, null buffer is 0 whatever the running value, so such chunks
+// were refused as damaged). An unknown technique chunk with no payload reads and stays raw, and
+// the writer writes one that reads back; a known chunk with no payload is refused for what it is,
+// a record that ends before its fields, never as a CRC mismatch.
+TEST(TraceCorruptionTest, EmptyPayloads) {
+  const Properties P;
+  TechniqueRecord empty;
+  empty.type = fourcc("EMPT");
+  {
+    Builder t;
+    t.add(P).add(sample_frame_begin(0)).technique(empty).add(FrameEnd{0, 0, 0}).end(1);
+    ASSERT_EQ(read_error(t.b), "");
+    FrameReader frames(TraceReader(t.b, "t.nbtrace"));
+    const auto f = frames.next();
+    ASSERT_TRUE(f);
+    ASSERT_EQ(f->technique_records.size(), 1u);
+    EXPECT_FALSE(f->technique_records[0].decoded);
+    EXPECT_EQ(f->technique_records[0].type, fourcc("EMPT"));
+    EXPECT_TRUE(f->technique_records[0].payload.empty());
+  }
+  {
+    const fs::path file = scratch("empty_chunk.nbtrace");
+    TraceWriter w(file, {});
+    w.begin_frame(FrameBegin{});
+    w.write(empty);
+    w.end_frame({0, 0, 0.0});
+    w.close();
+    FrameReader frames(file);
+    const auto f = frames.next();
+    ASSERT_TRUE(f);
+    ASSERT_EQ(f->technique_records.size(), 1u);
+    EXPECT_TRUE(f->technique_records[0].payload.empty());
+    EXPECT_FALSE(frames.next());
+  }
+  // Every known type with an empty payload, where its kind of chunk may stand.
+  const auto refused = [&](const Bytes& b, const std::string& chunk) {
+    const std::string e = read_error(b);
+    EXPECT_TRUE(has(e, chunk)) << chunk << ": " << e;
+    EXPECT_FALSE(has(e, "CRC")) << chunk << ": " << e;
+    EXPECT_TRUE(has(e, "the payload of 0 bytes") && has(e, "(it decodes short)")) << chunk << ": " << e;
+  };
+  refused(Builder().chunk(ChunkType::Header, {}).b, "chunk 0 (HEAD)");
+  refused(Builder().add(P).chunk(ChunkType::Scene, {}).b, "chunk 1 (SCEN)");
+  refused(Builder().add(P).chunk(ChunkType::FrameBegin, {}).b, "chunk 1 (FRAM)");
+  for (const ChunkType t : {ChunkType::Draw, ChunkType::Depth, ChunkType::Levels, ChunkType::Truth, ChunkType::DrawBatch,
+                            ChunkType::Stencil, ChunkType::Light, ChunkType::FrameEnd})
+    refused(Builder().add(P).add(sample_frame_begin(0)).chunk(t, {}).b, "chunk 2 (" + chunk_type_name(static_cast<std::uint32_t>(t)) + ")");
+  refused(Builder().add(P).chunk(ChunkType::End, {}).b, "chunk 1 (END )");
+  ASSERT_FALSE(technique_chunks().empty());
+  for (const ChunkSpec& spec : technique_chunks())
+    refused(Builder().add(P).add(sample_frame_begin(0)).chunk(static_cast<ChunkType>(spec.type), {}, false, kFlagTechnique).b,
+            "chunk 2 (" + chunk_type_name(spec.type) + ")");
+}
+
 // The particles technique's PRTC record (traces/format/particles_chunk.h) is decoded by every
 // reader; each flipped byte, a payload one byte short or long and a vector count past the payload
 // are refused naming the chunk.
