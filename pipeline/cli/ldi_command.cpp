@@ -34,6 +34,7 @@
 #include "traces/capture/ldi/mesh_loader.h"
 #include "traces/capture/ldi/test_points.h"
 #include "traces/gl/context.h"
+#include "pipeline/io/output_folder.h"
 
 namespace nbsim::cli {
 
@@ -233,9 +234,7 @@ int run_table1(const Table1Args& a) {
   std::filesystem::path dir;
   if (!a.out.empty()) {
     dir = a.out;
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec) throw InputError(fmt::format("cannot create '{}': {}", a.out, ec.message()));
+    io::create_output_folder(dir);
   }
 
   gl::Context context;

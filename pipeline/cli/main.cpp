@@ -13,6 +13,7 @@
 #include "model/common/error.h"
 #include "model/config/json_input.h"
 #include "pipeline/cli/command.h"
+#include "pipeline/io/output_folder.h"
 
 namespace nbsim::cli {
 
@@ -109,21 +110,29 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "nbsim: error: %s\n", e.what());
     return 2;
   }
+  // A refused or failed command removes the output folders it created (pipeline/io/output_folder.h);
+  // exit 1 from the command itself is a result (counters that differ, sweep points that failed)
+  // and keeps them.
+  const auto failed = [](int status) {
+    io::remove_created_output_folders();
+    return status;
+  };
   try {
-    return action ? action() : 0;
+    const int status = action ? action() : 0;
+    return status == 2 ? failed(status) : status;
   } catch (const InputError& e) {
     std::fflush(stdout);
     std::fprintf(stderr, "nbsim: error: %s\n", e.what());
-    return 2;
+    return failed(2);
   } catch (const nlohmann::json::exception& e) {
     // The JSON nbsim reads is the user's (configs, sweeps, run outputs given back to it): a value
     // the JSON library refuses is bad input, never an internal failure. The message is cut.
     std::fflush(stdout);
     std::fprintf(stderr, "nbsim: error: bad JSON input: %s\n", nbsim::config::excerpt_text(e.what(), 400).c_str());
-    return 2;
+    return failed(2);
   } catch (const std::exception& e) {
     std::fflush(stdout);
     std::fprintf(stderr, "nbsim: failed: %s\n", e.what());
-    return 1;
+    return failed(1);
   }
 }

@@ -16,6 +16,7 @@
 #include "pipeline/cli/command.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/scenes/demo_scene.h"
+#include "pipeline/io/output_folder.h"
 
 namespace nbsim::cli {
 
@@ -112,9 +113,7 @@ int run_query(const DepthSource& src, const NBufferOptions& nbo, const std::stri
 int run_build(const DepthSource& src, const NBufferOptions& nbo, const fs::path& out) {
   const DepthImage depth = src.load();
   const NBuffer nb(depth, nbo.config());
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw InputError(fmt::format("cannot create output directory '{}': {}", out.string(), ec.message()));
+  io::create_output_folder(out, "output directory");
   // One grey ramp for every level (level 0's range), so the levels can be compared by eye.
   const auto [lo, hi] = std::minmax_element(depth.texels.begin(), depth.texels.end());
   ojson levels = ojson::array();

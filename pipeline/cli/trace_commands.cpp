@@ -23,6 +23,7 @@
 #include "traces/format/describe.h"
 #include "traces/format/reader.h"
 #include "traces/format/writer.h"
+#include "pipeline/io/output_folder.h"
 
 namespace nbsim::cli {
 
@@ -381,9 +382,7 @@ int run_dump(const DumpOptions& o) {
   }
   if (!o.levels.empty()) {
     const fs::path dir(o.levels);
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw InputError(fmt::format("cannot create output directory '{}': {}", dir.string(), ec.message()));
+    io::create_output_folder(dir, "output directory");
     for (const tr::NBufferLevels& l : f.levels) {
       const std::string prefix = f.levels.size() == 1 ? "level" : fmt::format("{}_level", to_string(static_cast<FarOp>(l.op)));
       const std::size_t plane = static_cast<std::size_t>(l.width) * static_cast<std::size_t>(l.height);

@@ -16,6 +16,7 @@
 #include "model/sim/timeline.h"
 #include "pipeline/io/json_spill.h"
 #include "traces/format/reader.h"
+#include "pipeline/io/output_folder.h"
 
 namespace nbsim::pipeline {
 
@@ -533,11 +534,7 @@ ReplaySummary replay(const ReplayOptions& o) {
         "--vcd records SystemC time, which the units run ahead of with gpu.quantum_cycles={}: use --timeline "
         "(it records each unit's own time) or gpu.quantum_cycles=0",
         o.config.quantum_cycles));
-  if (o.out) {
-    std::error_code ec;
-    std::filesystem::create_directories(*o.out, ec);
-    if (ec) throw InputError(fmt::format("cannot create output folder '{}': {}", o.out->string(), ec.message()));
-  }
+  if (o.out) io::create_output_folder(*o.out);
   auto frames = std::make_shared<trace::FrameReader>(o.trace);
   const trace::TraceReader& tr = frames->trace();
   const trace::Header& head = tr.header();  // parsed and checked when the trace was opened

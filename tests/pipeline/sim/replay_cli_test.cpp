@@ -13,6 +13,7 @@
 
 #include "tests/common/run_nbsim.h"
 #include "traces/format/codec.h"
+#include "traces/format/reader.h"
 #include "traces/format/writer.h"
 
 namespace {
@@ -291,6 +292,62 @@ TEST(ReplayCliTest, RefusesDepthOfAnotherSizeThanTheViewport) {
   for (const char* f : {"run.json", "draws.csv", "frames.csv"}) EXPECT_FALSE(fs::exists(out / f)) << f << " left by a failed run";
   const CliResult c = run_nbsim("compare " + t.string());
   EXPECT_EQ(c.status, 2) << c.out << c.err;
+}
+
+// A technique chunk this nbsim does not know, with an empty payload (flag bit 1: readers keep it
+// raw), in every frame of a sample: `trace verify` finds the trace sound and the replay's counts
+// are the sample's (the reader used to compute such a chunk's CRC as 0 and call it damaged).
+TEST(ReplayCliTest, UnknownEmptyTechniqueChunkVerifiesAndReplays) {
+  namespace tr = nbsim::trace;
+  const fs::path t = scratch("empty_chunk.nbt");
+  {
+    tr::FrameReader in{fs::path(sample("city_small_oq.nbt"))};
+    tr::TraceWriter w(t, in.trace().properties());
+    if (in.trace().scene()) w.write(*in.trace().scene());
+    tr::TechniqueRecord empty;
+    empty.type = tr::fourcc("ZERO");
+    while (const auto f = in.next()) {
+      w.begin_frame(f->begin);
+      for (const tr::DrawRecord& d : f->draws) w.write(d);
+      w.write(empty);
+      for (const tr::DepthSnapshot& d : f->depths) w.write(d);
+      for (const tr::NBufferLevels& l : f->levels) w.write(l);
+      if (f->truth) w.write(*f->truth);
+      w.end_frame(f->end);
+    }
+    w.close();
+  }
+  const CliResult v = run_nbsim("trace verify " + t.string());
+  EXPECT_EQ(v.status, 0) << v.err;
+  EXPECT_TRUE(has(v.out, "sound")) << v.out;
+  const fs::path a = scratch("empty_chunk_out"), b = scratch("empty_chunk_sample_out");
+  for (const auto& [trace, out] : {std::pair{t.string(), a}, std::pair{sample("city_small_oq.nbt"), b}}) {
+    const CliResult r = run_nbsim("replay " + trace + " --out " + out.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  const nlohmann::json ja = read_json(a / "run.json")["summary"], jb = read_json(b / "run.json")["summary"];
+  for (const char* k : {"frames", "draws", "draws_exact", "fragments_model", "passed_model", "depth_tests", "cycles"})
+    EXPECT_EQ(ja[k], jb[k]) << k;
+}
+
+// A refused replay removes the output folder it created (and the parents it created for it), but
+// never a folder that was there before it ran.
+TEST(ReplayCliTest, RefusedReplayRemovesTheFolderItCreated) {
+  const fs::path t = scratch("damaged_for_out.nbt");
+  fs::copy_file(sample("city_small_oq.nbt"), t, fs::copy_options::overwrite_existing);
+  fs::resize_file(t, fs::file_size(t) / 2);
+  const fs::path created = scratch("made_by_replay");
+  fs::remove_all(created);
+  CliResult r = run_nbsim("replay " + t.string() + " --out " + (created / "run").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_FALSE(fs::exists(created)) << "the folder a refused replay created is removed";
+  const fs::path existing = scratch("there_before");
+  fs::create_directories(existing);
+  std::ofstream(existing / "keep.txt") << "mine";
+  r = run_nbsim("replay " + t.string() + " --out " + existing.string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(fs::exists(existing / "keep.txt")) << "a folder that was there before stays, with its files";
+  EXPECT_FALSE(fs::exists(existing / "run.json"));
 }
 
 }  // namespace
