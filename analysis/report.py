@@ -182,27 +182,37 @@ class Report:
         if not path.exists():
             raise Missing(["figure4_map.csv"])
         try:
-            W, H, one, four = plot_coverage.load(path)
+            W, H, maps, lookups, cases = plot_coverage.load(path)
         except (OSError, UnicodeDecodeError, csv.Error, KeyError, ValueError) as e:
             msg = str(e)
             raise BadInput(msg if msg.startswith(str(path)) else f"{path}: {type(e).__name__}: {msg}") from e
         self.used(path, "Figure 4")
-        s = plot_coverage.summary(one, four)
-        rows = [{"covering": "one square (1 lookup)", "mean_extra": s["one_mean_extra"], "worst_extra": s["one_worst_extra"],
-                 "exact": float(np.count_nonzero(one == 0) / s["sizes"])},
-                {"covering": "four squares (at most 4 lookups)", "mean_extra": s["four_mean_extra"],
-                 "worst_extra": s["four_worst_extra"], "exact": s["four_exact_fraction"]}]
-        cols = [("covering", "covering", None), ("mean extra pixels read (% of the box)", "mean_extra", lambda v: pct(v, 0)),
+        s = plot_coverage.summary(maps, lookups)
+        rows = [{"covering": f"{n}: {plot_coverage.TITLES.get(n, n)}", "mean_extra": v["mean_extra"],
+                 "worst_extra": v["worst_extra"], "exact": v["exact_fraction"],
+                 "lookups": v["mean_lookups"] if v["mean_lookups"] is not None else float("nan")} for n, v in s.items()]
+        cols = [("covering", "covering", None), ("mean extra pixels read (% of the box)", "mean_extra", lambda v: pct(v, 1)),
                 ("worst (x the box)", "worst_extra", lambda v: f"{v:.0f}x"),
-                ("exact for (% of box sizes)", "exact", pct)]
+                ("exact for (% of box sizes)", "exact", pct),
+                ("lookups a box (mean)", "lookups", lambda v: "" if v != v else f"{v:.2f}")]
         tab = self.table("figure4", cols, rows)
-        plot_coverage.plot(W, H, one, four, self.out / "figure4.png")
+        shares = plot_coverage.case_shares(maps, cases)
+        case_rows = [dict({"case": c["case"], "share": c["share"]}, **{f"extra_{n}": e for n, e in c["extra"].items()})
+                     for c in shares]
+        case_cols = [("case of Fig. 3", "case", None), ("share of box sizes", "share", pct)] + \
+                    [(f"mean extra, {n}", f"extra_{n}", lambda v: pct(v, 1)) for n in maps]
+        case_tab = self.table("figure4_cases", case_cols, case_rows)
+        plot_coverage.plot(W, H, maps, self.out / "figure4.png")
+        sizes = next(iter(s.values()))["sizes"]
         return (f"<p>From <code>{self.rel(path)}</code>: every box size from 1x1 to {W}x{H} "
-                f"({s['sizes']:,} sizes), how many pixels beyond the box the covering squares read.</p>" + tab +
+                f"({sizes:,} sizes), how many pixels beyond the box each covering's squares read.</p>" + tab +
+                "<p>The same by the paper's five cases (a property of the box's shape: the case each box falls in).</p>" +
+                case_tab +
                 self.figure("figure4.png", "Extra pixels read over the box area, log colour scale, x = box width, "
-                            "y = box height. Read off: four squares are exact (darkest) on the bands where "
-                            "floor(log2 w) = floor(log2 h), and worst for thin boxes along the axes; one square is "
-                            "looser everywhere."))
+                            "y = box height, one map per covering. Read off: the paper's covering is exact (darkest) "
+                            "wherever both sides exceed half the bounding power of two, and its thin rows and columns "
+                            "read squares of a quarter of it; the corner squares overhang by up to a whole square on "
+                            "thin boxes; one square is looser everywhere."))
 
     # ------------------------------------------------------------------------------ Table 2
     def load_table2(self):

@@ -2,89 +2,145 @@
 #include "model/nbuffer/covering.h"
 
 #include <algorithm>
+#include <string>
 
 #include "model/common/error.h"
+#include "model/common/names.h"
 
 namespace nbsim {
 
-std::string_view to_string(CoveringKind k) noexcept { return k == CoveringKind::Four ? "four" : "one"; }
-
-std::string_view to_string(CoveringCase c) noexcept {
-  switch (c) {
-    case CoveringCase::Exact: return "exact";
-    case CoveringCase::SideBySide: return "side_by_side";
-    case CoveringCase::Stacked: return "stacked";
-    case CoveringCase::Four: return "four";
-    case CoveringCase::Overhang: return "overhang";
-  }
-  return "?";
+std::string_view to_string(CoveringKind k) noexcept { return enum_name(kCoveringKindNames, k); }
+std::string_view to_string(CoveringAlign a) noexcept { return enum_name(kCoveringAlignNames, a); }
+std::string_view to_string(CoveringCase c) noexcept { return enum_name(kCoveringCaseNames, c); }
+std::optional<CoveringKind> parse_covering_kind(std::string_view s) noexcept { return parse_enum_name<CoveringKind>(kCoveringKindNames, s); }
+std::optional<CoveringAlign> parse_covering_align(std::string_view s) noexcept {
+  return parse_enum_name<CoveringAlign>(kCoveringAlignNames, s);
 }
 
-std::optional<CoveringKind> parse_covering_kind(std::string_view s) noexcept {
-  if (s == "four") return CoveringKind::Four;
-  if (s == "one") return CoveringKind::One;
-  return std::nullopt;
+std::string covering_name(const CoveringSpec& s) {
+  return std::string(to_string(s.kind)) + "/" + std::string(to_string(s.align));
+}
+
+std::optional<CoveringSpec> parse_covering_name(std::string_view s) noexcept {
+  const auto slash = s.find('/');
+  if (slash == std::string_view::npos) return std::nullopt;
+  const auto kind = parse_covering_kind(s.substr(0, slash));
+  const auto align = parse_covering_align(s.substr(slash + 1));
+  if (!kind || !align) return std::nullopt;
+  return CoveringSpec{*kind, *align};
+}
+
+CoveringCase covering_case(int w, int h) noexcept {
+  const int s = 1 << ceil_log2(static_cast<unsigned>(std::max(w, h)));
+  const int q = s / 2;
+  if (w > q && h > q) return CoveringCase::FourQuadrants;  // also 1x1 (q = 0)
+  if (w > q) return 2 * h <= q ? CoveringCase::FourInARow : CoveringCase::TwoSideBySide;
+  return 2 * w <= q ? CoveringCase::FourInAColumn : CoveringCase::TwoStacked;
 }
 
 namespace {
 
-CoveringCase classify(int w, int h, int side) noexcept {
-  if (w < side || h < side) return CoveringCase::Overhang;
-  if (w == side && h == side) return CoveringCase::Exact;
-  if (w == side) return CoveringCase::Stacked;
-  if (h == side) return CoveringCase::SideBySide;
-  return CoveringCase::Four;
+// The squares' starts along one axis for a span [start, start + len) and squares of `side`: when
+// the span is longer, one every `side` from the start and the last flush with the end (at most
+// four: len <= 4 side); when it is not longer, one square flush with the start, or with the end
+// when `at_end` (moved to 0 when that would start below 0 while the span does not).
+int anchors(int start, int len, int side, bool at_end, std::array<int, 4>& out) {
+  if (len <= side) {
+    int a = at_end ? start + len - side : start;
+    if (a < 0 && start >= 0) a = 0;
+    out[0] = a;
+    return 1;
+  }
+  const int n = (len + side - 1) / side;
+  NBSIM_CHECK(n <= 4, "a covering's span needs more than four squares");
+  for (int k = 0; k + 1 < n; ++k) out[static_cast<std::size_t>(k)] = start + k * side;
+  out[static_cast<std::size_t>(n - 1)] = start + len - side;
+  return n;
 }
 
-Covering corners(const Rect& r, int level) {
+Covering grid(const Rect& r, int level, bool top, CoveringCase kase) {
   Covering c;
   c.level = level;
-  const int s = 1 << level;
-  NBSIM_CHECK(r.w <= 2 * s && r.h <= 2 * s, "rectangle larger than four squares of the top level");
-  c.kase = classify(r.w, r.h, s);
-  const int nx = r.w > s ? 2 : 1, ny = r.h > s ? 2 : 1;
-  const int xs[2] = {r.x, r.x + r.w - s}, ys[2] = {r.y, r.y + r.h - s};
+  c.kase = kase;
+  const int side = 1 << level;
+  std::array<int, 4> xs{}, ys{};
+  const int nx = anchors(r.x, r.w, side, false, xs), ny = anchors(r.y, r.h, side, top, ys);
+  NBSIM_CHECK(nx * ny <= 4, "a covering with more than four squares");
   for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) c.squares[static_cast<std::size_t>(c.count++)] = {xs[i], ys[j]};
+    for (int i = 0; i < nx; ++i) c.squares[static_cast<std::size_t>(c.count++)] = {xs[static_cast<std::size_t>(i)], ys[static_cast<std::size_t>(j)]};
   return c;
+}
+
+Covering paper(const Rect& r, bool top, int top_level) {
+  const CoveringCase kase = covering_case(r.w, r.h);
+  const int s_log = ceil_log2(static_cast<unsigned>(std::max(r.w, r.h)));
+  // Squares of side q (a quadrant), or q/2 in a row or a column; a 1x1 rectangle: level 0.
+  const int level = s_log == 0 ? 0 : (kase == CoveringCase::FourInARow || kase == CoveringCase::FourInAColumn ? s_log - 2 : s_log - 1);
+  NBSIM_CHECK(level <= top_level, "rectangle larger than the top level's covering");
+  return grid(r, level, top, kase);
+}
+
+Covering corners(const Rect& r, bool top, int top_level) {
+  const int level = std::min(floor_log2(static_cast<unsigned>(std::max(r.w, r.h))), top_level);
+  NBSIM_CHECK(r.w <= 2 << level && r.h <= 2 << level, "rectangle larger than four squares of the top level");
+  return grid(r, level, top, covering_case(r.w, r.h));
+}
+
+bool power_of_two_square(const Rect& r) noexcept { return r.w == r.h && (r.w & (r.w - 1)) == 0; }
+
+// The direct covering of a power-of-two square: one texel of the level of its side.
+Covering direct(const Rect& r) {
+  {
+    Covering c;
+    c.level = floor_log2(static_cast<unsigned>(r.w));
+    c.kase = covering_case(r.w, r.h);
+    c.count = 1;
+    c.squares[0] = {r.x, r.y};
+    return c;
+  }
 }
 
 }  // namespace
 
 int level_needed(const Rect& r, CoveringKind kind) noexcept {
   const auto m = static_cast<unsigned>(std::max(r.w, r.h));
-  return kind == CoveringKind::Four ? floor_log2(m) : ceil_log2(m);
+  switch (kind) {
+    case CoveringKind::Paper: {
+      const CoveringCase kase = covering_case(r.w, r.h);
+      const int s_log = ceil_log2(m);
+      return s_log == 0 ? 0 : (kase == CoveringCase::FourInARow || kase == CoveringCase::FourInAColumn ? s_log - 2 : s_log - 1);
+    }
+    case CoveringKind::Corners: return floor_log2(m);
+    case CoveringKind::One: return ceil_log2(m);
+  }
+  return ceil_log2(m);
 }
 
-Covering cover_four(const Rect& r, int top_level) {
+Covering cover(const Rect& r, CoveringSpec spec, int top_level) {
   NBSIM_CHECK(!r.empty(), "covering an empty rectangle");
-  return corners(r, std::min(level_needed(r, CoveringKind::Four), top_level));
+  if (spec.direct_squares && power_of_two_square(r) && floor_log2(static_cast<unsigned>(r.w)) <= top_level) return direct(r);
+  const bool top = spec.align == CoveringAlign::Top;
+  switch (spec.kind) {
+    case CoveringKind::Paper: return paper(r, top, top_level);
+    case CoveringKind::Corners: return corners(r, top, top_level);
+    case CoveringKind::One: {
+      const int n = level_needed(r, CoveringKind::One);
+      return n > top_level ? corners(r, top, top_level) : grid(r, n, top, covering_case(r.w, r.h));
+    }
+  }
+  NBSIM_CHECK(false, "unknown covering kind");
+  return {};
 }
 
-Covering cover_one(const Rect& r, int top_level) {
-  NBSIM_CHECK(!r.empty(), "covering an empty rectangle");
-  const int n = level_needed(r, CoveringKind::One);
-  if (n > top_level) return cover_four(r, top_level);
-  Covering c;
-  c.level = n;
-  c.kase = classify(r.w, r.h, 1 << n);
-  c.count = 1;
-  c.squares[0] = {r.x, r.y};
-  return c;
-}
-
-Covering cover(const Rect& r, CoveringKind kind, int top_level) {
-  return kind == CoveringKind::Four ? cover_four(r, top_level) : cover_one(r, top_level);
-}
 
 long long covered_area(const Covering& c) noexcept {
-  // The squares form a grid (one or two anchors per axis) whose intervals overlap or touch, so
-  // the union is a rectangle: the span of the anchors plus one side, on each axis.
+  // The squares form a grid (one to four starts per axis) whose intervals overlap or touch, so the
+  // union is a rectangle: the span of the starts plus one side, on each axis.
   const int s = c.side();
   int x0 = c.squares[0].x, x1 = x0, y0 = c.squares[0].y, y1 = y0;
   for (int i = 1; i < c.count; ++i) {
-    x0 = std::min(x0, c.squares[i].x), x1 = std::max(x1, c.squares[i].x);
-    y0 = std::min(y0, c.squares[i].y), y1 = std::max(y1, c.squares[i].y);
+    x0 = std::min(x0, c.squares[static_cast<std::size_t>(i)].x), x1 = std::max(x1, c.squares[static_cast<std::size_t>(i)].x);
+    y0 = std::min(y0, c.squares[static_cast<std::size_t>(i)].y), y1 = std::max(y1, c.squares[static_cast<std::size_t>(i)].y);
   }
   return static_cast<long long>(x1 - x0 + s) * (y1 - y0 + s);
 }

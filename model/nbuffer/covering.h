@@ -1,14 +1,31 @@
-// The covering of a screen rectangle by N-buffer squares (Décoret 2005, section 3.2 and Fig. 3).
-// Pure arithmetic, no storage: the N-buffer query, the coverage report (Fig. 4) and the hardware
-// model's query port all use it.
+// The covering of a screen rectangle by N-buffer squares (Décoret 2005, section 2, Figs. 3 and 4):
+// which texels of which level a query reads. Pure arithmetic, no storage: the N-buffer query, the
+// unit's query port, the coverage report (Fig. 4) and, through shaders/common/covering.glsl (its
+// GLSL twin, tested box for box against this file), every GL shader that queries an N-buffer.
 //
-// Four-square covering: n = floor(log2(max(w, h))), clamped to the top level; squares of side
-// S = 2^n anchored at the rectangle's corners. Along an axis where the rectangle is longer than S
-// the two anchors are x and x + w - S (they overlap or touch because w <= 2S); where it is not, one
-// anchor x suffices. So a query reads 1, 2 or 4 texels, and the squares lie inside the rectangle
-// exactly when both sides are at least S, i.e. when floor(log2 w) == floor(log2 h).
-// One-square covering: a single square of side 2^ceil(log2(max(w, h))) at (x, y), or the
-// four-square covering of the top level when no level is that large.
+// The paper's covering (CoveringKind::Paper, the default). With S the smallest power of two at
+// least max(w, h) and q = S / 2 (a quadrant of the rectangle's bounding power-of-two square), the
+// rectangle falls in one of five cases (Fig. 3):
+//   four_quadrants    w > q and h > q: four squares of side q at its corners (exact);
+//   two_side_by_side  w > q >= h > q/2: two squares of side q side by side;
+//   four_in_a_row     w > q, h <= q/2: four squares of side q/2 in a row;
+//   two_stacked, four_in_a_column: the same turned (h > q >= w).
+// (A 1x1 rectangle is four_quadrants with its four corners in one texel of level 0.) The squares
+// of a row are aligned with the rectangle's TOP (CoveringAlign::Top), so that the overhang runs
+// down into what an object stands on (the paper's choice); a column's squares start at its left
+// edge. A top-aligned square that would start below the image (y < 0) starts at y = 0 instead: it
+// still holds the rectangle, which then reaches no higher than the square's side, and the query
+// stays complete (a square that reaches past the image's top or right edge is fine: pixels outside
+// the image are neutral). Along each axis the squares are placed at the start, one side apart, and
+// the last one flush with the far end, and squares that would repeat a texel are not read: a
+// query reads 1 to 4 texels, and on each axis the squares' union is exactly the rectangle's span
+// except along the overhanging axis of a row or column.
+//
+// The corner covering (CoveringKind::Corners, nbsim's covering before the paper's): squares of side
+// 2^floor(log2(max(w, h))) at the rectangle's corners, one or two anchors per axis; exact when
+// floor(log2 w) == floor(log2 h), otherwise the short side overhangs by up to a whole square.
+// The one-square covering (CoveringKind::One): a single square of side S (or the corner covering
+// of the top level when no level is that large).
 #pragma once
 
 #include <array>
@@ -20,20 +37,46 @@
 
 namespace nbsim {
 
-enum class CoveringKind : std::uint8_t { Four = 0, One = 1 };
+// Which squares answer a rectangle. Fixed values (they end up in configs and trace headers).
+enum class CoveringKind : std::uint8_t { Paper = 0, Corners = 1, One = 2 };
+inline constexpr std::array<std::string_view, 3> kCoveringKindNames = {"paper", "corners", "one"};
 
-// The five cases of Fig. 3, named by what the squares do to the rectangle.
+// Which edge an overhanging square is flush with, where the rectangle is shorter than the squares
+// vertically: the top (the paper's) or the bottom. Fixed values.
+enum class CoveringAlign : std::uint8_t { Top = 0, Bottom = 1 };
+inline constexpr std::array<std::string_view, 2> kCoveringAlignNames = {"top", "bottom"};
+
+// The five cases of Fig. 3, a property of the rectangle's shape (not of the covering that answers
+// it). Fixed values: statistics buckets are in this order.
 enum class CoveringCase : std::uint8_t {
-  Exact = 0,       // the rectangle is one square (w == h == S)
-  SideBySide = 1,  // h == S < w: two squares next to each other
-  Stacked = 2,     // w == S < h: two squares on top of each other
-  Four = 3,        // both sides longer than S: four overlapping squares, still exact
-  Overhang = 4,    // a side shorter than S: the squares stick out, extra pixels are read
+  FourQuadrants = 0,
+  TwoSideBySide = 1,
+  TwoStacked = 2,
+  FourInARow = 3,
+  FourInAColumn = 4,
 };
+inline constexpr std::array<std::string_view, 5> kCoveringCaseNames = {"four_quadrants", "two_side_by_side", "two_stacked",
+                                                                       "four_in_a_row", "four_in_a_column"};
 
 std::string_view to_string(CoveringKind k) noexcept;
+std::string_view to_string(CoveringAlign a) noexcept;
 std::string_view to_string(CoveringCase c) noexcept;
 std::optional<CoveringKind> parse_covering_kind(std::string_view s) noexcept;
+std::optional<CoveringAlign> parse_covering_align(std::string_view s) noexcept;
+
+// A covering scheme: the kind and the alignment (the paper's: paper, top). direct_squares: a
+// rectangle that is a power-of-two square is read with one lookup of the level of its side (the
+// paper's direct covering of point sprites, 3.2; the particles program sets it); no other.
+struct CoveringSpec {
+  CoveringKind kind = CoveringKind::Paper;
+  CoveringAlign align = CoveringAlign::Top;
+  bool direct_squares = false;
+  friend bool operator==(const CoveringSpec&, const CoveringSpec&) = default;
+};
+// "paper/top", "corners/bottom", ... (direct_squares is not named); and back (nothing when either
+// half is unknown).
+std::string covering_name(const CoveringSpec& s);
+std::optional<CoveringSpec> parse_covering_name(std::string_view s) noexcept;
 
 struct Square {
   int x = 0;  // lower-left corner, level-0 pixels
@@ -42,8 +85,8 @@ struct Square {
 
 struct Covering {
   int level = 0;  // level whose texels the squares are; side = 2^level
-  CoveringCase kase = CoveringCase::Exact;
-  int count = 0;  // 1, 2 or 4
+  CoveringCase kase = CoveringCase::FourQuadrants;
+  int count = 0;  // 1 to 4 distinct texels
   std::array<Square, 4> squares{};
 
   int side() const noexcept { return 1 << level; }
@@ -63,14 +106,20 @@ constexpr int nbuffer_level_count(int width, int height) noexcept {
   return l < 1 ? 1 : l;
 }
 
-// Coverings of a non-empty rectangle. top_level is the highest level that may be used; the
-// rectangle's sides must be at most 2^(top_level + 1) (true for any rectangle clipped to an image
-// whose N-buffer has top_level + 1 = nbuffer_level_count levels).
-Covering cover_four(const Rect& r, int top_level);
-Covering cover_one(const Rect& r, int top_level);
-Covering cover(const Rect& r, CoveringKind kind, int top_level);
+// The case of Fig. 3 a non-empty w x h rectangle falls in.
+CoveringCase covering_case(int w, int h) noexcept;
 
-// The level a covering of r needs when no level cap applies.
+// The covering of a non-empty rectangle. top_level is the highest level that may be used; the
+// rectangle's sides must be at most 2^(top_level + 1) (true for any rectangle clipped to an image
+// whose N-buffer has top_level + 1 = nbuffer_level_count levels). A rectangle inside an image
+// (x, y >= 0) gets squares inside it too (x, y >= 0).
+Covering cover(const Rect& r, CoveringSpec spec, int top_level);
+
+// The header property naming the covering of a capture's GL queries ("paper/top"); a trace without
+// it was captured with corners/bottom.
+inline constexpr std::string_view kCoveringProperty = "nbuffer_covering";
+
+// The level a covering of r reads when no level cap applies.
 int level_needed(const Rect& r, CoveringKind kind) noexcept;
 
 // Area of the union of the covering's squares (not clipped to any image), in pixels.

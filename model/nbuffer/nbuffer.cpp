@@ -203,7 +203,7 @@ void NBuffer::build_level(int dst) {
   reduce_rows(config_.op, level_ptr(dst - 1), level_ptr(dst), width_, height_, 1 << (dst - 1), 0, height_);
 }
 
-QueryResult NBuffer::query(const Rect& r, CoveringKind kind) const {
+QueryResult NBuffer::query(const Rect& r, CoveringSpec covering) const {
   if (r.empty())
     throw InputError("empty query rectangle " + std::to_string(r.x) + "," + std::to_string(r.y) + "," +
                      std::to_string(r.w) + "," + std::to_string(r.h) + " (width and height must be at least 1)");
@@ -213,7 +213,7 @@ QueryResult NBuffer::query(const Rect& r, CoveringKind kind) const {
                      std::to_string(r.w) + "," + std::to_string(r.h) + " lies outside the " +
                      std::to_string(width_) + "x" + std::to_string(height_) + " image");
   QueryResult q;
-  const Covering cov = cover(c, kind, full_levels_ - 1);
+  const Covering cov = cover(c, covering, full_levels_ - 1);
   q.level = cov.level;
   if (cov.level >= levels_) {  // partial build: the level is missing, answer the far limit
     q.value = far_limit(config_.op);
@@ -222,7 +222,7 @@ QueryResult NBuffer::query(const Rect& r, CoveringKind kind) const {
   }
   q.value = neutral_depth(config_.op);
   for (int i = 0; i < cov.count; ++i) {
-    // Anchors of a clipped rectangle lie inside the image; squares may reach past its right and
+    // The squares of a clipped rectangle start inside the image; they may reach past its right and
     // top edges, where the level already treats pixels as neutral.
     const Texel t{cov.squares[static_cast<std::size_t>(i)].x, cov.squares[static_cast<std::size_t>(i)].y};
     q.texels[static_cast<std::size_t>(q.texel_count++)] = t;

@@ -74,10 +74,11 @@ class NBuffer {
   // Replaces level 0 with `depth` (same size) and rebuilds every level.
   void build(const DepthImage& depth);
 
-  // Farthest depth of r (clipped to the image) with at most four lookups. Throws InputError when
-  // r is empty or lies outside the image. When the level the covering needs was not built, the
-  // answer is the far limit with complete == false (conservative, never wrong).
-  QueryResult query(const Rect& r, CoveringKind kind = CoveringKind::Four) const;
+  // Farthest depth of r (clipped to the image) with at most four lookups, placed by `covering`
+  // (covering.h). Throws InputError when r is empty or lies outside the image. When the level the
+  // covering needs was not built, the answer is the far limit with complete == false
+  // (conservative, never wrong).
+  QueryResult query(const Rect& r, CoveringSpec covering = {}) const;
 
   // Incremental updates; the result equals a full rebuild from the new level 0.
   // The pixels of `depth` inside `dirty` replace level 0's (depth must be the N-buffer's size).

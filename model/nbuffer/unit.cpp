@@ -91,11 +91,11 @@ std::uint64_t NBufferUnit::acquire_port() {
   return arrived;
 }
 
-QueryAnswer NBufferUnit::query(const Rect& r, float nearest_depth, CoveringKind kind) {
+QueryAnswer NBufferUnit::query(const Rect& r, float nearest_depth) {
   const std::uint64_t arrived = acquire_port();
 
   const NBufferUnitConfig& c = core_.config();
-  QueryAnswer a = core_.query(r, nearest_depth, kind);
+  QueryAnswer a = core_.query(r, nearest_depth);
   const std::uint64_t start = sim::local_cycles();
   const std::uint64_t update_texels = a.update.recomputed();
   const std::uint64_t update_n = sim::batch_cycles(update_texels, c.update_texels_per_cycle, c.update_latency_cycles);

@@ -32,7 +32,7 @@ class NBufferUnit : public sim::Unit {
               int width_px, int height_px, FarOp op, memory::Channel* channel);
 
   // Blocking calls: only from an SC_THREAD.
-  QueryAnswer query(const Rect& r, float nearest_depth, CoveringKind kind = CoveringKind::Four);
+  QueryAnswer query(const Rect& r, float nearest_depth);
   // A batch of queries (rects[i] with nearest[i]) through the query port as one pipelined stream:
   // the same waits as query(), then batch_cycles(total lookups, lookups_per_cycle,
   // lookup_latency_cycles) plus any lazy update work, one latency for the whole batch (the

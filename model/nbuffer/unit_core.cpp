@@ -33,9 +33,7 @@ std::vector<std::string> level_labels(int levels) {
 
 std::vector<std::string> case_labels() {
   std::vector<std::string> l;
-  for (int c = 0; c <= static_cast<int>(CoveringCase::Overhang); ++c)
-    l.emplace_back(nbsim::to_string(static_cast<CoveringCase>(c)));
-  return l;
+  return name_list(kCoveringCaseNames);
 }
 
 const NBufferUnitConfig& validated(const NBufferUnitConfig& c) {
@@ -84,6 +82,19 @@ void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c, const 
         "most lookups spent tiling a rectangle whose level is above level_cap; beyond, or 0, the query answers "
         "incomplete (never hidden)",
         0, kMaxCappedLookups);
+  {
+    std::vector<std::string> kinds{"trace"}, aligns{"trace"};
+    for (std::string_view k : kCoveringKindNames) kinds.emplace_back(k);
+    for (std::string_view a : kCoveringAlignNames) aligns.emplace_back(a);
+    s.add(key("covering"), c.covering,
+          "squares a query reads (Fig. 3): paper (the paper's five cases), corners (squares of side "
+          "2^floor(log2 max(w, h)) at the corners), one (a single square); trace: the capture's",
+          kinds);
+    s.add(key("align"), c.align,
+          "where a square taller than the rectangle sits: top (flush with its top edge, the paper's), bottom; trace: "
+          "the capture's",
+          aligns);
+  }
   s.add(key("update_policy"), c.update_policy,
         "when depth changes reach the levels: eager (at once), batched (at the end of a pass), lazy (when a query "
         "reads them)",
@@ -109,6 +120,10 @@ void NBufferUnitConfig::validate() const {
   if (resolution_divisor != 1 && resolution_divisor != 2 && resolution_divisor != 4 && resolution_divisor != 8)
     bad(fmt::format("{}.resolution_divisor must be 1, 2, 4 or 8, got {}", key_prefix, resolution_divisor));
   if (!parse_storage_format(format)) bad(fmt::format("{}.format must be one of f32, u24, u16, got '{}'", key_prefix, format));
+  if (covering != "trace" && !parse_covering_kind(covering))
+    bad(fmt::format("{}.covering must be one of trace, paper, corners, one, got '{}'", key_prefix, covering));
+  if (align != "trace" && !parse_covering_align(align))
+    bad(fmt::format("{}.align must be one of trace, top, bottom, got '{}'", key_prefix, align));
   if (!parse_update_policy(update_policy))
     bad(fmt::format("{}.update_policy must be one of eager, batched, lazy, got '{}'", key_prefix, update_policy));
   if (level_cap < -1 || level_cap > kMaxLevelCap)
@@ -141,6 +156,14 @@ StorageFormat NBufferUnitConfig::storage_format() const {
   const auto f = parse_storage_format(format);
   NBSIM_CHECK(f.has_value(), "nbuffer config used before validate()");
   return *f;
+}
+
+CoveringSpec NBufferUnitConfig::covering_spec(CoveringSpec capture) const {
+  CoveringSpec s = capture;
+  s.direct_squares = direct_squares;
+  if (covering != "trace") s.kind = *parse_covering_kind(covering);
+  if (align != "trace") s.align = *parse_covering_align(align);
+  return s;
 }
 
 UpdatePolicy NBufferUnitConfig::policy() const {
@@ -186,6 +209,7 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
       op_(op),
       format_(config_.storage_format()),
       policy_(config_.policy()),
+      covering_(config_.covering_spec()),
       divisor_(config_.resolution_divisor),
       depth_(checked_side(width_px, "width"), checked_side(height_px, "height"), far_limit(op)),
       reduced_(divisor_ > 1 ? DepthImage(ceil_div(width_px, divisor_), ceil_div(height_px, divisor_), far_limit(op))
@@ -514,7 +538,7 @@ void NBufferUnitCore::read_texel(QueryAnswer& a, int level, int x, int y) {
   }
 }
 
-QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth, CoveringKind kind) {
+QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth) {
   QueryAnswer a;
   a.value = far_limit(op_);
   auto done = [&](QueryOutcome o) {
@@ -526,7 +550,7 @@ QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth, CoveringK
   const Rect rr = to_reduced(r);  // empty when r is empty or off the image
   if (rr.empty()) return done(QueryOutcome::Offscreen);
   a.reduced = rr;
-  const Covering cov = cover(rr, kind, nb_.full_level_count() - 1);
+  const Covering cov = cover(rr, covering_, nb_.full_level_count() - 1);
   a.kase = cov.kase;
   a.level = cov.level;
   cases_.add(static_cast<std::size_t>(cov.kase));
@@ -540,28 +564,32 @@ QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth, CoveringK
       }
       a.update = apply_pending({x0, y0, x1 - x0 + cov.side(), y1 - y0 + cov.side()});
     }
-    const QueryResult q = nb_.query(rr, kind);
+    const QueryResult q = nb_.query(rr, covering_);
     NBSIM_CHECK(q.complete && q.level == cov.level, "N-buffer query read another level than its covering");
     a.value = neutral_depth(op_);
     for (const Texel& t : q.read()) read_texel(a, q.level, t.x, t.y);
     NBSIM_CHECK(a.value == q.value, "N-buffer unit's lookups disagree with the N-buffer's answer");
   } else {
     // The level needed is above level_cap: tile the rectangle with top-level squares anchored at
-    // its left/bottom edge every S pixels and once more flush with its right/top edge.
+    // its left/bottom edge every S pixels and once more flush with its right/top edge (a rectangle
+    // less tall than S: one row, flush with its top edge under the top alignment, as a covering).
     const int top = nb_.top_level(), side = 1 << top;
     const long long nx = rr.w > side ? ceil_div(rr.w, side) : 1, ny = rr.h > side ? ceil_div(rr.h, side) : 1;
     if (nx * ny > config_.capped_max_lookups) {
       a.complete = false;
       return done(QueryOutcome::Incomplete);
     }
+    // The first row's y: the rectangle's bottom, or (one row less tall than S, top alignment)
+    // flush with its top edge, moved up to 0 where that would start below the image.
+    const int row_y = rr.h < side && covering_.align == CoveringAlign::Top ? std::max(0, rr.y1() - side) : rr.y;
     a.tiled = true;
     a.level = top;
     ++tiled_queries_;
     if (policy_ == UpdatePolicy::Lazy)
-      a.update = apply_pending({rr.x, rr.y, std::max(rr.w, side), std::max(rr.h, side)});
+      a.update = apply_pending({rr.x, row_y, std::max(rr.w, side), std::max(rr.h, side)});
     a.value = neutral_depth(op_);
     for (long long j = 0; j < ny; ++j) {
-      const int y = j + 1 < ny ? rr.y + static_cast<int>(j) * side : std::max(rr.y, rr.y1() - side);
+      const int y = j + 1 < ny ? rr.y + static_cast<int>(j) * side : ny == 1 ? row_y : rr.y1() - side;
       for (long long i = 0; i < nx; ++i) {
         const int x = i + 1 < nx ? rr.x + static_cast<int>(i) * side : std::max(rr.x, rr.x1() - side);
         read_texel(a, top, x, y);

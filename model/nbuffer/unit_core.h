@@ -47,6 +47,13 @@ struct NBufferUnitConfig {
   std::string format = "f32";   // level storage: f32, u24 (as D24X8) or u16
   int level_cap = -1;           // highest level built; -1 builds all
   int capped_max_lookups = 16;  // lookups allowed to tile a rectangle whose level is capped; 0: answer incomplete
+  // The query's covering (covering.h): paper, corners or one, and its alignment, top or bottom;
+  // "trace" takes the capture's (the header's nbuffer_covering; a trace without it was captured
+  // with corners/bottom), which a program that compares its answers with GL's needs.
+  std::string covering = "trace";
+  std::string align = "trace";
+  // Not a key: the particles program reads power-of-two sprites with one lookup (CoveringSpec).
+  bool direct_squares = false;
   std::string update_policy = "eager";    // eager, batched or lazy
   int lookup_latency_cycles = 8;          // address, tag check and data of one lookup batch
   double lookups_per_cycle = 4.0;         // the four squares of a query in one cycle
@@ -66,6 +73,8 @@ struct NBufferUnitConfig {
   void validate() const;
   StorageFormat storage_format() const;  // the parsed `format` (call after validate())
   UpdatePolicy policy() const;           // the parsed `update_policy` (call after validate())
+  // The covering, "trace" in either field taken from `capture` (call after validate()).
+  CoveringSpec covering_spec(CoveringSpec capture = {}) const;
 };
 
 // What a query found. Fixed values: statistics buckets are in this order.
@@ -104,7 +113,7 @@ struct QueryAnswer {
   int level = 0;                            // level read, or the level needed when !complete
   bool complete = true;                     // false: the level needed was not built (value is the far limit)
   bool tiled = false;                       // the level was capped: the rectangle was tiled with top-level squares
-  CoveringCase kase = CoveringCase::Exact;  // case of the covering the rectangle needs (Fig. 3)
+  CoveringCase kase = CoveringCase::FourQuadrants;  // the rectangle's case of Fig. 3
   Rect reduced;                             // the rectangle at the storage resolution (clipped to it)
   int lookups = 0;                          // texels read: at most 4, or capped_max_lookups when tiled
   int texel_count = 0;                      // texels recorded below: min(lookups, 4), in level coordinates
@@ -140,9 +149,11 @@ class NBufferUnitCore {
   // Farthest depth of the full-resolution rectangle r and whether a primitive whose nearest depth
   // is `nearest_depth` is hidden behind it. Never throws: empty and off-screen rectangles answer
   // Offscreen with no lookups.
-  QueryAnswer query(const Rect& r, float nearest_depth, CoveringKind kind = CoveringKind::Four);
+  // The covering is the config's (covering_spec(): "trace" left unresolved is the paper's).
+  QueryAnswer query(const Rect& r, float nearest_depth);
 
   const NBufferUnitConfig& config() const noexcept { return config_; }
+  CoveringSpec covering() const noexcept { return covering_; }
   FarOp op() const noexcept { return op_; }
   int width_px() const noexcept { return depth_.width; }
   int height_px() const noexcept { return depth_.height; }
@@ -181,6 +192,7 @@ class NBufferUnitCore {
   FarOp op_;
   StorageFormat format_;
   UpdatePolicy policy_;
+  CoveringSpec covering_;
   int divisor_;
   DepthImage depth_;    // full resolution, the model's copy of the depth buffer
   DepthImage reduced_;  // storage resolution when divisor_ > 1 (else unused)

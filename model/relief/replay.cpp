@@ -24,9 +24,10 @@ raster::RasterPathConfig path_config(int width, int height, bool fused) {
 
 }  // namespace
 
-ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation)
+ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, CoveringSpec covering)
     : width_(width),
       height_(height),
+      covering_(covering),
       depth_(path_config(width, height, fused_interpolation).width_px, height, 1.0f),
       passed_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0),
       path_(path_config(width, height, fused_interpolation), depth_) {
@@ -39,6 +40,8 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   const std::uint64_t pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
   const std::vector<GlReliefFragments> records = read_relief_fragments(f, pixels);
   const FieldView view = gl.view();
+  WalkParams params = gl.params;  // the record's tunables with the capture's covering
+  params.covering = covering_;
   reference_.resize(pixels);
   referenced_.assign(pixels, 0);
   ReliefFrameCounts out;
@@ -90,7 +93,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       const float fy = static_cast<float>(px / static_cast<std::uint32_t>(width_)) + 0.5f;
       const std::optional<FragmentRay> ray = fragment_ray(gl.ray, gl.field.size, fx, fy);
       WalkResult w;
-      if (ray) w = walk(r.method, view, gl.params, *ray, observer, context);
+      if (ray) w = walk(r.method, view, params, *ray, observer, context);
       const std::uint32_t code = w.capped ? 2u : w.hit ? 1u : 0u;
       c.lookups += w.lookups, c.steps += w.steps, c.bisections += w.bisections;
       c.longest_walk = std::max<std::uint64_t>(c.longest_walk, w.lookups);

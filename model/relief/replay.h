@@ -53,8 +53,9 @@ struct ReliefFrameCounts {
 
 class ReliefReplay {
  public:
-  // The viewport (1 .. 16384 a side; InputError otherwise).
-  ReliefReplay(int width, int height, bool fused_interpolation = true);
+  // The viewport (1 .. 16384 a side; InputError otherwise). `covering`: the N-buffer walk's, the
+  // capture's (the trace header's nbuffer_covering).
+  ReliefReplay(int width, int height, bool fused_interpolation = true, CoveringSpec covering = {});
   ReliefReplay(const ReliefReplay&) = delete;
   ReliefReplay& operator=(const ReliefReplay&) = delete;
 
@@ -68,6 +69,7 @@ class ReliefReplay {
 
  private:
   int width_, height_;
+  CoveringSpec covering_;
   DepthImage depth_;
   std::vector<std::uint8_t> passed_;
   // The frame's references by pixel (the methods' draws share the frame's rays): computed at the

@@ -79,13 +79,14 @@ void ReliefUnitConfig::validate() const {
 }
 
 ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ReliefUnitConfig& config,
-                       memory::Channel& memory, int width, int height, double box_height, bool fused_interpolation)
+                       memory::Channel& memory, int width, int height, double box_height, bool fused_interpolation,
+                       CoveringSpec covering)
     : sim::Unit(name, registry),
       config_((config.validate(), config)),
       memory_(memory),
       client_(memory.add_client("relief")),
       box_height_(box_height),
-      replay_(width, height, fused_interpolation),
+      replay_(width, height, fused_interpolation, covering),
       cache_(cache_config(config)),
       frames_(stats().counter("frames", "frames", "frames replayed")),
       scene_draws_(stats().counter("scene_draws", "draws", "scene draws before the boxes (placement city)")),

@@ -46,7 +46,7 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   // `box_height`: the trace header's relief_box_height. `memory`: the shared channel; the unit
   // registers as its client "relief".
   ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ReliefUnitConfig& config, memory::Channel& memory,
-             int width, int height, double box_height, bool fused_interpolation);
+             int width, int height, double box_height, bool fused_interpolation, CoveringSpec covering = {});
 
   void run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
 

@@ -255,18 +255,13 @@ void walk_robust(Reader& r, const WalkParams& p, const FragmentRay& ray, WalkRes
 }
 
 // The N-buffer's maximum over the texels the surface depends on for x in [x0, x1], y in [y0, y1].
-float nbuffer_max(Reader& r, float x0, float x1, float y0, float y1) {
+float nbuffer_max(Reader& r, const CoveringSpec& covering, float x0, float x1, float y0, float y1) {
   const int n = r.f.size, top = r.f.levels - 1;
   const int i0 = std::clamp(floor_int(x0 - 0.5f), 0, n - 1), i1 = std::clamp(floor_int(x1 - 0.5f) + 1, 0, n - 1);
   const int j0 = std::clamp(floor_int(y0 - 0.5f), 0, n - 1), j1 = std::clamp(floor_int(y1 - 0.5f) + 1, 0, n - 1);
-  const int w = i1 - i0 + 1, h = j1 - j0 + 1;
-  const int level = std::min(floor_log2(static_cast<unsigned>(std::max(w, h))), top);
-  const int side = 1 << level;
-  const int xa = i0, xb = std::max(i0, i1 + 1 - side), ya = j0, yb = std::max(j0, j1 + 1 - side);
-  float m = r.level(level, xa, ya);
-  m = std::max(m, r.level(level, xb, ya));
-  m = std::max(m, r.level(level, xa, yb));
-  m = std::max(m, r.level(level, xb, yb));
+  const Covering c = cover(Rect{i0, j0, i1 - i0 + 1, j1 - j0 + 1}, covering, top);
+  float m = r.level(c.level, c.squares[0].x, c.squares[0].y);
+  for (int k = 1; k < c.count; ++k) m = std::max(m, r.level(c.level, c.squares[static_cast<std::size_t>(k)].x, c.squares[static_cast<std::size_t>(k)].y));
   return m;
 }
 
@@ -282,7 +277,7 @@ void walk_nbuffer(Reader& r, const WalkParams& p, const FragmentRay& ray, WalkRe
     const float te = advance(ray, t, static_cast<float>(1 << s), inv);
     const float xa = along(ray.o[0], t, ray.d[0]), xb = along(ray.o[0], te, ray.d[0]);
     const float ya = along(ray.o[1], t, ray.d[1]), yb = along(ray.o[1], te, ray.d[1]);
-    const float top_height = nbuffer_max(r, std::min(xa, xb), std::max(xa, xb), std::min(ya, yb), std::max(ya, yb));
+    const float top_height = nbuffer_max(r, p.covering, std::min(xa, xb), std::max(xa, xb), std::min(ya, yb), std::max(ya, yb));
     const float lowest = std::min(along(ray.o[2], t, ray.d[2]), along(ray.o[2], te, ray.d[2]));
     if (lowest > top_height) {
       if (te >= ray.t_out) return;

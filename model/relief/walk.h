@@ -23,15 +23,16 @@
 // - robust_clamp: the same, with a radius of 0 clamped to 1 (cheaper; a peak may be stepped over).
 // - nbuffer: empty-space skipping with the max N-buffer of the heightfield: from t, a span of 2^s
 //   texels of horizontal travel is skipped when the ray's lower end is above the N-buffer's
-//   maximum over the texels the span's surface depends on (one four-lookup query, covering.h's
-//   four-square covering); s grows by one after a skip and shrinks by one after a failed query; at
+//   maximum over the texels the span's surface depends on (one query of at most four lookups,
+//   covered as WalkParams::covering says, model/nbuffer/covering.h); s grows by one after a skip and shrinks by one after a failed query; at
 //   s = 0 a failed query walks one cell with the full cell test. The full cell test is the exact
 //   walk's plus the dip: where the height above the surface is convex along the ray inside the
 //   cell, its minimum (the vertex of the quadratic through the entry, the middle and the exit) is
 //   tested too. So the N-buffer walk finds saddles the exact walk misses.
 // A ray that leaves through the box's floor and found no hit before hits at t_out (FragmentRay).
 // Lookups count every texel read the shader issues: 4 per surface height (binary, robust), 4 per
-// cell (its corners; exact, nbuffer, robust's cell steps), 1 per radius, 4 per N-buffer query.
+// cell (its corners; exact, nbuffer, robust's cell steps), 1 per radius, 1 to 4 per N-buffer query
+// (the covering's distinct texels).
 #pragma once
 
 #include <array>
@@ -40,6 +41,8 @@
 #include <span>
 #include <string_view>
 #include <vector>
+
+#include "model/nbuffer/covering.h"
 
 namespace nbsim::relief {
 
@@ -56,6 +59,7 @@ struct WalkParams {
   int linear_steps = 16;  // binary: 1 to 1024
   int binary_steps = 8;   // binary and robust: bisections after the bracket, 0 to 32
   int root_steps = 16;    // exact, nbuffer and robust's cell steps: bisections inside a cell, 0 to 32
+  CoveringSpec covering;  // nbuffer: how a span's texel rectangle is covered (the capture's, its header's nbuffer_covering)
 };
 
 // The draw's ray frame (float, as the shader's uniforms).

@@ -7,8 +7,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <numeric>
+#include <vector>
 
 #include "model/common/error.h"
 #include "model/common/names.h"
@@ -83,7 +85,7 @@ struct NBufferOptions {
   }
 };
 
-int run_query(const DepthSource& src, const NBufferOptions& nbo, const std::string& covering,
+int run_query(const DepthSource& src, const NBufferOptions& nbo, const CoveringSpec& covering,
               const std::vector<std::string>& rect_texts) {
   std::vector<Rect> rects;
   for (const auto& t : rect_texts) rects.push_back(parse_rect(t));
@@ -93,17 +95,18 @@ int run_query(const DepthSource& src, const NBufferOptions& nbo, const std::stri
     if (clip(r, nb.width(), nb.height()).empty())
       throw InputError(fmt::format("rectangle {},{},{},{} lies outside the {}x{} image", r.x, r.y, r.w, r.h,
                                    nb.width(), nb.height()));
-  const CoveringKind kind = *parse_covering_kind(covering);
   for (const Rect& r : rects) {
-    const QueryResult q = nb.query(r, kind);
+    const QueryResult q = nb.query(r, covering);
     ojson texels = ojson::array();
     for (const Texel& t : q.read()) texels.push_back({t.x, t.y});
+    const Rect c = clip(r, nb.width(), nb.height());
     ojson line;
     line["rect"] = {r.x, r.y, r.w, r.h};
+    line["covering"] = covering_name(covering);
     line["level"] = q.level;
     line["texels"] = texels;
     line["value"] = tidy(q.value);
-    line["case"] = to_string(cover(clip(r, nb.width(), nb.height()), kind, nb.full_level_count() - 1).kase);
+    line["case"] = to_string(covering_case(c.w, c.h));
     line["complete"] = q.complete;
     fmt::print("{}\n", line.dump());
   }
@@ -151,75 +154,115 @@ std::array<std::uint8_t, 3> colour(double t) {
   return c;
 }
 
+// A covering measured by `coverage`: its name in the CSV and on the image, and, for a w x h box
+// at the origin, the level it reads, its lookups and the pixels it reads beyond the box.
+struct CoverageVariant {
+  std::string name;
+  std::string title;
+  std::function<Covering(const Rect&)> cover;
+};
+
+std::vector<CoverageVariant> coverage_variants() {
+  // Box sizes never exceed the image, so no covering clamps: an unbounded top level.
+  constexpr int top = 30;
+  return {
+      {"paper", "the paper's five cases (at most 4 lookups)", [](const Rect& r) { return cover(r, {CoveringKind::Paper}, top); }},
+      {"corners", "corner squares of side 2^floor(log2 max) (at most 4)",
+       [](const Rect& r) { return cover(r, {CoveringKind::Corners}, top); }},
+      {"one", "one square (1 lookup)", [](const Rect& r) { return cover(r, {CoveringKind::One}, top); }},
+  };
+}
+
 int run_coverage(const std::string& size, const fs::path& png, fs::path csv, int scale) {
   const auto [bw, bh] = parse_size(size, "--size");
   if (bw > kMaxCoverageSide || bh > kMaxCoverageSide)
     throw InputError(fmt::format("--size {} is too large: at most {}x{} box sizes", size, kMaxCoverageSide, kMaxCoverageSide));
-  // The image's size, checked before anything is written: two panels of (box sizes x scale) pixels,
-  // a gap and a colour ramp.
+  const std::vector<CoverageVariant> variants = coverage_variants();
+  const int panels = static_cast<int>(variants.size());
+  // The image's size, checked before anything is written: a panel of (box sizes x scale) pixels per
+  // variant, gaps and a colour ramp.
   if (scale < 1) scale = std::max(1, 512 / std::max(bw, bh));
   const int gap = 8 * scale, pw = bw * scale, ph = bh * scale, ramp = std::max(12, ph / 16);
-  const int iw = 2 * pw + gap, ih = ph + gap + ramp;
-  if (static_cast<long long>(iw) * ih > kMaxCoveragePixels)
-    throw InputError(fmt::format("--size {} with --scale {} makes a {}x{} image: at most {} M pixels (lower --scale)", size, scale, iw,
-                                 ih, kMaxCoveragePixels >> 20));
+  const long long iw_ll = static_cast<long long>(panels) * pw + static_cast<long long>(panels - 1) * gap;
+  const long long ih_ll = static_cast<long long>(ph) + gap + ramp;
+  if (iw_ll * ih_ll > kMaxCoveragePixels)
+    throw InputError(fmt::format("--size {} with --scale {} makes a {}x{} image: at most {} M pixels (lower --scale)", size, scale,
+                                 iw_ll, ih_ll, kMaxCoveragePixels >> 20));
+  const int iw = static_cast<int>(iw_ll), ih = static_cast<int>(ih_ll);
   if (csv.empty()) csv = fs::path(png).replace_extension(".csv");
-  // Box sizes never exceed the image, so the covering never clamps: use an unbounded top level.
-  const int top = 30;
-  std::vector<double> one_ratio, four_ratio;
-  one_ratio.reserve(static_cast<std::size_t>(bw) * bh);
-  four_ratio.reserve(one_ratio.capacity());
+  const std::size_t n = static_cast<std::size_t>(bw) * static_cast<std::size_t>(bh);
+  std::vector<std::vector<double>> ratio(variants.size());
+  for (auto& r : ratio) r.reserve(n);
+  // Per case of Fig. 3: boxes, and per variant the sum of extra / area and the boxes read exactly.
+  std::array<long long, kCoveringCaseNames.size()> boxes{};
+  std::vector<std::array<double, kCoveringCaseNames.size()>> case_extra(variants.size());
+  std::vector<long long> exact(variants.size(), 0), lookups(variants.size(), 0);
   std::ofstream out(csv);
   if (!out) throw InputError(fmt::format("cannot write '{}'", csv.string()));
-  out << "w,h,area,one_level,one_extra_px,four_level,four_lookups,four_case,four_extra_px\n";
-  long long exact = 0;
-  std::array<long long, 5> cases{};
+  out << "w,h,area,case";
+  for (const CoverageVariant& v : variants) out << fmt::format(",{0}_level,{0}_lookups,{0}_extra_px", v.name);
+  out << "\n";
   for (int h = 1; h <= bh; ++h) {
     for (int w = 1; w <= bw; ++w) {
       const Rect r{0, 0, w, h};
-      const Covering one = cover_one(r, top), four = cover_four(r, top);
-      const long long extra1 = covered_area(one) - r.area(), extra4 = covered_area(four) - r.area();
-      one_ratio.push_back(static_cast<double>(extra1) / static_cast<double>(r.area()));
-      four_ratio.push_back(static_cast<double>(extra4) / static_cast<double>(r.area()));
-      exact += extra4 == 0;
-      ++cases[static_cast<std::size_t>(four.kase)];
-      out << fmt::format("{},{},{},{},{},{},{},{},{}\n", w, h, r.area(), one.level, extra1, four.level, four.count,
-                         to_string(four.kase), extra4);
+      const auto kase = static_cast<std::size_t>(covering_case(w, h));
+      ++boxes[kase];
+      out << fmt::format("{},{},{},{}", w, h, r.area(), kCoveringCaseNames[kase]);
+      for (std::size_t i = 0; i < variants.size(); ++i) {
+        const Covering c = variants[i].cover(r);
+        const long long extra = covered_area(c) - r.area();
+        const double rel = static_cast<double>(extra) / static_cast<double>(r.area());
+        ratio[i].push_back(rel);
+        case_extra[i][kase] += rel;
+        exact[i] += extra == 0;
+        lookups[i] += c.count;
+        out << fmt::format(",{},{},{}", c.level, c.count, extra);
+      }
+      out << "\n";
     }
   }
   if (!out.flush()) throw InputError(fmt::format("cannot write '{}'", csv.string()));
 
-  // Two panels (one square | four squares), x = box width, y = box height (y up), then a colour
-  // ramp. Colour = log2(1 + extra / area), scaled by the largest value of both panels.
-  const double vmax = std::log2(1.0 + std::max(*std::max_element(one_ratio.begin(), one_ratio.end()),
-                                               *std::max_element(four_ratio.begin(), four_ratio.end())));
-  std::vector<std::uint8_t> rgb(static_cast<std::size_t>(iw) * ih * 3, 255);
+  // One panel per variant, x = box width, y = box height (y up), then a colour ramp. Colour =
+  // log2(1 + extra / area), scaled by the largest value of every panel.
+  double vmax = 0.0;
+  for (const auto& r : ratio) vmax = std::max(vmax, std::log2(1.0 + *std::max_element(r.begin(), r.end())));
+  std::vector<std::uint8_t> rgb(static_cast<std::size_t>(iw) * static_cast<std::size_t>(ih) * 3, 255);
   auto put = [&](int x, int y, std::array<std::uint8_t, 3> c) {
     std::copy(c.begin(), c.end(), rgb.begin() + 3 * (static_cast<std::ptrdiff_t>(y) * iw + x));
   };
-  for (int y = 0; y < ph; ++y) {
-    for (int x = 0; x < pw; ++x) {
-      const std::size_t k = static_cast<std::size_t>(y / scale) * bw + static_cast<std::size_t>(x / scale);
-      put(x, ramp + gap + y, colour(vmax > 0 ? std::log2(1.0 + one_ratio[k]) / vmax : 0.0));
-      put(pw + gap + x, ramp + gap + y, colour(vmax > 0 ? std::log2(1.0 + four_ratio[k]) / vmax : 0.0));
-    }
-  }
+  for (int p = 0; p < panels; ++p)
+    for (int y = 0; y < ph; ++y)
+      for (int x = 0; x < pw; ++x) {
+        const std::size_t k = static_cast<std::size_t>(y / scale) * static_cast<std::size_t>(bw) + static_cast<std::size_t>(x / scale);
+        put(p * (pw + gap) + x, ramp + gap + y,
+            colour(vmax > 0 ? std::log2(1.0 + ratio[static_cast<std::size_t>(p)][k]) / vmax : 0.0));
+      }
   for (int y = 0; y < ramp; ++y)
-    for (int x = 0; x < iw; ++x) put(x, y, colour(static_cast<double>(x) / (iw - 1)));
+    for (int x = 0; x < iw; ++x) put(x, y, colour(static_cast<double>(x) / std::max(1, iw - 1)));
   io::write_rgb8(iw, ih, rgb, png);
 
-  auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); };
-  auto worst = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); };
-  const double n = static_cast<double>(one_ratio.size());
-  fmt::print("coverage of every box size from 1x1 to {}x{} ({} sizes)\n", bw, bh, one_ratio.size());
-  fmt::print("  one square  : mean extra {:7.1f}% of the box, worst {:.0f}x the box\n", 100 * mean(one_ratio), worst(one_ratio));
-  fmt::print("  four squares: mean extra {:7.1f}% of the box, worst {:.0f}x the box, exact for {:.1f}% of sizes\n",
-             100 * mean(four_ratio), worst(four_ratio), 100.0 * static_cast<double>(exact) / n);
-  fmt::print("  four-square cases:");
-  for (std::size_t c = 0; c < cases.size(); ++c)
-    fmt::print(" {} {:.1f}%", to_string(static_cast<CoveringCase>(c)), 100.0 * static_cast<double>(cases[c]) / n);
-  fmt::print("\n  wrote {} (left: one square, right: four squares; x = width, y = height, colour = log2(1 + extra/area) up to {:.2f})\n",
-             png.string(), vmax);
+  const double count = static_cast<double>(n);
+  fmt::print("coverage of every box size from 1x1 to {}x{} ({} sizes)\n", bw, bh, n);
+  for (std::size_t i = 0; i < variants.size(); ++i) {
+    const double mean = std::accumulate(ratio[i].begin(), ratio[i].end(), 0.0) / count;
+    fmt::print("  {:<8} mean extra {:7.1f}% of the box, worst {:.1f}x the box, exact for {:5.1f}% of sizes, {:.2f} lookups a box  "
+               "({})\n",
+               variants[i].name, 100 * mean, *std::max_element(ratio[i].begin(), ratio[i].end()),
+               100.0 * static_cast<double>(exact[i]) / count, static_cast<double>(lookups[i]) / count, variants[i].title);
+  }
+  fmt::print("  the cases of Fig. 3 (share of box sizes; mean extra area of each covering in that case):\n");
+  for (std::size_t c = 0; c < boxes.size(); ++c) {
+    fmt::print("    {:<17} {:5.1f}%", kCoveringCaseNames[c], 100.0 * static_cast<double>(boxes[c]) / count);
+    for (std::size_t i = 0; i < variants.size(); ++i)
+      fmt::print("  {} {:6.1f}%", variants[i].name,
+                 boxes[c] ? 100.0 * case_extra[i][c] / static_cast<double>(boxes[c]) : 0.0);
+    fmt::print("\n");
+  }
+  std::string order;
+  for (const CoverageVariant& v : variants) order += (order.empty() ? "" : " | ") + v.name;
+  fmt::print("  wrote {} (panels, left to right: {}; x = width, y = height, colour = log2(1 + extra/area) up to {:.2f})\n",
+             png.string(), order, vmax);
   fmt::print("  wrote {}\n", csv.string());
   return 0;
 }
@@ -231,21 +274,31 @@ void add_nbuffer_commands(CLI::App& app, Action& action) {
   nb->require_subcommand(1);
 
   {
-    auto* cmd = nb->add_subcommand("query", "Answer rectangles with the four-square (or one-square) covering; one JSON line each");
+    auto* cmd = nb->add_subcommand("query", "Answer rectangles with a covering of at most four squares (Fig. 3); one JSON line each");
     auto src = std::make_shared<DepthSource>();
     auto nbo = std::make_shared<NBufferOptions>();
-    auto covering = std::make_shared<std::string>("four");
+    auto covering = std::make_shared<std::string>("paper");
+    auto align = std::make_shared<std::string>("top");
     auto rects = std::make_shared<std::vector<std::string>>();
     src->add_options(cmd);
     nbo->add_options(cmd);
-    cmd->add_option("--covering", *covering, "four: at most four squares of one level; one: a single larger square")
-        ->check(CLI::IsMember({"four", "one"}))
+    cmd->add_option("--covering", *covering,
+                    "paper: the paper's five cases (Fig. 3); corners: squares of side 2^floor(log2 max(w,h)) at the corners; "
+                    "one: a single square")
+        ->check(CLI::IsMember(name_list(kCoveringKindNames)))
+        ->capture_default_str();
+    cmd->add_option("--align", *align, "Squares taller than the rectangle are flush with its top (the paper's) or its bottom")
+        ->check(CLI::IsMember(name_list(kCoveringAlignNames)))
         ->capture_default_str();
     cmd->add_option("--rect", *rects, "Rectangle X,Y,W,H in pixels, y up (repeatable)")->required()->allow_extra_args(false);
-    cmd->footer("Prints {\"rect\":[x,y,w,h],\"level\":i,\"texels\":[[x,y],...],\"value\":v,\"case\":c,\"complete\":b} per rectangle.\n"
-                "Rectangles partly outside the image are clipped; empty or fully outside ones are refused (exit 2).");
-    cmd->callback([&action, src, nbo, covering, rects] {
-      action = [=] { return run_query(*src, *nbo, *covering, *rects); };
+    cmd->footer("Prints {\"rect\":[x,y,w,h],\"covering\":\"paper/top\",\"level\":i,\"texels\":[[x,y],...],\"value\":v,\"case\":c,\n"
+                "\"complete\":b} per rectangle; case is the rectangle's case of Fig. 3 (four_quadrants, two_side_by_side,\n"
+                "two_stacked, four_in_a_row, four_in_a_column). Rectangles partly outside the image are clipped; empty or fully\n"
+                "outside ones are refused (exit 2).");
+    cmd->callback([&action, src, nbo, covering, align, rects] {
+      action = [=] {
+        return run_query(*src, *nbo, {*parse_covering_kind(*covering), *parse_covering_align(*align)}, *rects);
+      };
     });
   }
   {
@@ -259,7 +312,8 @@ void add_nbuffer_commands(CLI::App& app, Action& action) {
     cmd->callback([&action, src, nbo, out] { action = [=] { return run_build(*src, *nbo, *out); }; });
   }
   {
-    auto* cmd = nb->add_subcommand("coverage", "Figure 4: extra pixels read by one square and by four squares, for every box size");
+    auto* cmd = nb->add_subcommand("coverage",
+                                   "Figure 4: extra pixels each covering (paper, corners, one) reads, for every box size");
     auto size = std::make_shared<std::string>("256x256");
     auto out = std::make_shared<std::string>();
     auto csv = std::make_shared<std::string>();

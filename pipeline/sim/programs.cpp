@@ -97,8 +97,9 @@ Program particles(const ProgramContext& c) {
   Program p;
   const HiZUnitConfig* hiz = nullptr;
   if (s.mode == particles::Mode::NBuffer) {
-    nbuffer::NBufferUnitConfig nb = c.config.nbuffers.at("nbuffer");
+    nbuffer::NBufferUnitConfig nb = c.nbuffer_config("nbuffer");
     if (nb.level_cap < 0) nb.level_cap = s.top_level;  // the partial build the capture made
+    nb.direct_squares = true;  // a power-of-two sprite is one lookup (the paper's direct covering, 3.2)
     s.top_level = nb.level_cap;
     p.structures.push_back(std::make_unique<query::NBufferStructure>("nbuffer", c.registry, nb, c.setup.width_px,
                                                                      c.setup.height_px, c.setup.op, &c.memory));
@@ -138,7 +139,7 @@ Program shadows(const ProgramContext& c) {
   s.margin = *cm;
   Program p;
   const auto nbuffer = [&](const char* instance, FarOp op) {
-    return std::make_unique<query::NBufferStructure>(instance, c.registry, c.config.nbuffers.at(instance), s.litmap_size,
+    return std::make_unique<query::NBufferStructure>(instance, c.registry, c.nbuffer_config(instance), s.litmap_size,
                                                      s.litmap_size, op, &c.memory);
   };
   auto min_nb = nbuffer("litmap_min", FarOp::Min);
@@ -177,8 +178,9 @@ Program relief(const ProgramContext& c) {
     throw InputError(fmt::format("the relief trace's relief_box_height '{}' is not a number", text));
   }
   Program p;
+  // The N-buffer walk covers as the capture did (its GL walks are compared one by one).
   auto unit = std::make_unique<relief::ReliefUnit>("relief", c.registry, c.config.relief, c.memory, c.setup.width_px, c.setup.height_px,
-                                                   box_height, c.config.depth.fused_interpolation);
+                                                   box_height, c.config.depth.fused_interpolation, c.capture_covering());
   p.frames = unit.get();
   p.unit = std::move(unit);
   return p;
@@ -240,13 +242,35 @@ std::unique_ptr<query::Structure> ProgramContext::structure(std::string_view ins
   const int w = setup.width_px, h = setup.height_px;
   const auto nb = config.nbuffers.find(instance);
   if (nb != config.nbuffers.end() && kind == query::Kind::NBuffer)
-    return std::make_unique<query::NBufferStructure>(name.c_str(), registry, nb->second, w, h, op, &memory);
+    return std::make_unique<query::NBufferStructure>(name.c_str(), registry, nbuffer_config(instance), w, h, op, &memory);
   const auto hiz = config.hiz.find(instance);
   if (hiz != config.hiz.end() && kind == query::Kind::TileHiZ)
     return std::make_unique<query::TileHiZUnit>(name.c_str(), registry, hiz->second, w, h, op);
   if (hiz != config.hiz.end() && kind == query::Kind::HiZPyramid)
     return std::make_unique<query::HiZPyramidUnit>(name.c_str(), registry, hiz->second, op);
   throw InputError(fmt::format("no query structure instance '{}' of kind {}", instance, query::to_string(kind)));
+}
+
+CoveringSpec ProgramContext::capture_covering() const {
+  CoveringSpec capture{CoveringKind::Corners, CoveringAlign::Bottom};
+  for (const auto& [k, v] : setup.properties) {
+    if (k != kCoveringProperty) continue;
+    const std::optional<CoveringSpec> s = parse_covering_name(v);
+    if (!s)
+      throw InputError(fmt::format("the trace header's {} '{}' is not a covering (paper, corners or one, '/', top or bottom)",
+                                   kCoveringProperty, v));
+    capture = *s;
+  }
+  return capture;
+}
+
+nbuffer::NBufferUnitConfig ProgramContext::nbuffer_config(std::string_view instance) const {
+  nbuffer::NBufferUnitConfig nb = config.nbuffers.at(std::string(instance));
+  nb.validate();
+  const CoveringSpec spec = nb.covering_spec(capture_covering());
+  nb.covering = std::string(to_string(spec.kind));
+  nb.align = std::string(to_string(spec.align));
+  return nb;
 }
 
 Program build_program(std::string_view technique, const ProgramContext& context) {

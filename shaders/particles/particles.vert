@@ -4,9 +4,10 @@
 //   MODE_NONE    no test;
 //   MODE_CENTER  one lookup of the scene depth at the centre pixel (the baseline that pops);
 //   MODE_NB      the max (min under reversed Z) N-buffer: the sprite's pixel rectangle (clipped to the
-//                viewport) covered by at most four squares of one level (one when its side is a
-//                power of two), kept untested when the whole sprite needs a level above the ones
-//                built;
+//                viewport) covered by at most four squares of one level (nb_cover_sprite of the
+//                covering library the host inserts: one square when the rectangle is a
+//                power-of-two square), kept untested when the whole sprite needs a level above the
+//                ones built;
 //   MODE_HIZ     the Hi-Z mip pyramid: the lowest level where the rectangle spans at most 2x2 texels.
 // HIDDEN(d, f) says a sprite at depth d is behind a farthest depth f (host: LESS or reversed Z, with
 // a margin). REFERENCE: the reference pass (no test, no decisions written, the particle's id out).
@@ -62,16 +63,13 @@ void main() {
   }
 #elif defined(MODE_NB)
   if (on_screen) {
-    const ivec2 wh = c1 - c0;
-    const int n = findMSB(max(wh.x, wh.y));
     if (findMSB(max(hi.x - lo.x, hi.y - lo.y)) <= top_level) {
-      const int s = 1 << n;
-      const ivec2 far_corner = ivec2(wh.x > s ? c0.x + wh.x - s : c0.x, wh.y > s ? c0.y + wh.y - s : c0.y);
-      float f = texelFetch(levels, ivec3(c0, n), 0).r;
-      lookups = 1u;
-      if (far_corner.x != c0.x) { f = FAR(f, texelFetch(levels, ivec3(far_corner.x, c0.y, n), 0).r); lookups += 1u; }
-      if (far_corner.y != c0.y) { f = FAR(f, texelFetch(levels, ivec3(c0.x, far_corner.y, n), 0).r); lookups += 1u; }
-      if (far_corner.x != c0.x && far_corner.y != c0.y) { f = FAR(f, texelFetch(levels, ivec3(far_corner, n), 0).r); lookups += 1u; }
+      int level;
+      ivec2 squares[4];
+      const int n = nb_cover_sprite(ivec4(c0, c1 - c0), top_level, level, squares);
+      float f = texelFetch(levels, ivec3(squares[0], level), 0).r;
+      for (int k = 1; k < n; ++k) f = FAR(f, texelFetch(levels, ivec3(squares[k], level), 0).r);
+      lookups = uint(n);
       culled = HIDDEN(d, f);
     }
   }

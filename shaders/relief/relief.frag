@@ -213,18 +213,14 @@ float walk_robust(bool clamp_zero, int cap) {
   capped = true;
   return -1.0;
 }
-int floor_log2(int v) { return findMSB(v); }
 float nbuffer_max(float x0, float x1, float y0, float y1) {
   int i0 = clamp(int(floor(x0 - 0.5)), 0, size - 1), i1 = clamp(int(floor(x1 - 0.5)) + 1, 0, size - 1);
   int j0 = clamp(int(floor(y0 - 0.5)), 0, size - 1), j1 = clamp(int(floor(y1 - 0.5)) + 1, 0, size - 1);
-  int w = i1 - i0 + 1, h = j1 - j0 + 1;
-  int level = min(floor_log2(max(w, h)), top_level);
-  int side = 1 << level;
-  int xa = i0, xb = max(i0, i1 + 1 - side), ya = j0, yb = max(j0, j1 + 1 - side);
-  float m = level_at(level, xa, ya);
-  m = max(m, level_at(level, xb, ya));
-  m = max(m, level_at(level, xa, yb));
-  m = max(m, level_at(level, xb, yb));
+  int level;
+  ivec2 squares[4];
+  const int n = nb_cover(ivec4(i0, j0, i1 - i0 + 1, j1 - j0 + 1), top_level, level, squares);
+  float m = level_at(level, squares[0].x, squares[0].y);
+  for (int k = 1; k < n; ++k) m = max(m, level_at(level, squares[k].x, squares[k].y));
   return m;
 }
 float walk_nbuffer(int cap) {

@@ -314,11 +314,20 @@ inline int log2_ceil(long long v) {
   return n;
 }
 
-// The level a full N-buffer with `levels` levels reads for the clipped rectangle c.
-inline int expected_level(const Rect& c, CoveringKind kind, int levels) {
+// The level a full N-buffer with `levels` levels reads for the clipped rectangle c under `spec`:
+// the paper's q = S / 2, or q / 4 for a row or column no more than q / 2 thick (Fig. 3), with S the
+// smallest power of two at least max(w, h); the corners' floor(log2 max(w, h)); one square's
+// ceil(log2 max(w, h)) (the corners' of the top level when that is too high).
+inline int expected_level(const Rect& c, CoveringSpec spec, int levels) {
   const int m = std::max(c.w, c.h);
   const int one = log2_ceil(m);
-  if (kind == CoveringKind::One && one <= levels - 1) return one;
+  if (spec.kind == CoveringKind::Paper) {
+    if (one == 0) return 0;
+    const long long q = 1LL << (one - 1);
+    const bool thin = (c.w > q && 2LL * c.h <= q) || (c.h > q && 2LL * c.w <= q);
+    return thin ? one - 2 : one - 1;
+  }
+  if (spec.kind == CoveringKind::One && one <= levels - 1) return one;
   return std::min(log2_floor(m), levels - 1);
 }
 
@@ -327,22 +336,21 @@ inline int expected_level(const Rect& c, CoveringKind kind, int levels) {
 // the brute-force farthest depth of the square of that texel, clipped to the image. Returns ""
 // when every rule holds, else one line per broken rule, naming it.
 template <class SquareFar>
-std::string check_nbuffer_answer(int width, int height, FarOp op, int levels, const Rect& c, CoveringKind kind,
+std::string check_nbuffer_answer(int width, int height, FarOp op, int levels, const Rect& c, CoveringSpec spec,
                                  const QueryResult& q, float truth, SquareFar&& square_far) {
   std::string err;  // stays empty (no allocation) while every rule holds
   auto fail = [&](const std::string& rule) {
-    err += err.empty() ? str(c) + (kind == CoveringKind::Four ? " four: " : " one: ") : std::string("; ");
+    err += err.empty() ? str(c) + " " + covering_name(spec) + ": " : std::string("; ");
     err += rule;
   };
   if (!q.complete) fail("complete: a full build answered complete=false");
-  const int level = expected_level(c, kind, levels);
+  const int level = expected_level(c, spec, levels);
   if (q.level != level) fail("level: read level " + std::to_string(q.level) + ", expected " + std::to_string(level));
   if (q.level < 0 || q.level >= levels) return err;
   const int side = 1 << q.level;
-  // Four squares: one anchor per axis when the side fits in a square, two otherwise. One square:
-  // a single read, unless the top level is too small and it falls back to four.
-  const bool one_square = kind == CoveringKind::One && level == log2_ceil(std::max(c.w, c.h));
-  const int want_count = one_square ? 1 : (c.w > side ? 2 : 1) * (c.h > side ? 2 : 1);
+  // Along each axis: one square when the side fits in a square, else ceil(side length / square).
+  const auto per_axis = [side](int len) { return len > side ? (len + side - 1) / side : 1; };
+  const int want_count = per_axis(c.w) * per_axis(c.h);
   if (q.texel_count < 1 || q.texel_count > 4) {
     fail("at most four: read " + std::to_string(q.texel_count) + " texels");
     return err;
@@ -367,12 +375,18 @@ std::string check_nbuffer_answer(int width, int height, FarOp op, int levels, co
     fail("conservative: answered " + std::to_string(q.value) + ", nearer than the true farthest " + std::to_string(truth));
   if (q.value != over_squares)
     fail("union: answered " + std::to_string(q.value) + ", the squares read hold " + std::to_string(over_squares));
-  if (!one_square && log2_floor(c.w) == log2_floor(c.h)) {  // the four-square covering is exact
+  if (c.w >= side && c.h >= side) {  // no side shorter than a square: the covering is exact
     for (const Texel& t : read) {
       const Rect sq = clip({t.x, t.y, side, side}, width, height);
       if (sq.x < c.x || sq.y < c.y || sq.x1() > c.x1() || sq.y1() > c.y1())
-        fail("exact: floor(log2 w) == floor(log2 h) but square " + str(sq) + " reads pixels outside");
+        fail("exact: both sides are at least " + std::to_string(side) + " but square " + str(sq) + " reads pixels outside");
     }
+  }
+  // The paper's rows overhang downward (top alignment) unless that would leave the image.
+  if (spec.kind == CoveringKind::Paper && c.h < side) {
+    const int want_y = spec.align == CoveringAlign::Top ? std::max(0, c.y1() - side) : c.y;
+    for (const Texel& t : read)
+      if (t.y != want_y) fail("align: a row's square starts at y " + std::to_string(t.y) + ", expected " + std::to_string(want_y));
   }
   return err;
 }

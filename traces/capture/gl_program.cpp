@@ -5,6 +5,8 @@
 
 #include <stdexcept>
 
+#include "nbsim_shaders.h"
+
 namespace nbsim::capture {
 
 GLuint compile_shader(GLenum type, const std::string& source, const char* name) {
@@ -55,6 +57,11 @@ void make_triangle_vertex_array(std::span<const float> xyz, std::span<const std:
   glEnableVertexArrayAttrib(vao, 0);
   glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(vao, 0, 0);
+}
+
+std::string covering_glsl(const CoveringSpec& spec) {
+  return "#define COVERING_KIND " + std::to_string(static_cast<int>(spec.kind)) + "\n#define COVERING_TOP " +
+         (spec.align == CoveringAlign::Top ? "1" : "0") + "\n" + shaders::common_covering_glsl;
 }
 
 std::string with_defines(const char* source, const std::string& defines) {

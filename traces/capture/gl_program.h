@@ -13,6 +13,8 @@
 #include <span>
 #include <string>
 
+#include "model/nbuffer/covering.h"
+
 namespace nbsim::capture {
 
 // Compiles one shader stage; throws std::runtime_error with GL's log, naming `name`, on failure.
@@ -31,5 +33,9 @@ void make_triangle_vertex_array(std::span<const float> xyz, std::span<const std:
 
 // `source` with `defines` inserted after its #version line.
 std::string with_defines(const char* source, const std::string& defines);
+
+// The GLSL covering library (shaders/common/covering.glsl: nb_cover, nb_cover_sprite) for `spec`,
+// with its #defines, to insert with with_defines() into a shader that queries an N-buffer.
+std::string covering_glsl(const CoveringSpec& spec);
 
 }  // namespace nbsim::capture

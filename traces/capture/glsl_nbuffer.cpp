@@ -12,7 +12,7 @@
 
 namespace nbsim::capture {
 
-GlslNBuffer::GlslNBuffer(int width, int height, FarOp op, int max_level)
+GlslNBuffer::GlslNBuffer(int width, int height, FarOp op, int max_level, CoveringSpec covering)
     : width_(width),
       height_(height),
       levels_(std::clamp(max_level + 1, 1, nbuffer_level_count(width, height))),
@@ -24,7 +24,8 @@ GlslNBuffer::GlslNBuffer(int width, int height, FarOp op, int max_level)
                               compile_shader(GL_FRAGMENT_SHADER, with_defines(shaders::common_nbuffer_build_frag, far),
                                              "common/nbuffer_build.frag")},
                              "nbuffer_build");
-  query_prog_ = link_program({compile_shader(GL_COMPUTE_SHADER, with_defines(shaders::common_nbuffer_query_comp, far),
+  query_prog_ = link_program({compile_shader(GL_COMPUTE_SHADER,
+                                             with_defines(shaders::common_nbuffer_query_comp, far + covering_glsl(covering)),
                                              "common/nbuffer_query.comp")},
                              "nbuffer_query");
   glCreateBuffers(1, &query_ssbo_);

@@ -23,7 +23,8 @@ class GlslNBuffer {
  public:
   // Levels: nbuffer_level_count(width, height) (model/nbuffer/covering.h), or fewer: levels 0 ..
   // max_level when max_level is below the last of them (a partial build).
-  GlslNBuffer(int width, int height, FarOp op, int max_level = 1 << 30);
+  // query() covers each rectangle as `covering` says (shaders/common/covering.glsl).
+  GlslNBuffer(int width, int height, FarOp op, int max_level = 1 << 30, CoveringSpec covering = {});
   ~GlslNBuffer();
   GlslNBuffer(const GlslNBuffer&) = delete;
   GlslNBuffer& operator=(const GlslNBuffer&) = delete;

@@ -78,6 +78,28 @@ std::int64_t OptionValues::integer(const OptionSpec& spec) const {
   return v;
 }
 
+OptionSpec covering_option(std::vector<std::string> kinds) {
+  return choice_option("covering",
+                       "How an N-buffer query covers a rectangle: paper (the paper's five cases, Fig. 3), corners (squares of side "
+                       "2^floor(log2 max(w,h)) at its corners, nbsim's before the paper's), one (a single square)",
+                       "paper", std::move(kinds));
+}
+
+const OptionSpec& align_option() {
+  static const OptionSpec spec = choice_option(
+      "align", "Where a square taller than the rectangle sits: top (flush with its top edge, the paper's) or bottom", "top",
+      {"top", "bottom"});
+  return spec;
+}
+
+CoveringSpec read_covering(const OptionValues& values, const OptionSpec& covering) {
+  return {*parse_covering_kind(values.text(covering)), *parse_covering_align(values.text(align_option()))};
+}
+
+std::pair<std::string, std::string> covering_property(const CoveringSpec& spec) {
+  return {std::string(kCoveringProperty), covering_name(spec)};
+}
+
 const OptionSpec& seed_option() {
   static const OptionSpec seed{"seed", "Seed of the scene and the camera path", "1", OptionSpec::Kind::Integer, 0, 4294967295LL, {}};
   return seed;

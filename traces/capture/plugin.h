@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "model/nbuffer/covering.h"
+
 namespace nbsim::capture {
 
 struct OptionSpec {
@@ -52,6 +54,17 @@ class OptionValues {
  private:
   std::map<std::string, std::string> values_;
 };
+
+// --covering and --align: how a technique's GL queries cover a rectangle with N-buffer squares
+// (model/nbuffer/covering.h); default paper and top, the paper's. `kinds`: the coverings the
+// technique's queries offer. The capture records them as the header's nbuffer_covering
+// (kCoveringProperty, "paper/top"), which the model's replay takes by default.
+OptionSpec covering_option(std::vector<std::string> kinds = {"paper", "corners", "one"});
+const OptionSpec& align_option();
+// The covering given by the two options (their specs' defaults when unset).
+CoveringSpec read_covering(const OptionValues& values, const OptionSpec& covering);
+// The header property of a covering: {kCoveringProperty, "paper/top"}.
+std::pair<std::string, std::string> covering_property(const CoveringSpec& spec);
 
 // --seed: one option that the scenes and the camera paths that are random share, so that one seed
 // fixes the scene and the path together.

@@ -199,7 +199,7 @@ TEST(StorageTest, QuantizedNBufferIsConservative) {
       std::mt19937 rng(8);
       for (int n = 0; n < 20000; ++n) {
         const Rect r = ref::random_rect(rng, img.width, img.height, true);
-        for (const CoveringKind kind : {CoveringKind::Four, CoveringKind::One}) {
+        for (const CoveringSpec kind : {CoveringSpec{CoveringKind::Paper, CoveringAlign::Top}, CoveringSpec{CoveringKind::Corners, CoveringAlign::Bottom}, CoveringSpec{CoveringKind::One, CoveringAlign::Top}}) {
           const QueryResult q = nb.query(r, kind), e = exact.query(r, kind);
           if (!at_least_as_far(op, q.value, e.value))
             fails.add("conservative: " + ref::str(r) + " answered " + hex(q.value) + ", nearer than F32's " + hex(e.value));

@@ -15,7 +15,10 @@ namespace nbsim {
 namespace {
 
 constexpr FarOp kOps[] = {FarOp::Max, FarOp::Min};
-constexpr CoveringKind kKinds[] = {CoveringKind::Four, CoveringKind::One};
+constexpr CoveringSpec kKinds[] = {{CoveringKind::Paper, CoveringAlign::Top},
+                                   {CoveringKind::Paper, CoveringAlign::Bottom},
+                                   {CoveringKind::Corners, CoveringAlign::Bottom},
+                                   {CoveringKind::One, CoveringAlign::Top}};
 
 std::string name_of(FarOp op) { return std::string(to_string(op)); }
 
@@ -37,7 +40,7 @@ void check_every_rect(const DepthImage& img, FarOp op, const std::string& what, 
   const std::vector<DepthImage> levels = ref::nbuffer_levels(img, op, nb.level_count());
   auto square_far = [&](int l, int x, int y) { return levels[static_cast<std::size_t>(l)].at(x, y); };
   ref::for_each_rect(img, op, [&](const Rect& r, float truth) {
-    for (const CoveringKind kind : kKinds) {
+    for (const CoveringSpec kind : kKinds) {
       const QueryResult q = nb.query(r, kind);
       const std::string e =
           ref::check_nbuffer_answer(img.width, img.height, op, nb.level_count(), r, kind, q, truth, square_far);
@@ -56,7 +59,7 @@ void check_random_rects(const DepthImage& img, FarOp op, int count, std::uint32_
     const Rect r = ref::random_rect(rng, img.width, img.height, true);
     const Rect c = clip(r, img.width, img.height);
     const float truth = table.farthest(c);
-    for (const CoveringKind kind : kKinds) {
+    for (const CoveringSpec kind : kKinds) {
       const QueryResult q = nb.query(r, kind);
       const std::string e =
           ref::check_nbuffer_answer(img.width, img.height, op, nb.level_count(), c, kind, q, truth, square_far);
@@ -253,7 +256,7 @@ TEST(NBufferTest, PartlyOutsideRectsAreClipped) {
               const Rect r{x, y, rw, rh};
               const Rect c = clip(r, w, h);
               if (c.empty()) continue;
-              for (const CoveringKind kind : kKinds) {
+              for (const CoveringSpec kind : kKinds) {
                 const QueryResult q = nb.query(r, kind), qc = nb.query(c, kind);
                 if (q.value != qc.value || q.level != qc.level || q.texel_count != qc.texel_count || q.texels != qc.texels)
                   f.add("clip: " + ref::str(r) + " answers differently from its clipped part " + ref::str(c));
@@ -277,7 +280,7 @@ TEST(NBufferTest, EmptyOrOutsideRectsThrow) {
       {{0, -4, 4, 4}, "ends at the bottom edge"}, {{100, 100, 1, 1}, "far outside"},
   };
   for (const Row& row : rows)
-    for (const CoveringKind kind : kKinds) EXPECT_THROW(nb.query(row.r, kind), InputError) << row.why;
+    for (const CoveringSpec kind : kKinds) EXPECT_THROW(nb.query(row.r, kind), InputError) << row.why;
   EXPECT_NO_THROW(nb.query({-4, -4, 5, 5})) << "one pixel inside is enough";
 }
 
@@ -322,14 +325,16 @@ TEST(NBufferTest, EdgeCases) {
     int fx, fy;  // -1: none
     float fv;
     Rect r;
-    CoveringKind kind;
+    CoveringSpec kind;
     float value;
     int level, count;
   };
   constexpr auto Max = FarOp::Max;
   constexpr auto Min = FarOp::Min;
-  constexpr auto Four = CoveringKind::Four;
-  constexpr auto One = CoveringKind::One;
+  // Four: the corner covering with bottom alignment (nbsim's before the paper's); One: one square.
+  constexpr CoveringSpec Four{CoveringKind::Corners, CoveringAlign::Bottom};
+  constexpr CoveringSpec One{CoveringKind::One, CoveringAlign::Bottom};
+  constexpr CoveringSpec Paper{CoveringKind::Paper, CoveringAlign::Top};
   const Row rows[] = {
       {"equal depth: every pixel 0.5, the answer is exactly 0.5", 16, 16, Max, 0.5f, -1, -1, 0, {3, 3, 9, 5}, Four, 0.5f, 3, 2},
       {"far plane: a buffer at 1.0 answers 1.0", 16, 16, Max, 1.0f, -1, -1, 0, {0, 0, 16, 16}, Four, 1.0f, 3, 4},
@@ -355,6 +360,16 @@ TEST(NBufferTest, EdgeCases) {
       {"rectangle larger than the image is clipped to it", 6, 6, Max, 0.25f, 5, 0, 0.9f, {-10, -10, 40, 40}, Four, 0.9f, 2, 4},
       {"1-pixel-high row: squares overhang upward only, x = 31 past its end is not read", 40, 3, Max, 0.25f, 31, 0, 0.9f, {0, 0, 31, 1}, Four, 0.25f, 4, 2},
       {"1-pixel-high row: squares overhang upward into a far pixel", 40, 3, Max, 0.25f, 20, 2, 0.9f, {0, 0, 31, 1}, Four, 0.9f, 4, 2},
+      {"paper: a 16x3 row is four level-2 squares, moved up to y = 0, not the pixel at y = 10", 32, 32, Max, 0.25f, 3, 10, 0.9f,
+       {0, 0, 16, 3}, Paper, 0.25f, 2, 4},
+      {"paper: a row reads down from its top edge, not the pixel above it", 40, 16, Max, 0.25f, 20, 13, 0.9f, {0, 12, 31, 1}, Paper,
+       0.25f, 3, 4},
+      {"paper: a row reads down from its top edge into a far pixel below it", 40, 16, Max, 0.25f, 20, 6, 0.9f, {0, 12, 31, 1}, Paper,
+       0.9f, 3, 4},
+      {"paper: a power-of-two square is four quadrants of the level below", 32, 32, Max, 0.25f, 15, 0, 0.9f, {0, 0, 16, 16}, Paper,
+       0.9f, 3, 4},
+      {"paper: the whole 641x479 image spans two quadrants side by side: two squares of level 9", 641, 479, Max, 0.25f, 640,
+       478, 0.9f, {0, 0, 641, 479}, Paper, 0.9f, 9, 2},
   };
   for (const Row& row : rows) {
     DepthImage img(row.w, row.h, row.background);

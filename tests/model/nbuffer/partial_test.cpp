@@ -16,7 +16,9 @@ namespace nbsim {
 namespace {
 
 constexpr FarOp kOps[] = {FarOp::Max, FarOp::Min};
-constexpr CoveringKind kKinds[] = {CoveringKind::Four, CoveringKind::One};
+constexpr CoveringSpec kKinds[] = {{CoveringKind::Paper, CoveringAlign::Top},
+                                   {CoveringKind::Corners, CoveringAlign::Bottom},
+                                   {CoveringKind::One, CoveringAlign::Bottom}};
 
 // Compares the partial answer p with the full build's answer f to the same rectangle, whose
 // true farthest depth is truth; "" when every rule holds.
@@ -104,7 +106,7 @@ TEST(PartialBuildTest, EveryRectAgreesWithFullBuild) {
       for (int k = 0; k < full.level_count(); ++k) {
         const NBuffer part(img, {.op = op, .max_level = k});
         ref::for_each_rect(img, op, [&](const Rect& r, float truth) {
-          for (const CoveringKind kind : kKinds) {
+          for (const CoveringSpec kind : kKinds) {
             const QueryResult p = part.query(r, kind), q = full.query(r, kind);
             (p.complete ? complete : incomplete) += 1;
             const std::string e = check_partial(p, q, k, op, truth);
@@ -133,7 +135,7 @@ TEST(PartialBuildTest, RandomRects641x479) {
       for (int n = 0; n < 20000; ++n) {
         const Rect r = ref::random_rect(rng, 641, 479, true);
         const float truth = table.farthest(r);
-        for (const CoveringKind kind : kKinds) {
+        for (const CoveringSpec kind : kKinds) {
           const std::string e = check_partial(part.query(r, kind), full.query(r, kind), k, op, truth);
           if (!e.empty()) f.add(ref::str(r) + ": " + e);
         }
@@ -175,15 +177,19 @@ TEST(PartialBuildTest, UpdatesMatchPartialRebuild) {
 
 // Hand-checked partial answers; each row says why it is there.
 TEST(PartialBuildTest, EdgeCases) {
-  struct Row { const char* why; int max_level; FarOp op; Rect r; CoveringKind kind; bool complete; int level; };
+  struct Row { const char* why; int max_level; FarOp op; Rect r; CoveringSpec kind; bool complete; int level; };
+  constexpr CoveringSpec Four{CoveringKind::Corners, CoveringAlign::Bottom}, One{CoveringKind::One, CoveringAlign::Bottom},
+      Paper{CoveringKind::Paper, CoveringAlign::Top};
   const Row rows[] = {
-      {"8x8 needs level 3, built", 3, FarOp::Max, {0, 0, 8, 8}, CoveringKind::Four, true, 3},
-      {"8x8 needs level 3, only 0..2 built", 2, FarOp::Max, {0, 0, 8, 8}, CoveringKind::Four, false, 3},
-      {"5x5: four squares need level 2 (built)", 2, FarOp::Max, {0, 0, 5, 5}, CoveringKind::Four, true, 2},
-      {"5x5: one square needs level 3 (missing)", 2, FarOp::Max, {0, 0, 5, 5}, CoveringKind::One, false, 3},
-      {"reversed Z: incomplete answers 0, the far plane", 0, FarOp::Min, {3, 3, 2, 2}, CoveringKind::Four, false, 1},
-      {"1-pixel rectangle needs only level 0", 0, FarOp::Max, {7, 7, 1, 1}, CoveringKind::One, true, 0},
-      {"clipped to 2x2 at the corner: level 1 is enough", 1, FarOp::Max, {30, 30, 10, 10}, CoveringKind::Four, true, 1},
+      {"8x8 needs level 3, built", 3, FarOp::Max, {0, 0, 8, 8}, Four, true, 3},
+      {"8x8 needs level 3, only 0..2 built", 2, FarOp::Max, {0, 0, 8, 8}, Four, false, 3},
+      {"8x8, the paper's covering: four level-2 squares, built", 2, FarOp::Max, {0, 0, 8, 8}, Paper, true, 2},
+      {"8x2, the paper's covering: a row of level-1 squares", 1, FarOp::Max, {0, 4, 8, 2}, Paper, true, 1},
+      {"5x5: four squares need level 2 (built)", 2, FarOp::Max, {0, 0, 5, 5}, Four, true, 2},
+      {"5x5: one square needs level 3 (missing)", 2, FarOp::Max, {0, 0, 5, 5}, One, false, 3},
+      {"reversed Z: incomplete answers 0, the far plane", 0, FarOp::Min, {3, 3, 2, 2}, Four, false, 1},
+      {"1-pixel rectangle needs only level 0", 0, FarOp::Max, {7, 7, 1, 1}, One, true, 0},
+      {"clipped to 2x2 at the corner: level 1 is enough", 1, FarOp::Max, {30, 30, 10, 10}, Four, true, 1},
   };
   const DepthImage img = ref::uniform(32, 32, 8, 0.1f, 0.9f);
   for (const Row& row : rows) {

@@ -18,7 +18,7 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   config::Schema s;
   NBufferUnitConfig::describe(s, c);
   const auto d = s.describe();
-  ASSERT_EQ(d.size(), 12u);
+  ASSERT_EQ(d.size(), 14u);
   auto find = [&](const std::string& key) {
     for (const auto& e : d)
       if (e["key"] == key) return e;
@@ -28,6 +28,8 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   EXPECT_EQ(find("nbuffer.resolution_divisor")["default"], 1);
   EXPECT_EQ(find("nbuffer.format")["default"], "f32");
   EXPECT_EQ(find("nbuffer.level_cap")["default"], -1);
+  EXPECT_EQ(find("nbuffer.covering")["default"], "trace");
+  EXPECT_EQ(find("nbuffer.align")["default"], "trace");
   EXPECT_EQ(find("nbuffer.update_policy")["default"], "eager");
   EXPECT_EQ(find("nbuffer.lookup_latency_cycles")["unit"], "cycles");
   EXPECT_EQ(find("nbuffer.lookups_per_cycle")["default"], 4.0);

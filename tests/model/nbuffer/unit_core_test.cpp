@@ -146,6 +146,10 @@ TEST(NBufferUnitCoreTest, ConservativeForEveryPolicyAndDivisor) {
           cfg.update_policy = policy;
           cfg.resolution_divisor = d;
           cfg.format = size.format;
+          // Each covering and alignment in turn over the configurations.
+          const int variant = d + static_cast<int>(op) + static_cast<int>(std::string(policy).size());
+          cfg.covering = std::string(kCoveringKindNames[static_cast<std::size_t>(variant % 3)]);
+          cfg.align = std::string(kCoveringAlignNames[static_cast<std::size_t>(variant % 2)]);
           const int w = size.w, h = size.h;
           Rig rig(op, cfg, w, h);
           std::mt19937 rng(1000u + static_cast<unsigned>(d) * 7u + static_cast<unsigned>(op) * 3u +
@@ -158,8 +162,8 @@ TEST(NBufferUnitCoreTest, ConservativeForEveryPolicyAndDivisor) {
             for (int q = 0; q < 3; ++q) {
               const Rect r = ref::random_rect(rng, w, h, true);
               const float nearest = random_nearest(rng, op, ref::farthest(rig.truth, op, r));
-              const auto kind = ref::uniform_int(rng, 0, 1) ? CoveringKind::Four : CoveringKind::One;
-              const QueryAnswer a = rig.core->query(r, nearest, kind);
+              const CoveringSpec kind = rig.core->covering();
+              const QueryAnswer a = rig.core->query(r, nearest);
               hidden += a.hidden, visible += a.outcome == QueryOutcome::Visible;
               if (auto e = check(rig, r, nearest, a); !e.empty()) fails.add(e);
               if (std::string(policy) != "batched" && a.outcome != QueryOutcome::Offscreen) {

@@ -61,7 +61,7 @@ TEST(NBufferUnitTest, QueryTakesLatencyPlusThroughput) {
   const Row rows[] = {
       {{3, 5, 30, 30}, 4, 1 + 8, 4 + 8},  // level 4, two anchors per axis
       {{0, 0, 20, 16}, 2, 1 + 8, 2 + 8},  // level 4, side by side
-      {{0, 0, 16, 16}, 1, 1 + 8, 1 + 8},  // one exact square
+      {{0, 0, 16, 16}, 4, 1 + 8, 4 + 8},  // the paper's covering: four quadrants of level 3
       {{70, 0, 4, 4}, 0, 0, 0},           // off the image: no lookups, no cycles
   };
   std::vector<std::string> errors;
@@ -78,8 +78,9 @@ TEST(NBufferUnitTest, QueryTakesLatencyPlusThroughput) {
   sc_core::sc_start();
   for (const auto& e : errors) ADD_FAILURE() << e;
   EXPECT_EQ(reg.values()["fast"]["busy_cycles"], 27) << "busy cycles are the query cycles";
-  EXPECT_EQ(reg.values()["slow"]["busy_cycles"], 12 + 10 + 9);
-  EXPECT_EQ(reg.values()["fast"]["lookups"]["4"], 7);
+  EXPECT_EQ(reg.values()["slow"]["busy_cycles"], 12 + 10 + 12);
+  EXPECT_EQ(reg.values()["fast"]["lookups"]["4"], 6);
+  EXPECT_EQ(reg.values()["fast"]["lookups"]["3"], 4);
 }
 
 // Cache misses go to the memory channel: a cold query waits for the line fills, a warm one does not.

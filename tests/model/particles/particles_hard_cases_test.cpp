@@ -32,6 +32,9 @@
 namespace nbsim::particles {
 namespace {
 
+// The particles' covering: the paper's, a power-of-two sprite in one lookup (the capture's default).
+constexpr CoveringSpec kSpriteCovering{CoveringKind::Paper, CoveringAlign::Top, true};
+
 // Powers of two: window <-> clip conversions are exact, so GL's window position is the one given.
 constexpr int kW = 64, kH = 32;
 constexpr float kMargin = 1e-6f;  // the capture's cull_margin (traces/capture/particles/particles.cpp)
@@ -173,6 +176,7 @@ class GlParticles {
     std::string defines = std::string("#define ") + kModeDefines[static_cast<int>(mode)] + "\n";
     defines += reversed ? "#define ZERO_TO_ONE\n#define FAR(a, b) min(a, b)\n#define HIDDEN(d, f) ((d) + margin < (f))\n"
                         : "#define FAR(a, b) max(a, b)\n#define HIDDEN(d, f) ((d) - margin > (f))\n";
+    defines += capture::covering_glsl(kSpriteCovering);
     const GLuint prog = capture::link_program(
         {capture::compile_shader(GL_VERTEX_SHADER, capture::with_defines(shaders::particles_particles_vert, defines),
                                  "particles/particles.vert"),
@@ -211,7 +215,7 @@ ModelOutcome model(const Particle& p, const DepthImage& scene, const NBuffer& nb
   m.passes = !m.drawn.empty() && sprite_passes(m.drawn, p.depth, scene, op);
   m.center = center_test(p, m.rect, scene, kMargin, op);
   if (nb_testable(m.rect, nb.top_level())) {
-    const QueryResult q = nb.query(m.rect.clipped);
+    const QueryResult q = nb.query(m.rect.clipped, kSpriteCovering);
     EXPECT_TRUE(q.complete) << "a testable sprite's level is built";
     m.nb.tested = true;
     m.nb.lookups = static_cast<std::uint32_t>(q.texel_count);
@@ -345,7 +349,8 @@ TEST_F(ParticlesHardCasesTest, PartlyOffscreenAndCentreOutsideTheFrustum) {
   EXPECT_TRUE(same(in.none.covered, Rect{0, 8, 11, 16})) << "GL: square [-5, 11) cut at x 0";
   EXPECT_TRUE(same(in.m.rect.clipped, Rect{0, 8, 11, 16}));
   EXPECT_TRUE(in.nb.culled);
-  EXPECT_EQ(in.nb.lookups, 1u) << "11 x 16 clipped: one square of level 4 (it also reads columns 11..15)";
+  EXPECT_EQ(in.nb.lookups, 4u) << "11 x 16 clipped: the paper's four quadrants of level 3 (the corner covering read one "
+                                   "level-4 square, columns 11..15 too)";
   DepthImage edge = hidden;
   edge.at(0, 8) = 1.0f;  // the only pixel showing is on the screen border
   const Both shown = decide({3.25f, 16.25f, 0.5f, 16.0f}, edge, 4, false);
@@ -358,7 +363,7 @@ TEST_F(ParticlesHardCasesTest, PartlyOffscreenAndCentreOutsideTheFrustum) {
   EXPECT_EQ(out.none.covered_pixels, 0u) << "GL clips the point by its centre: nothing drawn";
   EXPECT_EQ(out.center.lookups, 0u) << "the centre pixel is off-screen: no lookup";
   EXPECT_TRUE(out.m.rect.on_screen) << "the shader's rectangle still reaches columns 0..5";
-  EXPECT_EQ(out.nb.lookups, 1u) << "nb reads the on-screen part [0, 6) x [8, 24)";
+  EXPECT_EQ(out.nb.lookups, 2u) << "nb reads the on-screen part [0, 6) x [8, 24): two stacked level-3 squares";
   EXPECT_FALSE(out.nb.culled);
   const Both hid = decide({-2.0f, 16.25f, 0.5f, 16.0f}, hidden, 4, false);
   EXPECT_TRUE(hid.nb.culled) << "culled though GL would draw nothing anyway: no cost, no pop";

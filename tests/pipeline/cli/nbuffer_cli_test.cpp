@@ -369,7 +369,7 @@ TEST(NBufferCliTest, SizesBounded) {
       {"nbuffer query --scene city --size 46341x46341 --rect 0,0,1,1", "the built-in scene is at most 4096x4096"},
       {"nbuffer build --scene city --size 4097x16 --out " + out.string(), "at most 4096x4096"},
       {"nbuffer query --scene city --size 16x99999999999 --rect 0,0,1,1", "--size"},
-      {"nbuffer coverage --size 1024x1024 --scale 16 --out " + (out / "c.png").string(), "makes a 32896x17536 image: at most 64 M pixels"},
+      {"nbuffer coverage --size 1024x1024 --scale 16 --out " + (out / "c.png").string(), "makes a 49408x17536 image: at most 64 M pixels"},
       {"nbuffer coverage --size 16777216x1 --out " + (out / "c.png").string(), "at most 4096x4096 box sizes"},
   };
   for (const Row& row : rows) {
@@ -408,7 +408,8 @@ TEST(NBufferCliTest, BuildWritesEveryLevel) {
   EXPECT_TRUE(fs::exists(out / "levels.json"));
 }
 
-// coverage writes the image and the CSV and prints a summary.
+// coverage writes the image and the CSV and prints a summary: every covering's mean extra area and
+// the shares of the five cases of Fig. 3.
 TEST(NBufferCliTest, CoverageWritesImageAndCsv) {
   const fs::path png = scratch("cov.png");
   const CliResult r = nbsim("nbuffer coverage --size 16x8 --out " + png.string());
@@ -419,7 +420,21 @@ TEST(NBufferCliTest, CoverageWritesImageAndCsv) {
   int rows = 0;
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 1 + 16 * 8) << "one header and one row per box size";
-  EXPECT_TRUE(has(r.out, "four squares")) << r.out;
+  for (const char* part : {"paper    mean extra", "corners  mean extra", "one      mean extra", "four_quadrants", "two_side_by_side",
+                           "two_stacked", "four_in_a_row", "four_in_a_column"})
+    EXPECT_TRUE(has(r.out, part)) << part << ": " << r.out;
+}
+
+// Figure 4 over every box from 1x1 to 256x256: the paper's covering adds 129.7 % of the box on
+// average, nbsim's corner covering before it 284.3 %, one square 921.7 % (CoveringTest checks each
+// covering's area against a brute-force count of its pixels).
+TEST(NBufferCliTest, CoverageOfFigure4) {
+  const fs::path png = scratch("fig4.png");
+  const CliResult r = nbsim("nbuffer coverage --size 256x256 --scale 1 --out " + png.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "paper    mean extra   129.7% of the box")) << r.out;
+  EXPECT_TRUE(has(r.out, "corners  mean extra   284.3% of the box")) << r.out;
+  EXPECT_TRUE(has(r.out, "one      mean extra   921.7% of the box")) << r.out;
 }
 
 }  // namespace

@@ -33,23 +33,23 @@ const std::string kSample = (fs::path(NBSIM_SAMPLES) / "city_small_oq.nbt").stri
 // other property and every record as they are.
 void retag(const fs::path& src, const fs::path& dst, const std::string& technique) {
   namespace tr = nbsim::trace;
-  tr::TraceReader in(src);
+  tr::FrameReader in{src};
   tr::Properties props;
-  for (const auto& [k, v] : in.properties())
+  for (const auto& [k, v] : in.trace().properties())
     if (k != "technique") props.emplace_back(k, v);
   if (!technique.empty()) props.emplace_back("technique", technique);
   tr::TraceWriter out(dst, props);
-  if (in.scene()) out.write(*in.scene());
-  while (const auto chunk = in.next()) {
-    switch (chunk->type) {
-      case tr::ChunkType::FrameBegin: out.begin_frame(in.decode<tr::FrameBegin>(*chunk)); break;
-      case tr::ChunkType::Draw: out.write(in.decode<tr::DrawRecord>(*chunk)); break;
-      case tr::ChunkType::Depth: out.write(in.decode<tr::DepthSnapshot>(*chunk)); break;
-      case tr::ChunkType::Levels: out.write(in.decode<tr::NBufferLevels>(*chunk)); break;
-      case tr::ChunkType::Truth: out.write(in.decode<tr::GroundTruth>(*chunk)); break;
-      case tr::ChunkType::FrameEnd: out.end_frame(in.decode<tr::FrameEnd>(*chunk)); break;
-      default: break;  // HEAD, SCEN (consumed by the reader) and END (written by close)
-    }
+  if (in.trace().scene()) out.write(*in.trace().scene());
+  while (const auto f = in.next()) {  // every record the frame reader groups, in the writer's order
+    out.begin_frame(f->begin);
+    for (const tr::DrawRecord& d : f->draws) out.write(d);
+    for (const tr::DepthSnapshot& d : f->depths) out.write(d);
+    for (const tr::NBufferLevels& l : f->levels) out.write(l);
+    for (const tr::StencilSnapshot& st : f->stencils) out.write(st);
+    if (f->light) out.write_light(*f->light);
+    for (const tr::TechniqueRecord& t : f->technique_records) out.write(t);
+    if (f->truth) out.write(*f->truth);
+    out.end_frame(f->end);
   }
   out.close();
 }

@@ -81,7 +81,7 @@ TEST(CaptureCliTest, OldAndNewSpellingsGiveIdenticalTraces) {
   ASSERT_NE(r.property("command_line"), nullptr);
   EXPECT_EQ(*r.property("command_line"),
             "nbsim capture occlusion_culling --scene city --path fly --size 64x48 --frames 3 --seed 2 --objects 300 "
-            "--mode nb_hier --levels-every 1 -o " + old_file.string());
+            "--mode nb_hier --levels-every 1 --covering paper --align top -o " + old_file.string());
   EXPECT_EQ(*r.property("technique"), "occlusion_culling");
   fs::remove_all(old_file.parent_path());
 }

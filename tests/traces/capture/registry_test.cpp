@@ -167,13 +167,13 @@ TEST(CaptureRegistryTest, CanonicalCommandLineSpellsEverythingOut) {
   o.options = {{"seed", "3"}, {"objects", "1200"}, {"mode", "oq"}, {"levels-every", "0"}};
   EXPECT_EQ(canonical_command_line(o, "t.nbt"),
             "nbsim capture occlusion_culling --scene city --path walk --size 128x96 --frames 8 --seed 3 --objects 1200 "
-            "--mode oq --levels-every 0 -o t.nbt");
+            "--mode oq --levels-every 0 --covering paper --align top -o t.nbt");
   o.path = "fly";
   o.reversed_z = true;
   o.options = {};
   EXPECT_EQ(canonical_command_line(o, "t.nbt"),
             "nbsim capture occlusion_culling --scene city --path fly --size 128x96 --frames 8 --seed 1 --objects 6000 "
-            "--mode nb_hier --levels-every 10 --reversed-z -o t.nbt");
+            "--mode nb_hier --levels-every 10 --covering paper --align top --reversed-z -o t.nbt");
 }
 
 }  // namespace

@@ -54,6 +54,11 @@ const OptionSpec& levels_every_option() {
   return spec;
 }
 
+const OptionSpec& culling_covering_option() {
+  static const OptionSpec spec = covering_option();
+  return spec;
+}
+
 class OcclusionCulling final : public Technique {
  public:
   explicit OcclusionCulling(const TechniqueSetup& s)
@@ -64,17 +69,20 @@ class OcclusionCulling final : public Technique {
         reversed_(s.projection.reversed_z),
         mode_(*scene::parse_test_mode(s.options.text(mode_option()))),
         levels_every_(static_cast<int>(s.options.integer(levels_every_option()))),
+        covering_(read_covering(s.options, culling_covering_option())),
         pass_(s.scene, true),
         target_(s.width, s.height) {
     if (mode_ == TestMode::NBuffer || mode_ == TestMode::NBufferHier)
-      nbuffer_ = std::make_unique<GlslNBuffer>(s.width, s.height, reversed_ ? FarOp::Min : FarOp::Max);
+      nbuffer_ = std::make_unique<GlslNBuffer>(s.width, s.height, reversed_ ? FarOp::Min : FarOp::Max, 1 << 30, covering_);
     if (reversed_) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   }
 
   trace::Properties variant_properties() const override { return {{"test_mode", std::string(scene::to_string(mode_))}}; }
 
   trace::Properties setting_properties() const override {
-    return {{"nearest_margin", fmt::format("{}", kNearestMargin)}, {"levels_every", std::to_string(levels_every_)}};
+    return {{"nearest_margin", fmt::format("{}", kNearestMargin)},
+            {"levels_every", std::to_string(levels_every_)},
+            covering_property(covering_)};
   }
 
   CapturedFrame render(std::uint32_t index, const CameraPose& pose) override;
@@ -89,6 +97,7 @@ class OcclusionCulling final : public Technique {
   bool reversed_;
   TestMode mode_;
   int levels_every_;
+  CoveringSpec covering_;  // of the GLSL N-buffer's queries (nb, nb_hier); the model's default too
   ScenePass pass_;
   RenderTarget target_;
   DrawRecorder recorder_;
@@ -233,7 +242,7 @@ void OcclusionCulling::test_with_nbuffer(const std::vector<scene::TestItem>& ite
 }  // namespace
 
 const std::vector<OptionSpec>& occlusion_culling_options() {
-  static const std::vector<OptionSpec> options = {mode_option(), levels_every_option()};
+  static const std::vector<OptionSpec> options = {mode_option(), levels_every_option(), culling_covering_option(), align_option()};
   return options;
 }
 

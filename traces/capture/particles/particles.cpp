@@ -84,6 +84,12 @@ const OptionSpec& levels_every_option() {
   static const OptionSpec spec = levels_every_spec("the GLSL N-buffer levels");
   return spec;
 }
+// The vertex stage reads only the levels built, so the one-square covering (which may need a
+// level above them) is not offered; a power-of-two sprite is one lookup under either.
+const OptionSpec& particles_covering_option() {
+  static const OptionSpec spec = covering_option({"paper", "corners"});
+  return spec;
+}
 
 // "X:Z,X:Z" -> positions; throws InputError naming the bad item.
 std::vector<std::pair<double, double>> parse_emitters(const std::string& text) {
@@ -131,7 +137,8 @@ class Particles final : public Technique {
             {"level_cap", std::to_string(level_cap_)},
             {"levels_built", std::to_string(levels_built_)},
             {"cull_margin", fmt::format("{}", kMargin)},
-            {"levels_every", std::to_string(levels_every_)}};
+            {"levels_every", std::to_string(levels_every_)},
+            covering_property(covering_)};
   }
 
   CapturedFrame render(std::uint32_t index, const CameraPose& pose) override;
@@ -147,6 +154,7 @@ class Particles final : public Technique {
   std::string sprite_;
   std::uint32_t count_;
   int level_cap_, levels_built_ = 0, levels_every_;
+  CoveringSpec covering_;  // of mode nb's lookups
   std::string emitters_text_;
   std::uint32_t seed_;
   std::vector<Emitter> emitters_;
@@ -171,6 +179,7 @@ Particles::Particles(const TechniqueSetup& s)
       count_(static_cast<std::uint32_t>(s.options.integer(particles_option()))),
       level_cap_(static_cast<int>(s.options.integer(level_cap_option()))),
       levels_every_(static_cast<int>(s.options.integer(levels_every_option()))),
+      covering_(read_covering(s.options, particles_covering_option())),
       emitters_text_(s.options.text(emitters_option())),
       seed_(static_cast<std::uint32_t>(s.options.integer(seed_option()))),
       pass_(s.scene, false),
@@ -193,6 +202,7 @@ Particles::Particles(const TechniqueSetup& s)
   std::string defines = fmt::format("#define {}\n", kModeDefines[static_cast<std::size_t>(mode_)]);
   defines += reversed_ ? "#define ZERO_TO_ONE\n#define FAR(a, b) min(a, b)\n#define HIDDEN(d, f) ((d) + margin < (f))\n"
                        : "#define FAR(a, b) max(a, b)\n#define HIDDEN(d, f) ((d) - margin > (f))\n";
+  defines += covering_glsl(covering_);
   particle_prog_ = link_program({compile_shader(GL_VERTEX_SHADER, with_defines(shaders::particles_particles_vert, defines),
                                                 "particles/particles.vert"),
                                  compile_shader(GL_FRAGMENT_SHADER, shaders::common_count_frag, "common/count.frag")},
@@ -379,7 +389,7 @@ CapturedFrame Particles::render(std::uint32_t index, const CameraPose& pose) {
 const std::vector<OptionSpec>& particles_options() {
   static const std::vector<OptionSpec> options = {particles_option(), sprite_option(),   mode_option(),
                                                   level_cap_option(), emitters_option(), levels_every_option(),
-                                                  seed_option()};
+                                                  particles_covering_option(), align_option(), seed_option()};
   return options;
 }
 

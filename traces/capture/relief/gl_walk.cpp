@@ -30,11 +30,13 @@ struct GlReliefWalker::Objects {
   }
 };
 
-GlReliefWalker::GlReliefWalker(int width, int height) : gl_(std::make_unique<Objects>()), width_(width), height_(height) {
+GlReliefWalker::GlReliefWalker(int width, int height, CoveringSpec covering)
+    : gl_(std::make_unique<Objects>()), width_(width), height_(height), covering_(covering) {
   NBSIM_CHECK(width > 0 && height > 0, "relief viewport");
   Objects& o = *gl_;
   o.program = link_program({compile_shader(GL_VERTEX_SHADER, shaders::relief_relief_vert, "relief/relief.vert"),
-                            compile_shader(GL_FRAGMENT_SHADER, shaders::relief_relief_frag, "relief/relief.frag")},
+                            compile_shader(GL_FRAGMENT_SHADER, with_defines(shaders::relief_relief_frag, covering_glsl(covering)),
+                                           "relief/relief.frag")},
                            "relief", true);
   glCreateVertexArrays(1, &o.vao);
   glCreateBuffers(1, &o.vbo);
@@ -113,6 +115,7 @@ void GlReliefWalker::clear_depth() {
 GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, const relief::WalkParams& params, DrawRecorder& recorder,
                                  GLuint framebuffer) {
   NBSIM_CHECK(size_ > 0, "relief: draw before set_field");
+  NBSIM_CHECK(params.covering == covering_, "relief: a draw's covering is not the one the walker's shader was built with");
   Objects& o = *gl_;
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer ? framebuffer : o.fbo);
   glViewport(0, 0, width_, height_);

@@ -33,8 +33,9 @@ struct ReliefView {
 
 class GlReliefWalker {
  public:
-  // A width x height viewport.
-  GlReliefWalker(int width, int height);
+  // A width x height viewport; the N-buffer walk covers its spans as `covering` says (draw()'s
+  // params must carry the same).
+  GlReliefWalker(int width, int height, CoveringSpec covering = {});
   ~GlReliefWalker();
   GlReliefWalker(const GlReliefWalker&) = delete;
   GlReliefWalker& operator=(const GlReliefWalker&) = delete;
@@ -58,6 +59,7 @@ class GlReliefWalker {
   struct Objects;
   std::unique_ptr<Objects> gl_;
   int width_, height_;
+  CoveringSpec covering_;
   int size_ = 0;
 };
 

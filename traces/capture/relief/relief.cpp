@@ -120,6 +120,11 @@ const OptionSpec& box_at_option() {
       "auto");
   return spec;
 }
+const OptionSpec& relief_covering_option() {
+  static const OptionSpec spec = covering_option();
+  return spec;
+}
+
 const OptionSpec& tolerance_option() {
   static const OptionSpec spec =
       text_option("tolerance", "Hit error tolerance for the capture's own counts, texels (model/relief/score.h)", "0.25");
@@ -249,9 +254,10 @@ class Relief final : public Technique {
     params_.linear_steps = static_cast<int>(o.integer(linear_steps_option()));
     params_.binary_steps = static_cast<int>(o.integer(binary_steps_option()));
     params_.root_steps = static_cast<int>(o.integer(root_steps_option()));
+    params_.covering = read_covering(o, relief_covering_option());
     tolerance_ = parse_number(o.text(tolerance_option()), "tolerance", 0.0, 1e6);
     if (city_ && apex_ > 0.0) throw InputError("--placement city takes the box, not a --frustum");
-    walker_ = std::make_unique<GlReliefWalker>(width_, height_);
+    walker_ = std::make_unique<GlReliefWalker>(width_, height_, params_.covering);
     if (city_) {
       pass_ = std::make_unique<ScenePass>(scene_, false);
       target_ = std::make_unique<RenderTarget>(width_, height_);
@@ -272,6 +278,7 @@ class Relief final : public Technique {
             {"relief_linear_steps", std::to_string(params_.linear_steps)},
             {"relief_binary_steps", std::to_string(params_.binary_steps)},
             {"relief_root_steps", std::to_string(params_.root_steps)},
+            covering_property(params_.covering),
             {"relief_seed", std::to_string(seed_)},
             {"relief_view", "the box [0,1]^2 x [0,relief_box_height] seen from angle k mod count of relief_angles off its up axis, "
                             "azimuth 37 + 61 k + 13 seed degrees, framing the box; rays rebuilt from gl_FragCoord (model/relief/walk.h)"},
@@ -468,7 +475,8 @@ const std::vector<OptionSpec>& relief_options() {
   static const std::vector<OptionSpec> options = {field_option(),        field_param_option(), field_size_option(),   field_file_option(),  field_mesh_option(),
                                                   radius_file_option(),  max_radius_option(),  methods_option(),      angles_option(),
                                                   box_height_option(),   frustum_option(),     linear_steps_option(), binary_steps_option(), root_steps_option(),
-                                                  tolerance_option(),    placement_option(),   box_at_option(),       seed_option()};
+                                                  tolerance_option(),    placement_option(),   box_at_option(),       relief_covering_option(),
+                                                  align_option(),        seed_option()};
   return options;
 }
 

@@ -74,6 +74,11 @@ const OptionSpec& light_fov_option() {
   static const OptionSpec spec = integer_option("light-fov", "The spot light's field of view, degrees", 60, 1, 179);
   return spec;
 }
+const OptionSpec& shadows_covering_option() {
+  static const OptionSpec spec = covering_option();
+  return spec;
+}
+
 const OptionSpec& levels_every_option() {
   static const OptionSpec spec = levels_every_spec("both N-buffers' levels");
   return spec;
@@ -151,7 +156,8 @@ class Shadows final : public Technique {
             {"stencil_volumes", "zfail_caps_two_sided_depth_clamp"},
             {"reproject_tolerance", fmt::format("{} + {} m", kReprojectRel, kReprojectM)},
             {"clamp_margin", fmt::format("{} + {} m", kClampRel, kClampM)},
-            {"levels_every", std::to_string(levels_every_)}};
+            {"levels_every", std::to_string(levels_every_)},
+            covering_property(covering_)};
   }
   std::string depth_format() const override { return "DEPTH24_STENCIL8"; }
 
@@ -176,6 +182,7 @@ class Shadows final : public Technique {
   Projection projection_;
   Mode mode_;
   int litmap_, light_fov_, levels_every_;
+  CoveringSpec covering_;  // of the eight lookups a caster makes
   std::string light_text_;
   std::uint32_t seed_;
   std::vector<CasterMesh> casters_;
@@ -202,6 +209,7 @@ Shadows::Shadows(const TechniqueSetup& s)
       litmap_(static_cast<int>(s.options.integer(litmap_option()))),
       light_fov_(static_cast<int>(s.options.integer(light_fov_option()))),
       levels_every_(static_cast<int>(s.options.integer(levels_every_option()))),
+      covering_(read_covering(s.options, shadows_covering_option())),
       light_text_(s.options.text(light_option())),
       seed_(static_cast<std::uint32_t>(s.options.integer(seed_option()))),
       casters_(find_casters(s.scene)),
@@ -317,8 +325,8 @@ CasterResult Shadows::measure(const CasterMesh& c, const LightCamera& light, con
     return r;
   }
   r.x = lx, r.y = ly, r.w = hx - lx + 1, r.h = hy - ly + 1;
-  // Four lookups in each N-buffer: the nearest (min) and the farthest (max) visible receiver.
-  const Covering cov = cover_four(Rect{r.x, r.y, r.w, r.h}, lo.levels - 1);
+  // Up to four lookups in each N-buffer: the nearest (min) and the farthest (max) visible receiver.
+  const Covering cov = cover(Rect{r.x, r.y, r.w, r.h}, covering_, lo.levels - 1);
   const std::size_t plane = static_cast<std::size_t>(cov.level) * static_cast<std::size_t>(litmap_) * static_cast<std::size_t>(litmap_);
   for (int k = 0; k < cov.count; ++k) {
     const std::size_t at = plane + static_cast<std::size_t>(cov.squares[static_cast<std::size_t>(k)].y) * static_cast<std::size_t>(litmap_) +
@@ -695,8 +703,9 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
 }  // namespace
 
 const std::vector<OptionSpec>& shadows_options() {
-  static const std::vector<OptionSpec> options = {shadow_mode_option(), litmap_option(), light_option(), light_fov_option(),
-                                                  levels_every_option(), seed_option()};
+  static const std::vector<OptionSpec> options = {shadow_mode_option(), litmap_option(),    light_option(),
+                                                  light_fov_option(),   levels_every_option(), shadows_covering_option(),
+                                                  align_option(),       seed_option()};
   return options;
 }
 
