@@ -18,9 +18,14 @@ namespace {
 
 namespace OIIO = OIIO_NAMESPACE;
 
-// OpenImageIO's message, or `fallback` when it gives none (its readers do not all say why).
-std::string reason(const std::string& error, std::string_view fallback) {
-  return error.empty() ? std::string(fallback) : error;
+// OpenImageIO's message, or `fallback` when it gives none (its readers do not all say why), or the
+// message completed by `fallback` when it stops at a colon (libtiff passes on zlib's empty message:
+// fuzz_depth_image found "ZLib error: ").
+std::string reason(std::string error, std::string_view fallback) {
+  while (!error.empty() && std::isspace(static_cast<unsigned char>(error.back()))) error.pop_back();
+  if (error.empty()) return std::string(fallback);
+  if (error.back() == ':') return error + " " + std::string(fallback);
+  return error;
 }
 
 // The byte where a PFM's pixels start, 0 when the file is not a PFM (OpenImageIO reads PFM with

@@ -274,6 +274,17 @@ TEST(NBufferCliTest, RefusesTiffWhoseStripsDoNotFitTheFile) {
   EXPECT_FALSE(fs::exists(scratch("tiff_levels"))) << "a refused command removes the folders it created";
 }
 
+// fuzz_depth_image's fourth finding: a TIFF whose deflate strip does not decode, where libtiff
+// passes on zlib's empty message and OpenImageIO reports "ZLib error: ", a refusal that stopped
+// at a colon. The reason is completed.
+TEST(NBufferCliTest, RefusalNeverEndsAtAColon) {
+  const fs::path f = finding_file("tiff_zlib_error_without_message", "zlib.tif");
+  const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "ZLib error: OpenImageIO cannot decode its pixel data")) << r.err;
+  EXPECT_FALSE(has(r.err, ": \n")) << r.err;
+}
+
 // TIFFs built byte by byte (tests/pipeline/io/tiff_builder.h) are real TIFFs to OpenImageIO: each
 // layout the precheck accepts reads back the pixel values written, and a compressed strip that
 // does not decode is refused (OpenImageIO's TIFF reader reports it only through its error state;
