@@ -23,7 +23,8 @@ TITLES = {
     "paper": "the paper's five cases (at most 4 lookups)",
     "corners": "corner squares, 2^floor(log2 max) (at most 4)",
     "one": "one square (1 lookup)",
-    "rect": "rectangle levels (at most 4)",
+    "rect": "rectangle levels, every one (exact, at most 4)",
+    "rect_aspect1": "rectangle levels, sides at most 2x apart",
 }
 CASES = ["four_quadrants", "two_side_by_side", "two_stacked", "four_in_a_row", "four_in_a_column"]
 

@@ -44,27 +44,29 @@ namespace {
 // the span is longer, one every `side` from the start and the last flush with the end (at most
 // four: len <= 4 side); when it is not longer, one square flush with the start, or with the end
 // when `at_end` (moved to 0 when that would start below 0 while the span does not).
-int anchors(int start, int len, int side, bool at_end, std::array<int, 4>& out) {
+int anchors(int start, int len, int log2_side, bool at_end, std::array<int, 4>& out) {
+  const int side = 1 << log2_side;
   if (len <= side) {
     int a = at_end ? start + len - side : start;
     if (a < 0 && start >= 0) a = 0;
     out[0] = a;
     return 1;
   }
-  const int n = (len + side - 1) / side;
+  const int n = (len + side - 1) >> log2_side;
   NBSIM_CHECK(n <= 4, "a covering's span needs more than four squares");
   for (int k = 0; k + 1 < n; ++k) out[static_cast<std::size_t>(k)] = start + k * side;
   out[static_cast<std::size_t>(n - 1)] = start + len - side;
   return n;
 }
 
-Covering grid(const Rect& r, int level, bool top, CoveringCase kase) {
+// Rectangles of 2^lw x 2^lh over r, at most four.
+Covering grid(const Rect& r, int lw, int lh, bool top, CoveringCase kase) {
   Covering c;
-  c.level = level;
+  c.level = lw;
+  c.log2_w = lw, c.log2_h = lh;
   c.kase = kase;
-  const int side = 1 << level;
   std::array<int, 4> xs{}, ys{};
-  const int nx = anchors(r.x, r.w, side, false, xs), ny = anchors(r.y, r.h, side, top, ys);
+  const int nx = anchors(r.x, r.w, lw, false, xs), ny = anchors(r.y, r.h, lh, top, ys);
   NBSIM_CHECK(nx * ny <= 4, "a covering with more than four squares");
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) c.squares[static_cast<std::size_t>(c.count++)] = {xs[static_cast<std::size_t>(i)], ys[static_cast<std::size_t>(j)]};
@@ -77,13 +79,13 @@ Covering paper(const Rect& r, bool top, int top_level) {
   // Squares of side q (a quadrant), or q/2 in a row or a column; a 1x1 rectangle: level 0.
   const int level = s_log == 0 ? 0 : (kase == CoveringCase::FourInARow || kase == CoveringCase::FourInAColumn ? s_log - 2 : s_log - 1);
   NBSIM_CHECK(level <= top_level, "rectangle larger than the top level's covering");
-  return grid(r, level, top, kase);
+  return grid(r, level, level, top, kase);
 }
 
 Covering corners(const Rect& r, bool top, int top_level) {
   const int level = std::min(floor_log2(static_cast<unsigned>(std::max(r.w, r.h))), top_level);
   NBSIM_CHECK(r.w <= 2 << level && r.h <= 2 << level, "rectangle larger than four squares of the top level");
-  return grid(r, level, top, covering_case(r.w, r.h));
+  return grid(r, level, level, top, covering_case(r.w, r.h));
 }
 
 bool power_of_two_square(const Rect& r) noexcept { return r.w == r.h && (r.w & (r.w - 1)) == 0; }
@@ -93,6 +95,7 @@ Covering direct(const Rect& r) {
   {
     Covering c;
     c.level = floor_log2(static_cast<unsigned>(r.w));
+    c.log2_w = c.log2_h = c.level;
     c.kase = covering_case(r.w, r.h);
     c.count = 1;
     c.squares[0] = {r.x, r.y};
@@ -125,7 +128,7 @@ Covering cover(const Rect& r, CoveringSpec spec, int top_level) {
     case CoveringKind::Corners: return corners(r, top, top_level);
     case CoveringKind::One: {
       const int n = level_needed(r, CoveringKind::One);
-      return n > top_level ? corners(r, top, top_level) : grid(r, n, top, covering_case(r.w, r.h));
+      return n > top_level ? corners(r, top, top_level) : grid(r, n, n, top, covering_case(r.w, r.h));
     }
   }
   NBSIM_CHECK(false, "unknown covering kind");
@@ -133,16 +136,31 @@ Covering cover(const Rect& r, CoveringSpec spec, int top_level) {
 }
 
 
+Covering cover_rect(const Rect& r, int levels_x, int levels_y, int max_aspect_log2, CoveringAlign align) {
+  NBSIM_CHECK(!r.empty(), "covering an empty rectangle");
+  NBSIM_CHECK(max_aspect_log2 == -1 || max_aspect_log2 >= 1, "rectangle levels: max_aspect_log2 is -1 or at least 1");
+  const auto exponent = [](int len) { return len <= 1 ? 0 : ceil_log2(static_cast<unsigned>(len)) - 1; };
+  int i = exponent(r.w), j = exponent(r.h);
+  NBSIM_CHECK(i < levels_x && j < levels_y, "rectangle larger than the rectangle levels");
+  if (max_aspect_log2 >= 1) {
+    if (i - j > max_aspect_log2) j = std::min(i - max_aspect_log2, levels_y - 1);
+    if (j - i > max_aspect_log2) i = std::min(j - max_aspect_log2, levels_x - 1);
+  }
+  Covering c = grid(r, i, j, align == CoveringAlign::Top, covering_case(r.w, r.h));
+  c.level = -1;
+  return c;
+}
+
 long long covered_area(const Covering& c) noexcept {
   // The squares form a grid (one to four starts per axis) whose intervals overlap or touch, so the
   // union is a rectangle: the span of the starts plus one side, on each axis.
-  const int s = c.side();
+  const int sw = c.width_px(), sh = c.height_px();
   int x0 = c.squares[0].x, x1 = x0, y0 = c.squares[0].y, y1 = y0;
   for (int i = 1; i < c.count; ++i) {
     x0 = std::min(x0, c.squares[static_cast<std::size_t>(i)].x), x1 = std::max(x1, c.squares[static_cast<std::size_t>(i)].x);
     y0 = std::min(y0, c.squares[static_cast<std::size_t>(i)].y), y1 = std::max(y1, c.squares[static_cast<std::size_t>(i)].y);
   }
-  return static_cast<long long>(x1 - x0 + s) * (y1 - y0 + s);
+  return static_cast<long long>(x1 - x0 + sw) * (y1 - y0 + sh);
 }
 
 }  // namespace nbsim

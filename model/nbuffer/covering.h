@@ -29,6 +29,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -84,20 +85,22 @@ struct Square {
 };
 
 struct Covering {
-  int level = 0;  // level whose texels the squares are; side = 2^level
+  int level = 0;  // level whose texels the squares are (square levels: side = 2^level)
+  // The squares' sides are 2^log2_w x 2^log2_h: both `level` for square levels; rectangle levels
+  // (cover_rect) read rectangles, and their level is the N-buffer's plane of that size.
+  int log2_w = 0, log2_h = 0;
   CoveringCase kase = CoveringCase::FourQuadrants;
   int count = 0;  // 1 to 4 distinct texels
-  std::array<Square, 4> squares{};
+  std::array<Square, 4> squares{};  // lower-left corners (of rectangles, for rectangle levels)
 
-  int side() const noexcept { return 1 << level; }
+  int side() const noexcept { return 1 << log2_w; }  // square levels
+  int width_px() const noexcept { return 1 << log2_w; }
+  int height_px() const noexcept { return 1 << log2_h; }
 };
 
-constexpr int floor_log2(unsigned v) noexcept {
-  int n = -1;
-  while (v) { v >>= 1; ++n; }
-  return n;
-}
-constexpr int ceil_log2(unsigned v) noexcept { return v <= 1 ? 0 : floor_log2(v - 1) + 1; }
+// floor(log2 v) (-1 for 0) and ceil(log2 v) (0 for 0 and 1).
+constexpr int floor_log2(unsigned v) noexcept { return static_cast<int>(std::bit_width(v)) - 1; }
+constexpr int ceil_log2(unsigned v) noexcept { return v <= 1 ? 0 : static_cast<int>(std::bit_width(v - 1)); }
 
 // Number of N-buffer levels for an image: ceil(log2(max(W, H))), at least 1.
 constexpr int nbuffer_level_count(int width, int height) noexcept {
@@ -118,6 +121,17 @@ Covering cover(const Rect& r, CoveringSpec spec, int top_level);
 // The header property naming the covering of a capture's GL queries ("paper/top"); a trace without
 // it was captured with corners/bottom.
 inline constexpr std::string_view kCoveringProperty = "nbuffer_covering";
+
+// The covering of rectangle levels (the paper's future work, like RIP-maps: NBufferConfig::shape
+// rect), where level (i, j) holds the farthest of 2^i x 2^j neighbourhoods: rectangles of
+// 2^i x 2^j with i = ceil(log2 w) - 1 (0 for w = 1) and j likewise, at most two per axis, so every
+// rectangle is read exactly with at most four lookups. With max_aspect_log2 = k >= 1 the levels
+// have |i - j| <= k (and the last row and column of levels, which every rectangle needs, are
+// whole): a thinner rectangle reads rectangles whose short exponent is raised to the long one's
+// minus k (at most the axis's last), one flush with the top (per `align`) or two on that axis.
+// levels_x and levels_y: the exponents' counts (ceil(log2 W), ceil(log2 H), at least 1). `level`
+// is -1: the N-buffer gives the plane.
+Covering cover_rect(const Rect& r, int levels_x, int levels_y, int max_aspect_log2, CoveringAlign align);
 
 // The level a covering of r reads when no level cap applies.
 int level_needed(const Rect& r, CoveringKind kind) noexcept;

@@ -2,6 +2,7 @@
 #include "model/nbuffer/nbuffer.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <new>
 #include <numeric>
 #include <string>
@@ -93,6 +94,29 @@ NBSIM_ROW_LOOP_CLONES RowChange apply_row(const float* __restrict row, float* __
   return c;
 }
 
+// Rectangle levels: row [x0, x1) of a level from the row `a` of its parent, one step of `s` texels
+// horizontally (a[x] and a[x + s]), or vertically with `b` the parent's row s above (null past
+// the image's top: a[x] alone).
+template <FarOp Op>
+[[gnu::always_inline]] inline void reduce_rect_row(const float* a, const float* b, float* out, int x0, int x1, int width,
+                                                   int s, bool horizontal) noexcept {
+  if (horizontal) {
+    const int split = std::clamp(width - s, x0, x1);
+    for (int x = x0; x < split; ++x) out[x] = far2<Op>(a[x], a[x + s]);
+    for (int x = split; x < x1; ++x) out[x] = a[x];
+  } else if (b) {
+    for (int x = x0; x < x1; ++x) out[x] = far2<Op>(a[x], b[x]);
+  } else {
+    for (int x = x0; x < x1; ++x) out[x] = a[x];
+  }
+}
+
+NBSIM_ROW_LOOP_CLONES void reduce_rect_row(FarOp op, const float* a, const float* b, float* out, int x0, int x1, int width, int s,
+                                           bool horizontal) noexcept {
+  if (op == FarOp::Max) reduce_rect_row<FarOp::Max>(a, b, out, x0, x1, width, s, horizontal);
+  else reduce_rect_row<FarOp::Min>(a, b, out, x0, x1, width, s, horizontal);
+}
+
 void grow(Rect& box, int x, int y) noexcept {
   if (box.empty()) { box = {x, y, 1, 1}; return; }
   const int x0 = std::min(box.x, x), y0 = std::min(box.y, y);
@@ -109,14 +133,113 @@ long long UpdateStats::total_changed() const noexcept {
   return std::accumulate(texels_changed.begin(), texels_changed.end(), 0LL);
 }
 
+std::vector<std::pair<int, int>> rect_levels(int width, int height, int max_aspect_log2) {
+  const int lx = std::max(1, ceil_log2(static_cast<unsigned>(width))), ly = std::max(1, ceil_log2(static_cast<unsigned>(height)));
+  const auto allowed = [&](int i, int j) {
+    return max_aspect_log2 < 0 || std::abs(i - j) <= max_aspect_log2 || (i > j && j == ly - 1) || (j > i && i == lx - 1);
+  };
+  std::vector<std::pair<int, int>> out;
+  for (int s = 0; s <= lx + ly - 2; ++s)
+    for (int i = 0; i < lx; ++i)
+      if (const int j = s - i; j >= 0 && j < ly && allowed(i, j)) out.emplace_back(i, j);
+  return out;
+}
+
 NBuffer::NBuffer(int width, int height, NBufferConfig config) : width_(width), height_(height), config_(config) {
   if (width < 1 || height < 1)
     throw InputError("N-buffer size must be at least 1x1, got " + std::to_string(width) + "x" + std::to_string(height));
-  full_levels_ = nbuffer_level_count(width, height);
   if (config.max_level < -1)
     throw InputError("N-buffer max_level must be -1 (all levels) or at least 0, got " + std::to_string(config.max_level));
-  levels_ = config.max_level < 0 ? full_levels_ : std::min(config.max_level, full_levels_ - 1) + 1;
+  if (config.shape == LevelShape::Rect) {
+    if (config.max_level != -1)
+      throw InputError("rectangle levels are built whole: max_level must be -1, got " + std::to_string(config.max_level));
+    if (config.max_aspect_log2 != -1 && config.max_aspect_log2 < 1)
+      throw InputError("rectangle levels: max_aspect_log2 must be -1 (every level) or at least 1 (0 would be the square "
+                       "levels), got " + std::to_string(config.max_aspect_log2));
+    levels_x_ = std::max(1, ceil_log2(static_cast<unsigned>(width)));
+    levels_y_ = std::max(1, ceil_log2(static_cast<unsigned>(height)));
+    exponents_ = nbsim::rect_levels(width, height, config.max_aspect_log2);
+    plane_of_.assign(static_cast<std::size_t>(levels_x_) * static_cast<std::size_t>(levels_y_), -1);
+    for (std::size_t p = 0; p < exponents_.size(); ++p)
+      plane_of_[static_cast<std::size_t>(exponents_[p].first + levels_x_ * exponents_[p].second)] = static_cast<int>(p);
+    parent_.assign(exponents_.size(), -1);
+    horizontal_.assign(exponents_.size(), 1);
+    for (std::size_t p = 1; p < exponents_.size(); ++p) {
+      const auto [i, j] = exponents_[p];
+      const bool h = i >= j;  // wider (or square): from the level half as wide
+      const int from = plane_of_[static_cast<std::size_t>(h ? (i - 1) + levels_x_ * j : i + levels_x_ * (j - 1))];
+      NBSIM_CHECK(from >= 0 && static_cast<std::size_t>(from) < p, "rectangle level built before its parent");
+      parent_[p] = from;
+      horizontal_[p] = h ? 1 : 0;
+    }
+    full_levels_ = levels_ = static_cast<int>(exponents_.size());
+  } else {
+    full_levels_ = nbuffer_level_count(width, height);
+    levels_ = config.max_level < 0 ? full_levels_ : std::min(config.max_level, full_levels_ - 1) + 1;
+  }
+  const long long bytes = static_cast<long long>(levels_) * static_cast<long long>(pixels()) * 4;
+  if (bytes > kMaxNBufferBytes)
+    throw InputError("an N-buffer of " + std::to_string(levels_) + (has_rect_levels() ? " rectangle" : "") + " levels of " +
+                     std::to_string(width) + "x" + std::to_string(height) + " floats needs " + std::to_string(bytes >> 20) +
+                     " MiB, above the limit of " + std::to_string(kMaxNBufferBytes >> 20) + " MiB" +
+                     (has_rect_levels() ? " (fewer rectangle levels: a max_aspect_log2 of 1 or 2; or a resolution divisor)" : ""));
   data_.assign(static_cast<std::size_t>(levels_) * pixels(), far_limit(config.op));
+}
+
+std::pair<int, int> NBuffer::level_exponents(int level) const noexcept {
+  return has_rect_levels() ? exponents_[static_cast<std::size_t>(level)] : std::pair{level, level};
+}
+
+std::string NBuffer::level_label(int level) const {
+  if (!has_rect_levels()) return std::to_string(level);
+  const auto [i, j] = exponents_[static_cast<std::size_t>(level)];
+  return std::to_string(1 << i) + "x" + std::to_string(1 << j);
+}
+
+Covering NBuffer::covering(const Rect& clipped, CoveringSpec spec) const {
+  if (!has_rect_levels()) return cover(clipped, spec, full_levels_ - 1);
+  Covering c = cover_rect(clipped, levels_x_, levels_y_, config_.max_aspect_log2, spec.align);
+  c.level = plane_of_[static_cast<std::size_t>(c.log2_w + levels_x_ * c.log2_h)];
+  NBSIM_CHECK(c.level >= 0, "a rectangle covering reads a level that is not built");
+  return c;
+}
+
+long long NBuffer::rect_reduce(int p, const Rect& region, Rect& changed) {
+  const auto [i, j] = exponents_[static_cast<std::size_t>(p)];
+  const bool h = horizontal_[static_cast<std::size_t>(p)] != 0;
+  const int s = 1 << ((h ? i : j) - 1);
+  const float* src = level_ptr(parent_[static_cast<std::size_t>(p)]);
+  float* dst = level_ptr(p);
+  std::vector<float> row(static_cast<std::size_t>(width_));
+  long long count = 0;
+  for (int y = region.y; y < region.y1(); ++y) {
+    const float* a = src + static_cast<std::size_t>(y) * width_;
+    const float* b = !h && y + s < height_ ? a + static_cast<std::size_t>(s) * width_ : nullptr;
+    reduce_rect_row(config_.op, a, b, row.data(), region.x, region.x1(), width_, s, h);
+    const RowChange c = apply_row(row.data(), dst + static_cast<std::size_t>(y) * width_, region.x, region.x1());
+    count += c.count;
+    if (c.count) { grow(changed, c.first, y); grow(changed, c.last, y); }
+  }
+  return count;
+}
+
+UpdateStats NBuffer::rect_update_from(Rect changed0, UpdateStats stats) {
+  // Plane p texel (x, y) reads its parent at x and x + s (or y and y + s): a change in box B of the
+  // parent reaches [B.x - s, B.x1) (or [B.y - s, B.y1)) of p; only the texels that change go on.
+  std::vector<Rect> changed(exponents_.size());
+  changed[0] = changed0;
+  for (std::size_t p = 1; p < exponents_.size(); ++p) {
+    const Rect& from = changed[static_cast<std::size_t>(parent_[p])];
+    if (from.empty()) continue;
+    const auto [i, j] = exponents_[p];
+    const bool h = horizontal_[p] != 0;
+    const int s = 1 << ((h ? i : j) - 1);
+    const Rect reach = clip(h ? Rect{from.x - s, from.y, from.w + s, from.h} : Rect{from.x, from.y - s, from.w, from.h + s}, width_,
+                            height_);
+    stats.texels_recomputed[p] = reach.area();
+    stats.texels_changed[p] = rect_reduce(static_cast<int>(p), reach, changed[p]);
+  }
+  return stats;
 }
 
 NBuffer::NBuffer(const DepthImage& depth, NBufferConfig config) : NBuffer(depth.width, depth.height, config) {
@@ -181,6 +304,7 @@ NBSIM_ROW_LOOP_CLONES void reduce_rows(FarOp op, const float* src, float* dst, i
 
 void NBuffer::build(const DepthImage& depth) {
   NBSIM_CHECK(depth.width == width_ && depth.height == height_, "depth image size differs from the N-buffer's");
+  if (has_rect_levels()) return build_rect(depth);
   // Level i's rows [y0, y1) need level i - 1's rows [y0, y1 + s): bands go from the top down.
   int banded = 1;  // levels [1, banded) are built band by band
   while (banded < levels_ && (1 << (banded - 1)) <= build_band_max_step) ++banded;
@@ -199,6 +323,25 @@ void NBuffer::build(const DepthImage& depth) {
   for (int i = banded; i < levels_; ++i) build_level(i);
 }
 
+void NBuffer::build_rect(const DepthImage& depth) {
+  const std::size_t n = pixels();
+  float* l0 = level_ptr(0);
+  if (config_.format == StorageFormat::F32) std::copy(depth.texels.begin(), depth.texels.end(), l0);
+  else for (std::size_t i = 0; i < n; ++i) l0[i] = quantize_toward_far(depth.texels[i], config_.format, config_.op);
+  for (int p = 1; p < levels_; ++p) {
+    const auto [i, j] = exponents_[static_cast<std::size_t>(p)];
+    const bool h = horizontal_[static_cast<std::size_t>(p)] != 0;
+    const int s = 1 << ((h ? i : j) - 1);
+    const float* src = level_ptr(parent_[static_cast<std::size_t>(p)]);
+    float* dst = level_ptr(p);
+    for (int y = 0; y < height_; ++y) {
+      const float* a = src + static_cast<std::size_t>(y) * width_;
+      reduce_rect_row(config_.op, a, !h && y + s < height_ ? a + static_cast<std::size_t>(s) * width_ : nullptr,
+                      dst + static_cast<std::size_t>(y) * width_, 0, width_, width_, s, h);
+    }
+  }
+}
+
 void NBuffer::build_level(int dst) {
   reduce_rows(config_.op, level_ptr(dst - 1), level_ptr(dst), width_, height_, 1 << (dst - 1), 0, height_);
 }
@@ -213,7 +356,7 @@ QueryResult NBuffer::query(const Rect& r, CoveringSpec covering) const {
                      std::to_string(r.w) + "," + std::to_string(r.h) + " lies outside the " +
                      std::to_string(width_) + "x" + std::to_string(height_) + " image");
   QueryResult q;
-  const Covering cov = cover(c, covering, full_levels_ - 1);
+  const Covering cov = this->covering(c, covering);
   q.level = cov.level;
   if (cov.level >= levels_) {  // partial build: the level is missing, answer the far limit
     q.value = far_limit(config_.op);
@@ -258,6 +401,7 @@ UpdateStats NBuffer::update(const DepthImage& depth, const Rect& dirty) {
     if (c.count) { grow(changed, c.first, y); grow(changed, c.last, y); }
   }
   stats.texels_recomputed[0] = r.area();
+  if (has_rect_levels()) return rect_update_from(changed, std::move(stats));
 
   // Level i: a texel at (x, y) reads level i - 1 at x and x + s, y and y + s, so a change in box B
   // of level i - 1 reaches [B.x - s, B.x1) x [B.y - s, B.y1) of level i, clipped to the image.
@@ -317,6 +461,11 @@ UpdateStats NBuffer::update(std::span<const PixelWrite> writes) {
   }
   changed.resize(kept);
   stats.texels_changed[0] = static_cast<long long>(changed.size());
+  if (has_rect_levels()) {  // the changed pixels' box goes up the rectangle levels
+    Rect box;
+    for (const Texel t : changed) grow(box, t.x, t.y);
+    return rect_update_from(box, std::move(stats));
+  }
 
   // Level i: a changed texel (x, y) of level i - 1 is read by the level-i texels at x or x - s and
   // y or y - s. Recompute each of those once; only those whose value changes propagate further.

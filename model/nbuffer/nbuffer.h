@@ -9,8 +9,12 @@
 #pragma once
 
 #include <cstddef>
+#include <array>
 #include <cstdint>
 #include <span>
+#include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "model/common/depth.h"
@@ -21,13 +25,34 @@
 
 namespace nbsim {
 
+// The neighbourhoods the levels hold. Fixed values.
+//   square: level i holds 2^i x 2^i squares (the paper's N-buffer);
+//   rect:   level (i, j) holds 2^i x 2^j rectangles, for i < ceil(log2 W) and j < ceil(log2 H) (the
+//           paper's future work, like RIP-maps): every rectangle is read exactly with at most four
+//           lookups (covering.h cover_rect), for about ceil(log2 H) times the square levels' memory.
+enum class LevelShape : std::uint8_t { Square = 0, Rect = 1 };
+inline constexpr std::array<std::string_view, 2> kLevelShapeNames = {"square", "rect"};
+
+// The most memory an N-buffer's levels may take (floats in memory, whatever the storage format:
+// 4 GiB, a sixth of the project's machines). Tunable.
+inline constexpr long long kMaxNBufferBytes = 4LL << 30;
+
 struct NBufferConfig {
   FarOp op = FarOp::Max;
   StorageFormat format = StorageFormat::F32;
   // Highest level built (a partial build models only what a scene needs: sprites of at most 32 px
-  // need levels up to 5). -1 builds all nbuffer_level_count(W, H) levels. Tunable.
+  // need levels up to 5). -1 builds all nbuffer_level_count(W, H) levels. Tunable. Square levels
+  // only (rectangle levels are always built whole).
   int max_level = -1;
+  LevelShape shape = LevelShape::Square;
+  // Rectangle levels: only those with |i - j| <= max_aspect_log2 (and the last row and column of
+  // levels, which the covering needs), -1 for all; at least 1. Tunable.
+  int max_aspect_log2 = -1;
 };
+
+// The rectangle levels (i, j) an image of width x height has, in build order (a level after the
+// one it is built from), for `max_aspect_log2` (see NBufferConfig).
+std::vector<std::pair<int, int>> rect_levels(int width, int height, int max_aspect_log2);
 
 // Memory for the levels. Buffers of 2 MiB and more start on a 2 MiB boundary and, on Linux, are
 // offered transparent huge pages (madvise), so that the build's ten-odd row streams, one to four
@@ -75,10 +100,13 @@ class NBuffer {
   void build(const DepthImage& depth);
 
   // Farthest depth of r (clipped to the image) with at most four lookups, placed by `covering`
-  // (covering.h). Throws InputError when r is empty or lies outside the image. When the level the
-  // covering needs was not built, the answer is the far limit with complete == false
-  // (conservative, never wrong).
+  // (covering.h; rectangle levels read cover_rect's rectangles, with the covering's alignment).
+  // Throws InputError when r is empty or lies outside the image. When the level the covering needs
+  // was not built, the answer is the far limit with complete == false (conservative, never wrong).
   QueryResult query(const Rect& r, CoveringSpec covering = {}) const;
+  // The covering query() reads for a rectangle already clipped to the image; its level is the
+  // plane read (for rectangle levels, the plane of its 2^log2_w x 2^log2_h rectangles).
+  Covering covering(const Rect& clipped, CoveringSpec spec) const;
 
   // Incremental updates; the result equals a full rebuild from the new level 0.
   // The pixels of `depth` inside `dirty` replace level 0's (depth must be the N-buffer's size).
@@ -93,6 +121,11 @@ class NBuffer {
   int full_level_count() const noexcept { return full_levels_; }
   int level_count() const noexcept { return levels_; }
   int top_level() const noexcept { return levels_ - 1; }
+  bool has_rect_levels() const noexcept { return config_.shape == LevelShape::Rect; }
+  // The neighbourhood of plane `level`: 2^i x 2^j (square levels: i = j = level).
+  std::pair<int, int> level_exponents(int level) const noexcept;
+  // "3" for square level 3, "8x4" for the rectangle level of 8 x 4 neighbourhoods.
+  std::string level_label(int level) const;
 
   float texel(int level, int x, int y) const noexcept {
     return data_[offset(level) + static_cast<std::size_t>(y) * width_ + x];
@@ -108,7 +141,12 @@ class NBuffer {
   std::size_t offset(int level) const noexcept { return static_cast<std::size_t>(level) * pixels(); }
   float* level_ptr(int i) noexcept { return data_.data() + offset(i); }
   void build_level(int dst);
+  void build_rect(const DepthImage& depth);
   UpdateStats new_stats() const;
+  // Rectangle levels: plane `p` from its parent plane over the texels [x0, x1) x [y0, y1); returns
+  // the changed texels' count and grows `changed` by their box.
+  long long rect_reduce(int p, const Rect& region, Rect& changed);
+  UpdateStats rect_update_from(Rect changed0, UpdateStats stats);
 
   int width_ = 0, height_ = 0;
   NBufferConfig config_;
@@ -116,6 +154,13 @@ class NBuffer {
   std::vector<float, LevelAllocator<float>> data_;  // levels_ planes of width_ * height_ texels
   std::vector<std::uint32_t> stamp_;   // per-pixel visit marks for set updates (lazily sized)
   std::uint32_t epoch_ = 0;
+  // Rectangle levels: each plane's exponents, the plane it is built from (-1 for level 0) and
+  // whether that step is horizontal; the plane of each (i, j) (i + levels_x * j; -1: not built).
+  std::vector<std::pair<int, int>> exponents_;
+  std::vector<int> parent_;
+  std::vector<std::uint8_t> horizontal_;
+  std::vector<int> plane_of_;
+  int levels_x_ = 1, levels_y_ = 1;
 };
 
 }  // namespace nbsim

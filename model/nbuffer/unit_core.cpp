@@ -22,12 +22,14 @@ constexpr int kMaxLatencyCycles = 1'000'000;
 constexpr double kMinRate = 1.0 / 64.0, kMaxLookupRate = 1024.0, kMaxUpdateRate = 65536.0;
 constexpr int kMaxCacheBytes = 1 << 30, kMinLineBytes = 4, kMaxLineBytes = 4096, kMaxWays = 64;
 constexpr int kMaxSidePx = 16384;
+constexpr int kMaxAspectLog2 = 14;
 
 constexpr std::string_view kOutcomeLabels[] = {"hidden", "visible", "incomplete", "offscreen"};
 
-std::vector<std::string> level_labels(int levels) {
+// "0", "1", ... for square levels; "1x1", "2x1", ... (the neighbourhood) for rectangle levels.
+std::vector<std::string> level_labels(const NBuffer& nb) {
   std::vector<std::string> l;
-  for (int i = 0; i < levels; ++i) l.push_back(std::to_string(i));
+  for (int i = 0; i < nb.level_count(); ++i) l.push_back(nb.level_label(i));
   return l;
 }
 
@@ -95,6 +97,14 @@ void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c, const 
           "the capture's",
           aligns);
   }
+  s.add(key("levels"), c.levels,
+        "the levels' neighbourhoods: square (2^i x 2^i, the paper's N-buffer) or rect (2^i x 2^j, the paper's future "
+        "work: every rectangle exact in at most four lookups, about log2(height) times the memory; the covering key "
+        "does not apply, align does)",
+        name_list(kLevelShapeNames));
+  s.add(key("max_aspect_log2"), c.max_aspect_log2, "",
+        "levels=rect: only the levels whose sides differ by at most 2^this (-1: all); thinner rectangles read taller ones",
+        -1, kMaxAspectLog2);
   s.add(key("update_policy"), c.update_policy,
         "when depth changes reach the levels: eager (at once), batched (at the end of a pass), lazy (when a query "
         "reads them)",
@@ -124,6 +134,14 @@ void NBufferUnitConfig::validate() const {
     bad(fmt::format("{}.covering must be one of trace, paper, corners, one, got '{}'", key_prefix, covering));
   if (align != "trace" && !parse_covering_align(align))
     bad(fmt::format("{}.align must be one of trace, top, bottom, got '{}'", key_prefix, align));
+  if (!parse_enum_name<LevelShape>(kLevelShapeNames, levels))
+    bad(fmt::format("{}.levels must be square or rect, got '{}'", key_prefix, levels));
+  if (max_aspect_log2 == 0 || max_aspect_log2 < -1 || max_aspect_log2 > kMaxAspectLog2)
+    bad(fmt::format("{}.max_aspect_log2 must be -1 (every rectangle level) or 1 to {}, got {} (0 would be the square levels: "
+                    "{}.levels=square)",
+                    key_prefix, kMaxAspectLog2, max_aspect_log2, key_prefix));
+  if (levels == "rect" && level_cap != -1)
+    bad(fmt::format("{}.levels=rect builds every level: {}.level_cap must be -1, got {}", key_prefix, key_prefix, level_cap));
   if (!parse_update_policy(update_policy))
     bad(fmt::format("{}.update_policy must be one of eager, batched, lazy, got '{}'", key_prefix, update_policy));
   if (level_cap < -1 || level_cap > kMaxLevelCap)
@@ -164,6 +182,12 @@ CoveringSpec NBufferUnitConfig::covering_spec(CoveringSpec capture) const {
   if (covering != "trace") s.kind = *parse_covering_kind(covering);
   if (align != "trace") s.align = *parse_covering_align(align);
   return s;
+}
+
+LevelShape NBufferUnitConfig::shape() const {
+  const auto s = parse_enum_name<LevelShape>(kLevelShapeNames, levels);
+  NBSIM_CHECK(s.has_value(), "nbuffer config used before validate()");
+  return *s;
 }
 
 UpdatePolicy NBufferUnitConfig::policy() const {
@@ -214,7 +238,8 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
       depth_(checked_side(width_px, "width"), checked_side(height_px, "height"), far_limit(op)),
       reduced_(divisor_ > 1 ? DepthImage(ceil_div(width_px, divisor_), ceil_div(height_px, divisor_), far_limit(op))
                             : DepthImage()),
-      nb_(ceil_div(width_px, divisor_), ceil_div(height_px, divisor_), NBufferConfig{op, format_, config_.level_cap}),
+      nb_(ceil_div(width_px, divisor_), ceil_div(height_px, divisor_),
+          NBufferConfig{op, format_, config_.level_cap, config_.shape(), config_.max_aspect_log2}),
       cache_(config_.cache),
       queries_(g.vector(
           "queries", "queries", "queries by outcome",
@@ -222,7 +247,7 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
       cases_(
           g.vector("query_cases", "queries", "queries by the case of the covering they need (Fig. 3)", case_labels())),
       lookups_(g.vector("lookups", "lookups", "texels read by queries (depth tests of the query port), per level",
-                        level_labels(nb_.level_count()))),
+                        level_labels(nb_))),
       tiled_queries_(
           g.counter("tiled_queries", "queries", "queries whose level was capped, answered by tiling the top level")),
       hits_(g.counter("cache_hits", "lookups", "lookups that hit the texel cache")),
@@ -231,9 +256,9 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
                             "bytes read from memory: cache-line fills and level texels streamed by updates")),
       bytes_written_(g.counter("bytes_written", "bytes", "level texels written to memory by updates and clears")),
       recomputed_(g.vector("texels_recomputed", "texels", "texels the update engine recomputed, per level",
-                           level_labels(nb_.level_count()))),
+                           level_labels(nb_))),
       changed_(g.vector("texels_changed", "texels", "recomputed texels whose stored value changed, per level",
-                        level_labels(nb_.level_count()))),
+                        level_labels(nb_))),
       reduced_pixels_(
           g.counter("depth_pixels_reduced", "pixels",
                     "depth pixels read to form reduced-resolution level-0 texels (resolution_divisor > 1)")),
@@ -550,7 +575,7 @@ QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth) {
   const Rect rr = to_reduced(r);  // empty when r is empty or off the image
   if (rr.empty()) return done(QueryOutcome::Offscreen);
   a.reduced = rr;
-  const Covering cov = cover(rr, covering_, nb_.full_level_count() - 1);
+  const Covering cov = nb_.covering(rr, covering_);
   a.kase = cov.kase;
   a.level = cov.level;
   cases_.add(static_cast<std::size_t>(cov.kase));
@@ -562,7 +587,7 @@ QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth) {
         const Square& s = cov.squares[static_cast<std::size_t>(i)];
         x0 = std::min(x0, s.x), y0 = std::min(y0, s.y), x1 = std::max(x1, s.x), y1 = std::max(y1, s.y);
       }
-      a.update = apply_pending({x0, y0, x1 - x0 + cov.side(), y1 - y0 + cov.side()});
+      a.update = apply_pending({x0, y0, x1 - x0 + cov.width_px(), y1 - y0 + cov.height_px()});
     }
     const QueryResult q = nb_.query(rr, covering_);
     NBSIM_CHECK(q.complete && q.level == cov.level, "N-buffer query read another level than its covering");

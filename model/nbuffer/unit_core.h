@@ -54,6 +54,9 @@ struct NBufferUnitConfig {
   std::string align = "trace";
   // Not a key: the particles program reads power-of-two sprites with one lookup (CoveringSpec).
   bool direct_squares = false;
+  // The levels' neighbourhoods (nbuffer.h LevelShape): square or rect; rect: max_aspect_log2.
+  std::string levels = "square";
+  int max_aspect_log2 = -1;
   std::string update_policy = "eager";    // eager, batched or lazy
   int lookup_latency_cycles = 8;          // address, tag check and data of one lookup batch
   double lookups_per_cycle = 4.0;         // the four squares of a query in one cycle
@@ -73,6 +76,7 @@ struct NBufferUnitConfig {
   void validate() const;
   StorageFormat storage_format() const;  // the parsed `format` (call after validate())
   UpdatePolicy policy() const;           // the parsed `update_policy` (call after validate())
+  LevelShape shape() const;              // the parsed `levels` (call after validate())
   // The covering, "trace" in either field taken from `capture` (call after validate()).
   CoveringSpec covering_spec(CoveringSpec capture = {}) const;
 };

@@ -160,6 +160,26 @@ void run_build(const NBufferBenchOptions& options, const std::function<void(cons
     });
     cases.push_back(std::move(c));
   }
+  // Rectangle levels (nbuffer.h LevelShape::Rect): every level, built the same way, their cost and
+  // memory against the square levels'.
+  struct RectCase {
+    int w, h;
+    NBuffer nb;
+    const DepthImage* depth;
+  };
+  std::vector<std::unique_ptr<RectCase>> rect_cases;
+  NBufferConfig rect_config = bench_config;
+  rect_config.shape = LevelShape::Rect;
+  for (const auto& c : cases) {
+    auto r = std::make_unique<RectCase>(RectCase{c->w, c->h, NBuffer(c->w, c->h, rect_config), &c->depth});
+    r->nb.build(c->depth);
+    RectCase* p = r.get();
+    section.add("build_rect/" + size_text(c->w, c->h), [p] {
+      p->nb.build(*p->depth);
+      benchmark::ClobberMemory();
+    });
+    rect_cases.push_back(std::move(r));
+  }
   const Collector& results = section.run();
   for (const auto& c : cases) {
     const std::string size = size_text(c->w, c->h);
@@ -171,6 +191,22 @@ void run_build(const NBufferBenchOptions& options, const std::function<void(cons
     line["build_ms"] = sig4(build_ms);
     line["copy_ms"] = sig4(copy_ms);
     line["ratio"] = sig4(build_ms / copy_ms);
+    emit(line);
+  }
+  for (const auto& r : rect_cases) {
+    const std::string size = size_text(r->w, r->h);
+    const double rect_ms = results.ms("build_rect/" + size), square_ms = results.ms("build/" + size);
+    const NBuffer square(r->w, r->h, bench_config);
+    ojson line;
+    line["bench"] = "build_rect";
+    line["size"] = size;
+    line["levels"] = r->nb.level_count();
+    line["bytes"] = r->nb.storage_bytes();
+    line["square_levels"] = square.level_count();
+    line["square_bytes"] = square.storage_bytes();
+    line["build_ms"] = sig4(rect_ms);
+    line["square_build_ms"] = sig4(square_ms);
+    line["ratio_vs_square"] = sig4(rect_ms / square_ms);
     emit(line);
   }
 }
@@ -193,6 +229,14 @@ void run_query(const NBufferBenchOptions& options, const std::function<void(cons
   }
 
   Section section(options);
+  NBufferConfig rect_config = bench_config;
+  rect_config.shape = LevelShape::Rect;
+  const NBuffer rect(depth, rect_config);
+  section.add("query/rect", [&] {
+    float acc = 0.0f;
+    for (const Rect& r : rects) acc += rect.query(r).value;
+    benchmark::DoNotOptimize(acc);
+  });
   // The three coverings (model/nbuffer/covering.h), each with the paper's top alignment.
   for (const CoveringKind kind : {CoveringKind::Paper, CoveringKind::Corners, CoveringKind::One}) {
     section.add("query/" + std::string(to_string(kind)), [&, kind] {
@@ -221,7 +265,7 @@ void run_query(const NBufferBenchOptions& options, const std::function<void(cons
   });
   const Collector& results = section.run();
   const double corners_qps = query_count / results.seconds("query/corners");
-  for (const char* method : {"paper", "corners", "one", "hiz", "brute"}) {
+  for (const char* method : {"paper", "corners", "one", "rect", "hiz", "brute"}) {
     const double qps = query_count / results.seconds(std::string("query/") + method);
     ojson line;
     line["bench"] = "query";

@@ -16,8 +16,11 @@
 //   buffer of L planes allocated as the levels are (LevelAllocator: the same alignment and pages,
 //   so that the ratio measures the build, not the memory). ratio < 1 means the build costs less
 //   than streaming its levels once.
+// - {"bench":"build_rect","size":"WxH","levels":P,"bytes":b,"square_levels":L,"square_bytes":s,
+//   "build_ms":t,"square_build_ms":u,"ratio_vs_square":t/u}, one per size: the rectangle levels
+//   (LevelShape::Rect, every one) built likewise; bytes in the storage format.
 // - {"bench":"query","size":"1024x1024","method":m,"queries_per_s":q,"ratio_vs_corners":r} for m in
-//   paper, corners, one (NBuffer coverings, covering.h), hiz (HiZPyramid), brute (scan
+//   paper, corners, one (NBuffer coverings, covering.h), rect (the rectangle levels, exact), hiz (HiZPyramid), brute (scan
 //   every level-0 pixel of the rectangle: the reference). 4096 pre-generated random rectangles,
 //   fixed seed, each side log-uniform in 1..512 px, placed uniformly inside the image.
 // - {"bench":"update","size":"1024x1024","dirty":"SxS","update_ms":u,"rebuild_ms":b,"ratio":u/b,

@@ -67,6 +67,8 @@ struct NBufferOptions {
   std::string op = "max";
   std::string format = "f32";
   int max_level = -1;
+  std::string levels = "square";
+  int max_aspect_log2 = -1;
 
   void add_options(CLI::App* cmd) {
     cmd->add_option("--op", op, "Farthest is max (depth func LESS) or min (reversed Z, min-litmaps)")
@@ -75,13 +77,22 @@ struct NBufferOptions {
     cmd->add_option("--format", format, "Level storage: f32, u24 or u16 unorm (rounded toward far)")
         ->check(CLI::IsMember(name_list(kStorageFormatNames)))
         ->capture_default_str();
-    cmd->add_option("--max-level", max_level, "Build levels 0..K only (partial build); -1 builds all")
+    cmd->add_option("--max-level", max_level, "Build levels 0..K only (partial build, square levels); -1 builds all")
         ->check(CLI::Range(-1, 30))
+        ->capture_default_str();
+    cmd->add_option("--levels", levels,
+                    "square: 2^i x 2^i neighbourhoods (the paper's); rect: 2^i x 2^j (the paper's future work, every "
+                    "rectangle exact in at most four lookups)")
+        ->check(CLI::IsMember(name_list(kLevelShapeNames)))
+        ->capture_default_str();
+    cmd->add_option("--max-aspect-log2", max_aspect_log2, "--levels rect: only levels whose sides differ by at most 2^K; -1 all")
+        ->check(CLI::Range(-1, 14))
         ->capture_default_str();
   }
 
   NBufferConfig config() const {
-    return {op == "max" ? FarOp::Max : FarOp::Min, *parse_storage_format(format), max_level};
+    return {op == "max" ? FarOp::Max : FarOp::Min, *parse_storage_format(format), max_level,
+            *parse_enum_name<LevelShape>(kLevelShapeNames, levels), max_aspect_log2};
   }
 };
 
@@ -126,7 +137,8 @@ int run_build(const DepthSource& src, const NBufferOptions& nbo, const fs::path&
     io::write_depth(level, out / (stem + ".exr"));
     io::write_preview(level, out / (stem + ".png"), *lo, *hi);
     const auto [llo, lhi] = std::minmax_element(level.texels.begin(), level.texels.end());
-    levels.push_back({{"level", i}, {"side", 1 << i}, {"min", tidy(*llo)}, {"max", tidy(*lhi)},
+    const auto [ei, ej] = nb.level_exponents(i);
+    levels.push_back({{"level", i}, {"label", nb.level_label(i)}, {"width", 1 << ei}, {"height", 1 << ej}, {"min", tidy(*llo)}, {"max", tidy(*lhi)},
                       {"exr", stem + ".exr"}, {"png", stem + ".png"}});
   }
   ojson summary;
@@ -170,6 +182,9 @@ std::vector<CoverageVariant> coverage_variants() {
       {"corners", "corner squares of side 2^floor(log2 max) (at most 4)",
        [](const Rect& r) { return cover(r, {CoveringKind::Corners}, top); }},
       {"one", "one square (1 lookup)", [](const Rect& r) { return cover(r, {CoveringKind::One}, top); }},
+      {"rect", "rectangle levels, every one (at most 4, exact)", [](const Rect& r) { return cover_rect(r, top, top, -1, CoveringAlign::Top); }},
+      {"rect_aspect1", "rectangle levels with sides at most 2x apart (at most 4)",
+       [](const Rect& r) { return cover_rect(r, top, top, 1, CoveringAlign::Top); }},
   };
 }
 
@@ -313,7 +328,7 @@ void add_nbuffer_commands(CLI::App& app, Action& action) {
   }
   {
     auto* cmd = nb->add_subcommand("coverage",
-                                   "Figure 4: extra pixels each covering (paper, corners, one) reads, for every box size");
+                                   "Figure 4: extra pixels each covering (paper, corners, one, rectangle levels) reads, for every box size");
     auto size = std::make_shared<std::string>("256x256");
     auto out = std::make_shared<std::string>();
     auto csv = std::make_shared<std::string>();

@@ -18,7 +18,7 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   config::Schema s;
   NBufferUnitConfig::describe(s, c);
   const auto d = s.describe();
-  ASSERT_EQ(d.size(), 14u);
+  ASSERT_EQ(d.size(), 16u);
   auto find = [&](const std::string& key) {
     for (const auto& e : d)
       if (e["key"] == key) return e;
@@ -30,6 +30,8 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   EXPECT_EQ(find("nbuffer.level_cap")["default"], -1);
   EXPECT_EQ(find("nbuffer.covering")["default"], "trace");
   EXPECT_EQ(find("nbuffer.align")["default"], "trace");
+  EXPECT_EQ(find("nbuffer.levels")["default"], "square");
+  EXPECT_EQ(find("nbuffer.max_aspect_log2")["default"], -1);
   EXPECT_EQ(find("nbuffer.update_policy")["default"], "eager");
   EXPECT_EQ(find("nbuffer.lookup_latency_cycles")["unit"], "cycles");
   EXPECT_EQ(find("nbuffer.lookups_per_cycle")["default"], 4.0);
@@ -103,6 +105,12 @@ TEST(NBufferUnitConfigTest, ValidateRefusesInconsistentValues) {
        "nbuffer.update_texels_per_cycle must be"},
       {[](NBufferUnitConfig& c) { c.lookup_latency_cycles = -1; }, "nbuffer.lookup_latency_cycles must be"},
       {[](NBufferUnitConfig& c) { c.capped_max_lookups = -1; }, "nbuffer.capped_max_lookups must be"},
+      {[](NBufferUnitConfig& c) { c.covering = "four"; }, "nbuffer.covering must be one of trace, paper, corners, one, got 'four'"},
+      {[](NBufferUnitConfig& c) { c.align = "left"; }, "nbuffer.align must be one of trace, top, bottom, got 'left'"},
+      {[](NBufferUnitConfig& c) { c.levels = "ripmap"; }, "nbuffer.levels must be square or rect, got 'ripmap'"},
+      {[](NBufferUnitConfig& c) { c.levels = "rect", c.max_aspect_log2 = 0; }, "nbuffer.max_aspect_log2 must be -1"},
+      {[](NBufferUnitConfig& c) { c.levels = "rect", c.level_cap = 3; },
+       "nbuffer.levels=rect builds every level: nbuffer.level_cap must be -1, got 3"},
   };
   for (const Row& row : rows) {
     NBufferUnitConfig c;

@@ -86,7 +86,8 @@ struct Rig {
 
   // The N-buffer a fresh build over the truth gives (what every policy reaches once applied).
   NBuffer fresh() const {
-    return NBuffer(reduce(truth, cfg.resolution_divisor, op), NBufferConfig{op, cfg.storage_format(), cfg.level_cap});
+    return NBuffer(reduce(truth, cfg.resolution_divisor, op),
+                   NBufferConfig{op, cfg.storage_format(), cfg.level_cap, cfg.shape(), cfg.max_aspect_log2});
   }
 };
 
@@ -150,6 +151,8 @@ TEST(NBufferUnitCoreTest, ConservativeForEveryPolicyAndDivisor) {
           const int variant = d + static_cast<int>(op) + static_cast<int>(std::string(policy).size());
           cfg.covering = std::string(kCoveringKindNames[static_cast<std::size_t>(variant % 3)]);
           cfg.align = std::string(kCoveringAlignNames[static_cast<std::size_t>(variant % 2)]);
+          // And rectangle levels (all of them, or |i - j| <= 1) in a quarter of the configurations.
+          if (variant % 4 == 3) cfg.levels = "rect", cfg.max_aspect_log2 = variant % 8 == 3 ? -1 : 1;
           const int w = size.w, h = size.h;
           Rig rig(op, cfg, w, h);
           std::mt19937 rng(1000u + static_cast<unsigned>(d) * 7u + static_cast<unsigned>(op) * 3u +

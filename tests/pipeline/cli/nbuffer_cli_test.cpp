@@ -380,7 +380,7 @@ TEST(NBufferCliTest, SizesBounded) {
       {"nbuffer query --scene city --size 46341x46341 --rect 0,0,1,1", "the built-in scene is at most 4096x4096"},
       {"nbuffer build --scene city --size 4097x16 --out " + out.string(), "at most 4096x4096"},
       {"nbuffer query --scene city --size 16x99999999999 --rect 0,0,1,1", "--size"},
-      {"nbuffer coverage --size 1024x1024 --scale 16 --out " + (out / "c.png").string(), "makes a 49408x17536 image: at most 64 M pixels"},
+      {"nbuffer coverage --size 1024x1024 --scale 16 --out " + (out / "c.png").string(), "makes a 82432x17536 image: at most 64 M pixels"},
       {"nbuffer coverage --size 16777216x1 --out " + (out / "c.png").string(), "at most 4096x4096 box sizes"},
   };
   for (const Row& row : rows) {
@@ -431,7 +431,7 @@ TEST(NBufferCliTest, CoverageWritesImageAndCsv) {
   int rows = 0;
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 1 + 16 * 8) << "one header and one row per box size";
-  for (const char* part : {"paper    mean extra", "corners  mean extra", "one      mean extra", "four_quadrants", "two_side_by_side",
+  for (const char* part : {"paper    mean extra", "corners  mean extra", "one      mean extra", "rect     mean extra", "four_quadrants", "two_side_by_side",
                            "two_stacked", "four_in_a_row", "four_in_a_column"})
     EXPECT_TRUE(has(r.out, part)) << part << ": " << r.out;
 }
@@ -446,6 +446,7 @@ TEST(NBufferCliTest, CoverageOfFigure4) {
   EXPECT_TRUE(has(r.out, "paper    mean extra   129.7% of the box")) << r.out;
   EXPECT_TRUE(has(r.out, "corners  mean extra   284.3% of the box")) << r.out;
   EXPECT_TRUE(has(r.out, "one      mean extra   921.7% of the box")) << r.out;
+  EXPECT_TRUE(has(r.out, "rect     mean extra     0.0% of the box, worst 0.0x the box, exact for 100.0% of sizes")) << r.out;
 }
 
 }  // namespace

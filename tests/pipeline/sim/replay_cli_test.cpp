@@ -6,7 +6,9 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <algorithm>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <vector>
 #include <string>
@@ -348,6 +350,75 @@ TEST(ReplayCliTest, RefusedReplayRemovesTheFolderItCreated) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_TRUE(fs::exists(existing / "keep.txt")) << "a folder that was there before stays, with its files";
   EXPECT_FALSE(fs::exists(existing / "run.json"));
+}
+
+// The rectangle levels with every level (nbuffer.levels=rect) are the ideal per-pixel rectangle
+// test: every bounds test of a culling replay is culled exactly when its nearest depth is farther
+// than the farthest pixel of its rectangle in GL's depth after the occluders, counted here by brute
+// force. The paper's covering and the corner squares, reading squares that overhang the rectangle,
+// cull a subset of those (never one the ideal test keeps).
+TEST(ReplayCliTest, RectangleLevelsAreTheIdealRectangleTest) {
+  namespace tr = nbsim::trace;
+  const std::string trace = sample("city_small_oq.nbt");
+  std::vector<std::vector<float>> depth;  // after the occluders, per frame (y up)
+  int width = 0;
+  {
+    tr::FrameReader frames{fs::path(trace)};
+    while (const auto f = frames.next()) {
+      const tr::DepthSnapshot* d = f->depth(tr::DepthWhich::AfterOccluders);
+      ASSERT_NE(d, nullptr);
+      depth.push_back(d->texels);
+      width = d->width;
+    }
+  }
+  struct Row {
+    int frame, x, y, w, h;
+    float nearest;
+    bool near, culled;
+  };
+  const auto read_culls = [](const fs::path& csv) {
+    std::vector<Row> rows;
+    std::ifstream in(csv);
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      std::vector<std::string> c;
+      std::stringstream ss(line);
+      for (std::string cell; std::getline(ss, cell, ',');) c.push_back(cell);
+      rows.push_back({std::stoi(c[0]), std::stoi(c[4]), std::stoi(c[5]), std::stoi(c[6]), std::stoi(c[7]), std::stof(c[8]),
+                      c[9] == "1", c[10] == "culled"});
+    }
+    return rows;
+  };
+  const auto ideal = [&](const Row& r) {
+    if (r.near || r.w <= 0 || r.h <= 0) return false;
+    float far = 0.0f;
+    for (int y = r.y; y < r.y + r.h; ++y)
+      for (int x = r.x; x < r.x + r.w; ++x) far = std::max(far, depth[static_cast<std::size_t>(r.frame)][static_cast<std::size_t>(y * width + x)]);
+    return r.nearest > far;
+  };
+  std::map<std::string, int> culled;
+  for (const char* variant : {"--set nbuffer.levels=rect", "--set nbuffer.covering=paper --set nbuffer.align=top",
+                              "--set nbuffer.covering=corners --set nbuffer.align=bottom"}) {
+    const fs::path out = scratch("ideal_" + std::to_string(culled.size()));
+    const CliResult r = run_nbsim("replay " + trace + " --set cull.mode=nb " + variant + " --out " + out.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::vector<Row> rows = read_culls(out / "culls.csv");
+    ASSERT_GT(rows.size(), 1000u);
+    int n = 0, differ = 0, beyond = 0;
+    for (const Row& row : rows) {
+      const bool want = ideal(row);
+      n += row.culled;
+      differ += row.culled != want;
+      beyond += row.culled && !want;
+    }
+    EXPECT_EQ(beyond, 0) << variant << ": culled what the ideal rectangle test keeps";
+    if (std::string(variant).find("rect") != std::string::npos) EXPECT_EQ(differ, 0) << variant << ": not the ideal test";
+    culled[variant] = n;
+  }
+  EXPECT_GT(culled["--set nbuffer.levels=rect"], culled["--set nbuffer.covering=paper --set nbuffer.align=top"]);
+  EXPECT_GT(culled["--set nbuffer.covering=paper --set nbuffer.align=top"],
+            culled["--set nbuffer.covering=corners --set nbuffer.align=bottom"]);
 }
 
 }  // namespace
