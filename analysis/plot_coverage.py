@@ -95,15 +95,19 @@ def plot(W, H, maps, out):
     vmax = max(float(np.nanmax(g)) for g in maps.values())
     vmax = max(vmax, 10 * floor)
     n = len(maps)
-    fig, axes = plt.subplots(1, n, figsize=(5.2 * n + 1, 5.6), constrained_layout=True, squeeze=False)
+    cols = min(n, 3)
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols + 1, 5.0 * rows + 0.6), constrained_layout=True, squeeze=False)
+    for ax in axes.flat[n:]:
+        ax.axis("off")
     im = None
-    for ax, (name, g) in zip(axes[0], maps.items()):
+    for ax, (name, g) in zip(axes.flat, maps.items()):
         im = ax.imshow(np.maximum(g, floor), origin="lower", extent=(0.5, W + 0.5, 0.5, H + 0.5),
                        norm=LogNorm(vmin=floor, vmax=vmax), cmap="viridis", interpolation="nearest")
         ax.set_title(f"{name}: {TITLES.get(name, name)}\nmean extra {100 * np.nanmean(g):.1f}% of the box", fontsize=10)
         ax.set_xlabel("box width w (pixels)")
         ax.set_ylabel("box height h (pixels)")
-    cb = fig.colorbar(im, ax=axes[0].tolist(), shrink=0.9)
+    cb = fig.colorbar(im, ax=axes.ravel().tolist(), shrink=0.9)
     cb.set_label(f"extra pixels read / box area (exact = {floor:g})")
     fig.suptitle("N-buffer covering tightness (Décoret 2005, Fig. 4)")
     fig.savefig(out, dpi=110)

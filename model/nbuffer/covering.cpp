@@ -44,7 +44,7 @@ namespace {
 // the span is longer, one every `side` from the start and the last flush with the end (at most
 // four: len <= 4 side); when it is not longer, one square flush with the start, or with the end
 // when `at_end` (moved to 0 when that would start below 0 while the span does not).
-int anchors(int start, int len, int log2_side, bool at_end, std::array<int, 4>& out) {
+[[gnu::always_inline]] inline int anchors(int start, int len, int log2_side, bool at_end, std::array<int, 4>& out) {
   const int side = 1 << log2_side;
   if (len <= side) {
     int a = at_end ? start + len - side : start;
@@ -60,7 +60,7 @@ int anchors(int start, int len, int log2_side, bool at_end, std::array<int, 4>& 
 }
 
 // Rectangles of 2^lw x 2^lh over r, at most four.
-Covering grid(const Rect& r, int lw, int lh, bool top, CoveringCase kase) {
+[[gnu::always_inline]] inline Covering grid(const Rect& r, int lw, int lh, bool top, CoveringCase kase) {
   Covering c;
   c.level = lw;
   c.log2_w = lw, c.log2_h = lh;
@@ -74,9 +74,14 @@ Covering grid(const Rect& r, int lw, int lh, bool top, CoveringCase kase) {
 }
 
 Covering paper(const Rect& r, bool top, int top_level) {
-  const CoveringCase kase = covering_case(r.w, r.h);
+  // covering_case() and the level from one ceil(log2): squares of side q (a quadrant), or q/2 in a
+  // row or a column; a 1x1 rectangle: level 0.
   const int s_log = ceil_log2(static_cast<unsigned>(std::max(r.w, r.h)));
-  // Squares of side q (a quadrant), or q/2 in a row or a column; a 1x1 rectangle: level 0.
+  const int q = (1 << s_log) >> 1;
+  CoveringCase kase = CoveringCase::FourQuadrants;
+  if (!(r.w > q && r.h > q))
+    kase = r.w > q ? (2 * r.h <= q ? CoveringCase::FourInARow : CoveringCase::TwoSideBySide)
+                   : (2 * r.w <= q ? CoveringCase::FourInAColumn : CoveringCase::TwoStacked);
   const int level = s_log == 0 ? 0 : (kase == CoveringCase::FourInARow || kase == CoveringCase::FourInAColumn ? s_log - 2 : s_log - 1);
   NBSIM_CHECK(level <= top_level, "rectangle larger than the top level's covering");
   return grid(r, level, level, top, kase);

@@ -113,14 +113,45 @@ int run_query(const DepthSource& src, const NBufferOptions& nbo, const CoveringS
     const Rect c = clip(r, nb.width(), nb.height());
     ojson line;
     line["rect"] = {r.x, r.y, r.w, r.h};
-    line["covering"] = covering_name(covering);
+    line["covering"] = nb.has_rect_levels() ? "rect/" + std::string(to_string(covering.align)) : covering_name(covering);
     line["level"] = q.level;
+    const auto [ei, ej] = nb.level_exponents(q.level);
+    line["neighbourhood"] = fmt::format("{}x{}", 1 << ei, 1 << ej);
     line["texels"] = texels;
     line["value"] = tidy(q.value);
     line["case"] = to_string(covering_case(c.w, c.h));
     line["complete"] = q.complete;
     fmt::print("{}\n", line.dump());
   }
+  return 0;
+}
+
+// `nbuffer memory`: the level count and bytes of an N-buffer, computed (nothing is allocated).
+int run_memory(const std::string& size, const NBufferOptions& nbo) {
+  const auto [w, h] = parse_size(size, "--size");
+  const NBufferConfig c = nbo.config();
+  if (c.shape == LevelShape::Rect && c.max_aspect_log2 == 0)
+    throw InputError("--max-aspect-log2 0 would be the square levels: give -1 or at least 1, or --levels square");
+  std::vector<std::string> labels;
+  if (c.shape == LevelShape::Rect) {
+    for (const auto& [i, j] : rect_levels(w, h, c.max_aspect_log2)) labels.push_back(fmt::format("{}x{}", 1 << i, 1 << j));
+  } else {
+    const int full = nbuffer_level_count(w, h);
+    const int n = c.max_level < 0 ? full : std::min(c.max_level, full - 1) + 1;
+    for (int i = 0; i < n; ++i) labels.push_back(std::to_string(i));
+  }
+  const long long pixels = static_cast<long long>(w) * h, n = static_cast<long long>(labels.size());
+  ojson line;
+  line["size"] = fmt::format("{}x{}", w, h);
+  line["levels"] = nbo.levels;
+  line["max_aspect_log2"] = c.shape == LevelShape::Rect ? ojson(c.max_aspect_log2) : ojson(nullptr);
+  line["format"] = nbo.format;
+  line["level_count"] = n;
+  line["level_labels"] = labels;
+  line["storage_bytes"] = n * pixels * nbsim::storage_bytes(c.format);
+  line["memory_bytes"] = n * pixels * 4;
+  line["within_limit"] = n * pixels * 4 <= kMaxNBufferBytes;
+  fmt::print("{}\n", line.dump());
   return 0;
 }
 
@@ -205,6 +236,8 @@ int run_coverage(const std::string& size, const fs::path& png, fs::path csv, int
                                  iw_ll, ih_ll, kMaxCoveragePixels >> 20));
   const int iw = static_cast<int>(iw_ll), ih = static_cast<int>(ih_ll);
   if (csv.empty()) csv = fs::path(png).replace_extension(".csv");
+  for (const fs::path& f : {fs::path(png), csv})
+    if (f.has_parent_path()) io::create_output_folder(f.parent_path());
   const std::size_t n = static_cast<std::size_t>(bw) * static_cast<std::size_t>(bh);
   std::vector<std::vector<double>> ratio(variants.size());
   for (auto& r : ratio) r.reserve(n);
@@ -261,7 +294,7 @@ int run_coverage(const std::string& size, const fs::path& png, fs::path csv, int
   fmt::print("coverage of every box size from 1x1 to {}x{} ({} sizes)\n", bw, bh, n);
   for (std::size_t i = 0; i < variants.size(); ++i) {
     const double mean = std::accumulate(ratio[i].begin(), ratio[i].end(), 0.0) / count;
-    fmt::print("  {:<8} mean extra {:7.1f}% of the box, worst {:.1f}x the box, exact for {:5.1f}% of sizes, {:.2f} lookups a box  "
+    fmt::print("  {:<12} mean extra {:7.1f}% of the box, worst {:.1f}x the box, exact for {:5.1f}% of sizes, {:.2f} lookups a box  "
                "({})\n",
                variants[i].name, 100 * mean, *std::max_element(ratio[i].begin(), ratio[i].end()),
                100.0 * static_cast<double>(exact[i]) / count, static_cast<double>(lookups[i]) / count, variants[i].title);
@@ -306,8 +339,9 @@ void add_nbuffer_commands(CLI::App& app, Action& action) {
         ->check(CLI::IsMember(name_list(kCoveringAlignNames)))
         ->capture_default_str();
     cmd->add_option("--rect", *rects, "Rectangle X,Y,W,H in pixels, y up (repeatable)")->required()->allow_extra_args(false);
-    cmd->footer("Prints {\"rect\":[x,y,w,h],\"covering\":\"paper/top\",\"level\":i,\"texels\":[[x,y],...],\"value\":v,\"case\":c,\n"
-                "\"complete\":b} per rectangle; case is the rectangle's case of Fig. 3 (four_quadrants, two_side_by_side,\n"
+    cmd->footer("Prints {\"rect\":[x,y,w,h],\"covering\":\"paper/top\",\"level\":i,\"neighbourhood\":\"WxH\",\"texels\":[[x,y],...],\n"
+                "\"value\":v,\"case\":c,\"complete\":b} per rectangle (neighbourhood: the pixels each texel read holds, 2^i x 2^i,\n"
+                "or 2^i x 2^j with --levels rect); case is the rectangle's case of Fig. 3 (four_quadrants, two_side_by_side,\n"
                 "two_stacked, four_in_a_row, four_in_a_column). Rectangles partly outside the image are clipped; empty or fully\n"
                 "outside ones are refused (exit 2).");
     cmd->callback([&action, src, nbo, covering, align, rects] {
@@ -325,6 +359,17 @@ void add_nbuffer_commands(CLI::App& app, Action& action) {
     nbo->add_options(cmd);
     cmd->add_option("--out", *out, "Output directory (level_NN.exr, level_NN.png, levels.json)")->required();
     cmd->callback([&action, src, nbo, out] { action = [=] { return run_build(*src, *nbo, *out); }; });
+  }
+  {
+    auto* cmd = nb->add_subcommand("memory", "The levels an N-buffer of a size has and the memory they take, without building it");
+    auto size = std::make_shared<std::string>("512x512");
+    auto nbo = std::make_shared<NBufferOptions>();
+    cmd->add_option("--size", *size, "Image size, WxH")->capture_default_str();
+    nbo->add_options(cmd);
+    cmd->footer("Prints {\"size\":\"WxH\",\"levels\":\"square|rect\",\"max_aspect_log2\":k,\"format\":f,\"level_count\":n,\n"
+                "\"level_labels\":[...],\"storage_bytes\":b,\"memory_bytes\":m,\"within_limit\":bool}: storage_bytes in the\n"
+                "storage format, memory_bytes as the model holds them (floats); above the limit the model refuses the N-buffer.");
+    cmd->callback([&action, size, nbo] { action = [=] { return run_memory(*size, *nbo); }; });
   }
   {
     auto* cmd = nb->add_subcommand("coverage",

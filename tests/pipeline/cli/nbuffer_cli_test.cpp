@@ -53,7 +53,7 @@ fs::path depth_with(float bad, int x, int y, const std::string& name) {
 
 // --help works on every nbuffer subcommand and exits 0.
 TEST(NBufferCliTest, HelpExitsZero) {
-  for (const char* sub : {"", "nbuffer", "nbuffer query", "nbuffer build", "nbuffer coverage", "info"}) {
+  for (const char* sub : {"", "nbuffer", "nbuffer query", "nbuffer build", "nbuffer coverage", "nbuffer memory", "info"}) {
     const CliResult r = nbsim(std::string(sub) + " --help");
     EXPECT_EQ(r.status, 0) << sub << ": " << r.err;
     EXPECT_TRUE(has(r.out, "Usage")) << sub << ": " << r.out;
@@ -431,9 +431,36 @@ TEST(NBufferCliTest, CoverageWritesImageAndCsv) {
   int rows = 0;
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 1 + 16 * 8) << "one header and one row per box size";
-  for (const char* part : {"paper    mean extra", "corners  mean extra", "one      mean extra", "rect     mean extra", "four_quadrants", "two_side_by_side",
+  for (const char* part : {"paper        mean extra", "corners      mean extra", "one          mean extra", "rect         mean extra", "rect_aspect1 mean extra", "four_quadrants", "two_side_by_side",
                            "two_stacked", "four_in_a_row", "four_in_a_column"})
     EXPECT_TRUE(has(r.out, part)) << part << ": " << r.out;
+}
+
+// `nbuffer memory` counts the levels and bytes without building them: the square levels of 640x480
+// (10 levels), every rectangle level (10 x 9), those with sides at most 2x apart (26), and the
+// limit (every rectangle level of 4096x4096 is 9 GiB).
+TEST(NBufferCliTest, MemoryOfTheLevels) {
+  const auto memory = [](const std::string& args) {
+    const CliResult r = nbsim("nbuffer memory " + args);
+    EXPECT_EQ(r.status, 0) << args << ": " << r.err;
+    return nlohmann::json::parse(r.out);
+  };
+  nlohmann::json j = memory("--size 640x480");
+  EXPECT_EQ(j["level_count"], 10);
+  EXPECT_EQ(j["memory_bytes"], 10LL * 640 * 480 * 4);
+  j = memory("--size 640x480 --levels rect");
+  EXPECT_EQ(j["level_count"], 90);
+  EXPECT_EQ(j["level_labels"][1], "1x2");
+  EXPECT_EQ(j["level_labels"][2], "2x1");
+  j = memory("--size 640x480 --levels rect --max-aspect-log2 1 --format u16");
+  EXPECT_EQ(j["level_count"], 26);
+  EXPECT_EQ(j["storage_bytes"], 26LL * 640 * 480 * 2);
+  EXPECT_EQ(j["within_limit"], true);
+  EXPECT_EQ(memory("--size 4096x4096 --levels rect")["within_limit"], false);
+  const CliResult r = nbsim("nbuffer query --scene city --size 4096x4096 --levels rect --rect 0,0,4,4");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "an N-buffer of 144 rectangle levels of 4096x4096 floats needs 9216 MiB, above the limit of 4096 MiB")) << r.err;
+  EXPECT_TRUE(r.out.empty());
 }
 
 // Figure 4 over every box from 1x1 to 256x256: the paper's covering adds 129.7 % of the box on
@@ -443,10 +470,10 @@ TEST(NBufferCliTest, CoverageOfFigure4) {
   const fs::path png = scratch("fig4.png");
   const CliResult r = nbsim("nbuffer coverage --size 256x256 --scale 1 --out " + png.string());
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_TRUE(has(r.out, "paper    mean extra   129.7% of the box")) << r.out;
-  EXPECT_TRUE(has(r.out, "corners  mean extra   284.3% of the box")) << r.out;
-  EXPECT_TRUE(has(r.out, "one      mean extra   921.7% of the box")) << r.out;
-  EXPECT_TRUE(has(r.out, "rect     mean extra     0.0% of the box, worst 0.0x the box, exact for 100.0% of sizes")) << r.out;
+  EXPECT_TRUE(has(r.out, "paper        mean extra   129.7% of the box")) << r.out;
+  EXPECT_TRUE(has(r.out, "corners      mean extra   284.3% of the box")) << r.out;
+  EXPECT_TRUE(has(r.out, "one          mean extra   921.7% of the box")) << r.out;
+  EXPECT_TRUE(has(r.out, "rect         mean extra     0.0% of the box, worst 0.0x the box, exact for 100.0% of sizes")) << r.out;
 }
 
 }  // namespace
