@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <random>
 #include <string>
 #include <vector>
@@ -14,7 +15,9 @@
 #include "model/nbuffer/nbuffer.h"
 #include "nbsim_shaders.h"
 #include "tests/common/gl_context_suite.h"
+#include "traces/capture/draw_recorder.h"
 #include "traces/capture/gl_program.h"
+#include "traces/capture/glsl_nbuffer.h"
 
 namespace nbsim {
 namespace {
@@ -149,6 +152,49 @@ TEST_F(CoveringGlTest, ShaderCoversEveryBoxAsTheCore) {
     }
   }
   EXPECT_GT(compared, 50000);
+}
+
+// Occlusion culling's own query shader (shaders/common/nbuffer_query.comp through GlslNBuffer, its
+// levels built by GL from a depth texture) answers thousands of random boxes as the core does: a
+// box whose nearest depth is the core's answer is visible, one a hair farther is hidden, so GL's
+// farthest depth equals the core's bit for bit, for each covering and both ops.
+TEST_F(CoveringGlTest, OcclusionQueryShaderAnswersAsTheCore) {
+  std::mt19937 rng(77);
+  for (const auto& [w, h] : {std::pair{45, 31}, std::pair{64, 32}})
+    for (const FarOp op : {FarOp::Max, FarOp::Min})
+      for (const CoveringSpec spec : {CoveringSpec{CoveringKind::Paper, CoveringAlign::Top},
+                                      CoveringSpec{CoveringKind::Corners, CoveringAlign::Bottom},
+                                      CoveringSpec{CoveringKind::One, CoveringAlign::Top}}) {
+        DepthImage d(w, h, 0.0f);
+        for (float& v : d.texels) v = std::uniform_real_distribution<float>(0.0f, 1.0f)(rng);
+        GLuint depth = 0;
+        glCreateTextures(GL_TEXTURE_2D, 1, &depth);
+        glTextureStorage2D(depth, 1, GL_DEPTH_COMPONENT32F, w, h);
+        glTextureSubImage2D(depth, 0, 0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, d.texels.data());
+        capture::GlslNBuffer gl(w, h, op, 1 << 30, spec);
+        capture::DrawRecorder recorder;
+        recorder.begin_frame(64);
+        gl.build(depth, recorder, {});
+        const NBuffer core(d, {op});
+        std::vector<Rect> boxes = boxes_for(w, h, rng, 1000);
+        std::vector<scene::BoundsTest> tests;
+        for (const Rect& r : boxes) {
+          const float v = core.query(r, spec).value;
+          const float farther = std::nextafter(v, op == FarOp::Max ? 2.0f : -1.0f);
+          tests.push_back({r.x, r.y, r.w, r.h, v, false, true});
+          tests.push_back({r.x, r.y, r.w, r.h, farther, false, true});
+        }
+        gl.query(tests);
+        int wrong = 0;
+        for (std::size_t i = 0; i < boxes.size(); ++i)
+          if (!tests[2 * i].visible || tests[2 * i + 1].visible) {
+            if (++wrong <= 5)
+              ADD_FAILURE() << covering_name(spec) << " box " << boxes[i].x << "," << boxes[i].y << " " << boxes[i].w << "x"
+                            << boxes[i].h << ": GL's answer differs from the core's " << core.query(boxes[i], spec).value;
+          }
+        EXPECT_EQ(wrong, 0) << covering_name(spec) << " " << w << "x" << h;
+        glDeleteTextures(1, &depth);
+      }
 }
 
 }  // namespace
