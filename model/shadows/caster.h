@@ -69,8 +69,9 @@ FrameCasters read_casters(const scene::Frame& f);
 
 // The exact depth range of the visible receivers in a rectangle: the min of `litmap_min` and the
 // max of `litmap_max` over its lexels (the images as GL drew them). GL's N-buffer answers read the
-// squares of the four-square covering, which may reach past the rectangle, so they are this range
-// or looser; the conservative checks compare with it, the equality checks with GL's.
+// squares of the capture's covering (model/nbuffer/covering.h), which may reach past the rectangle,
+// so they are this range or looser; the conservative checks compare with it, the equality checks
+// with GL's.
 struct DepthRange {
   float z_min = 1.0f, z_max = 0.0f;
 };

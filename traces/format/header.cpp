@@ -147,6 +147,13 @@ const std::vector<Key>& keys() {
        }},
       {"levels_every", "a whole number, at least 0", "1", "the N-buffer levels are recorded every k-th frame (0: never)",
        [](Header& h, std::string_view k, std::string_view v, std::string_view e) { h.levels_every = count(k, v, e); }},
+      {"nbuffer_covering", "paper, corners or one, '/', top or bottom", "paper/top",
+       "how the capture's N-buffer queries cover a rectangle (model/nbuffer/covering.h; absent: corners/bottom, nbsim's covering "
+       "before the paper's)",
+       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
+         h.covering = parse_covering_name(v);
+         if (!h.covering) refuse(k, v, e);
+       }},
       {"nbsim_version", "text", "0.1.0", "the capturing nbsim's version", nullptr},
       {"command_line", "text", "nbsim capture occlusion_culling --scene city --frames 60 -o walk.nbtrace", "the capture's command line", nullptr},
   };

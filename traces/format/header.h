@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "model/nbuffer/covering.h"
 #include "traces/format/records.h"
 
 namespace nbsim::trace {
@@ -38,6 +39,7 @@ struct Header {
   double near_m = 0.0;                          // "near": > 0, 0 when absent
   double far_m = 0.0;                           // "far": > near, 0 when absent
   double nearest_margin = 0.0;                  // "nearest_margin": >= 0
+  std::optional<CoveringSpec> covering;         // "nbuffer_covering": "paper/top" (absent: corners/bottom)
 
   // "Farthest" under this header's depth func: FarOp::Min under GREATER/GEQUAL (reversed Z).
   FarOp far_op() const noexcept;

@@ -130,6 +130,8 @@ TEST(TraceHeaderTest, RefusesMalformedValues) {
       {"near", "inf", "a distance above 0"},
       {"fov_y_deg", "180", "above 0 and below 180"},
       {"nearest_margin", "-1e-6", "0 .. 1"},
+      {"nbuffer_covering", "four", "paper, corners or one, '/', top or bottom"},   // nbsim's old covering name
+      {"nbuffer_covering", "paper/left", "paper, corners or one, '/', top or bottom"},
   };
   for (const Row& row : rows) {
     const std::string e = open_error({{"scene", "city"}, {row.key, row.value}});
