@@ -1,6 +1,6 @@
 // JSON the user gives (config files, sweep files, --set values): read and parsed within stated
 // limits, and echoed into messages only as bounded excerpts. Used by the config schema
-// (schema.h), `nbsim explore`'s sweep files and the --config option. README.md "Limits" lists
+// (schema.h), `nbsim explore`'s sweep files and the --config option. docs/limits.md lists
 // every limit here with the message given when it is exceeded.
 #pragma once
 

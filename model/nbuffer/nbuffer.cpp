@@ -255,7 +255,7 @@ namespace {
 // together from the G + 1 rows below (G = 4; 2 or single rows where four do not fit), so that each
 // horizontal pair far(a[x], a[x + s]) is loaded and reduced once instead of twice, and (3) runs its
 // row loops in an AVX2 clone where the CPU has AVX2 (NBSIM_ROW_LOOP_CLONES). With the levels' huge pages (allocate_level_storage) that takes 1024x1024 from
-// about 1.2-1.5 to about 0.8 times the level-by-level copy (README, Table 1, has the measurements).
+// about 1.2-1.5 to about 0.8 times the level-by-level copy (docs/results.md, Table 1, has the measurements).
 // The two constants are tunable: (64, 64) and the pairs (64, 16), (32, 32), (128, 64), (128, 128)
 // and (64, all) timed within the noise of one another with `nbsim bench nbuffer --only build` at
 // 1024x1024 on the project's shared 2-core machines (1 MiB L2 per core, 32 MiB L3).

@@ -58,7 +58,7 @@ void thread_failed(std::exception_ptr e) {
 }
 
 namespace {
-// Sanitizer builds only (README "Sanitizers"). Debian's SystemC 2.3.4 tells AddressSanitizer about
+// Sanitizer builds only (docs/testing.md, "Sanitizers"). Debian's SystemC 2.3.4 tells AddressSanitizer about
 // its coroutine switches in yield() but not in abort(), the switch a finishing thread makes, and
 // never learns the main stack's bounds; after sc_start returns, ASan may still believe the main
 // thread runs on a coroutine's stack. An exception thrown then (the rethrow below) is not given its

@@ -478,7 +478,7 @@ void add_trace_commands(CLI::App& app, Action& action) {
     cmd->footer("The input is checked whole first (as by 'nbsim trace verify'), then read again once per pass, one frame\n"
                 "at a time, so memory stays at one frame however many frames are written. Pass p numbers input frame n as\n"
                 "p * (last frame number + 1) + n. The header keeps the input's properties, with 'frames' set to N and\n"
-                "'repeated_from' naming the input. For memory and speed measurements of long traces (README).");
+                "'repeated_from' naming the input. For memory and speed measurements of long traces (docs/exploration.md).");
     cmd->callback([&action, o] { action = [=] { return run_repeat(*o); }; });
   }
   {

@@ -15,7 +15,7 @@ namespace nbsim::io::backend {
 
 inline constexpr int kAbiVersion = 1;
 
-// The largest depth image read (README "Limits"), checked against the file's header before any
+// The largest depth image read (docs/limits.md), checked against the file's header before any
 // pixel is allocated: a side of at most 16384 pixels (the trace format's image limit) and at most
 // 4096 x 4096 pixels in all (64 MiB of floats; `nbsim capture` renders at most 4096x4096). Tunable.
 inline constexpr long long kMaxDepthSide = 16384;
