@@ -310,6 +310,9 @@ TEST(NBufferCliTest, ReadsHandBuiltTiffsAndRefusesUndecodableStrips) {
       {"big.tif", TiffBuilder(4, 3, px).bigtiff()},
       {"strips.tif", TiffBuilder(4, 3, px).set(278, TiffBuilder::kShort, {1}).strips({{0, 16}, {16, 16}, {32, 16}})},
       {"rows_above.tif", TiffBuilder(4, 3, px).set(278, TiffBuilder::kLong, {8})},
+      {"rows_all.tif", TiffBuilder(4, 3, px).set(278, TiffBuilder::kLong, {0xFFFFFFFFu})},
+      {"rows_2_31.tif", TiffBuilder(4, 3, px).set(278, TiffBuilder::kLong, {0x80000005u})},
+      {"no_rows_per_strip.tif", TiffBuilder(4, 3, px).erase(278)},
   };
   for (const auto& row : rows) {
     const fs::path f = write(row.tiff, row.name);
