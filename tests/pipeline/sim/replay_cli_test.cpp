@@ -330,6 +330,21 @@ TEST(ReplayCliTest, UnknownEmptyTechniqueChunkVerifiesAndReplays) {
   const nlohmann::json ja = read_json(a / "run.json")["summary"], jb = read_json(b / "run.json")["summary"];
   for (const char* k : {"frames", "draws", "draws_exact", "fragments_model", "passed_model", "depth_tests", "cycles"})
     EXPECT_EQ(ja[k], jb[k]) << k;
+  // A known chunk type (the particles' PRTC) with an empty payload is refused for what it is.
+  const fs::path known = scratch("empty_known_chunk.nbt");
+  {
+    tr::TraceWriter w(known, {{"viewport", "8x8"}});
+    w.begin_frame(tr::FrameBegin{});
+    tr::TechniqueRecord prtc;
+    prtc.type = tr::fourcc("PRTC");
+    w.write(prtc);
+    w.end_frame({0, 0, 0.0});
+    w.close();
+  }
+  const CliResult k = run_nbsim("trace verify " + known.string());
+  EXPECT_EQ(k.status, 2) << k.out;
+  EXPECT_TRUE(has(k.err, "(PRTC)") && has(k.err, "the payload of 0 bytes") && has(k.err, "decodes short")) << k.err;
+  EXPECT_FALSE(has(k.err, "CRC")) << k.err;
 }
 
 // A refused replay removes the output folder it created (and the parents it created for it), but
