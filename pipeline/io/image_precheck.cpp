@@ -289,7 +289,7 @@ class Tiff {
                            tag_name(static_cast<std::uint16_t>(*tag)), at, *count, unit, offset.value_or(0), f_.bytes());
       e.values_at = *offset;
     }
-    entries_[static_cast<std::uint16_t>(*tag)] = e;
+    entries_.emplace(static_cast<std::uint16_t>(*tag), e);  // libtiff keeps a tag's first entry
     return "";
   }
 
@@ -338,8 +338,11 @@ class Tiff {
       if (rps == 0) return "is a damaged TIFF: it declares 0 RowsPerStrip";
       // OpenImageIO reads converted scanlines in chunks of whole strips as RowsPerStrip declares
       // them (values below 2^31; larger ones it ignores), so a RowsPerStrip above the image's rows
-      // costs that many rows of buffer.
-      const std::uintmax_t row_bytes = chunk_bytes(uw, 1) * planes;
+      // costs that many rows of buffer, each row as OpenImageIO holds it in memory: every sample
+      // in 1, 2, 4 or 8 bytes (a 1-bit sample takes a byte; fuzz_depth_image found the file's
+      // packed bits underestimating it eightfold).
+      const std::uintmax_t sample_bytes = bits <= 8 ? 1 : bits <= 16 ? 2 : bits <= 32 ? 4 : 8;
+      const std::uintmax_t row_bytes = uw * samples * sample_bytes;
       if (rps > uh && rps < 0x80000000u && rps * row_bytes > kMaxReadBufferBytes)
         return fmt::format("declares RowsPerStrip {} for an image of {} rows: reading it would take a buffer of {} "
                            "rows of {} bytes ({} MiB, above the {} MiB limit)",

@@ -272,6 +272,11 @@ TEST(NBufferCliTest, RefusesTiffWhoseStripsDoNotFitTheFile) {
   EXPECT_TRUE(has(r.err, f.string()) && has(r.err, "declares RowsPerStrip 63008 for an image of 4 rows")) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
   EXPECT_FALSE(fs::exists(scratch("tiff_levels"))) << "a refused command removes the folders it created";
+  // The long runs found the same with 1-bit samples, which OpenImageIO holds a byte each (745 MB).
+  const fs::path g = finding_file("tiff_one_bit_rows_per_strip", "one_bit.tif");
+  const CliResult s = nbsim("nbuffer query --depth " + g.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(s.status, 2) << s.err;
+  EXPECT_TRUE(has(s.err, "declares RowsPerStrip 63008 for an image of 4 rows")) << s.err;
 }
 
 // fuzz_depth_image's fourth finding: a TIFF whose deflate strip does not decode, where libtiff

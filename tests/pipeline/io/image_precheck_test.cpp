@@ -59,6 +59,12 @@ TEST(ImagePrecheckTest, RefusesRowsPerStripThatWouldCostAHugeBuffer) {
   t.set(278, TiffBuilder::kShort, {63008}).set(339, TiffBuilder::kShort, {1}).strips({{0, 39}});
   const std::string e = check(t);
   EXPECT_TRUE(has(e, "RowsPerStrip 63008 for an image of 4 rows") && has(e, "2842 MiB, above the 256 MiB limit")) << e;
+  // The long runs' finding: no BitsPerSample (1 bit a sample): the file packs a row in 1,479 bytes
+  // but OpenImageIO holds each sample in a byte, 63008 rows of 11825 bytes (710 MiB).
+  TiffBuilder one_bit(11825, 4, {});
+  one_bit.erase(258).erase(339).set(278, TiffBuilder::kShort, {63008}).strips({{0, 39}});
+  const std::string e1 = check(one_bit);
+  EXPECT_TRUE(has(e1, "a buffer of 63008 rows of 11825 bytes (710 MiB, above the 256 MiB limit)")) << e1;
   // The same strip with 4 rows a strip: the strip past the end is what is refused.
   t.set(278, TiffBuilder::kShort, {4});
   const std::string e2 = check(t);
