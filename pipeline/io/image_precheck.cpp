@@ -120,8 +120,24 @@ std::string check_png(File& f, long long max_side, long long max_pixels) {
   }
 }
 
+// The bytes OpenEXR reads for a value of a fixed-size attribute type, whatever its declared size
+// (so a declared size that differs leaves the reader somewhere else than the size says: the next
+// attribute is then read from inside this one's value); 0 for a type of variable size.
+std::uint32_t exr_fixed_size(std::string_view type) noexcept {
+  static constexpr std::pair<std::string_view, std::uint32_t> kSizes[] = {
+      {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"deepImageState", 1}, {"double", 8},
+      {"envmap", 1}, {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1}, {"m33f", 36}, {"m33d", 72},
+      {"m44f", 64}, {"m44d", 128}, {"rational", 8}, {"tiledesc", 9}, {"timecode", 8}, {"v2i", 8}, {"v2f", 8},
+      {"v2d", 16}, {"v3i", 12}, {"v3f", 12}, {"v3d", 24}};
+  for (const auto& [name, bytes] : kSizes)
+    if (name == type) return bytes;
+  return 0;
+}
+
 // OpenEXR: the headers' attributes (name, type, 32-bit size, value) each within the file
-// (OpenEXR allocates an attribute's declared size), and the data window within the limits.
+// (OpenEXR allocates an attribute's declared size), a fixed-size type's value of its size, the
+// sizes a variable value declares inside it (a preview's pixels, a string vector's strings: OpenEXR
+// allocates them), and the data window within the limits.
 std::string check_exr(File& f, long long max_side, long long max_pixels) {
   const auto version = f.read<4>(4);
   if (!version) return "is a damaged OpenEXR file: it ends inside its version field";
@@ -147,6 +163,30 @@ std::string check_exr(File& f, long long max_side, long long max_pixels) {
         return fmt::format("is a damaged OpenEXR file: attribute '{}' at byte {} declares {} bytes, past the end of the "
                            "{}-byte file",
                            printable(*name), at - 4, size, f.bytes());
+      if (const std::uint32_t fixed = exr_fixed_size(*type); fixed != 0 && static_cast<std::uint32_t>(size) != fixed)
+        return fmt::format("is a damaged OpenEXR file: attribute '{}' at byte {} of type {} declares {} bytes, and a {} "
+                           "holds {}",
+                           printable(*name), at - 4, *type, size, *type, fixed);
+      if (*type == "preview") {  // width, height (32 bits each), then 4 bytes a pixel
+        const auto wh = f.read<8>(at);
+        const std::uint64_t pw = wh && size >= 8 ? static_cast<std::uint32_t>(little_endian(wh->data())) : 0;
+        const std::uint64_t ph = wh && size >= 8 ? static_cast<std::uint32_t>(little_endian(wh->data() + 4)) : 0;
+        if (!wh || size < 8 || 8 + 4 * pw * ph != static_cast<std::uint64_t>(size))
+          return fmt::format("is a damaged OpenEXR file: preview attribute '{}' at byte {} declares {} bytes, which do not hold "
+                             "its {}x{} pixels",
+                             printable(*name), at - 4, size, pw, ph);
+      }
+      if (*type == "stringvector") {  // strings of a 32-bit length each, within the value
+        for (std::uintmax_t read = 0; read < static_cast<std::uintmax_t>(size);) {
+          const auto len = f.read<4>(at + read);
+          const std::int32_t n = len && read + 4 <= static_cast<std::uintmax_t>(size) ? little_endian(len->data()) : -1;
+          if (n < 0 || read + 4 + static_cast<std::uintmax_t>(n) > static_cast<std::uintmax_t>(size))
+            return fmt::format("is a damaged OpenEXR file: string vector attribute '{}' at byte {} holds a string that does "
+                               "not fit its {} bytes",
+                               printable(*name), at - 4, size);
+          read += 4 + static_cast<std::uintmax_t>(n);
+        }
+      }
       if (*name == "dataWindow" && *type == "box2i" && size == 16) {
         const auto box = f.read<16>(at);
         if (!box) return "is a damaged OpenEXR file: its data window ends early";

@@ -336,6 +336,16 @@ TEST(NBufferCliTest, ReadsHandBuiltTiffsAndRefusesUndecodableStrips) {
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+// fuzz_depth_image in CI (with its 512 MB allocation limit): an OpenEXR header whose v2f attribute
+// declares 0 bytes; OpenEXR reads the v2f's 8 bytes anyway and then an "attribute" of 1.9 GB from
+// inside the next one. A fixed-size type must declare its size.
+TEST(NBufferCliTest, RefusesExrAttributeOfTheWrongSize) {
+  const fs::path f = finding_file("exr_fixed_size_attribute_desync", "desync.exr");
+  const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "attribute 'screenWindowCenter' at byte 484 of type v2f declares 0 bytes, and a v2f holds 8")) << r.err;
+}
+
 // The OpenImageIO backend is loaded only when an image is touched: without it, a query on the
 // built-in scene still runs, and an image read names the missing backend (exit 2, no crash).
 TEST(NBufferCliTest, ImageBackendLoadedOnlyWhenNeeded) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <tuple>
 #include <string>
 
 #include "pipeline/io/image_precheck.h"
@@ -127,6 +128,57 @@ TEST(ImagePrecheckTest, RefusesTilesThatDoNotFit) {
   EXPECT_TRUE(has(e, "without a TileWidth and a TileLength of at least 1")) << e;
   e = check(tiled(65536, 16));
   EXPECT_TRUE(has(e, "tiles of 65536x16 pixels, above the depth image limit")) << e;
+}
+
+// An OpenEXR header written byte by byte: the required attributes of a 4x3 scanline image, then
+// `extra` ones (name, type, declared size, value bytes), the header's end and no pixels (the
+// precheck reads the headers only).
+std::string check_exr(const std::vector<std::tuple<std::string, std::string, std::int32_t, std::vector<std::uint8_t>>>& extra) {
+  std::vector<std::uint8_t> b = {0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0};
+  const auto put_i32 = [&b](std::int32_t v) {
+    for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(static_cast<std::uint32_t>(v) >> (8 * i)));
+  };
+  const auto attribute = [&](const std::string& name, const std::string& type, std::int32_t size, const std::vector<std::uint8_t>& value) {
+    b.insert(b.end(), name.begin(), name.end()), b.push_back(0);
+    b.insert(b.end(), type.begin(), type.end()), b.push_back(0);
+    put_i32(size);
+    b.insert(b.end(), value.begin(), value.end());
+  };
+  std::vector<std::uint8_t> box = {0, 0, 0, 0, 0, 0, 0, 0, 3, 0, 0, 0, 2, 0, 0, 0};
+  attribute("channels", "chlist", 19, {'Z', 0, 2, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0});
+  attribute("compression", "compression", 1, {0});
+  attribute("dataWindow", "box2i", 16, box);
+  attribute("displayWindow", "box2i", 16, box);
+  attribute("lineOrder", "lineOrder", 1, {0});
+  for (const auto& [name, type, size, value] : extra) attribute(name, type, size, value);
+  b.push_back(0);
+  const auto path = nbsim::testing::scratch_path("nbsim_precheck", "t.exr");
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  const nbsim::io::ImagePrecheck p = nbsim::io::precheck_depth_file(path.string(), kSide, kPixels);
+  EXPECT_EQ(p.format, "exr");
+  return p.refusal;
+}
+
+// OpenEXR reads a fixed-size type's value at its own size whatever the declared one, so a size that
+// differs would make the next attribute be read from inside this one (fuzz_depth_image in CI: a v2f
+// of 0 bytes, then a 1.9 GB "attribute"); and it allocates a preview's pixels and a string
+// vector's strings as they declare them.
+TEST(ImagePrecheckTest, OpenExrAttributeValuesHoldWhatTheirTypesDeclare) {
+  using Attr = std::tuple<std::string, std::string, std::int32_t, std::vector<std::uint8_t>>;
+  EXPECT_EQ(check_exr({}), "");
+  EXPECT_EQ(check_exr({Attr{"screenWindowCenter", "v2f", 8, std::vector<std::uint8_t>(8, 0)}}), "");
+  std::string e = check_exr({Attr{"screenWindowCenter", "v2f", 0, {}}});
+  EXPECT_TRUE(has(e, "attribute 'screenWindowCenter'") && has(e, "of type v2f declares 0 bytes, and a v2f holds 8")) << e;
+  e = check_exr({Attr{"pixelAspectRatio", "float", 8, std::vector<std::uint8_t>(8, 0)}});
+  EXPECT_TRUE(has(e, "of type float declares 8 bytes, and a float holds 4")) << e;
+  // A 2x1 preview: 8 + 2 * 1 * 4 bytes.
+  EXPECT_EQ(check_exr({Attr{"preview", "preview", 16, {2, 0, 0, 0, 1, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8}}}), "");
+  e = check_exr({Attr{"preview", "preview", 16, {0xff, 0xff, 0, 0, 0xff, 0xff, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8}}});
+  EXPECT_TRUE(has(e, "preview attribute 'preview'") && has(e, "do not hold its 65535x65535 pixels")) << e;
+  // A string vector of "ab" and "": (4 + 2) + 4 bytes.
+  EXPECT_EQ(check_exr({Attr{"names", "stringvector", 10, {2, 0, 0, 0, 'a', 'b', 0, 0, 0, 0}}}), "");
+  e = check_exr({Attr{"names", "stringvector", 10, {2, 0, 0, 0, 'a', 'b', 0, 0, 0, 0x70}}});
+  EXPECT_TRUE(has(e, "string vector attribute 'names'") && has(e, "holds a string that does not fit its 10 bytes")) << e;
 }
 
 }  // namespace
