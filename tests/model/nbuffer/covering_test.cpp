@@ -229,10 +229,13 @@ TEST(CoveringTest, HardCases) {
       {"the top-right pixel", {32, 16, 1, 1}, 0.75f},
       {"one pixel more than a power of two wide, along the top edge", {0, 16, 17, 1}, 0.25f, false},
   };
-  for (const Row& row : rows)
-    for (const CoveringSpec& spec : kAll)
-      if (row.one_square_too || spec.kind != CoveringKind::One)
+  for (const Row& row : rows) {
+    for (const CoveringSpec& spec : kAll) {
+      if (row.one_square_too || spec.kind != CoveringKind::One) {
         EXPECT_EQ(nb.query(row.r, spec).value, row.value) << row.why << " " << covering_name(spec);
+      }
+    }
+  }
   // A row one pixel above the bottom edge: under top alignment its squares would start below the
   // image and start at y = 0 instead, so they read the far pixel (0, 0) under the row; bottom
   // alignment reads rows 1..8 only.
