@@ -2,7 +2,7 @@
 //
 // - Depth is GL window depth in [0, 1]; the clear value is 1.0 and the default depth func is LESS.
 // - Images are y up: pixel (x, y) has its centre at (x + 0.5, y + 0.5) and row 0 is the bottom row.
-//   Files on disk are top-down; pipeline/io flips rows on the way in and out.
+//   Files on disk are top-down; io/ flips rows on the way in and out.
 // - "Farthest" is max under LESS/LEQUAL (FarOp::Max) and min under reversed Z, GREATER/GEQUAL
 //   (FarOp::Min). Min-litmaps for shadow clamping use FarOp::Min too.
 #pragma once

@@ -104,8 +104,8 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
     const std::string p = std::string(to_string(m)) + "_";
     const std::string of = std::string(" (") + std::string(to_string(m)) + ")";
     PerMethod& c = per_method_[static_cast<std::size_t>(m)];
-    const auto counter = [&](const char* name, const char* unit, const std::string& what) {
-      return &stats().counter(p + name, unit, what + of);
+    const auto counter = [&](const char* counter_name, const char* unit, const std::string& what) {
+      return &stats().counter(p + counter_name, unit, what + of);
     };
     c.draws = counter("draws", "draws", "box draws");
     c.rasterized = counter("rasterized", "fragments", "the model's box fragments before the early depth test");

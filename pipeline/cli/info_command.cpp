@@ -10,7 +10,7 @@
 
 #include "pipeline/cli/command.h"
 #include "model/common/error.h"
-#include "pipeline/io/image_io.h"
+#include "io/image_io.h"
 #include "traces/gl/context.h"
 
 #include <glm/detail/setup.hpp>

@@ -34,7 +34,7 @@
 #include "traces/capture/ldi/mesh_loader.h"
 #include "traces/capture/ldi/test_points.h"
 #include "traces/gl/context.h"
-#include "pipeline/io/output_folder.h"
+#include "io/output_folder.h"
 
 namespace nbsim::cli {
 

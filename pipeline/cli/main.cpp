@@ -13,7 +13,7 @@
 #include "model/common/error.h"
 #include "model/config/json_input.h"
 #include "pipeline/cli/command.h"
-#include "pipeline/io/output_folder.h"
+#include "io/output_folder.h"
 
 namespace nbsim::cli {
 
@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "nbsim: error: %s\n", e.what());
     return 2;
   }
-  // A refused or failed command removes the output folders it created (pipeline/io/output_folder.h);
+  // A refused or failed command removes the output folders it created (io/output_folder.h);
   // exit 1 from the command itself is a result (counters that differ, sweep points that failed)
   // and keeps them.
   const auto failed = [](int status) {

@@ -16,9 +16,9 @@
 #include "model/common/names.h"
 #include "model/nbuffer/nbuffer.h"
 #include "pipeline/cli/command.h"
-#include "pipeline/io/image_io.h"
+#include "io/image_io.h"
 #include "pipeline/scenes/demo_scene.h"
-#include "pipeline/io/output_folder.h"
+#include "io/output_folder.h"
 
 namespace nbsim::cli {
 

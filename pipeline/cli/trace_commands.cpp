@@ -17,13 +17,13 @@
 
 #include "model/common/error.h"
 #include "pipeline/cli/command.h"
-#include "pipeline/io/image_io.h"
-#include "pipeline/io/json_spill.h"
+#include "io/image_io.h"
+#include "io/json_spill.h"
 #include "traces/format/codec.h"
 #include "traces/format/describe.h"
 #include "traces/format/reader.h"
 #include "traces/format/writer.h"
-#include "pipeline/io/output_folder.h"
+#include "io/output_folder.h"
 
 namespace nbsim::cli {
 

@@ -14,9 +14,9 @@
 #include "model/sim/kernel.h"
 #include "model/relief/walk.h"
 #include "model/sim/timeline.h"
-#include "pipeline/io/json_spill.h"
+#include "io/json_spill.h"
 #include "traces/format/reader.h"
-#include "pipeline/io/output_folder.h"
+#include "io/output_folder.h"
 
 namespace nbsim::pipeline {
 

@@ -1,4 +1,4 @@
-// Fuzz target: the depth-image loader (pipeline/io/image_io.h read_depth, through the OpenImageIO
+// Fuzz target: the depth-image loader (io/image_io.h read_depth, through the OpenImageIO
 // backend), as `nbuffer build/query --depth FILE` reads a file. The first byte picks the file's
 // extension (OpenImageIO picks its reader by extension first, then by content): .pfm, .exr, .tif,
 // .png; the rest is the file. Anything but a DepthImage or an InputError naming the reason is a
@@ -15,7 +15,7 @@
 #include <string>
 
 #include "model/common/error.h"
-#include "pipeline/io/image_io.h"
+#include "io/image_io.h"
 
 namespace {
 

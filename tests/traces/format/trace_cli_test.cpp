@@ -9,7 +9,7 @@
 #include <sstream>
 #include <sys/wait.h>
 
-#include "pipeline/io/image_io.h"
+#include "io/image_io.h"
 #include "tests/common/run_nbsim.h"
 #include "tests/traces/format/sample_trace.h"
 #include "traces/format/describe.h"

@@ -21,7 +21,7 @@
 #include "model/relief/score.h"
 #include "model/relief/walk.h"
 #include "model/scene/visibility.h"
-#include "pipeline/io/image_io.h"
+#include "io/image_io.h"
 #include "traces/capture/camera.h"
 #include "traces/capture/draw_recorder.h"
 #include "traces/capture/ldi/mesh_loader.h"
@@ -335,7 +335,6 @@ class Relief final : public Technique {
     }
     walker_->set_field(field_, radius_, recorder_);
     const std::vector<float> levels = walker_->levels();
-    const relief::FieldView view{field_.size, field_.heights, radius_.radius, levels, walker_->level_count()};
     std::vector<GlFragments> gl;
     if (!city_) walker_->clear_depth();
     for (relief::Method m : methods_) gl.push_back(walker_->draw(m, cam.view, params_, recorder_, city_ ? target_->framebuffer() : 0));

@@ -1,5 +1,5 @@
 // libnbsim_oiio.so: nbsim's image files through OpenImageIO; see oiio_backend.h.
-#include "pipeline/io/oiio_backend.h"
+#include "io/oiio_backend.h"
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
@@ -11,7 +11,7 @@
 #include <iterator>
 #include <string_view>
 
-#include "pipeline/io/image_precheck.h"
+#include "io/image_precheck.h"
 
 namespace nbsim::io::backend {
 namespace {

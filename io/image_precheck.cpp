@@ -1,5 +1,5 @@
 // Depth image files checked before OpenImageIO opens them; see image_precheck.h.
-#include "pipeline/io/image_precheck.h"
+#include "io/image_precheck.h"
 
 #include <fmt/format.h>
 

@@ -1,5 +1,5 @@
 // Output folders removed again when a command fails; see output_folder.h.
-#include "pipeline/io/output_folder.h"
+#include "io/output_folder.h"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-// ImagePrecheckTest: pipeline/io/image_precheck.h on TIFF files built byte by byte: every layout a
+// ImagePrecheckTest: io/image_precheck.h on TIFF files built byte by byte: every layout a
 // writer produces is accepted, and every declared strip, tile, value array or buffer that does not
 // fit the file or the limits is refused with a reason naming the field (fuzz_depth_image found a
 // TIFF whose strip lay past the end of the file: it was read as zeros, after a 2.98 GB buffer).
@@ -8,9 +8,9 @@
 #include <tuple>
 #include <string>
 
-#include "pipeline/io/image_precheck.h"
+#include "io/image_precheck.h"
 #include "tests/common/scratch.h"
-#include "tests/pipeline/io/tiff_builder.h"
+#include "tests/io/tiff_builder.h"
 
 namespace {
 

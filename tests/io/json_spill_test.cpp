@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <string>
 
-#include "pipeline/io/json_spill.h"
+#include "io/json_spill.h"
 
 namespace {
 

@@ -1,6 +1,6 @@
 // Image reading and writing through the OpenImageIO backend, loaded on first use; see image_io.h
 // and oiio_backend.h (why the backend is a separate library).
-#include "pipeline/io/image_io.h"
+#include "io/image_io.h"
 
 #include <dlfcn.h>
 #include <fmt/format.h>
@@ -12,7 +12,7 @@
 #include <string>
 
 #include "model/common/error.h"
-#include "pipeline/io/oiio_backend.h"
+#include "io/oiio_backend.h"
 
 namespace nbsim::io {
 
