@@ -28,7 +28,7 @@ NUMERIC = ["cycles_per_frame", "depth_tests_per_frame", "memory_bytes_per_frame"
 # The declared results of occlusion culling as nbsim wrote them before technique_results.json
 # existed (pipeline/techniques/results.cpp holds the declaration; only what the report reads is
 # here): a sweep folder without that file is read with these. AnalysisTest checks that they agree
-# with the file nbsim explore writes today.
+# with the file nbsim explore writes.
 LEGACY_TECHNIQUE = {
     "technique": "occlusion_culling",
     "metrics": [{"name": n, "must_be_zero": n == "false_culls"} for n in (
@@ -590,8 +590,8 @@ LDI_NEED = ["shape", "ldi_size", "vertices", "d_min", "d_max", "layers", "m_crop
 LDI_OPTIONAL_NUMBERS = ["c_ratio", "ms_viewpoint", "ms_peel", "ms_crop", "ms_compress", "triangles",
                         "paper_c_ratio", "gl_parity_mismatches", "classified_anywhere", "misclassified_anywhere",
                         "fetches_anywhere_layers", "fetches_anywhere_ranges"]
-# The paper's Table 1 rows we can set beside ours (Trapp & Doellner 2008, 1024x1024 LDIs): only the
-# numbers the issue quotes; the rest of their table was not at hand. Fixed by the paper.
+# The paper's Table 1 rows set beside ours (Trapp & Doellner 2008, 1024x1024 LDIs): the two
+# compression ratios at the ends of its range; its other rows are not reproduced. Fixed by the paper.
 PAPER_LDI = {"sphere": ("Sphere, 994 vertices, d = 2", 1.78), "nested": ("Hebe, d up to 18", 0.32)}
 
 

@@ -3,7 +3,8 @@
 find_package(PkgConfig REQUIRED)
 
 # SystemC ships no CMake package on Debian: use pkg-config. Debian built it as C++17, so every
-# translation unit that includes SystemC must see SC_CPLUSPLUS=201703L (see PLATFORM.md).
+# translation unit that includes SystemC must see SC_CPLUSPLUS=201703L, or linking fails on
+# sc_api_version_2_3_4_cxx202002L (docs/architecture.md, "Platform facts").
 pkg_check_modules(SYSTEMC REQUIRED IMPORTED_TARGET systemc>=2.3 tlm)
 add_library(nbsim::systemc INTERFACE IMPORTED)
 target_link_libraries(nbsim::systemc INTERFACE PkgConfig::SYSTEMC)

@@ -10,7 +10,7 @@
 // for slivers the float plane itself is far off the true plane). The minimum vertex depth is then
 // not a bound on the fragments' depths, and a test built on it could cull a triangle with a visible
 // fragment. Setup's pixel box and depth plane give bounds that hold for every fragment, bit for bit
-// (tests/cull/cull_primitive_test.cpp checks them against brute force).
+// (tests/model/cull/cull_primitive_test.cpp checks them against brute force).
 #pragma once
 
 #include <array>

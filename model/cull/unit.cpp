@@ -90,7 +90,8 @@ CullUnit::CullUnit(const sc_core::sc_module_name& name, stats::Registry& registr
       primitive_false_culls_(stats().counter("primitive_false_culls", "triangles",
                                              "dropped triangles with a fragment passing against the occluders' depth")),
       check_(setup.width_px, setup.height_px) {
-  // Derived when the statistics are dumped (ARCHITECTURE.md: the paper-comparable count).
+  // Derived when the statistics are dumped: the paper-comparable count (docs/architecture.md,
+  // "Definitions": depth test).
   stats().formula("query_depth_tests", "tests",
                   "depth tests spent on visibility queries: box fragments, and texels compared for bounds and triangles",
                   [this] { return static_cast<double>(query_depth_tests()); });

@@ -8,8 +8,8 @@
 //   3: y + w < 0, 4: z + w < 0 (z < 0 for clip control ZERO_TO_ONE), 5: z > w. Depth clamp turns
 //   the two z planes off.
 // - draw_llvm.c generate_viewport: every vertex gets 1/w = 1 / w and window = fmuladd(c * (1/w),
-//   scale, translate); LLVM fuses fmuladd into one FMA on hosts that have it (the x86-64 hosts
-//   PLATFORM.md lists do), so `fused_viewport` is on by default.
+//   scale, translate); LLVM fuses fmuladd into one FMA on hosts that have it (this project's x86-64
+//   hosts do: docs/architecture.md, "Platform facts"), so `fused_viewport` is on by default.
 // - draw_pt_fetch_shade_pipeline_llvm.c: a batch of vertices in which any vertex has an outcode
 //   runs through the draw pipeline (clip stage, then cull stage) as a whole; other batches go
 //   straight to llvmpipe's setup, which culls by itself (model/raster/setup.h).

@@ -25,7 +25,7 @@ void HiZUnitConfig::describe(config::Schema& s, HiZUnitConfig& c, const std::str
   s.add(key("build_texels_per_cycle"), c.build_texels_per_cycle, "texels/cycle",
         "Hi-Z texels recomputed a cycle (tile updates, pyramid rebuild)", 0.01, 1024.0);
   s.add(key("build_latency_cycles"), c.build_latency_cycles, "cycles", "latency of one Hi-Z update or rebuild", 0, 100000);
-  if (prefix == "hiz")  // occlusion culling's instance: its timing keys were the cull stage's
+  if (prefix == "hiz")  // occlusion culling's instance: the cull stage's spellings name these keys
     for (const char* field : {"lookups_per_cycle", "lookup_latency_cycles", "build_texels_per_cycle", "build_latency_cycles"})
       s.renamed(std::string("cull.hiz_") + field, key(field));
 }

@@ -26,7 +26,8 @@ struct HiZUnitConfig {
   // culling's. Set by describe(); messages name the keys with it.
   std::string key_prefix = "hiz";
 
-  // Declares "<prefix>.<field>", bound to `c` (hiz's timing keys were "cull.hiz_<field>" before).
+  // Declares "<prefix>.<field>", bound to `c`; for prefix "hiz", setting "cull.hiz_<field>" is
+  // refused with a message naming "hiz.<field>".
   static void describe(config::Schema& schema, HiZUnitConfig& c, const std::string& prefix = "hiz");
   // Throws InputError naming the key when a value is outside its limits.
   void validate() const;

@@ -4,8 +4,8 @@
 //
 // Conventions, stated once for model/ldi/:
 // - Depth is linear depth in [0, 1] along the orthographic view direction, 0 nearest (the shape
-//   scaled into the unit cube). It is NOT GL window depth of a perspective view (ARCHITECTURE.md):
-//   the peel writes it into an R32F colour layer.
+//   scaled into the unit cube). It is NOT GL window depth of a perspective view (docs/architecture.md,
+//   "Definitions"): the peel writes it into an R32F colour layer.
 // - Texel (x, y), y up, x in [0, width), y in [0, height); layer k of a texel is its k-th nearest
 //   surface depth, so a texel's layers are non-decreasing in k (equal depths are allowed: duplicate
 //   faces that a peel did record twice).

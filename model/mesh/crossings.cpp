@@ -31,9 +31,9 @@ Wide edge(std::int64_t ax, std::int64_t ay, std::int64_t bx, std::int64_t by, st
 
 // The tie rule: the sign an exactly-zero edge function takes, i.e. its sign after moving q by
 // (+e, +e^2): inside (+1) when the edge a -> b runs downward, or exactly horizontal rightward.
-// llvmpipe's rule as measured on GL (tests/traces/capture/ldi_peel_test.cpp: a box whose edges lie
-// on texel centres): its top-left rule works in y-down window coordinates whose row 0 is an FBO's
-// bottom row, which is a bottom-left rule in the view plane's y-up coordinates.
+// llvmpipe's rule as measured on GL (LdiPeelTest.BoxEdgesOnTexelCentresFollowTheTieRule: a box
+// whose edges lie on texel centres): its top-left rule works in y-down window coordinates whose row
+// 0 is an FBO's bottom row, which is a bottom-left rule in the view plane's y-up coordinates.
 int tie_sign(std::int64_t dx, std::int64_t dy) { return (dy < 0 || (dy == 0 && dx > 0)) ? 1 : -1; }
 
 }  // namespace

@@ -15,11 +15,11 @@
 // an edge or a vertex is decided by
 // llvmpipe's fill rule as GL applies it to an FBO: top-left in GL's y-down rasterizer space, whose
 // row 0 is the FBO's bottom row, so bottom-left in the view plane's (right, up) coordinates, y up
-// (measured: tests/traces/capture/ldi_peel_test.cpp). An edge function that is exactly zero counts
-// as inside when the edge, walked in the triangle's order, runs downward (dy < 0) or exactly
-// horizontal rightward (dy == 0, dx > 0). That is the same as moving the line by an infinitesimal
-// (+e, +e^2) in (right,
-// up), for both orientations of the projected triangle, so a line through a shared edge or vertex
+// (measured: LdiPeelTest.BoxEdgesOnTexelCentresFollowTheTieRule). An edge function that is
+// exactly zero counts as inside when the edge, walked in the triangle's order, runs downward
+// (dy < 0) or exactly horizontal rightward (dy == 0, dx > 0). That is the same as moving the line
+// by an infinitesimal (+e, +e^2) in (right, up), for both orientations of the projected triangle,
+// so a line through a shared edge or vertex
 // counts each crossing once, and one grazing a silhouette edge counts 0 or 2 (parity kept). A
 // triangle whose projection has zero area (its plane contains the view direction: edge-on) counts 0.
 #pragma once

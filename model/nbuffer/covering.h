@@ -21,9 +21,10 @@
 // query reads 1 to 4 texels, and on each axis the squares' union is exactly the rectangle's span
 // except along the overhanging axis of a row or column.
 //
-// The corner covering (CoveringKind::Corners, nbsim's covering before the paper's): squares of side
-// 2^floor(log2(max(w, h))) at the rectangle's corners, one or two anchors per axis; exact when
-// floor(log2 w) == floor(log2 h), otherwise the short side overhangs by up to a whole square.
+// The corner covering (CoveringKind::Corners; with bottom alignment, the covering of a trace whose
+// header names none): squares of side 2^floor(log2(max(w, h))) at the rectangle's corners, one or
+// two anchors per axis; exact when floor(log2 w) == floor(log2 h), otherwise the short side
+// overhangs by up to a whole square.
 // The one-square covering (CoveringKind::One): a single square of side S (or the corner covering
 // of the top level when no level is that large).
 #pragma once

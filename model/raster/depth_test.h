@@ -85,7 +85,7 @@ struct DepthState {
 // Per-draw counters of the depth test (added to, never reset, by the unit).
 struct DepthCounters {
   std::uint64_t fragments = 0;    // rasterized fragments (GL's fragment-shader atomic counter)
-  std::uint64_t depth_tests = 0;  // comparisons against the buffer (ARCHITECTURE.md's unit)
+  std::uint64_t depth_tests = 0;  // comparisons against the buffer (docs/architecture.md: "depth test")
   std::uint64_t passed = 0;       // GL_SAMPLES_PASSED
   std::uint64_t written = 0;      // depth values stored
   std::uint64_t blocks = 0;       // 4x4 blocks with at least one fragment

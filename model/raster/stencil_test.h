@@ -15,7 +15,7 @@
 // GL clamps ref to [0, 255] and uses the low 8 bits of both masks (st_atom_depth.c,
 // _mesa_get_stencil_ref); stencil_face() does the same. With the stencil test disabled the
 // stencil buffer is neither read nor written and the depth test runs alone (EarlyDepthTest,
-// bit for bit today's path).
+// bit for bit the depth-only path).
 //
 // Early tests, discard and gl_FragDepth (lp_state_fs.c generate_fs_loop, Mesa 22.3): llvmpipe runs
 // depth and stencil together, early (before the shader) unless the shader writes depth, has

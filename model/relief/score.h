@@ -1,4 +1,4 @@
-// Hit error of a relief walk against the exact reference (ARCHITECTURE.md "Hit error"): the
+// Hit error of a relief walk against the exact reference (docs/architecture.md, "Definitions"): the
 // fragment's float ray (walk.h fragment_ray) in double through reference.h, then
 // - wrong_hit: the walk hit where the reference misses;
 // - wrong_miss: the walk missed (or was capped) where the reference hits;

@@ -60,7 +60,7 @@ enum class DrawRole : std::uint8_t {
   ReliefBox = 14,     // a relief box drawn with one ray-walk method (relief): early fragment tests, depth write off, every fragment casts its ray, a miss discards
 };
 
-// The culling technique a frame ran (ARCHITECTURE.md Table 2 modes).
+// The culling technique a frame ran: the Table 2 modes (docs/architecture.md, "Definitions").
 enum class TestMode : std::uint8_t { OcclusionQuery = 0, OcclusionQueryHier = 1, NBuffer = 2, NBufferHier = 3, None = 4 };
 
 // What a draw rasterizes: triangles (three clip-space vertices each) or point sprites (one vertex
@@ -96,7 +96,8 @@ struct DepthState {
   bool depth_clamp = false;
 };
 
-// GL's own counters for one draw (PLATFORM.md says what each counts on llvmpipe).
+// GL's own counters for one draw (what each counts on llvmpipe: docs/architecture.md, "Platform
+// facts").
 struct GlCounters {
   std::uint64_t fragments = 0;         // rasterized fragments: atomic counter, no early fragment tests
   std::uint64_t samples_passed = 0;    // GL_SAMPLES_PASSED

@@ -58,7 +58,7 @@ struct FrameCasters {
   std::vector<std::int32_t> x, y, w, h, draw;
   std::vector<float> caster_near, caster_far, z_min, z_max, clamp_near, clamp_far;
   // GL's reference pass (every caster's infinite volume, not recorded as draws): its fill and the
-  // pixels where the mode's mask differs from its mask; absent from traces captured before them.
+  // pixels where the mode's mask differs from its mask; empty when the record does not hold them.
   std::optional<std::uint64_t> reference_fill, mask_diff_pixels;
   std::size_t size() const noexcept { return object.size(); }
   Rect rect(std::size_t i) const noexcept { return Rect{x[i], y[i], w[i], h[i]}; }

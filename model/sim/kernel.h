@@ -1,6 +1,7 @@
 // SystemC basics shared by every unit wrapper: the model's cycle, the current cycle, and a report
-// handler that makes SystemC warnings and errors loud (STYLE.md: they fail tests). Only the thin
-// wrappers include this header; the algorithm cores never include SystemC.
+// handler that makes SystemC warnings and errors loud (they fail tests: docs/architecture.md, "Code
+// conventions"). Only the thin wrappers include this header; the algorithm cores never include
+// SystemC.
 #pragma once
 
 #include <systemc>

@@ -1,6 +1,7 @@
-// Statistics are the product (STYLE.md): counters are always on, declared once with a name, a unit
-// and a description, grouped per unit under the module hierarchy's full name ("gpu.nbuffer"), and
-// ratios are derived when the statistics are dumped. Plain C++: SystemC wrappers own the groups.
+// Statistics are the product (docs/architecture.md, "Code conventions"): counters are always on,
+// declared once with a name, a unit and a description, grouped per unit under the module
+// hierarchy's full name ("gpu.nbuffer"), and ratios are derived when the statistics are dumped.
+// Plain C++: SystemC wrappers own the groups.
 #pragma once
 
 #include <cstdint>

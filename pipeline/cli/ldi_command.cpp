@@ -6,12 +6,12 @@
 // reference in double precision. One row per (shape, side): vertices, d_min/d_max over the grid's
 // directions, the chosen direction's layers, M_crop and M_comp in the paper's units (32-bit values;
 // M_comp = 2 w_c^2 counts both channels, as the paper does), C_ratio, the four times, and per
-// reader the points misclassified and the texels a test read. Two references: the issue's, on the
-// capture's test points (the exact crossings along the point's texel-centre line: what GL's
-// rasterization and depth precision get wrong), and "anywhere", on as many points uniform in the
-// unit cube (each anywhere in its texel, its exact answer on its own line: the LDI's sampling
-// error, which falls with the LDI's side). Writes OUT/ldi.json (a JSON list,
-// the report's input) and OUT/ldi.csv; prints the table beside the paper's two rows we have.
+// reader the points misclassified and the texels a test read. Two references: the texel-centre
+// one, on the capture's test points (the exact crossings along the point's texel-centre line:
+// what GL's rasterization and depth precision get wrong), and "anywhere", on as many points
+// uniform in the unit cube (each anywhere in its texel, its exact answer on its own line: the
+// LDI's sampling error, which falls with the LDI's side). Writes OUT/ldi.json (a JSON list, the
+// report's input) and OUT/ldi.csv; prints the table beside the paper's two rows we have.
 #include <fmt/format.h>
 
 #include <cmath>
@@ -53,8 +53,9 @@ struct Table1Args {
   bool json = false;
 };
 
-// The paper's Table 1 rows we can set beside ours: only the numbers the issue quotes (its other rows
-// were not at hand). A nested shape of 9 shells (d = 18) stands in for Hebe (d up to 18).
+// The paper's Table 1 rows set beside ours: the two compression ratios at the ends of its range
+// (the sphere, 1.78, and Hebe, 0.32); its other rows are not reproduced. A nested shape of 9
+// shells (d = 18) stands in for Hebe (d up to 18).
 struct PaperRow {
   const char* shape;
   const char* label;

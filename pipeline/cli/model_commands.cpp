@@ -347,7 +347,7 @@ void add_model_commands(CLI::App& app, Action& action) {
     cmd->add_option("--jobs", *jobs, "Replays run at a time (one process each)")->check(CLI::Range(1, 16));
     mo->add_options(cmd);
     // The rows and columns come from the trace's technique (pipeline/techniques/results.cpp); the
-    // footer names today's only table.
+    // footer shows occlusion culling's table.
     if (const auto* oc = techniques::find_technique_results("occlusion_culling"); oc && oc->table)
       cmd->footer(oc->table->footer + "\nRows and columns: the trace's technique's declared table; a technique without one exits 2.");
     cmd->callback([&action, trace, out, json, jobs, mo] {

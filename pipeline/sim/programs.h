@@ -37,9 +37,8 @@ struct ProgramContext {
   // reads) of `kind` over the viewport, farthest by `op`. Throws InputError for an unknown instance.
   std::unique_ptr<query::Structure> structure(std::string_view instance, query::Kind kind, FarOp op) const;
   // The config of N-buffer instance `instance` with a covering or alignment of "trace" made the
-  // capture's (the header's nbuffer_covering, e.g. "paper/top"; corners/bottom, nbsim's covering
-  // before the paper's, when the header has none). Throws InputError for a header value that is
-  // not a covering.
+  // capture's (the header's nbuffer_covering, e.g. "paper/top"; corners/bottom when the header has
+  // none). Throws InputError for a header value that is not a covering.
   nbuffer::NBufferUnitConfig nbuffer_config(std::string_view instance) const;
   // The covering of the capture's GL queries: the header's nbuffer_covering, corners/bottom when it
   // has none (InputError for a value that is not a covering).

@@ -301,8 +301,9 @@ nlohmann::ordered_json cull_summary(const nlohmann::ordered_json& cull, const nl
 }
 
 // The particles program's run totals (summary "particles"), from its statistics and its N-buffer's
-// when the run is done. Depth tests as ARCHITECTURE.md counts them: the queries' texels read, the
-// particle draws' fragments, and the partial build's texels; the scene's own depth tests apart.
+// when the run is done. Depth tests as docs/architecture.md ("Definitions") counts them: the
+// queries' texels read, the particle draws' fragments, and the partial build's texels; the scene's
+// own depth tests apart.
 nlohmann::ordered_json particles_summary(const nlohmann::ordered_json& p, std::string_view mode, std::uint64_t cycles) {
   const std::uint64_t frames = stat(p, "frames");
   const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };

@@ -81,9 +81,9 @@ struct ReplaySummary {
 
   double fragment_error() const;  // |model - gl| / gl over all draws
   double passed_error() const;
-  // Issue 4's thresholds: total fragment and passed-sample error at most 0.01%, at least 99% of
-  // draws exact, at least 99.99% of depth pixels within the tolerance; and every stencil pixel
-  // equal to GL's (the stencil buffer is bit-exact or wrong).
+  // The counter comparison's thresholds: total fragment and passed-sample error at most 0.01%, at
+  // least 99% of draws exact, at least 99.99% of depth pixels within the tolerance; and every
+  // stencil pixel equal to GL's (the stencil buffer is bit-exact or wrong).
   bool within_thresholds() const;
   // The stencil fields appear only for traces that have stencil draws or stencil images.
   nlohmann::ordered_json to_json() const;

@@ -39,7 +39,7 @@ void depth_test_and_nbuffer_labels(ReportLabels& l) {
   l.memory_short = "memory";
 }
 
-// Occlusion culling (Décoret 2005, 4.2; ARCHITECTURE.md "Shared definitions"): depth tests per
+// Occlusion culling (Décoret 2005, 4.2; docs/architecture.md, "Definitions"): depth tests per
 // frame against culling efficiency, with false culls as the correctness count (must be 0).
 TechniqueResults occlusion_culling() {
   TechniqueResults t;
@@ -154,9 +154,9 @@ TechniqueResults occlusion_culling() {
   return t;
 }
 
-// Particles (Décoret 2005, 3.2/4.3; ARCHITECTURE.md "Definitions for the other techniques"): the
-// depth tests of the vertex-stage queries, the sprites' rasterization and the partial build per
-// frame, against the sprites culled less than the exact sprite test would. The test is the trace's
+// Particles (Décoret 2005, 3.2/4.3; popping in docs/architecture.md, "Definitions"): the depth
+// tests of the vertex-stage queries, the sprites' rasterization and the partial build per frame,
+// against the sprites culled less than the exact sprite test would. The test is the trace's
 // particle_mode (none, center, nb, hiz: one capture each) unless particles.mode names another, so
 // a sweep varies the query structure (nbuffer.*, hiz.*) and the mode (exactly on a none capture). Popping and false culls must be 0 for the conservative modes nb
 // and hiz; center pops by design (the paper's rejected baseline), and its points are flagged as

@@ -1,9 +1,9 @@
-// The results each technique declares (ARCHITECTURE.md "The technique seam", results side): its
-// cost, error and outcome metrics (read by JSON pointer from a replay's run.json), its reference
-// setting (the exact point its relative errors are measured against), its paper-style table if it
-// has one, and its headline cost and error for Pareto plots. `nbsim explore` (results.csv,
-// technique_results.json), `nbsim table2` and analysis/report.py read this one table; a new
-// technique adds one row to technique_results(). Plain C++ (no SystemC).
+// The results each technique declares (docs/architecture.md, "Adding a technique: the results
+// side"): its cost, error and outcome metrics (read by JSON pointer from a replay's run.json), its
+// reference setting (the exact point its relative errors are measured against), its paper-style
+// table if it has one, and its headline cost and error for Pareto plots. `nbsim explore`
+// (results.csv, technique_results.json), `nbsim table2` and analysis/report.py read this one table;
+// a new technique adds one row to technique_results(). Plain C++ (no SystemC).
 //
 // The technique-independent results stay with their readers: the timing reference (cycle_error
 // against gpu.quantum_cycles=0 ...) in pipeline/explore/sweep.h, counter_error against GL's

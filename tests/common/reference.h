@@ -300,7 +300,8 @@ inline std::vector<NamedImage> adversarial_images(int w, int h, FarOp op, std::u
 }
 
 // ---------------------------------------------------------------------------------------------
-// The rules every N-buffer answer obeys (ARCHITECTURE.md, "Query"), checked one by one.
+// The rules every N-buffer answer obeys (docs/architecture.md, "Definitions": query), checked one
+// by one.
 
 // floor(log2 v) and ceil(log2 v) for v >= 1, written independently of covering.h.
 inline int log2_floor(long long v) {

@@ -4,7 +4,8 @@
 // post-transform gl_Position captured with transform feedback. Results are read once, at the end of
 // the frame (collect), except for samples_passed, which a technique may wait for at once.
 // A shader that counts fragments declares `buffer Fragments { uint fragments[]; }` at binding 0
-// and adds 1 at fragments[draw_slot] without early fragment tests (PLATFORM.md).
+// and adds 1 at fragments[draw_slot] without early fragment tests, so that it counts every
+// rasterized fragment (docs/architecture.md, "Platform facts").
 #pragma once
 
 #include <cstddef>

@@ -1,7 +1,7 @@
-// The ground truth of visibility (ARCHITECTURE.md): every object of `order` drawn, nothing culled,
-// into the target's ID buffer with a cleared depth buffer, in that order (so that ties at equal
-// depth resolve as in the technique's frame); an object is visible iff one pixel shows it. Its
-// fragment counts go to a scratch counter slot and are not recorded.
+// The ground truth of visibility (docs/architecture.md, "Definitions"): every object of `order`
+// drawn, nothing culled, into the target's ID buffer with a cleared depth buffer, in that order (so
+// that ties at equal depth resolve as in the technique's frame); an object is visible iff one pixel
+// shows it. Its fragment counts go to a scratch counter slot and are not recorded.
 #pragma once
 
 #include <glm/mat4x4.hpp>

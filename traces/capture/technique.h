@@ -1,9 +1,9 @@
-// The capture side of the technique seam (ARCHITECTURE.md): a technique is a class that owns its
-// GL resources and passes and renders one frame at a time into a frame record, built from the
-// shared pieces (gl_program.h, draw_recorder.h, scene_pass.h, render_target.h, readback.h,
-// ground_truth.h). Techniques are chosen by name from one table (techniques.cpp): the name, a
-// one-line description, the options the technique reads and its factory. The header's "technique"
-// property is the row's name.
+// The capture side of the technique seam (docs/architecture.md, "Adding a technique: the renderer
+// side"): a technique is a class that owns its GL resources and passes and renders one frame at a
+// time into a frame record, built from the shared pieces (gl_program.h, draw_recorder.h,
+// scene_pass.h, render_target.h, readback.h, ground_truth.h). Techniques are chosen by name from
+// one table (techniques.cpp): the name, a one-line description, the options the technique reads
+// and its factory. The header's "technique" property is the row's name.
 #pragma once
 
 #include <cstdint>
@@ -49,7 +49,7 @@ class Technique {
 
   // Header properties the technique adds. The header is: GL and depth convention, "technique" =
   // the row's name, variant_properties(), the scene's, the camera path's and the projection's,
-  // setting_properties(), the tool's. (This is the order of every trace captured so far.)
+  // setting_properties(), the tool's, in this order.
   virtual trace::Properties variant_properties() const = 0;   // what the technique is (e.g. test_mode)
   virtual trace::Properties setting_properties() const = 0;   // how it is tuned (e.g. nearest_margin)
   // The header's "depth_format": the GL format of the depth buffer the technique renders into.

@@ -101,9 +101,9 @@ std::string error_of(const std::function<void()>& f) {
 
 // A wrong value nested 10,000 deep is refused with a short message (the echo is cut, not dumped whole).
 TEST(ConfigSchemaTest, DeepValueEchoedBriefly) {
-  // 2,000 levels: the old code's message echoed all 4,000 brackets (deeper values crashed it in the
-  // dump). Moved, never copied: nlohmann's copy recurses, and under ASan's larger frames a copy of
-  // 10,000 levels overflows the test's own stack.
+  // 2,000 levels: a message that dumps the value would echo all 4,000 brackets (and deeper values
+  // would crash the dump). Moved, never copied: nlohmann's copy recurses, and under ASan's larger
+  // frames a copy of 10,000 levels overflows the test's own stack.
   nlohmann::json deep = 1;
   for (int i = 0; i < 2000; ++i) deep = nlohmann::json::array({std::move(deep)});
   nlohmann::json config = nlohmann::json::object();

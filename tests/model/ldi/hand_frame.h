@@ -1,4 +1,4 @@
-// Hand-made frames of the ldi technique for the tests (no GL trace of it exists on this branch):
+// Hand-made frames of the ldi technique for the tests (built in code, so these tests need no GL):
 // a shape in the unit cube seen along -z (OrthoFrame's default: right +x, up +y), its triangles
 // projected orthographically in double and rounded to float into clip positions (clip control
 // zero-to-one, w = 1, so window depth is the linear depth d = 1 - z), one LdiPeel draw a pass, and

@@ -1,7 +1,8 @@
 // The ldi program's plain core: the raster path's peel compare on hand-made triangles
 // (RasterPeelTest), the model's peel against the exact crossing reference (PeelReplayTest), and one
-// frame's comparison with GL's records, its counts and its refusals (LdiFrameTest). GL traces of
-// the technique do not exist on this branch: the frames are made by hand (hand_frame.h).
+// frame's comparison with GL's records, its counts and its refusals (LdiFrameTest). The frames are
+// made by hand (hand_frame.h), so these tests run without GL; LdiPeelTest and LdiCliTest test
+// captures on llvmpipe.
 #include <gtest/gtest.h>
 
 #include <bit>

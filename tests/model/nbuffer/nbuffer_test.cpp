@@ -1,5 +1,5 @@
 // NBufferTest: construction and queries of model/nbuffer/nbuffer.h against the brute-force
-// reference of tests/model/reference.h (NBufferReferenceTest checks that reference itself).
+// reference of tests/common/reference.h (NBufferReferenceTest checks that reference itself).
 #include "model/nbuffer/nbuffer.h"
 
 #include <gtest/gtest.h>
@@ -331,7 +331,8 @@ TEST(NBufferTest, EdgeCases) {
   };
   constexpr auto Max = FarOp::Max;
   constexpr auto Min = FarOp::Min;
-  // Four: the corner covering with bottom alignment (nbsim's before the paper's); One: one square.
+  // Four: the corner covering with bottom alignment (a trace's when its header names none); One:
+  // one square.
   constexpr CoveringSpec Four{CoveringKind::Corners, CoveringAlign::Bottom};
   constexpr CoveringSpec One{CoveringKind::One, CoveringAlign::Bottom};
   constexpr CoveringSpec Paper{CoveringKind::Paper, CoveringAlign::Top};

@@ -177,7 +177,7 @@ TEST(NBufferUnitConfigTest, HiZKeys) {
   EXPECT_EQ(c.pyramid(FarOp::Max).format, StorageFormat::U24);
   EXPECT_THROW(s.set("hiz.tile_px=0"), InputError);
   EXPECT_THROW(s.set("hiz.tiles_px=4"), InputError);
-  // The timing keys moved from the cull stage to the Hi-Z unit: the old names say where.
+  // The Hi-Z timing keys belong to the Hi-Z unit: their cull-stage spellings are refused naming it.
   try {
     s.set("cull.hiz_lookups_per_cycle=2");
     ADD_FAILURE() << "the old key cull.hiz_lookups_per_cycle was accepted";

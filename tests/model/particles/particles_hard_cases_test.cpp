@@ -1,6 +1,6 @@
-// ParticlesHardCasesTest: the hard cases of issue 12, each built by hand on a small depth buffer
-// and decided twice: by GL (the capture's own vertex shader, shaders/particles/particles.vert, run
-// on Mesa's llvmpipe with the same defines as the capture, against levels built by the model's
+// ParticlesHardCasesTest: the hard cases of particle culling, each built by hand on a small depth
+// buffer and decided twice: by GL (the capture's own vertex shader, shaders/particles/particles.vert,
+// run on Mesa's llvmpipe with the same defines as the capture, against levels built by the model's
 // N-buffer core, which ParticlesTest.PartialLevelsEqualTheCoreAndBigSpritesAreKept shows equal to
 // the capture's GLSL levels) and by the model's cores (model/particles/sprite.h). For each case:
 // GL's decision and lookups equal the model's, what GL draws (mode none: its covered pixels and

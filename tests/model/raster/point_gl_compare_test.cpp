@@ -450,7 +450,7 @@ TEST_F(PointGlCompareTest, DepthTestOffMatchesGl) {
   EXPECT_EQ(o.passed, o.fragments);
 }
 
-// ---- the hard cases of issue 12, each stated as what GL draws -----------------------------------
+// ---- the hard cases of particle sprites, each stated as what GL draws ---------------------------
 
 // A one-point case on the cleared (far) buffer under LESS.
 Case single(const std::string& name, float x, float y, float size, float d = 0.5f) {

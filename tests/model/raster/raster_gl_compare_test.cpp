@@ -1,8 +1,8 @@
 // RasterGlCompareTest: the counter comparison of the raster path against GL. Each test captures a
 // small fresh trace with the GL renderer on Mesa (llvmpipe) and replays it: per draw, rasterized
-// fragments and passed samples must match GL's counters within issue 4's thresholds (99% of draws
-// exact, totals within 0.01%), the clipper's input and output counts GL's, and 99.99% of the depth
-// snapshot pixels lie within 1e-6 of GL's.
+// fragments and passed samples must match GL's counters within the comparison's thresholds (99% of
+// draws exact, totals within 0.01%), the clipper's input and output counts GL's, and 99.99% of the
+// depth snapshot pixels lie within 1e-6 of GL's.
 #include <gtest/gtest.h>
 #include <unistd.h>
 

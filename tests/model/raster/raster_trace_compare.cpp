@@ -1,7 +1,7 @@
 // raster_trace_compare: a developer tool beside the raster tests. Replays a captured trace through
 // the raster path and prints the comparison against GL's counters and depth snapshots as one JSON
-// line, then the first mismatching draws. Exit 0 within issue 4's thresholds, 1 outside, 2 on a
-// bad trace or argument.
+// line, then the first mismatching draws. Exit 0 within the comparison's thresholds
+// (trace_compare.h), 1 outside, 2 on a bad trace or argument.
 //   raster_trace_compare TRACE [--unfused-viewport] [--unfused-interpolation] [--batch N] [--list N]
 #include <cstdio>
 #include <cstdlib>

@@ -56,7 +56,7 @@ struct CompareSummary {
   double model_seconds = 0.0;   // host time spent in RasterPath::draw
   std::vector<DrawMismatch> mismatches;
 
-  // The thresholds of issue 4: at least 99% of draws exact, total fragment and passed-sample
+  // The comparison's thresholds: at least 99% of draws exact, total fragment and passed-sample
   // error at most 0.01%, at least 99.99% of depth pixels within the tolerance.
   bool within_thresholds() const;
 };

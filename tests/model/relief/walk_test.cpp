@@ -1,4 +1,4 @@
-// ReliefWalkTest: the walks of model/relief/walk.h on the hard cases, each against the exact
+// ReliefWalkTest: the walks of model/relief/walk.h on the relief hard cases, each against the exact
 // reference (reference.h, score.h): the saddle of Baboud & Decoret's Figure 3 (the exact walk
 // misses it, the robust search and the N-buffer walk must not), a single-texel spike (radius 0), a 0
 // to 1 step seen at grazing angles, a long empty run (the N-buffer walk skips it in a few lookups),

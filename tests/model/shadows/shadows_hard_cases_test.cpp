@@ -1,4 +1,4 @@
-// ShadowsHardCasesTest: the hard cases of issue 13 not covered elsewhere, each a small capture on
+// ShadowsHardCasesTest: the shadows hard cases not covered elsewhere, each a small capture on
 // llvmpipe with a fixed light (--light) and a fixed camera (CaptureOptions::poses), in the three
 // shadow modes, replayed by the shadows program. For each case: the culled and clamped masks equal
 // the infinite one pixel for pixel on every frame (and GL's count of differing pixels is 0); the
@@ -6,8 +6,8 @@
 // the capture's; and the case's own expectation, checked on the SHDC record and the images.
 //
 // Covered elsewhere, not repeated: the ground facing the light (z_min == z_max) and the camera
-// inside a shadow volume (ShadowsTest in tests/traces/capture/shadows_test.cpp, capture side), the
-// three scenes in every mode replayed (ShadowsReplayTest).
+// inside a shadow volume (ShadowsTest, capture side), the three scenes in every mode replayed
+// (ShadowsReplayTest).
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -155,9 +155,10 @@ int caster_of(const scene::TechniqueRecord& rec, std::uint32_t object) {
 // Receivers smaller than a lexel: 16-lexel litmaps over 40 boxes, the light high and oblique, so
 // that every box's bounds span less than a lexel of the litmap (the litmaps may miss a box's faces
 // entirely); the observer looks down at the boxes, which receive each other's shadows.
-// Found a bug (fixed): the clamped mode lost 46 mask pixels over 2 frames: each 16-lexel lexel
-// spans tens of metres of ground, whose lexel-centre samples ended 218.6 m from the light while
-// mask pixels lay up to 223.6 m; the slab now holds the light depth of every mask pixel's receiver.
+// What it guards: each lexel of a 16-lexel litmap spans tens of metres of ground, whose lexel-centre
+// samples end 218.6 m from the light while mask pixels lie up to 223.6 m, so a slab taken from the
+// lexel centres alone would lose 46 mask pixels over 2 frames in the clamped mode; the slab must
+// hold the light depth of every mask pixel's receiver (the receiver splat, docs/shadows.md).
 TEST(ShadowsHardCasesTest, ReceiversSmallerThanALexel) {
   Case c;
   c.options = {{"boxes", "40"}, {"seed", "3"}, {"litmap", "16"}, {"light-fov", "60"}};
@@ -192,9 +193,9 @@ TEST(ShadowsHardCasesTest, ReceiversSmallerThanALexel) {
 // Receivers at grazing angles from the light: a light 2 m above the ground, 150 m beyond the
 // site's edge, looking across it: the ground meets its rays at about 1 degree; the boxes' shadows
 // are long streaks on it, seen from above.
-// Found a bug (fixed): the clamped mode lost 1,031 mask pixels: one lexel row spans up to about
-// 100 m of ground, so the far planes from lexel centres (212 to 260 m) fell short of shadowed
-// ground seen by the observer (up to 270 m); the slab now holds every mask pixel's receiver.
+// What it guards: one lexel row spans up to about 100 m of ground, so far planes from lexel
+// centres (212 to 260 m) fall short of shadowed ground seen by the observer (up to 270 m) and the
+// clamped mode would lose 1,031 mask pixels; the slab must hold every mask pixel's receiver.
 TEST(ShadowsHardCasesTest, ReceiversAtGrazingAngles) {
   Case c;
   c.options = {{"boxes", "12"}, {"seed", "6"}, {"litmap", "128"}, {"light-fov", "40"}};
@@ -248,10 +249,10 @@ TEST(ShadowsHardCasesTest, CasterCrossingTheLightsNearPlane) {
 // two boxes, beyond the taller one A, so that A stands between the light and the other box B. In
 // B's light-space rectangle the nearest visible receiver is A, in front of B: B's slab starts
 // before B, so its volume is loose (no near plane) but drawn and correct.
-// Found a bug (fixed): the clamped mode lost 59 mask pixels: B's far plane from the lexel centres
-// (z_max 0.998497, 101.8 m with the margin) fell short of ground behind B that the observer sees
-// (up to 111.6 m; the light is low, so the ground's depth changes metres within a lexel); the
-// slab now holds every mask pixel's receiver.
+// What it guards: B's far plane from the lexel centres (z_max 0.998497, 101.8 m with the margin)
+// falls short of ground behind B that the observer sees (up to 111.6 m; the light is low, so the
+// ground's depth changes metres within a lexel), and the clamped mode would lose 59 mask pixels;
+// the slab must hold every mask pixel's receiver.
 TEST(ShadowsHardCasesTest, IntermediateOccluder) {
   Case c;
   c.options = {{"boxes", "2"}, {"seed", "12"}, {"litmap", "256"}, {"light-fov", "60"}};

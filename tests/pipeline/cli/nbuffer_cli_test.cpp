@@ -175,8 +175,8 @@ fs::path pfm_with(const std::string& name, const std::string& header, std::size_
 
 // A depth image whose header declares more than the limit (16384 a side, 4096x4096 pixels in all)
 // is refused with exit 2 before its pixels are allocated, the message naming the file, the size
-// and the limit (a tiny PFM declaring 32768x32768 used to allocate 4 GiB and then fail with an
-// empty reason). The sizes here stay small enough that the old code would not allocate much.
+// and the limit (without the check, a tiny PFM declaring 32768x32768 would allocate 4 GiB before
+// failing). The sizes here stay small enough that even an unchecked read would not allocate much.
 TEST(NBufferCliTest, RefusesDepthImageAboveSizeLimit) {
   const struct {
     const char* header;
@@ -195,7 +195,7 @@ TEST(NBufferCliTest, RefusesDepthImageAboveSizeLimit) {
 }
 
 // A PFM with fewer pixel bytes than its header declares is refused with exit 2 and a reason that
-// gives the sizes (it used to end in an empty "cannot be read: ").
+// gives the sizes (never an empty "cannot be read: ").
 TEST(NBufferCliTest, RefusesTruncatedPfm) {
   const fs::path f = pfm_with("short.pfm", "Pf\n4 4\n-1.0\n", 40);
   const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
@@ -208,10 +208,10 @@ TEST(NBufferCliTest, RefusesTruncatedPfm) {
   EXPECT_EQ(nbsim("nbuffer query --depth " + whole.string() + " --rect 0,0,1,1").status, 0) << "the complete file reads";
 }
 
-// fuzz_depth_image's first finding: a 402-byte PNG whose text chunk declares 1.8 GB. libpng
-// allocated and cleared the declared length before reading it (2 GB and a 15 s timeout); every
-// PNG chunk is now checked against the file's size before OpenImageIO opens it. The input is the
-// finding as the fuzzer kept it (its first byte picked the extension).
+// A 402-byte PNG whose text chunk declares 1.8 GB (a fuzz_depth_image finding). libpng allocates
+// and clears the declared length before reading it (2 GB and a 15 s timeout), so every PNG chunk
+// is checked against the file's size before OpenImageIO opens it. The input is the finding as the
+// fuzzer kept it (its first byte picked the extension).
 // A fuzz finding kept in tests/fuzz/corpus/fuzz_depth_image/, written as the file it stood for.
 fs::path finding_file(const std::string& finding, const std::string& name) {
   std::ifstream in(fs::path(NBSIM_SOURCE_DIR) / "tests/fuzz/corpus/fuzz_depth_image" / finding, std::ios::binary);
@@ -235,9 +235,10 @@ TEST(NBufferCliTest, RefusesPngChunkPastTheFileEnd) {
   EXPECT_EQ(nbsim("nbuffer query --depth " + png.string() + " --rect 0,0,1,1").status, 0);
 }
 
-// fuzz_depth_image's second finding: a 43-byte OpenEXR header whose string attribute declares
-// 1.8 GB (OpenEXR allocated it: out of memory). Before that fix, a file OpenImageIO did not
-// recognise by its extension was also offered to every reader it has (DICOM, video, raw, ...).
+// A 43-byte OpenEXR header whose string attribute declares 1.8 GB (a fuzz_depth_image finding;
+// OpenEXR would allocate it: out of memory). The file is recognised by its first bytes, whatever
+// its extension, and opened by that format's reader only, never offered to every reader
+// OpenImageIO has (DICOM, video, raw, ...).
 TEST(NBufferCliTest, RefusesExrAttributePastTheFileEnd) {
   const fs::path f = finding_file("exr_attribute_past_end", "attribute_past_end.exr");
   CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
@@ -259,11 +260,12 @@ TEST(NBufferCliTest, RefusesExrAttributePastTheFileEnd) {
   EXPECT_TRUE(has(r.err, "not a depth image format nbsim reads (OpenEXR, TIFF, PNG or PFM")) << r.err;
 }
 
-// fuzz_depth_image's third finding: a 230-byte TIFF declaring 11825x4 pixels in strips of 63008
-// rows, its one strip past the end of the file. OpenImageIO sized its read buffer by RowsPerStrip
-// (2.98 GB) and, when that fitted, returned zeros without an error: `nbuffer build` wrote 14
-// levels of 0.0 and exited 0. Now refused (exit 2, the file and the field named) before
-// OpenImageIO opens it, within a few hundred MB, and the output folder it asked for is not left.
+// A 230-byte TIFF declaring 11825x4 pixels in strips of 63008 rows, its one strip past the end of
+// the file (a fuzz_depth_image finding). OpenImageIO sizes its read buffer by RowsPerStrip
+// (2.98 GB) and, when that fits, returns zeros without an error, so an unchecked `nbuffer build`
+// would write 14 levels of 0.0 and exit 0. It is refused (exit 2, the file and the field named)
+// before OpenImageIO opens it, within a few hundred MB, and the output folder it asked for is not
+// left.
 TEST(NBufferCliTest, RefusesTiffWhoseStripsDoNotFitTheFile) {
   const fs::path f = finding_file("tiff_strip_past_end", "strip_past_end.tif");
   const fs::path out = scratch("tiff_levels/deeper");
@@ -272,16 +274,17 @@ TEST(NBufferCliTest, RefusesTiffWhoseStripsDoNotFitTheFile) {
   EXPECT_TRUE(has(r.err, f.string()) && has(r.err, "declares RowsPerStrip 63008 for an image of 4 rows")) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
   EXPECT_FALSE(fs::exists(scratch("tiff_levels"))) << "a refused command removes the folders it created";
-  // The long runs found the same with 1-bit samples, which OpenImageIO holds a byte each (745 MB).
+  // The same with 1-bit samples, which OpenImageIO holds a byte each (745 MB; a long fuzz run's
+  // finding).
   const fs::path g = finding_file("tiff_one_bit_rows_per_strip", "one_bit.tif");
   const CliResult s = nbsim("nbuffer query --depth " + g.string() + " --rect 0,0,1,1");
   EXPECT_EQ(s.status, 2) << s.err;
   EXPECT_TRUE(has(s.err, "declares RowsPerStrip 63008 for an image of 4 rows")) << s.err;
 }
 
-// fuzz_depth_image's fourth finding: a TIFF whose deflate strip does not decode, where libtiff
-// passes on zlib's empty message and OpenImageIO reports "ZLib error: ", a refusal that stopped
-// at a colon. The reason is completed.
+// A TIFF whose deflate strip does not decode (a fuzz_depth_image finding): libtiff passes on
+// zlib's empty message and OpenImageIO reports "ZLib error: ", which would stop at a colon. The
+// reason is completed.
 TEST(NBufferCliTest, RefusalNeverEndsAtAColon) {
   const fs::path f = finding_file("tiff_zlib_error_without_message", "zlib.tif");
   const CliResult r = nbsim("nbuffer query --depth " + f.string() + " --rect 0,0,1,1");
@@ -292,8 +295,8 @@ TEST(NBufferCliTest, RefusalNeverEndsAtAColon) {
 
 // TIFFs built byte by byte (tests/pipeline/io/tiff_builder.h) are real TIFFs to OpenImageIO: each
 // layout the precheck accepts reads back the pixel values written, and a compressed strip that
-// does not decode is refused (OpenImageIO's TIFF reader reports it only through its error state;
-// the pixels used to stay zero and the read succeed).
+// does not decode is refused (OpenImageIO's TIFF reader reports it only through its error state:
+// the pixels stay zero and the read succeeds).
 TEST(NBufferCliTest, ReadsHandBuiltTiffsAndRefusesUndecodableStrips) {
   using nbsim::testing::TiffBuilder;
   // 4x3, file rows top-down: the far value 0.9 is in the file's first row, last column, so at

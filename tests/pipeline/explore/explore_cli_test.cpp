@@ -173,7 +173,7 @@ TEST(ExploreCliTest, FailingPointRecorded) {
 }
 
 // A sweep naming a file that is not a trace is refused at validation, naming the file, before
-// any point runs (it used to pass, then fail every point).
+// any point runs (rather than passing validation and then failing every point).
 TEST(ExploreCliTest, NotATraceRefused) {
   const fs::path junk = scratch("junk.nbt");
   std::ofstream(junk) << "not a trace at all";
@@ -207,8 +207,8 @@ TEST(ExploreCliTest, BadSweepFilesRefused) {
   }
 }
 
-// A sweep of 1,000 x 1,000 points is refused at once by counting (it used to take minutes and
-// gigabytes in --dry-run); --max-points raises the limit.
+// A sweep of 1,000 x 1,000 points is refused at once by counting, before it is expanded (expanding
+// it would take minutes and gigabytes, even in --dry-run); --max-points raises the limit.
 TEST(ExploreCliTest, SweepSizeLimited) {
   nlohmann::json sweep = {{"traces", {kSample}}, {"axes", nlohmann::json::object()}};
   for (const char* key : {"nbuffer.lookup_latency_cycles", "memory.latency_cycles"}) {

@@ -107,9 +107,9 @@ TEST(ReplayCliTest, ConfigKeysAndRefusals) {
 }
 
 // The storage of every option of `nbsim config` outlives parsing: valgrind sees no write into freed
-// memory (the --defaults flag was bound to a shared_ptr its callback did not capture). In the
-// sanitizer build (scripts/sanitize sets NBSIM_SANITIZED) ASan watches the same run itself, and
-// valgrind cannot run an ASan executable.
+// memory (a flag such as --defaults bound to a shared_ptr that its callback does not capture would
+// write into freed memory). In the sanitizer build (scripts/sanitize sets NBSIM_SANITIZED) ASan
+// watches the same run itself, and valgrind cannot run an ASan executable.
 TEST(ReplayCliTest, ConfigFlagsWriteLiveMemory) {
   const bool sanitized = std::getenv("NBSIM_SANITIZED") != nullptr;
   if (!sanitized && !fs::exists("/usr/bin/valgrind")) GTEST_SKIP() << "valgrind is not installed (apt-get install valgrind)";
@@ -237,7 +237,7 @@ TEST(ReplayCliTest, RefusesDamagedTrace) {
 }
 
 // A header value that is not UTF-8 is refused by replay with exit 2 naming the key, before any
-// output is written (it used to fail in the JSON library and leave an empty run.json).
+// output is written (not an exception from the JSON library and an empty run.json).
 TEST(ReplayCliTest, RefusesNonUtf8HeaderWithoutOutput) {
   namespace tr = nbsim::trace;
   const fs::path t = scratch("latin1.nbt");
@@ -298,7 +298,8 @@ TEST(ReplayCliTest, RefusesDepthOfAnotherSizeThanTheViewport) {
 
 // A technique chunk this nbsim does not know, with an empty payload (flag bit 1: readers keep it
 // raw), in every frame of a sample: `trace verify` finds the trace sound and the replay's counts
-// are the sample's (the reader used to compute such a chunk's CRC as 0 and call it damaged).
+// are the sample's (the CRC of an empty payload is the running value over the chunk header, not 0:
+// trace::crc32).
 TEST(ReplayCliTest, UnknownEmptyTechniqueChunkVerifiesAndReplays) {
   namespace tr = nbsim::trace;
   const fs::path t = scratch("empty_chunk.nbt");

@@ -51,7 +51,7 @@ TEST(CaptureRegistryTest, RowsAreWellFormed) {
   expect_rows_well_formed(path_table(), "camera path");
 }
 
-// Every technique, scene and path name finds its own row; today's names are there.
+// Every technique, scene and path name finds its own row; the names the docs and scripts use are there.
 TEST(CaptureRegistryTest, EveryNameResolves) {
   for (const auto& r : technique_table()) EXPECT_EQ(&find_technique(r.info.name), &r) << r.info.name;
   for (const auto& r : scene_table()) EXPECT_EQ(&find_scene(r.info.name), &r) << r.info.name;

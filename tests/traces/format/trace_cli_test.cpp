@@ -302,7 +302,7 @@ TEST(TraceCliTest, InfoShowsVersion2Records) {
 }
 
 // A header value that is not UTF-8 is refused by verify and by info --json with exit 2, naming the
-// key and chunk 0, and nothing goes to stdout (info --json used to fail in the JSON library).
+// key and chunk 0, and nothing goes to stdout (info --json must not fail in the JSON library).
 TEST(TraceCliTest, RefusesNonUtf8Header) {
   const fs::path f = scratch("latin1.nbtrace");
   Bytes b;

@@ -519,10 +519,10 @@ TEST(TraceCorruptionTest, TechniqueChunks) {
 }
 
 // A chunk whose stored payload is empty: its CRC covers the chunk header alone, as the writer
-// computes it (zlib's CRC of an empty, null buffer is 0 whatever the running value, so such chunks
-// were refused as damaged). An unknown technique chunk with no payload reads and stays raw, and
-// the writer writes one that reads back; a known chunk with no payload is refused for what it is,
-// a record that ends before its fields, never as a CRC mismatch.
+// computes it (zlib's CRC of an empty, null buffer is 0 whatever the running value, so a reader
+// that used it would refuse such chunks as damaged). An unknown technique chunk with no payload
+// reads and stays raw, and the writer writes one that reads back; a known chunk with no payload is
+// refused for what it is, a record that ends before its fields, never as a CRC mismatch.
 TEST(TraceCorruptionTest, EmptyPayloads) {
   const Properties P;
   TechniqueRecord empty;
@@ -714,9 +714,8 @@ TEST(TraceCorruptionTest, ShadowChunk) {
   longer.push_back(0);
   e = error_of(longer);
   EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "decodes long")) << e;
-  // The layout before reference_fill and mask_diff_pixels were appended (never on main; only
-  // traces captured on the shadows-capture branch have it): refused naming the type, the missing
-  // field and where this nbsim's fields are listed.
+  // The layout without the last two fields, reference_fill and mask_diff_pixels: refused naming the
+  // type, the missing field and where this nbsim's fields are listed.
   std::vector<std::uint8_t> old_layout(raw.payload.begin(), raw.payload.end() - 16);
   e = error_of(old_layout);
   EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "technique chunk SHDC (ShadowCasters, technique shadows) does not have this nbsim's layout") &&

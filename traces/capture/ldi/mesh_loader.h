@@ -1,7 +1,7 @@
-// Real meshes for the layered-depth-image captures (issue 14), renderer side: a model file read with
-// libassimp (PLY, OBJ, STL, OFF and the other formats assimp knows) into the model's TriMesh
-// (model/mesh/mesh.h). Nothing here repairs a mesh: the capture runs check_mesh on the result and
-// refuses or reports a mesh that is not closed, instead of silently peeling it.
+// Real meshes for the layered-depth-image captures (docs/ldi_meshes.md), renderer side: a model
+// file read with libassimp (PLY, OBJ, STL, OFF and the other formats assimp knows) into the model's
+// TriMesh (model/mesh/mesh.h). Nothing here repairs a mesh: the capture runs check_mesh on the
+// result and refuses or reports a mesh that is not closed, instead of silently peeling it.
 #pragma once
 
 #include <cstdint>

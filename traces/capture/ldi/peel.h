@@ -22,7 +22,7 @@
 // Duplicate and coplanar faces: the test against the previous layer is strict (depth > previous),
 // so surfaces at equal float depth at a texel collapse into ONE layer, where the exact reference
 // lists one crossing per face. A shape with a duplicated face therefore shows an odd layer count
-// there (the "coplanar and duplicate faces" hard case); the peel keeps the collapsed count.
+// there (the "coplanar and duplicate faces" hard case); the peel keeps the collapsed count.
 #pragma once
 
 #include <array>

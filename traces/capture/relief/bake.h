@@ -1,4 +1,4 @@
-// Heightfields baked from a mesh on GL (the "heightfields baked from meshes"): the mesh,
+// Heightfields baked from a mesh on GL (--field-mesh; docs/relief.md): the mesh,
 // fitted into the unit cube (model/mesh/mesh.h normalize_to_unit_cube, margin 0) and shrunk in x and
 // y to leave a one-texel ring at height 0, is rendered orthographically from above into an N x N
 // DEPTH_COMPONENT32F target (clip control ZERO_TO_ONE, window depth = 1 - height, LESS against 1.0,
