@@ -15,9 +15,9 @@
 #include <string>
 #include <sys/wait.h>
 
-#include "pipeline/io/image_io.h"
+#include "io/image_io.h"
 #include "tests/common/run_nbsim.h"
-#include "tests/pipeline/io/tiff_builder.h"
+#include "tests/io/tiff_builder.h"
 
 namespace {
 
@@ -293,7 +293,7 @@ TEST(NBufferCliTest, RefusalNeverEndsAtAColon) {
   EXPECT_FALSE(has(r.err, ": \n")) << r.err;
 }
 
-// TIFFs built byte by byte (tests/pipeline/io/tiff_builder.h) are real TIFFs to OpenImageIO: each
+// TIFFs built byte by byte (tests/io/tiff_builder.h) are real TIFFs to OpenImageIO: each
 // layout the precheck accepts reads back the pixel values written, and a compressed strip that
 // does not decode is refused (OpenImageIO's TIFF reader reports it only through its error state:
 // the pixels stay zero and the read succeeds).
