@@ -28,10 +28,6 @@ this = pathlib.Path(__file__).resolve()
 CODE_SUFFIXES = {".h", ".cpp", ".glsl", ".comp", ".vert", ".frag", ".py", ".cmake", ".md"}
 # Documents that commands write into their output folders (analysis/report.py: headline.md).
 GENERATED = {"headline.md"}
-# Folders on their way to a new place: a mention of the old path is accepted while the file exists
-# at the new one (pipeline/io/ became io/, tests/pipeline/io/ became tests/io/; files still being
-# edited elsewhere may name the old path for a while).
-MOVED = [("tests/pipeline/io/", "tests/io/"), ("pipeline/io/", "io/")]
 
 
 def tracked_files():
@@ -98,11 +94,6 @@ def resolves(mention, citing, prefix=False):
     here = os.path.dirname(citing)
     if here:
         candidates.append(os.path.normpath(os.path.join(here, mention)).replace(os.sep, "/"))
-    for c in list(candidates):
-        for was, now in MOVED:
-            if c.startswith(was):
-                candidates.append(now + c[len(was):])
-                break
     if any(not c.startswith("../") and exists(c, prefix) for c in candidates):
         return True
     return "/" not in mention.rstrip("/") and mention in basenames
