@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <set>
+#include <string>
 
 #include "model/nbuffer/nbuffer.h"
 #include "traces/format/reader.h"
@@ -58,7 +59,11 @@ TEST_P(SampleTraceTest, ChecksItself) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Samples, SampleTraceTest,
-                         ::testing::Values("city_walk_512.nbt", "city_small_oq.nbt", "city_small_nb_reversed.nbt"));
+                         ::testing::Values("city_walk_512.nbt", "city_small_oq.nbt", "city_small_nb_reversed.nbt"),
+                         [](const ::testing::TestParamInfo<const char*>& p) {  // the file name without .nbt
+                           const std::string file = p.param;
+                           return file.substr(0, file.find('.'));
+                         });
 
 }  // namespace
 }  // namespace nbsim
