@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <string>
 #include <variant>
 
@@ -60,6 +61,12 @@ struct Variant {
   bool conservative;  // nb, hiz: no popping, no false cull
   bool all_kept = false;  // every on-screen sprite larger than the levels built
 };
+
+// How GoogleTest shows a Variant (GetParam() in a failure): its name and capture arguments.
+void PrintTo(const Variant& v, std::ostream* os) {
+  *os << v.name << " (capture particles " << v.args << (v.conservative ? ", conservative" : "")
+      << (v.all_kept ? ", all kept" : "") << ")";
+}
 
 class ParticlesReplayTest : public ::testing::TestWithParam<Variant> {};
 
