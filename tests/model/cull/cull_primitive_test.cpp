@@ -223,7 +223,9 @@ ReplayRun replay(const std::string& trace, const std::string& mode, const std::s
   return r;
 }
 
-class CullPrimitiveReplayTest : public ::testing::TestWithParam<std::tuple<const char*, const char*>> {};
+// (sample trace, cull mode) as strings: GoogleTest prints them as text (const char*s in a tuple
+// print with their addresses, which then change the ctest names from build to build).
+class CullPrimitiveReplayTest : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
 
 // Primitive granularity culls triangles, none with a fragment that could pass; every drawn object
 // keeps its passed samples; fewer depth tests are drawn; the query counts include the lookups.

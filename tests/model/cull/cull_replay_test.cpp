@@ -38,7 +38,9 @@ nlohmann::json replay_cull(const std::string& trace, const std::string& mode, co
   return j["summary"]["cull"];
 }
 
-class CullReplayTest : public ::testing::TestWithParam<std::tuple<const char*, const char*>> {};
+// (sample trace, cull mode) as strings: GoogleTest prints them as text (const char*s in a tuple
+// print with their addresses, which then change the ctest names from build to build).
+class CullReplayTest : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
 
 // A conservative mode never culls an object the ground truth shows visible, and it does decide.
 TEST_P(CullReplayTest, NoFalseCulls) {
