@@ -9,7 +9,7 @@ import pathlib
 import sys
 
 root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
-# The source trees, lowest layer first (io/ may also still be pipeline/io/: whatever exists).
+# The source trees, lowest layer first.
 source_tops = ["model", "io", "traces", "pipeline"]
 # Folders under tests/ that mirror no source folder, and why.
 test_helpers = {
