@@ -8,11 +8,14 @@
 option(NBSIM_PCH "Precompile the heavy third-party headers" ON)
 
 # ccache, when present and no launcher was chosen: its sloppiness settings let it cache files
-# compiled against a precompiled header (the header is rebuilt in the same second as its users).
+# compiled against a precompiled header (the header is rebuilt in the same second as its users);
+# the base directory and CCACHE_NOHASHDIR let a second clone hit the first clone's entries, also
+# in the builds with debug information (the sanitizer and fuzz builds), whose debug information
+# then names the first clone's folder.
 find_program(NBSIM_CCACHE ccache)
 if(NBSIM_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
   set(_launcher ${CMAKE_COMMAND} -E env CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
-      CCACHE_BASEDIR=${PROJECT_SOURCE_DIR} ${NBSIM_CCACHE})
+      CCACHE_BASEDIR=${PROJECT_SOURCE_DIR} CCACHE_NOHASHDIR=true ${NBSIM_CCACHE})
   set(CMAKE_CXX_COMPILER_LAUNCHER ${_launcher})
   set(CMAKE_C_COMPILER_LAUNCHER ${_launcher})
   message(STATUS "nbsim: compiling through ${NBSIM_CCACHE}")
