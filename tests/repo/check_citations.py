@@ -14,7 +14,7 @@ offence: it is outside the repository.
 Not checked: URLs; absolute paths (/tmp, /usr); output names that no top-level folder prefixes
 (run.json, results.csv, OUT/plot.png); the documents a command writes (GENERATED); a top-level
 folder and one word with neither extension nor closing slash ("depth tests/frame" is a unit); and
-placeholders, paths with an upper-case word outside a document's own name
+name patterns: paths with an upper-case word outside a document's own name
 (`traces/capture/DIR/NAME.h`). Prints each offence as path:line: message; exits 1 if any."""
 import os
 import pathlib
@@ -68,7 +68,7 @@ top_path = re.compile(r"(?<![\w./$-])((?:" + tops + r")/[\w./-]*)([*{<]?)")
 caps_word = re.compile(r"(?<![A-Za-z0-9])[A-Z][A-Z0-9]*(?:_[A-Z0-9]+)*(?![a-z])")
 
 
-def placeholder(path):
+def is_name_pattern(path):
     """True when a component other than a document's own name holds an upper-case word (DIR, NAME)."""
     parts = path.split("/")
     for i, part in enumerate(parts):
@@ -120,7 +120,7 @@ for name in files:
         for m in md_name.finditer(text):
             mention = m.group(1)
             seen.add(m.start(1))
-            if "/" in mention and placeholder(mention) or mention.rsplit("/", 1)[-1] in GENERATED:
+            if "/" in mention and is_name_pattern(mention) or mention.rsplit("/", 1)[-1] in GENERATED:
                 continue
             if not resolves(mention, name):
                 offences.append(f"{name}:{number}: cites {mention}, which is not in the repository")
@@ -128,7 +128,7 @@ for name in files:
             if m.start(1) in seen:
                 continue
             mention = m.group(1).rstrip(".,:;")
-            if mention.endswith(".md") or placeholder(mention):
+            if mention.endswith(".md") or is_name_pattern(mention):
                 continue
             rest = mention.split("/", 1)[1]
             if "/" not in rest and "." not in rest and not m.group(2) and not m.group(1).endswith("/"):

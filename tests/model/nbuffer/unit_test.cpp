@@ -13,21 +13,14 @@
 #include <vector>
 
 #include "tests/common/reference.h"
+#include "tests/common/sc_driver.h"
 
 extern "C" int sc_main(int, char*[]) { return 1; }  // libsystemc's main() needs one; gtest's main runs
 
 namespace nbsim::nbuffer {
 namespace {
 
-// A thread that runs a script (the caller of the unit: a cull stage, a depth unit).
-struct Driver : sc_core::sc_module {
-  std::function<void()> script;
-  SC_HAS_PROCESS(Driver);
-  Driver(const sc_core::sc_module_name& n, std::function<void()> s) : sc_core::sc_module(n), script(std::move(s)) {
-    SC_THREAD(run);
-  }
-  void run() { script(); }
-};
+using Driver = testing::ScriptDriver;
 
 NBufferUnitConfig timing(int latency, double per_cycle, const char* policy = "eager") {
   NBufferUnitConfig c;

@@ -12,20 +12,14 @@
 
 #include "model/hiz/pyramid.h"
 #include "model/hiz/tile_hiz.h"
+#include "tests/common/sc_driver.h"
 
 extern "C" int sc_main(int, char*[]) { return 1; }  // libsystemc's main() needs one; gtest's main runs
 
 namespace nbsim::query {
 namespace {
 
-struct Driver : sc_core::sc_module {
-  std::function<void()> script;
-  SC_HAS_PROCESS(Driver);
-  Driver(const sc_core::sc_module_name& n, std::function<void()> s) : sc_core::sc_module(n), script(std::move(s)) {
-    SC_THREAD(run);
-  }
-  void run() { script(); }
-};
+using Driver = testing::ScriptDriver;
 
 template <class F>
 std::uint64_t timed(F&& f) {
