@@ -681,7 +681,7 @@ def headline_ldi(label, rows, reading):
 
 # ------------------------------------------------------------------------------------ relief textures
 RELIEF_METHODS = ["binary", "exact", "robust", "robust_clamp", "nbuffer"]
-# relief.json (nbsim relief TRACE... --out; pipeline/techniques/relief_table.h): an object of these lists. Per
+# relief.json (nbsim relief TRACE... --out; pipeline/techniques/relief/relief_table.h): an object of these lists. Per
 # list: the keys each row must hold, those of them that are strings, numbers (null allowed: a ratio over no
 # fragment, a paper row we have no rows for) and counts (whole numbers not below 0).
 RELIEF_LISTS = {

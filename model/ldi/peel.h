@@ -26,9 +26,9 @@
 
 namespace nbsim::ldi {
 
-inline constexpr std::uint32_t kLdiImageRecordType = 0x4C49444Cu;  // fourcc "LDIL" (traces/format/ldi_chunk.h)
+inline constexpr std::uint32_t kLdiImageRecordType = 0x4C49444Cu;  // fourcc "LDIL" (traces/format/ldi/ldi_chunk.h)
 inline constexpr std::uint32_t kLdiTestsRecordType = 0x5449444Cu;  // fourcc "LDIT"
-// LDIT's point kinds (traces/format/ldi_chunk.h LdiPointKind, fixed values) and their names.
+// LDIT's point kinds (traces/format/ldi/ldi_chunk.h LdiPointKind, fixed values) and their names.
 inline constexpr std::size_t kPointKinds = 4;
 inline constexpr std::array<const char*, kPointKinds> kPointKindNames = {"random", "crop_boundary", "near_surface", "midway"};
 inline constexpr std::int32_t kNearSurfaceReference = -1;  // LDIT `reference` of a point within epsilon of a surface

@@ -102,7 +102,7 @@ struct FrameParticles {
   std::vector<Particle> particles;
   std::vector<std::uint32_t> draw, culled, lookups, reference_samples;
 };
-inline constexpr std::uint32_t kParticlesRecordType = 0x43545250u;  // fourcc "PRTC" (traces/format/particles_chunk.h)
+inline constexpr std::uint32_t kParticlesRecordType = 0x43545250u;  // fourcc "PRTC" (traces/format/particles/particles_chunk.h)
 FrameParticles read_particles(const scene::Frame& f);
 
 }  // namespace nbsim::particles

@@ -22,7 +22,7 @@ namespace {
 
 constexpr const char* kFieldLabel = "ReliefField (RLFH)";
 constexpr const char* kFragmentsLabel = "ReliefFragments (RLFF)";
-// Limits fixed by the design (traces/format/relief_chunk.h, radius.h, walk.h WalkParams).
+// Limits fixed by the design (traces/format/relief/relief_chunk.h, radius.h, walk.h WalkParams).
 constexpr std::uint64_t kMaxRadiusLimit = 255, kMaxLinearSteps = 1024, kMaxBisections = 32;
 
 // A scalar field (u32 fields decode as uint64_t, f64 as double, strings as std::string).

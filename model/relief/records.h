@@ -1,5 +1,5 @@
 // The relief technique's records as the model reads them (no traces/ include: the fields come from
-// the frame's TechniqueRecords, decoded by the format library; traces/format/relief_chunk.h
+// the frame's TechniqueRecords, decoded by the format library; traces/format/relief/relief_chunk.h
 // documents them). Each reader checks what the model relies on and throws InputError naming the
 // frame, the record and the problem (a missing record or field, a field of the wrong type, vector
 // lengths, NaN, out-of-range values, radii that are not whole, an N-buffer that is not the max
@@ -18,7 +18,7 @@
 
 namespace nbsim::relief {
 
-inline constexpr std::uint32_t kReliefFieldRecordType = 0x48464C52u;      // fourcc "RLFH" (traces/format/relief_chunk.h)
+inline constexpr std::uint32_t kReliefFieldRecordType = 0x48464C52u;      // fourcc "RLFH" (traces/format/relief/relief_chunk.h)
 inline constexpr std::uint32_t kReliefFragmentsRecordType = 0x46464C52u;  // fourcc "RLFF"
 
 // RLFH, checked.

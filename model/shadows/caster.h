@@ -63,7 +63,7 @@ struct FrameCasters {
   std::size_t size() const noexcept { return object.size(); }
   Rect rect(std::size_t i) const noexcept { return Rect{x[i], y[i], w[i], h[i]}; }
 };
-inline constexpr std::uint32_t kShadowsRecordType = 0x43444853u;  // fourcc "SHDC" (traces/format/shadows_chunk.h)
+inline constexpr std::uint32_t kShadowsRecordType = 0x43444853u;  // fourcc "SHDC" (traces/format/shadows/shadows_chunk.h)
 // Throws InputError naming the frame and the field for a missing or damaged record.
 FrameCasters read_casters(const scene::Frame& f);
 

@@ -20,7 +20,7 @@
 #include "pipeline/explore/child.h"
 #include "pipeline/explore/runner.h"
 #include "pipeline/sim/replay.h"
-#include "pipeline/techniques/relief_table.h"
+#include "pipeline/techniques/relief/relief_table.h"
 #include "pipeline/techniques/results.h"
 #include "traces/format/reader.h"
 

@@ -13,10 +13,10 @@
 #include "model/common/error.h"
 #include "traces/format/bytes.h"
 #include "traces/format/codec.h"
-#include "traces/format/ldi_chunk.h"
-#include "traces/format/particles_chunk.h"
-#include "traces/format/relief_chunk.h"
-#include "traces/format/shadows_chunk.h"
+#include "traces/format/ldi/ldi_chunk.h"
+#include "traces/format/particles/particles_chunk.h"
+#include "traces/format/relief/relief_chunk.h"
+#include "traces/format/shadows/shadows_chunk.h"
 
 namespace nbsim::trace {
 

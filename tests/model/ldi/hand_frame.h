@@ -56,7 +56,7 @@ inline scene::DrawRecord peel_draw(const std::vector<std::array<float, 4>>& clip
 
 inline scene::TechniqueField field(const char* name, auto value) { return scene::TechniqueField{name, value}; }
 
-// LDIL for the stand-in LDI `gl`, fields in the registered order (traces/format/ldi_chunk.cpp).
+// LDIL for the stand-in LDI `gl`, fields in the registered order (traces/format/ldi/ldi_chunk.cpp).
 inline scene::TechniqueRecord ldil_record(const Ldi& gl) {
   const CompressedLdi c = compress(gl);
   scene::TechniqueRecord r;

@@ -42,7 +42,7 @@ std::vector<float> max_nbuffer(const std::vector<float>& heights) {
   return out;
 }
 
-// RLFH, fields in the registered order (traces/format/relief_chunk.cpp).
+// RLFH, fields in the registered order (traces/format/relief/relief_chunk.cpp).
 scene::TechniqueRecord field_record() {
   const std::vector<float> heights = sample_heights();
   scene::TechniqueRecord r;

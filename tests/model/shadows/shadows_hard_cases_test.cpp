@@ -30,7 +30,7 @@
 #include "traces/capture/capture.h"
 #include "traces/capture/scenes.h"
 #include "traces/format/reader.h"
-#include "traces/format/shadows_chunk.h"
+#include "traces/format/shadows/shadows_chunk.h"
 
 namespace nbsim::capture {
 namespace {

@@ -18,7 +18,7 @@
 #include "traces/capture/ldi/build.h"
 #include "traces/capture/ldi/mesh_loader.h"
 #include "traces/capture/ldi/test_points.h"
-#include "traces/format/ldi_chunk.h"
+#include "traces/format/ldi/ldi_chunk.h"
 
 namespace nbsim::capture {
 namespace {

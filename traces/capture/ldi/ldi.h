@@ -6,7 +6,7 @@
 // --grid, depth peeling at the chosen direction (every pass a draw of role LdiPeel), crop and
 // compression. Then --points test points (test_points.h) get GL's parity answers from both readers
 // (shaders/ldi/vpt.comp) and the exact reference. Records: the peel draws, LDIL and LDIT
-// (traces/format/ldi_chunk.h).
+// (traces/format/ldi/ldi_chunk.h).
 // The observer is not used: the scene, the camera path and --size only satisfy the capture driver
 // (the header says so in `observer`); use the cheapest scene (`--scene boxes --boxes 0`).
 #pragma once

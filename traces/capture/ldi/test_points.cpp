@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "traces/format/ldi_chunk.h"
+#include "traces/format/ldi/ldi_chunk.h"
 
 namespace nbsim::capture {
 namespace {

@@ -1,5 +1,5 @@
 // Test points of the volumetric parity test (Trapp & Doellner) for the `ldi` capture, and their exact
-// reference: the four kinds of traces/format/ldi_chunk.h (random, crop boundary, near a surface,
+// reference: the four kinds of traces/format/ldi/ldi_chunk.h (random, crop boundary, near a surface,
 // midway between layers) chosen from GL's LDI and crop, and per point the number of surface
 // crossings beyond it along its texel-centre line, in double precision (model/mesh/crossings.h),
 // or kLdiNearSurface (-1) when a crossing lies within epsilon of it.

@@ -24,7 +24,7 @@
 #include "traces/capture/readback.h"
 #include "traces/capture/render_target.h"
 #include "traces/capture/scene_pass.h"
-#include "traces/format/particles_chunk.h"
+#include "traces/format/particles/particles_chunk.h"
 
 namespace nbsim::capture {
 

@@ -6,7 +6,7 @@
 // (role Particles; gl_Position and gl_PointSize captured), each vertex culled by --mode -> the
 // reference pass (every particle, a passed-sample counter each; not a recorded draw). Records
 // the scene depth ("scene"), every --levels-every-th frame the N-buffer levels, and the PRTC
-// record (traces/format/particles_chunk.h) with every particle's centre, depth, size, the
+// record (traces/format/particles/particles_chunk.h) with every particle's centre, depth, size, the
 // decision GL took, its lookups and its reference samples.
 #pragma once
 

@@ -30,7 +30,7 @@
 #include "traces/capture/relief/view.h"
 #include "traces/capture/render_target.h"
 #include "traces/capture/scene_pass.h"
-#include "traces/format/relief_chunk.h"
+#include "traces/format/relief/relief_chunk.h"
 
 namespace nbsim::capture {
 namespace {

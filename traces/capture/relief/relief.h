@@ -6,7 +6,7 @@
 // [0, --box-height] from its own camera: the angle from the box's up axis cycles through --angles
 // (0 head-on, 89 grazing), the azimuth comes from --seed and the frame. Every --methods method
 // draws the box once (role relief_box, gl_walk.h); records: RLFH and one RLFF a draw
-// (traces/format/relief_chunk.h). The exact reference (model/relief/reference.h) scores GL's hits:
+// (traces/format/relief/relief_chunk.h). The exact reference (model/relief/reference.h) scores GL's hits:
 // the capture's counts give each method's hit error.
 // --frustum A replaces the box by a reverse-perspective frustum (view.h). --placement city stands the
 // box in the capture's scene instead (--box-at), viewed by the observer along --path: the scene's

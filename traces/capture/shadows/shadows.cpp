@@ -27,7 +27,7 @@
 #include "traces/capture/scene_pass.h"
 #include "traces/capture/shadows/volumes.h"
 #include "traces/format/header.h"
-#include "traces/format/shadows_chunk.h"
+#include "traces/format/shadows/shadows_chunk.h"
 
 namespace nbsim::capture {
 

@@ -29,7 +29,7 @@
 // Records: the light (LGHT), depth images "final", "litmap_min", "litmap_max", stencil images
 // "stencil" (after the mode's volumes), "light_region", "shadow_mask", "shadow_mask_infinite", the
 // N-buffer levels (sources "litmap_min" op min, "litmap_max" op max) every --levels-every-th frame,
-// and the SHDC record (traces/format/shadows_chunk.h).
+// and the SHDC record (traces/format/shadows/shadows_chunk.h).
 #pragma once
 
 #include <memory>

@@ -22,7 +22,7 @@
 #include "traces/capture/draw_recorder.h"
 #include "traces/capture/ldi/build.h"
 #include "traces/capture/ldi/test_points.h"
-#include "traces/format/ldi_chunk.h"
+#include "traces/format/ldi/ldi_chunk.h"
 #include "tests/common/gl_context_suite.h"
 
 namespace nbsim::capture {

@@ -18,7 +18,7 @@
 #include "traces/capture/capture.h"
 #include "traces/capture/particles/particle_systems.h"
 #include "traces/capture/scenes.h"
-#include "traces/format/particles_chunk.h"
+#include "traces/format/particles/particles_chunk.h"
 #include "traces/format/reader.h"
 #include "tests/common/scratch.h"
 

@@ -21,7 +21,7 @@
 #include "traces/capture/renderer.h"
 #include "traces/capture/scenes.h"
 #include "traces/format/reader.h"
-#include "traces/format/shadows_chunk.h"
+#include "traces/format/shadows/shadows_chunk.h"
 #include "tests/common/scratch.h"
 
 namespace nbsim::capture {

@@ -1,5 +1,5 @@
 // The shadows technique's chunk description; see shadows_chunk.h.
-#include "traces/format/shadows_chunk.h"
+#include "traces/format/shadows/shadows_chunk.h"
 
 #include <fmt/format.h>
 

@@ -1,5 +1,5 @@
 // The relief table; see relief_table.h.
-#include "pipeline/techniques/relief_table.h"
+#include "pipeline/techniques/relief/relief_table.h"
 
 #include <algorithm>
 #include <array>

@@ -1,5 +1,5 @@
 // The relief technique's chunk descriptions; see relief_chunk.h.
-#include "traces/format/relief_chunk.h"
+#include "traces/format/relief/relief_chunk.h"
 
 #include <fmt/format.h>
 

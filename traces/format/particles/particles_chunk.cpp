@@ -1,5 +1,5 @@
 // The particles technique's chunk description; see particles_chunk.h.
-#include "traces/format/particles_chunk.h"
+#include "traces/format/particles/particles_chunk.h"
 
 #include <fmt/format.h>
 

@@ -1,5 +1,5 @@
 // The LDI technique's chunk descriptions; see ldi_chunk.h.
-#include "traces/format/ldi_chunk.h"
+#include "traces/format/ldi/ldi_chunk.h"
 
 #include <fmt/format.h>
 

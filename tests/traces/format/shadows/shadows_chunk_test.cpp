@@ -1,0 +1,90 @@
+// ShadowsChunkTest: the shadows technique's SHDC record (traces/format/shadows/shadows_chunk.h) read back by every
+// reader, and every damage to it refused naming the chunk.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "tests/traces/format/chunk_builder.h"
+#include "traces/format/shadows/shadows_chunk.h"
+
+namespace {
+
+using namespace nbsim::trace;
+using namespace nbsim::trace::testing;
+
+// The shadows technique's SHDC record (traces/format/shadows/shadows_chunk.h) is decoded by every reader;
+// each flipped byte, a payload one byte short or long, a vector count past the payload and broken
+// rules (lengths, decisions, rectangles outside the litmap, draws below -1) are refused naming it.
+TEST(ShadowsChunkTest, DecodedAndDamageRefused) {
+  struct Fields {
+    std::vector<std::int32_t> x{0, 10, 0}, w{0, 6, 64};
+    std::vector<std::uint32_t> decision{2, 0, 3};
+    std::vector<std::int32_t> draw{-1, 7, 8};
+  };
+  auto payload = [](const Fields& f) {
+    bytes::Out o;
+    o.u32(3);
+    o.u32(64);                                              // litmap_size
+    o.counted_words(std::vector<std::uint32_t>{1, 2, 5});  // object
+    o.counted_words(f.x);
+    o.counted_words(std::vector<std::int32_t>{0, 20, 0});  // y
+    o.counted_words(f.w);
+    o.counted_words(std::vector<std::int32_t>{0, 5, 64});  // h
+    for (int k = 0; k < 4; ++k) o.counted_words(std::vector<float>{0.5f, 0.25f, 1.0f});  // caster_near/far, z_min/max
+    o.counted_words(std::vector<std::uint32_t>{0, 8, 0});  // lookups
+    o.counted_words(f.decision);
+    o.counted_words(std::vector<float>{0.0f, 0.3f, 0.0f});  // clamp_near
+    o.counted_words(std::vector<float>{INFINITY, 0.9f, INFINITY});  // clamp_far
+    o.counted_words(f.draw);
+    o.u64(1234567);  // reference_fill
+    o.u64(0);        // mask_diff_pixels
+    return o.take();
+  };
+  TechniqueRecord raw;
+  raw.type = kShadowsChunk;
+  raw.payload = payload(Fields{});
+  const TechniqueRecord r = decode_technique(kShadowsChunk, raw.payload);
+  ASSERT_TRUE(r.decoded) << "the format library registers SHDC";
+  EXPECT_EQ(encode(r), raw.payload) << "SHDC encodes back to the same bytes";
+  expect_reads_back_and_flips_refused(r, "SHDC");
+  std::vector<std::uint8_t> shorter = raw.payload;
+  shorter.pop_back();
+  std::string e = record_error(kShadowsChunk, shorter);
+  EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "decodes short")) << e;
+  std::vector<std::uint8_t> longer = raw.payload;
+  longer.push_back(0);
+  e = record_error(kShadowsChunk, longer);
+  EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "decodes long")) << e;
+  // The layout without the last two fields, reference_fill and mask_diff_pixels: refused naming the
+  // type, the missing field and where this nbsim's fields are listed.
+  std::vector<std::uint8_t> old_layout(raw.payload.begin(), raw.payload.end() - 16);
+  e = record_error(kShadowsChunk, old_layout);
+  EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "technique chunk SHDC (ShadowCasters, technique shadows) does not have this nbsim's layout") &&
+              has(e, "'reference_fill'") && has(e, "16 fields of 18 read") && has(e, "`nbsim trace format SHDC`"))
+      << e;
+  std::vector<std::uint8_t> hostile = raw.payload;
+  put_le32(hostile, 8, 0xFFFFFFFFu);  // the object vector's count
+  e = record_error(kShadowsChunk, hostile);
+  EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "4294967295")) << e;
+  struct Broken {
+    Fields f;
+    std::string message;
+  };
+  Broken rows[] = {{Fields{}, "field 'x' has 2 elements, but count is 3"},
+                   {Fields{}, "field 'decision' of caster 1 is 4, above 3"},
+                   {Fields{}, "caster 2's rectangle (0, 0, 65x64) is not inside the 64x64 litmap"},
+                   {Fields{}, "caster 1's rectangle (-1, 20, 6x5) is not inside"},
+                   {Fields{}, "field 'draw' of caster 0 is -2, below -1"}};
+  rows[0].f.x = {0, 10};
+  rows[1].f.decision = {2, 4, 3};
+  rows[2].f.w = {0, 6, 65};
+  rows[3].f.x = {0, -1, 0};
+  rows[4].f.draw = {-2, 7, 8};
+  for (const Broken& b : rows) {
+    e = record_error(kShadowsChunk, payload(b.f));
+    EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, b.message)) << b.message << ": " << e;
+  }
+}
+
+}  // namespace
