@@ -65,9 +65,6 @@ struct CullSetup {
   scene::DepthFunc depth_func = scene::DepthFunc::Less;
   const scene::SceneObjects* scene = nullptr;  // must outlive the unit; required
   bool fused_interpolation = true;  // the depth unit's (depth.fused_interpolation): per-primitive depth bounds
-  // The trace header's properties, in file order: the settings a technique's program reads (the
-  // particles' particle_mode, levels_built, cull_margin).
-  std::vector<std::pair<std::string, std::string>> properties;
 };
 
 class CullUnit : public sim::Unit,

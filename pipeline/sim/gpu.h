@@ -66,9 +66,10 @@ struct GpuConfig {
 
 class Gpu : public sc_core::sc_module {
  public:
-  // `technique` (the trace header's) and `setup` choose and feed the frame program (programs.h).
+  // The trace's `header` (its technique and the keys the technique declares) and `setup` choose and
+  // feed the frame program (programs.h); both must outlive the construction.
   Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& config, int width_px, int height_px,
-      cp::FrameSource source, float clear_depth, depth::ResultSink& sink, std::string_view technique,
+      cp::FrameSource source, float clear_depth, depth::ResultSink& sink, const trace::Header& header,
       const cull::CullSetup& setup, const std::filesystem::path* out = nullptr);
 
   const memory::Channel& memory() const noexcept { return memory_; }

@@ -37,12 +37,6 @@ Program occlusion_culling(const ProgramContext& c) {
   return p;
 }
 
-std::string_view property(const ProgramContext& c, std::string_view key, std::string_view technique = "particles") {
-  for (const auto& [k, v] : c.setup.properties)
-    if (k == key) return v;
-  throw InputError(fmt::format("the {} trace's header has no '{}' property", technique, key));
-}
-
 // A technique with its own culling refuses occlusion culling's cull.mode (`how`: what it culls with).
 void require_no_cull_mode(const ProgramContext& c, std::string_view how) {
   if (c.config.cull.parsed_mode() != cull::CullMode::Trace)
@@ -60,37 +54,19 @@ Program particles(const ProgramContext& c) {
   s.height_px = c.setup.height_px;
   s.op = c.setup.op;
   s.depth_func = c.setup.depth_func;
-  const std::string mode(property(c, "particle_mode"));
-  const auto m = particles::parse_mode(mode);
-  if (!m) throw InputError(fmt::format("the particles trace's particle_mode '{}' is not one of none, center, nb, hiz", mode));
-  s.mode = *m;
-  const std::string levels(property(c, "levels_built")), margin(property(c, "cull_margin"));
-  try {
-    std::size_t used = 0;
-    const int built = std::stoi(levels, &used);
-    if (used != levels.size() || built < 0 || built > 31) throw std::invalid_argument("range");
-    s.top_level = built - 1;
-    s.margin = std::stof(margin, &used);
-    if (used != margin.size() || !(s.margin >= 0.0f) || s.margin > 0.01f) throw std::invalid_argument("range");
-  } catch (const std::exception&) {
-    throw InputError(fmt::format("the particles trace's levels_built '{}' or cull_margin '{}' is not valid", levels, margin));
-  }
+  // The header's particle keys were checked against their declarations when the trace was opened
+  // (traces/format/particles/particles_chunk.cpp): the mode is a known one, the levels 0 .. 31.
+  s.mode = *particles::parse_mode(c.header.text("particle_mode"));
+  s.top_level = static_cast<int>(c.header.whole("levels_built")) - 1;
+  s.margin = static_cast<float>(c.header.real("cull_margin"));
   if (c.config.particles.mode != "trace") {
     // Another test than the capture's: the levels it builds follow from the capture's sprite sizes
     // and level cap, as the capture computes them for that mode.
     const auto other = particles::parse_mode(c.config.particles.mode);
     if (!other) throw InputError(fmt::format("particles.mode '{}' is not one of trace, none, center, nb, hiz", c.config.particles.mode));
-    const std::string sprite(property(c, "sprite")), cap(property(c, "level_cap"));
-    int largest = 0, level_cap = 0;
-    try {
-      std::size_t used = 0;
-      largest = sprite == "atten" ? static_cast<int>(particles::kMaxAttenuatedPx) : std::stoi(sprite, &used);
-      if (sprite != "atten" && (used != sprite.size() || largest < 1 || largest > 4096)) throw std::invalid_argument("range");
-      level_cap = std::stoi(cap, &used);
-      if (used != cap.size() || level_cap < 0 || level_cap > 31) throw std::invalid_argument("range");
-    } catch (const std::exception&) {
-      throw InputError(fmt::format("the particles trace's sprite '{}' or level_cap '{}' is not valid", sprite, cap));
-    }
+    const std::string& sprite = c.header.text("sprite");
+    const int largest = sprite == "atten" ? static_cast<int>(particles::kMaxAttenuatedPx) : static_cast<int>(c.header.whole("sprite"));
+    const int level_cap = static_cast<int>(c.header.whole("level_cap"));
     if (*other != s.mode) s.top_level = particles::top_level_needed(*other, largest, level_cap);
     s.mode = *other;
   }
@@ -122,21 +98,11 @@ Program shadows(const ProgramContext& c) {
   shadows::ShadowsSetup s;
   s.width_px = c.setup.width_px;
   s.height_px = c.setup.height_px;
-  const std::string mode(property(c, "shadow_mode", "shadows")), size(property(c, "litmap_size", "shadows"));
-  const std::string margin(property(c, "clamp_margin", "shadows"));
-  const auto m = shadows::parse_mode(mode);
-  if (!m) throw InputError(fmt::format("the shadows trace's shadow_mode '{}' is not one of infinite, culled, clamped", mode));
-  s.mode = *m;
-  try {
-    std::size_t used = 0;
-    s.litmap_size = std::stoi(size, &used);
-    if (used != size.size() || s.litmap_size < 1 || s.litmap_size > 16384) throw std::invalid_argument("range");
-  } catch (const std::exception&) {
-    throw InputError(fmt::format("the shadows trace's litmap_size '{}' is not a side of 1 to 16384 lexels", size));
-  }
-  const auto cm = shadows::parse_clamp_margin(margin);
-  if (!cm) throw InputError(fmt::format("the shadows trace's clamp_margin '{}' is not '<relative> + <metres> m'", margin));
-  s.margin = *cm;
+  // The header's shadows keys were checked against their declarations when the trace was opened
+  // (traces/format/shadows/shadows_chunk.cpp).
+  s.mode = *shadows::parse_mode(c.header.text("shadow_mode"));
+  s.litmap_size = static_cast<int>(c.header.whole("litmap_size"));
+  s.margin = *shadows::parse_clamp_margin(c.header.text("clamp_margin"));
   Program p;
   const auto nbuffer = [&](const char* instance, FarOp op) {
     return std::make_unique<query::NBufferStructure>(instance, c.registry, c.nbuffer_config(instance), s.litmap_size,
@@ -170,13 +136,7 @@ Program ldi(const ProgramContext& c) {
 // scored against the exact reference.
 Program relief(const ProgramContext& c) {
   require_no_cull_mode(c, "a relief trace walks its own rays");
-  double box_height = 0.0;
-  const std::string_view text = property(c, "relief_box_height", "relief");
-  try {
-    box_height = std::stod(std::string(text));
-  } catch (const std::exception&) {
-    throw InputError(fmt::format("the relief trace's relief_box_height '{}' is not a number", text));
-  }
+  const double box_height = c.header.real("relief_box_height");  // above 0: checked when the trace was opened
   Program p;
   // The N-buffer walk covers as the capture did (its GL walks are compared one by one).
   auto unit = std::make_unique<relief::ReliefUnit>("relief", c.registry, c.config.relief, c.memory, c.setup.width_px, c.setup.height_px,
@@ -252,16 +212,7 @@ std::unique_ptr<query::Structure> ProgramContext::structure(std::string_view ins
 }
 
 CoveringSpec ProgramContext::capture_covering() const {
-  CoveringSpec capture{CoveringKind::Corners, CoveringAlign::Bottom};
-  for (const auto& [k, v] : setup.properties) {
-    if (k != kCoveringProperty) continue;
-    const std::optional<CoveringSpec> s = parse_covering_name(v);
-    if (!s)
-      throw InputError(fmt::format("the trace header's {} '{}' is not a covering (paper, corners or one, '/', top or bottom)",
-                                   kCoveringProperty, v));
-    capture = *s;
-  }
-  return capture;
+  return header.covering.value_or(CoveringSpec{CoveringKind::Corners, CoveringAlign::Bottom});
 }
 
 nbuffer::NBufferUnitConfig ProgramContext::nbuffer_config(std::string_view instance) const {

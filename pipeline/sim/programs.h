@@ -17,6 +17,7 @@
 #include "model/memory/memory.h"
 #include "model/query/units.h"
 #include "model/raster/primitive_tester.h"
+#include "traces/format/header.h"
 
 namespace nbsim::pipeline {
 
@@ -27,6 +28,7 @@ struct GpuConfig;
 struct ProgramContext {
   stats::Registry& registry;
   const GpuConfig& config;
+  const trace::Header& header;     // the trace's, checked when it was opened: a program reads its technique's keys typed
   const cull::CullSetup& setup;    // the trace as the programs see it: viewport, depth convention, scene
   const DepthImage& depth_buffer;  // the depth unit's
   const raster::StencilImage& stencil_buffer;  // the depth unit's (8-bit, y up; cleared to 0 at each frame's start)
@@ -41,7 +43,7 @@ struct ProgramContext {
   // none). Throws InputError for a header value that is not a covering.
   nbuffer::NBufferUnitConfig nbuffer_config(std::string_view instance) const;
   // The covering of the capture's GL queries: the header's nbuffer_covering, corners/bottom when it
-  // has none (InputError for a value that is not a covering).
+  // has none.
   CoveringSpec capture_covering() const;
 };
 

@@ -565,8 +565,7 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.zero_to_one = head.clip_control == trace::ClipControl::ZeroToOne;
   setup.scene = tr.scene();
   setup.fused_interpolation = o.config.depth.fused_interpolation;
-  setup.properties = tr.properties();
-  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head.technique, setup,
+  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head, setup,
           o.out ? &*o.out : nullptr);
   for (const auto& [k, v] : tr.properties()) {  // DEPTH24_STENCIL8 captures compare 24-bit depths
     if (k != "depth_format") continue;

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cctype>
@@ -13,6 +14,7 @@
 #include "model/common/error.h"
 #include "model/common/names.h"
 #include "traces/format/schema.h"
+#include "traces/format/technique_chunks.h"
 
 namespace nbsim::trace {
 
@@ -160,6 +162,35 @@ const std::vector<Key>& keys() {
   return table;
 }
 
+// Checks one technique key's value against its declaration (InputError naming it otherwise).
+void check_technique_key(const HeaderKeySpec& key, std::string_view v) {
+  bool ok = true;
+  switch (key.kind) {
+    case HeaderKeySpec::Kind::Text: break;
+    case HeaderKeySpec::Kind::Whole: {
+      const auto n = v.starts_with('-') ? std::nullopt : number<std::uint64_t>(v);
+      ok = n && *n >= key.min && *n <= key.max;
+      break;
+    }
+    case HeaderKeySpec::Kind::Real: {
+      const auto x = number<double>(v);
+      ok = x && *x >= key.lo && *x <= key.hi && !(key.above_lo && *x == key.lo);
+      break;
+    }
+    case HeaderKeySpec::Kind::OneOf:
+      ok = std::find(key.choices.begin(), key.choices.end(), v) != key.choices.end();
+      break;
+    case HeaderKeySpec::Kind::Custom: ok = key.custom(v); break;
+  }
+  if (!ok) refuse(key.name, v, key.values);
+}
+
+const HeaderKeySpec* find_technique_key(std::string_view technique, std::string_view name) {
+  for (const HeaderKeySpec& k : technique_header_keys())
+    if (k.technique == technique && k.name == name) return &k;
+  return nullptr;
+}
+
 }  // namespace
 
 FarOp Header::far_op() const noexcept {
@@ -184,12 +215,35 @@ const std::string* Header::property(std::string_view key) const noexcept {
   return nullptr;
 }
 
+const std::string& Header::required(std::string_view key) const {
+  if (const std::string* v = property(key)) return *v;
+  throw InputError(fmt::format("the {} trace's header has no '{}' property", technique.empty() ? "(no technique)" : technique, key));
+}
+
+std::uint64_t Header::whole(std::string_view key) const {
+  const std::string& v = required(key);
+  const auto n = v.starts_with('-') ? std::nullopt : number<std::uint64_t>(v);
+  if (!n) refuse(key, v, "a whole number");
+  return *n;
+}
+
+double Header::real(std::string_view key) const {
+  const std::string& v = required(key);
+  const auto x = number<double>(v);
+  if (!x) refuse(key, v, "a finite number");
+  return *x;
+}
+
+const std::string& Header::text(std::string_view key) const { return required(key); }
+
 Header parse_header(const Properties& properties) {
   Header h;
   h.properties = properties;
   for (const auto& [k, v] : properties)
     for (const Key& key : keys())
       if (key.name == k && key.parse) key.parse(h, k, v, key.values);
+  for (const auto& [k, v] : properties)  // the keys the trace's technique declares
+    if (const HeaderKeySpec* key = find_technique_key(h.technique, k)) check_technique_key(*key, v);
   if (h.far_m != 0.0 && h.near_m != 0.0 && h.far_m <= h.near_m)
     refuse("far", *h.property("far"), fmt::format("a distance above near ({})", *h.property("near")));
   return h;
@@ -198,6 +252,11 @@ Header parse_header(const Properties& properties) {
 std::string header_keys_table() {
   std::string t = "| Key | Values | Example | Meaning |\n|-----|--------|---------|---------|\n";
   for (const Key& k : keys()) t += fmt::format("| `{}` | {} | `{}` | {} |\n", k.name, k.values, k.example, k.meaning);
+  t += "\nThe keys each technique declares, checked only in a trace of that technique (a trace of another "
+       "technique, or one without a technique, keeps them as free text):\n\n"
+       "| Technique | Key | Values | Example | Meaning |\n|-----------|-----|--------|---------|---------|\n";
+  for (const HeaderKeySpec& k : technique_header_keys())
+    t += fmt::format("| {} | `{}` | {} | `{}` | {} |\n", k.technique, k.name, k.values, k.example, k.meaning);
   return t;
 }
 

@@ -49,9 +49,20 @@ struct Header {
   std::string frame_byte_limit_rule() const;
   // The value of any property as written, or nullptr.
   const std::string* property(std::string_view key) const noexcept;
+  // A property a reader needs, typed: its value as written (text), a whole number or a finite
+  // number. parse_header has checked a key the trace's technique declares against its range, so
+  // these only refuse an absent key ("the <technique> trace's header has no '<key>' property")
+  // or, for a key no technique declares, a value that is not of the type (InputError).
+  const std::string& text(std::string_view key) const;
+  std::uint64_t whole(std::string_view key) const;
+  double real(std::string_view key) const;
+
+ private:
+  const std::string& required(std::string_view key) const;
 };
 
-// Parses and checks the typed keys. Throws InputError naming the property, its value and what it
+// Parses and checks the typed keys, and the keys the header's technique declares
+// (technique_chunks.h, HeaderKeySpec). Throws InputError naming the property, its value and what it
 // must be ("header property 'viewport' is '128x96x': expected WIDTHxHEIGHT, each 1 .. 16384");
 // TraceReader adds the file and chunk.
 Header parse_header(const Properties& properties);

@@ -2,6 +2,7 @@
 #include "traces/format/technique_chunks.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <array>
@@ -37,6 +38,14 @@ struct Registry {
 std::vector<ChunkSpec> built_in_chunks() {
   return {particles_chunk_spec(), shadows_chunk_spec(),      ldi_image_chunk_spec(),
           ldi_tests_chunk_spec(), relief_field_chunk_spec(), relief_fragments_chunk_spec()};
+}
+
+// Their header keys, in the same order.
+std::vector<HeaderKeySpec> built_in_header_keys() {
+  std::vector<HeaderKeySpec> keys;
+  for (std::vector<HeaderKeySpec> (*of)() : {particles_header_keys, shadows_header_keys, ldi_header_keys, relief_header_keys})
+    for (HeaderKeySpec& k : of()) keys.push_back(std::move(k));
+  return keys;
 }
 
 Registry& registry() {
@@ -209,6 +218,61 @@ std::string dump_technique(const TechniqueRecord& record) {
     s += fmt::format("  {}: {}\n", f.name, v);
   }
   return s;
+}
+
+const std::vector<HeaderKeySpec>& technique_header_keys() {
+  static const std::vector<HeaderKeySpec> keys = built_in_header_keys();
+  return keys;
+}
+
+namespace {
+
+std::string number_text(double v) { return fmt::format("{}", v); }
+
+}  // namespace
+
+HeaderKeySpec text_key(std::string technique, std::string name, std::string example, std::string meaning) {
+  HeaderKeySpec k;
+  k.technique = std::move(technique), k.name = std::move(name), k.values = "text";
+  k.example = std::move(example), k.meaning = std::move(meaning);
+  return k;
+}
+
+HeaderKeySpec whole_key(std::string technique, std::string name, std::uint64_t lo, std::uint64_t hi, std::string example,
+                        std::string meaning) {
+  HeaderKeySpec k = text_key(std::move(technique), std::move(name), std::move(example), std::move(meaning));
+  k.kind = HeaderKeySpec::Kind::Whole;
+  k.min = lo, k.max = hi;
+  k.values = fmt::format("a whole number, {} .. {}", lo, hi);
+  return k;
+}
+
+HeaderKeySpec real_key(std::string technique, std::string name, double lo, double hi, bool above_lo, std::string example,
+                       std::string meaning) {
+  HeaderKeySpec k = text_key(std::move(technique), std::move(name), std::move(example), std::move(meaning));
+  k.kind = HeaderKeySpec::Kind::Real;
+  k.lo = lo, k.hi = hi, k.above_lo = above_lo;
+  k.values = above_lo ? fmt::format("a number above {}, at most {}", number_text(lo), number_text(hi))
+                      : fmt::format("a number, {} .. {}", number_text(lo), number_text(hi));
+  return k;
+}
+
+HeaderKeySpec choice_key(std::string technique, std::string name, std::vector<std::string> choices, std::string example,
+                         std::string meaning) {
+  HeaderKeySpec k = text_key(std::move(technique), std::move(name), std::move(example), std::move(meaning));
+  k.kind = HeaderKeySpec::Kind::OneOf;
+  k.values = "one of " + fmt::format("{}", fmt::join(choices, ", "));
+  k.choices = std::move(choices);
+  return k;
+}
+
+HeaderKeySpec custom_key(std::string technique, std::string name, bool (*valid)(std::string_view), std::string values,
+                         std::string example, std::string meaning) {
+  HeaderKeySpec k = text_key(std::move(technique), std::move(name), std::move(example), std::move(meaning));
+  k.kind = HeaderKeySpec::Kind::Custom;
+  k.custom = valid;
+  k.values = std::move(values);
+  return k;
 }
 
 }  // namespace nbsim::trace

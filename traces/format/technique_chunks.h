@@ -68,4 +68,38 @@ std::string technique_table(const ChunkSpec& spec);
 // "  name: value" lines (raw: the payload's size).
 std::string dump_technique(const TechniqueRecord& record);
 
+// A header key a technique declares beside its chunk types. parse_header checks it when the
+// header's "technique" is `technique` (an InputError names the key, its value and `values`), the
+// replay reads it typed (Header::whole, real, text), and FORMAT.md lists it under HEAD's keys. A
+// property a technique writes without declaring it stays free text.
+struct HeaderKeySpec {
+  enum class Kind : std::uint8_t { Text, Whole, Real, OneOf, Custom };
+  std::string technique;  // the header's "technique" value
+  std::string name;       // the property's key
+  Kind kind = Kind::Text;
+  std::uint64_t min = 0, max = 0;                     // Whole: the closed range
+  double lo = 0.0, hi = 0.0;                          // Real: the range, closed unless above_lo
+  bool above_lo = false;                              // Real: lo itself excluded
+  std::vector<std::string> choices;                   // OneOf: the values, exactly as written
+  bool (*custom)(std::string_view value) = nullptr;   // Custom: whether a value is valid
+  std::string values;                                 // in words, for FORMAT.md and refusals
+  std::string example;
+  std::string meaning;
+};
+
+// Declarations of each kind; `values` is written from the range or the choices.
+HeaderKeySpec text_key(std::string technique, std::string name, std::string example, std::string meaning);
+HeaderKeySpec whole_key(std::string technique, std::string name, std::uint64_t lo, std::uint64_t hi, std::string example,
+                        std::string meaning);
+HeaderKeySpec real_key(std::string technique, std::string name, double lo, double hi, bool above_lo, std::string example,
+                       std::string meaning);
+HeaderKeySpec choice_key(std::string technique, std::string name, std::vector<std::string> choices, std::string example,
+                         std::string meaning);
+HeaderKeySpec custom_key(std::string technique, std::string name, bool (*valid)(std::string_view), std::string values,
+                         std::string example, std::string meaning);
+
+// The header keys of the techniques this build knows, in registration order (the same list as
+// their chunk types).
+const std::vector<HeaderKeySpec>& technique_header_keys();
+
 }  // namespace nbsim::trace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "model/common/error.h"
+#include "traces/format/technique_chunks.h"
 #include "tests/traces/format/sample_trace.h"
 
 namespace {
@@ -141,6 +142,74 @@ TEST(TraceHeaderTest, RefusesMalformedValues) {
   }
   const std::string e = open_error({{"near", "10"}, {"far", "5"}});
   EXPECT_TRUE(has(e, "header property 'far' is '5'") && has(e, "above near (10)")) << e;
+}
+
+// A technique's declared keys are checked when a trace of that technique is opened, with the same
+// refusal as the core keys; a trace of another technique (or none) keeps them as free text.
+TEST(TraceHeaderTest, TechniqueKeysCheckedForTheirTechnique) {
+  struct Row {
+    const char* technique;
+    const char* key;
+    const char* value;
+    const char* expected;
+  };
+  const Row rows[] = {
+      {"particles", "particle_mode", "zbuffer", "one of none, center, nb, hiz"},
+      {"particles", "levels_built", "32", "a whole number, 0 .. 31"},
+      {"particles", "levels_built", "-1", "a whole number, 0 .. 31"},
+      {"particles", "sprite", "0", "a side in pixels, 1 .. 4096, or atten"},
+      {"particles", "cull_margin", "0.5", "a number, 0 .. 0.01"},
+      {"shadows", "litmap_size", "0", "a whole number, 1 .. 16384"},
+      {"shadows", "clamp_margin", "0.01 + 0.1", "'<relative> + <metres> m'"},
+      {"shadows", "light_fov_deg", "0", "a number above 0, at most 180"},
+      {"ldi", "grid", "8x", "HxV, each 1 .. 1024"},
+      {"ldi", "max_layers", "0", "a whole number, 1 .. 2048"},
+      {"relief", "relief_box_height", "0", "a number above 0"},
+      {"relief", "relief_box_height", "nan", "a number above 0"},
+      {"relief", "relief_methods", "binary,,exact", "comma-separated: binary, exact"},
+      {"relief", "relief_angles", "0,180", "0 to below 180"},
+      {"relief", "relief_placement", "beside", "one of own, city"},
+  };
+  for (const Row& row : rows) {
+    const std::string e = open_error({{"technique", row.technique}, {row.key, row.value}});
+    EXPECT_TRUE(has(e, std::string("header property '") + row.key + "' is '" + row.value + "': expected")) << e;
+    EXPECT_TRUE(has(e, row.expected)) << "expected '" << row.expected << "' in: " << e;
+    EXPECT_TRUE(has(e, "h.nbtrace: chunk 0 (HEAD)")) << e;
+    EXPECT_EQ(open_error({{"technique", "occlusion_culling"}, {row.key, row.value}}), "")
+        << row.key << " is " << row.technique << "'s: another technique keeps it as text";
+    EXPECT_EQ(open_error({{row.key, row.value}}), "") << row.key << ": a trace without a technique keeps it as text";
+  }
+  // Order does not matter: the technique may come after its keys.
+  EXPECT_NE(open_error({{"litmap_size", "0"}, {"technique", "shadows"}}), "");
+  // Every declared key's own example is valid.
+  for (const HeaderKeySpec& k : technique_header_keys())
+    EXPECT_EQ(open_error({{"technique", k.technique}, {k.name, k.example}}), "") << k.technique << " " << k.name;
+}
+
+// The typed reads a replay makes: a whole number, a number, the text; an absent key is refused
+// naming the technique and the key.
+TEST(TraceHeaderTest, TypedReadsOfTechniqueKeys) {
+  const Header h = parse_header({{"technique", "particles"}, {"levels_built", "5"}, {"cull_margin", "1e-06"},
+                                 {"sprite", "atten"}, {"my.count", "twelve"}});
+  EXPECT_EQ(h.whole("levels_built"), 5u);
+  EXPECT_DOUBLE_EQ(h.real("cull_margin"), 1e-6);
+  EXPECT_EQ(h.text("sprite"), "atten");
+  try {
+    (void)h.whole("level_cap");
+    ADD_FAILURE() << "an absent key read as a number";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "the particles trace's header has no 'level_cap' property");
+  }
+  EXPECT_THROW((void)h.whole("my.count"), InputError) << "an undeclared key that is not a number";
+  EXPECT_THROW((void)h.real("sprite"), InputError);
+}
+
+// FORMAT.md's HEAD keys list every technique's keys with the technique's name.
+TEST(TraceHeaderTest, KeysTableListsTechniqueKeys) {
+  const std::string table = header_keys_table();
+  ASSERT_FALSE(technique_header_keys().empty());
+  for (const HeaderKeySpec& k : technique_header_keys())
+    EXPECT_TRUE(has(table, "| " + k.technique + " | `" + k.name + "` | " + k.values + " |")) << k.name;
 }
 
 }  // namespace

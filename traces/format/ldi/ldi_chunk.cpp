@@ -3,8 +3,11 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <string>
 #include <variant>
+
+#include "model/ldi/ldi.h"
 
 namespace nbsim::trace {
 
@@ -126,6 +129,38 @@ ChunkSpec ldi_tests_chunk_spec() {
         "double precision; -1 within epsilon of a surface"}}};
   spec.rule = tests_rule;
   return spec;
+}
+
+namespace {
+
+// "HxV": the viewpoint grid, each side 1 .. 1024.
+bool valid_grid(std::string_view v) {
+  const std::size_t x = v.find('x');
+  if (x == std::string_view::npos) return false;
+  const auto side = [](std::string_view s) {
+    unsigned n = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), n);
+    return ec == std::errc() && end == s.data() + s.size() && !s.starts_with('+') && n >= 1 && n <= 1024;
+  };
+  return side(v.substr(0, x)) && side(v.substr(x + 1));
+}
+
+}  // namespace
+
+std::vector<HeaderKeySpec> ldi_header_keys() {
+  const std::string t = "ldi";
+  return {text_key(t, "shape", "nested", "the closed shape: a procedural shape's name, or mesh"),
+          text_key(t, "shape_param", "3", "the procedural shape's parameter"),
+          whole_key(t, "ldi_size", 1, static_cast<std::uint64_t>(ldi::kMaxSideTexels), "128", "side of the square LDI, texels"),
+          custom_key(t, "grid", valid_grid, "HxV, each 1 .. 1024", "8x8", "the viewpoint-selection grid s_H x s_V"),
+          whole_key(t, "max_layers", 1, static_cast<std::uint64_t>(ldi::kMaxLayers), "64", "most layers the peel stores"),
+          whole_key(t, "points", 0, 0xFFFFFFFFu, "4096", "parity test points a frame"),
+          real_key(t, "epsilon", 0.0, 1.0, false, "1e-05", "the parity test's depth tolerance"),
+          whole_key(t, "ldi_seed", 0, 0xFFFFFFFFFFFFFFFFu, "1", "seed of the test points and the rotations"),
+          whole_key(t, "mesh_vertices", 0, 0xFFFFFFFFu, "1086", "the shape's vertices"),
+          whole_key(t, "mesh_triangles", 0, 0xFFFFFFFFu, "2160", "the shape's triangles"),
+          text_key(t, "ldi_placement", "frame 0 unrotated, ...", "how each frame places the shape"),
+          text_key(t, "ldi_depth", "peel: clip control ZERO_TO_ONE, ...", "the peel's depth convention")};
 }
 
 }  // namespace nbsim::trace

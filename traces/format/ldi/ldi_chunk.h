@@ -40,4 +40,7 @@ ChunkSpec ldi_image_chunk_spec();
 // reference >= -1.
 ChunkSpec ldi_tests_chunk_spec();
 
+// Its header keys (the LDI's size, grid and limits; the shape and how it was placed).
+std::vector<HeaderKeySpec> ldi_header_keys();
+
 }  // namespace nbsim::trace

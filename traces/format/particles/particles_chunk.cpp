@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <string>
 #include <variant>
 
@@ -45,6 +46,30 @@ ChunkSpec particles_chunk_spec() {
             "fragment tests, a counter per particle); culled with reference_samples > 0 is popping"}}};
   spec.rule = particles_rule;
   return spec;
+}
+
+namespace {
+
+// A sprite side the vertex stage can size: 1 to 4096 pixels, or atten (distance-attenuated).
+bool valid_sprite(std::string_view v) {
+  if (v == "atten") return true;
+  unsigned side = 0;
+  const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), side);
+  return ec == std::errc() && end == v.data() + v.size() && !v.starts_with('+') && side >= 1 && side <= 4096;
+}
+
+}  // namespace
+
+std::vector<HeaderKeySpec> particles_header_keys() {
+  const std::string t = "particles";
+  return {choice_key(t, "particle_mode", {"none", "center", "nb", "hiz"}, "nb", "the vertex stage's culling test"),
+          custom_key(t, "sprite", valid_sprite, "a side in pixels, 1 .. 4096, or atten (distance-attenuated, 1 to 64 pixels)", "16",
+                     "the sprites' side"),
+          whole_key(t, "particles", 0, 0xFFFFFFFFu, "10000", "particles a frame"),
+          text_key(t, "emitters", "auto", "auto, or the emitters' ground positions X:Z,X:Z,... in metres"),
+          whole_key(t, "level_cap", 0, 31, "5", "the highest N-buffer or Hi-Z level the capture may build"),
+          whole_key(t, "levels_built", 0, 31, "5", "the levels the capture built (the vertex stage reads levels 0 .. levels_built - 1)"),
+          real_key(t, "cull_margin", 0.0, 0.01, false, "1e-06", "depth margin of the vertex stage's test")};
 }
 
 }  // namespace nbsim::trace

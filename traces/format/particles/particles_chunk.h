@@ -19,4 +19,7 @@ inline constexpr std::uint32_t kParticlesChunk = fourcc("PRTC");
 // Its rule: every vector has `count` elements, culled is 0 or 1, lookups at most 4.
 ChunkSpec particles_chunk_spec();
 
+// Its header keys (what the replay reads to run the vertex stage's test again).
+std::vector<HeaderKeySpec> particles_header_keys();
+
 }  // namespace nbsim::trace

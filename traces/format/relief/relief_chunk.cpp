@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cmath>
 #include <string>
 #include <variant>
@@ -155,6 +156,57 @@ ChunkSpec relief_fragments_chunk_spec() {
        {"bisections", FieldKind::VecU32, "bisections the walk took"}}};
   spec.rule = fragments_rule;
   return spec;
+}
+
+namespace {
+
+// Comma-separated items, none empty, each valid by `item`.
+template <class Item>
+bool valid_list(std::string_view v, Item item) {
+  if (v.empty()) return false;
+  for (std::size_t at = 0;;) {
+    const std::size_t comma = v.find(',', at);
+    const std::string_view part = v.substr(at, comma == std::string_view::npos ? std::string_view::npos : comma - at);
+    if (part.empty() || !item(part)) return false;
+    if (comma == std::string_view::npos) return true;
+    at = comma + 1;
+  }
+}
+
+bool valid_methods(std::string_view v) {
+  return valid_list(v, [](std::string_view m) {
+    return m == "binary" || m == "exact" || m == "robust" || m == "robust_clamp" || m == "nbuffer";
+  });
+}
+
+bool valid_angles(std::string_view v) {
+  return valid_list(v, [](std::string_view a) {
+    double deg = 0.0;
+    const auto [end, ec] = std::from_chars(a.data(), a.data() + a.size(), deg);
+    return ec == std::errc() && end == a.data() + a.size() && deg >= 0.0 && deg < 180.0;
+  });
+}
+
+}  // namespace
+
+std::vector<HeaderKeySpec> relief_header_keys() {
+  const std::string t = "relief";
+  return {text_key(t, "relief_field", "fbm:0 seed 3", "the heightfield: a procedural field and its parameter, a file or a mesh"),
+          custom_key(t, "relief_methods", valid_methods, "comma-separated: binary, exact, robust, robust_clamp, nbuffer",
+                     "binary,exact,robust,robust_clamp,nbuffer", "the walks drawn, one box draw each"),
+          choice_key(t, "relief_placement", {"own", "city"}, "own", "the box seen from its own camera, or standing in the scene"),
+          whole_key(t, "relief_field_size", 1, 1u << 20, "64", "side of the heightfield, texels"),
+          real_key(t, "relief_box_height", 0.0, 1e6, true, "0.25", "height of the box over its width"),
+          real_key(t, "relief_frustum_apex", 0.0, 1e6, false, "0", "0: the box; A > 0: a reverse-perspective frustum, apex A box heights below"),
+          custom_key(t, "relief_angles", valid_angles, "comma-separated angles, degrees, 0 to below 180", "0,45,80,89",
+                     "view angles from the box's up axis; frame k takes angle k mod count"),
+          whole_key(t, "relief_max_radius", 1, 255, "16", "cap of the safety radius, texels"),
+          whole_key(t, "relief_linear_steps", 1, 1024, "16", "binary: linear steps before the bisection"),
+          whole_key(t, "relief_binary_steps", 0, 32, "8", "binary and robust: bisections after the bracket"),
+          whole_key(t, "relief_root_steps", 0, 32, "16", "exact, nbuffer and robust's cell steps: bisections inside a cell"),
+          whole_key(t, "relief_seed", 0, 0xFFFFFFFFFFFFFFFFu, "3", "seed of the heightfield and the view azimuths"),
+          text_key(t, "relief_box_at", "auto", "where a box in the scene stands"),
+          text_key(t, "relief_view", "the box [0,1]^2 x ...", "how the box is viewed")};
 }
 
 }  // namespace nbsim::trace

@@ -44,4 +44,8 @@ ChunkSpec relief_field_chunk_spec();
 // Rule: vector lengths, method below 5, hit at most 2, no NaN t, pixels strictly increasing.
 ChunkSpec relief_fragments_chunk_spec();
 
+// Its header keys (the heightfield, the box and the walks' parameters; the replay reads
+// relief_box_height, the relief table the field, its size and the angles).
+std::vector<HeaderKeySpec> relief_header_keys();
+
 }  // namespace nbsim::trace

@@ -6,6 +6,8 @@
 #include <string>
 #include <variant>
 
+#include "model/shadows/caster.h"
+
 namespace nbsim::trace {
 
 namespace {
@@ -75,6 +77,27 @@ ChunkSpec shadows_chunk_spec() {
         "pixels where the STNC shadow_mask differs from shadow_mask_infinite (0 for a correct frame)"}}};
   spec.rule = shadows_rule;
   return spec;
+}
+
+namespace {
+
+bool valid_margin(std::string_view v) { return shadows::parse_clamp_margin(v).has_value(); }
+
+}  // namespace
+
+std::vector<HeaderKeySpec> shadows_header_keys() {
+  const std::string t = "shadows";
+  const std::string margin = "'<relative> + <metres> m', relative 0 .. 1, metres 0 .. 1000";
+  return {choice_key(t, "shadow_mode", {"infinite", "culled", "clamped"}, "clamped", "which shadow volumes the capture drew"),
+          whole_key(t, "litmap_size", 1, 16384, "512", "side of the square min and max litmaps, lexels"),
+          text_key(t, "light", "auto", "auto (a spot light circling the scene's centre), or X,Y,Z,TX,TY,TZ in metres"),
+          real_key(t, "light_fov_deg", 0.0, 180.0, true, "60", "the spot light's field of view, degrees"),
+          whole_key(t, "casters", 0, 0xFFFFFFFFu, "2000", "the scene objects that cast shadows"),
+          text_key(t, "stencil_volumes", "zfail_caps_two_sided_depth_clamp", "how the volumes are drawn into the stencil buffer"),
+          custom_key(t, "reproject_tolerance", valid_margin, margin, "0.01 + 0.05 m",
+                     "tolerance of the observer depth reprojected into the litmaps"),
+          custom_key(t, "clamp_margin", valid_margin, margin, "0.01 + 0.1 m",
+                     "how far a clamped volume's slab is pushed back before the cull test")};
 }
 
 }  // namespace nbsim::trace

@@ -27,4 +27,7 @@ enum class CasterDecision : std::uint32_t {
 // litmap (x, y >= 0, w, h >= 0, x + w and y + h at most litmap_size), draw -1 or a draw index.
 ChunkSpec shadows_chunk_spec();
 
+// Its header keys (what the replay reads to build the litmaps' N-buffers and clamp the volumes).
+std::vector<HeaderKeySpec> shadows_header_keys();
+
 }  // namespace nbsim::trace
