@@ -28,6 +28,11 @@ void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
         "temporal decoupling quantum: a unit runs ahead of simulated time by up to this many cycles before it "
         "synchronises (0: every work item synchronises, the most detailed timing)",
         0, 10'000'000);
+  s.add("gpu.program", c.program,
+        "whether the trace's technique program runs: auto (the program its technique and this config ask for) or off "
+        "(none: the recorded draws replay through the generic units only, so what a program models, such as a "
+        "shader's discards or a second depth buffer, is not, and compare shows it)",
+        {"auto", "off"});
 }
 
 GpuConfig::GpuConfig() {

@@ -8,8 +8,9 @@
 //               [program] <------------------------ draw results -----------+        |
 //                     +-- [query structures: nbuffer / hiz] -----------------------------+
 // The frame program comes from the trace's technique and the config (programs.h: occlusion
-// culling's is the cull stage, model/cull/unit.h); with cull.mode=trace the command processor
-// replays the recorded draws and there is none.
+// culling's is the cull stage, model/cull/unit.h, none with its cull.mode=trace); with
+// gpu.program=off there is none for any technique and the command processor replays the
+// recorded draws.
 #pragma once
 
 #include <filesystem>
@@ -53,6 +54,10 @@ struct GpuConfig {
   // time before it synchronises (TLM-2.0 temporal decoupling, model/sim/unit.h). 0: every work
   // item synchronises (the most detailed timing). Counts never depend on it; cycles do.
   int quantum_cycles = 0;
+  // Whether the trace's technique program runs (programs.h): "auto" builds the program the trace's
+  // technique and this config ask for; "off" builds none, whatever the technique, and the recorded
+  // draws replay through the pipeline as the generic raster and depth units see them.
+  std::string program = "auto";
 
   // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.", "particles.",
   // "shadows.", "ldi.", "relief.", "nbuffer.", "hiz.", "gpu.").

@@ -225,6 +225,13 @@ nbuffer::NBufferUnitConfig ProgramContext::nbuffer_config(std::string_view insta
 }
 
 Program build_program(std::string_view technique, const ProgramContext& context) {
+  if (context.config.program == "off") {
+    if (context.config.cull.parsed_mode() != cull::CullMode::Trace)
+      throw InputError(fmt::format("gpu.program=off runs no program, but cull.mode={} asks a program to cull "
+                                   "(leave cull.mode at trace, or gpu.program at auto)",
+                                   context.config.cull.mode));
+    return {};
+  }
   for (const ProgramRow& r : kPrograms) {
     if (r.technique != technique) continue;
     if (!r.build)

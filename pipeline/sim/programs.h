@@ -81,8 +81,9 @@ struct StructureInstance {
 };
 std::span<const StructureInstance> structure_instances();
 
-// The program for a trace of `technique` under `config`. A technique without a row replays its
-// recorded draws, and refuses a config that asks a program to cull (cull.mode other than trace).
+// The program for a trace of `technique` under `config`: none with gpu.program=off (which refuses
+// a cull.mode that asks to cull). A technique without a row replays its recorded draws, and refuses
+// a config that asks a program to cull (cull.mode other than trace).
 Program build_program(std::string_view technique, const ProgramContext& context);
 
 }  // namespace nbsim::pipeline

@@ -226,6 +226,36 @@ TEST(ReplayCliTest, ProgramChosenByTechnique) {
   EXPECT_TRUE(has(culled.err, "programs exist for: occlusion_culling")) << culled.err;
 }
 
+
+// gpu.program=off runs no technique program, whatever the technique: the recorded draws replay
+// through the generic units, run.json holds no technique summary, and a trace whose GL draws a
+// program models beyond them (relief's shader discards the missed rays) no longer matches GL. A
+// cull.mode that asks to cull is refused with it.
+TEST(ReplayCliTest, ProgramOffReplaysTheRecordedDraws) {
+  const fs::path out = scratch("program_off");
+  const CliResult particles = run_nbsim("replay " + sample("particles_walk_256.nbt") + " --out " + out.string() + " --set gpu.program=off");
+  ASSERT_EQ(particles.status, 0) << particles.out << particles.err;
+  const nlohmann::json run = read_json(out / "run.json");
+  EXPECT_FALSE(run["summary"].contains("particles")) << "no particles program ran";
+  EXPECT_TRUE(run["summary"]["within_thresholds"].get<bool>()) << "the particle draws GL kept replay exactly";
+  const CliResult on = run_nbsim("compare " + sample("particles_walk_256.nbt") + " --json");
+  ASSERT_EQ(on.status, 0) << on.err;
+  EXPECT_TRUE(nlohmann::json::parse(on.out).contains("particles")) << "auto runs the particles program";
+
+  const CliResult relief = run_nbsim("compare " + sample("relief_fbm_64.nbt") + " --json --set gpu.program=off");
+  EXPECT_EQ(relief.status, 1) << relief.out << relief.err;
+  const nlohmann::json j = nlohmann::json::parse(relief.out);
+  EXPECT_FALSE(j["within_thresholds"].get<bool>());
+  EXPECT_FALSE(j.contains("relief"));
+  EXPECT_GT(j["passed_model"].get<long>(), j["passed_gl"].get<long>()) << "every box fragment passes without the walks' discards";
+
+  const CliResult refused = run_nbsim("compare " + sample("city_small_oq.nbt") + " --set gpu.program=off --set cull.mode=nb");
+  EXPECT_EQ(refused.status, 2) << refused.out << refused.err;
+  EXPECT_TRUE(has(refused.err, "gpu.program=off runs no program, but cull.mode=nb")) << refused.err;
+  const CliResult bad = run_nbsim("compare " + sample("city_small_oq.nbt") + " --set gpu.program=sometimes");
+  EXPECT_EQ(bad.status, 2) << bad.err;
+  EXPECT_TRUE(has(bad.err, "gpu.program")) << bad.err;
+}
 // A damaged trace is refused by replay with exit 2 and the chunk named.
 TEST(ReplayCliTest, RefusesDamagedTrace) {
   const fs::path t = scratch("damaged.nbt");
