@@ -1,7 +1,7 @@
 // The frame programs that replay a technique's traces, one row per technique, chosen by the name
 // the trace header carries ("technique"), and the query-structure instances a program may own.
-// Adding a technique's program is one row here (and its files under model/); the top level
-// (gpu.h) only wires what a row builds.
+// A technique's program is a row in its own folder (pipeline/techniques/<name>/program.h) and an
+// entry in the registration list in programs.cpp; the top level (gpu.h) only wires what a row builds.
 #pragma once
 
 #include <filesystem>
@@ -45,6 +45,9 @@ struct ProgramContext {
   // The covering of the capture's GL queries: the header's nbuffer_covering, corners/bottom when it
   // has none.
   CoveringSpec capture_covering() const;
+  // For a technique that culls in its own way: refuses a cull.mode other than trace (the cull
+  // stage's setting), saying in `how` what the technique culls with.
+  void require_no_cull_mode(std::string_view how) const;
 };
 
 

@@ -1,0 +1,10 @@
+// The particles technique's frame program (pipeline/sim/programs.h): its row of program_table().
+#pragma once
+
+#include "pipeline/sim/programs.h"
+
+namespace nbsim::pipeline {
+
+ProgramRow particles_program();
+
+}  // namespace nbsim::pipeline
