@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,6 +19,9 @@
 #include "pipeline/bench/nbuffer_bench.h"
 #include "pipeline/bench/replay_bench.h"
 #include "pipeline/cli/command.h"
+#include "traces/capture/paths.h"
+#include "traces/capture/scenes.h"
+#include "traces/capture/technique.h"
 
 namespace nbsim::cli {
 
@@ -104,46 +108,54 @@ void add_bench_commands(CLI::App& app, Action& action) {
   {
     auto* rep = bench->add_subcommand("replay", "Simulator speed: capture with llvmpipe, replay the same frames, ratio of the two");
     auto ro = std::make_shared<bench::ReplayBenchOptions>();
-    rep->add_option("--size", ro->size, "Viewport, WxH")->capture_default_str();
+    struct Given {
+      std::string size, scene, path, mode;
+      std::map<std::string, std::string> values;   // capture options by name
+      std::map<std::string, CLI::Option*> options;
+    };
+    auto g = std::make_shared<Given>();
+    rep->add_option("--technique", ro->technique, "Technique captured and replayed (a row of nbsim capture --help)")->capture_default_str();
     rep->add_option("--frames", ro->frames, "Frames")->check(CLI::Range(1, 10000))->capture_default_str();
-    rep->add_option("--technique", ro->technique, "Technique captured and replayed")
-        ->check(CLI::IsMember(std::vector<std::string>(std::begin(bench::kReplayBenchTechniques), std::end(bench::kReplayBenchTechniques))))
-        ->capture_default_str();
-    rep->add_option("--mode", ro->mode,
-                    "Capture test mode: occlusion_culling's (oq, oq_hier, nb, nb_hier, none; default oq), particles' "
-                    "(none, center, nb, hiz; default nb) or shadows' (infinite, culled, clamped; default clamped)");
-    rep->add_option("--scene", ro->scene, "Scene: city (default); shadows also terrain or boxes (flown over)");
-    rep->add_option("--particles", ro->particles, "Particles a frame (technique particles)")->capture_default_str();
-    rep->add_option("--sprite", ro->sprite, "Sprite size: 16, 24 or atten (technique particles)")->capture_default_str();
-    rep->add_option("--shape", ro->shape, "Shape peeled (technique ldi; default knot): sphere, knot, nested, coil");
-    rep->add_option("--ldi-size", ro->ldi_size, "LDI side, texels (technique ldi)")->check(CLI::Range(1, 4096))->capture_default_str();
-    rep->add_option("--field", ro->field, "Heightfield (technique relief; default fbm): fbm, walls, spikes, saddle, step");
-    rep->add_option("--field-size", ro->field_size, "Heightfield side, texels (technique relief)")
-        ->check(CLI::Range(2, 1024))
-        ->capture_default_str();
-    rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes; particles: scene, partial N-buffer or Hi-Z\n"
-                "build and the culled particle draws, not the reference pass), replay_ms (the SystemC model), ratio\n"
-                "replay/gl, depth_tests_per_s and cycles_per_s of the model, measured in the same run; for particles\n"
-                "also particles_summary (the replay's particles totals), for shadows shadows_summary (fill, casters\n"
-                "culled, mask pixels differing, N-buffer cost). Shadows: gl_ms spans the observer's depth, the litmaps,\n"
-                "both N-buffers, the CPU's per-caster work and the volumes, not the reference pass; the model replays\n"
-                "the observer and volume draws and builds both N-buffers, and takes the litmaps as GL made them.\n"
-                "Ldi: gl_ms spans viewpoint selection, the peel, crop, compression and GL's parity tests (not the exact\n"
-                "reference on the CPU); the model replays the peel passes, crops, compresses and runs both parity tests;\n"
-                "--size is ignored (the LDI is --ldi-size square).\n"
-                "Relief: gl_ms spans the N-buffer build and every method's box draw with its per-fragment read-back (not\n"
-                "the exact reference on the CPU); the model rasterizes each box draw and walks every fragment's ray with\n"
-                "the texel cache and the exact reference's scoring; --size is the viewport.");
-    rep->callback([&action, ro] {
+    CLI::Option* size = rep->add_option("--size", g->size, "Viewport, WxH (default: the technique's bench preset)");
+    CLI::Option* scene = rep->add_option("--scene", g->scene, "Scene (default: the technique's bench preset)");
+    CLI::Option* path = rep->add_option("--path", g->path, "Camera path (default: the technique's bench preset)");
+    CLI::Option* mode = rep->add_option("--mode", g->mode, "The technique's variant: the value of its bench preset's mode option");
+    // Every capture option of every technique, scene and camera path, passed on to the capture
+    // over the technique's preset (the capture refuses one its technique, scene and path lack).
+    std::vector<const capture::PluginInfo*> plugins;
+    for (const auto& r : capture::technique_table()) plugins.push_back(&r.info);
+    for (const auto& r : capture::scene_table()) plugins.push_back(&r.info);
+    for (const auto& r : capture::path_table()) plugins.push_back(&r.info);
+    for (const capture::PluginInfo* info : plugins)
+      for (const capture::OptionSpec& spec : info->options) {
+        if (g->options.count(spec.name) || spec.name == "mode") continue;
+        std::string readers;
+        for (const capture::PluginInfo* other : plugins)
+          for (const capture::OptionSpec& s : other->options)
+            if (s.name == spec.name) readers += (readers.empty() ? "" : ", ") + other->name;
+        g->options[spec.name] = rep->add_option("--" + spec.name, g->values[spec.name], fmt::format("{} [{}]", spec.help, readers))
+                                    ->group("Capture options (over the technique's bench preset)");
+      }
+    std::string presets;
+    for (const auto& r : capture::technique_table()) {
+      std::string opts;
+      for (const auto& [k, v] : r.bench.options.values()) opts += fmt::format(" --{} {}", k, v);
+      presets += fmt::format("  {:<18} --scene {} --path {} --size {}{}{}\n", r.info.name, r.bench.scene, r.bench.path, r.bench.size, opts,
+                             r.bench.mode_option.empty() || r.bench.mode_option == "mode" ? "" : fmt::format(" (--mode sets --{})", r.bench.mode_option));
+    }
+    rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes, as the capture times them: not its reference\n"
+                "passes), replay_ms (the SystemC model), ratio replay/gl, depth_tests_per_s and cycles_per_s of the model,\n"
+                "measured in the same run; the capture options used (options), and <technique>_summary: the replay's\n"
+                "technique totals. Each technique's bench preset (what is captured unless told otherwise):\n" + presets);
+    rep->callback([&action, ro, g, size, scene, path, mode] {
+      if (size->count()) ro->size = g->size;
+      if (scene->count()) ro->scene = g->scene;
+      if (path->count()) ro->path = g->path;
+      if (mode->count()) ro->mode = g->mode;
+      for (const auto& [name, option] : g->options)
+        if (option->count()) ro->options[name] = g->values[name];
       action = [ro] {
-        parse_size(ro->size, "--size");
-        if (ro->technique != "particles" && (ro->particles != bench::ReplayBenchOptions{}.particles ||
-                                             ro->sprite != bench::ReplayBenchOptions{}.sprite))
-          throw InputError("--particles and --sprite need --technique particles");
-        if (ro->technique != "ldi" && (!ro->shape.empty() || ro->ldi_size != bench::ReplayBenchOptions{}.ldi_size))
-          throw InputError("--shape and --ldi-size need --technique ldi");
-        if (ro->technique != "relief" && (!ro->field.empty() || ro->field_size != bench::ReplayBenchOptions{}.field_size))
-          throw InputError("--field and --field-size need --technique relief");
+        if (ro->size) parse_size(*ro->size, "--size");
         fmt::print("{}\n", bench::run_replay_bench(*ro).dump());
         return 0;
       };

@@ -471,6 +471,12 @@ double rel(std::uint64_t a, std::uint64_t b) {
 double ReplaySummary::fragment_error() const { return rel(fragments_model, fragments_gl); }
 double ReplaySummary::passed_error() const { return rel(passed_model, passed_gl); }
 
+const nlohmann::ordered_json& ReplaySummary::program_summary() const {
+  for (const nlohmann::ordered_json* s : {&particles, &shadows, &ldi, &relief})
+    if (!s->is_null()) return *s;
+  return particles;  // null
+}
+
 bool ReplaySummary::within_thresholds() const {
   const bool draws_ok = draws == 0 || static_cast<double>(draws_exact) >= 0.99 * static_cast<double>(draws);
   const bool depth_ok = depth_pixels == 0 || static_cast<double>(depth_pixels_matching) >= 0.9999 * static_cast<double>(depth_pixels);

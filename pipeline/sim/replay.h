@@ -79,6 +79,10 @@ struct ReplaySummary {
   // Relief traces: totals of the relief program per method (relief_summary in replay.cpp).
   nlohmann::ordered_json relief;
 
+  // The technique program's summary (whichever member above its program filled), null when no
+  // program summarised the run.
+  const nlohmann::ordered_json& program_summary() const;
+
   double fragment_error() const;  // |model - gl| / gl over all draws
   double passed_error() const;
   // The counter comparison's thresholds: total fragment and passed-sample error at most 0.01%, at

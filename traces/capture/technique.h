@@ -59,10 +59,20 @@ class Technique {
   virtual CapturedFrame render(std::uint32_t index, const CameraPose& pose) = 0;
 };
 
+// What `nbsim bench replay --technique NAME` captures unless told otherwise: a workload that runs
+// the technique's GL passes and its model program. The bench's own --scene, --path, --size and
+// capture options override these.
+struct BenchPreset {
+  std::string scene = "city", path = "walk", size = "512x512";
+  OptionValues options;     // capture options the preset sets (the rest keep their defaults)
+  std::string mode_option;  // the capture option the bench's --mode sets ("": --mode is refused)
+};
+
 struct TechniqueRow {
   PluginInfo info;
   // Throws InputError on bad option values.
   std::function<std::unique_ptr<Technique>(const TechniqueSetup&)> make;
+  BenchPreset bench;
 };
 
 const std::vector<TechniqueRow>& technique_table();

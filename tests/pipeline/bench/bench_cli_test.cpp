@@ -27,7 +27,11 @@ TEST(BenchReplayCliTest, ParticlesRatioPrinted) {
   EXPECT_EQ(j.at("technique"), "particles");
   EXPECT_EQ(j.at("mode"), "nb") << "the particles default mode";
   EXPECT_EQ(j.at("frames"), 2);
-  EXPECT_EQ(j.at("particles"), 2000);
+  EXPECT_EQ(j.at("options").at("particles"), "2000") << "a capture option over the preset";
+  EXPECT_EQ(j.at("options").at("sprite"), "24");
+  EXPECT_EQ(j.at("options").at("levels-every"), "0") << "the preset's";
+  EXPECT_EQ(j.at("scene"), "city");
+  EXPECT_EQ(j.at("path"), "walk");
   EXPECT_GT(j.at("gl_ms").get<double>(), 0.0) << "llvmpipe's technique passes are timed";
   EXPECT_GT(j.at("replay_ms").get<double>(), 0.0);
   EXPECT_GT(j.at("ratio").get<double>(), 0.0);
@@ -61,18 +65,18 @@ TEST(BenchReplayCliTest, ShadowsRatioPrinted) {
 // Bad arguments exit 2 with a message naming them.
 TEST(BenchReplayCliTest, BadArgumentsExitTwo) {
   testing::expect_refused("bench replay --size 32x24 --frames 1 ",
-                          {{"--technique raytracing", "--technique"},
-                           {"--technique shadows --mode nb", "--mode 'nb' is not a shadows mode (infinite, culled, clamped)"},
-                           {"--technique particles --scene boxes", "--scene boxes: particles benches the city only"},
+                          {{"--technique raytracing", "unknown technique 'raytracing'"},
+                           {"--technique shadows --mode nb", "--shadow-mode 'nb' is not one of infinite, culled, clamped"},
+                           {"--technique particles --scene boxes", "camera path 'walk' needs a scene with streets"},
                            {"--technique shadows --scene forest", "forest"},
-                           {"--technique particles --mode oq", "--mode 'oq' is not a particles mode"},
-                           {"--mode hiz", "--mode 'hiz' is not an occlusion_culling mode"},
-                           {"--particles 500", "--particles and --sprite need --technique particles"},
+                           {"--technique particles --mode oq", "--mode 'oq' is not one of none, center, nb, hiz"},
+                           {"--mode hiz", "--mode 'hiz' is not one of oq, oq_hier"},
+                           {"--particles 500", "option --particles is not an option of city, walk, occlusion_culling"},
                            {"--technique particles --particles 0", "--particles 0 is out of range"},
                            {"--technique particles --sprite 32", "--sprite '32' is not one of 16, 24, atten"},
-                           {"--shape knot", "--shape and --ldi-size need --technique ldi"},
-                           {"--technique ldi --mode nb", "--mode is not an ldi option"},
+                           {"--shape knot", "option --shape is not an option of city, walk, occlusion_culling"},
                            {"--technique ldi --shape teapot", "teapot"},
+                           {"--technique occlusion_culling --size 8", "--size"},
                            {"--technique ldi --ldi-size 0", "--ldi-size"}});
 }
 
@@ -84,7 +88,7 @@ TEST(BenchReplayCliTest, LdiRatioPrinted) {
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("technique"), "ldi");
   EXPECT_EQ(j.at("mode"), "knot") << "the ldi bench's default shape";
-  EXPECT_EQ(j.at("ldi_size"), 64);
+  EXPECT_EQ(j.at("options").at("ldi-size"), "64");
   EXPECT_TRUE(j.at("within_thresholds").get<bool>());
   const nlohmann::json& s = j.at("ldi_summary");
   EXPECT_EQ(s.at("peel_fragments"), s.at("gl_peel_fragments"));

@@ -25,5 +25,7 @@ const std::vector<OptionSpec>& ldi_options();
 // Reads and checks the options and the shape (an unusable mesh file is an InputError here, before
 // any output file exists).
 std::unique_ptr<Technique> make_ldi(const TechniqueSetup& setup);
+// Its `nbsim bench replay` workload.
+BenchPreset ldi_bench_preset();
 
 }  // namespace nbsim::capture

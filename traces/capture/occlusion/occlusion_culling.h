@@ -19,5 +19,7 @@ namespace nbsim::capture {
 const std::vector<OptionSpec>& occlusion_culling_options();
 
 std::unique_ptr<Technique> make_occlusion_culling(const TechniqueSetup& setup);
+// Its `nbsim bench replay` workload.
+BenchPreset occlusion_culling_bench_preset();
 
 }  // namespace nbsim::capture

@@ -22,5 +22,7 @@ namespace nbsim::capture {
 const std::vector<OptionSpec>& particles_options();
 
 std::unique_ptr<Technique> make_particles(const TechniqueSetup& setup);
+// Its `nbsim bench replay` workload.
+BenchPreset particles_bench_preset();
 
 }  // namespace nbsim::capture

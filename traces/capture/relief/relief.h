@@ -25,5 +25,7 @@ namespace nbsim::capture {
 
 const std::vector<OptionSpec>& relief_options();
 std::unique_ptr<Technique> make_relief(const TechniqueSetup& setup);
+// Its `nbsim bench replay` workload.
+BenchPreset relief_bench_preset();
 
 }  // namespace nbsim::capture

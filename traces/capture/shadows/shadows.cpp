@@ -709,6 +709,11 @@ const std::vector<OptionSpec>& shadows_options() {
   return options;
 }
 
+BenchPreset shadows_bench_preset() {
+  // Flown over: the terrain and the boxes have no streets to walk.
+  return {"city", "fly", "512x512", {{"shadow-mode", "clamped"}, {"levels-every", "0"}}, "shadow-mode"};
+}
+
 std::unique_ptr<Technique> make_shadows(const TechniqueSetup& setup) {
   check_frame_budget(setup);
   return std::make_unique<Shadows>(setup);

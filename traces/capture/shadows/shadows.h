@@ -44,5 +44,7 @@ namespace nbsim::capture {
 const std::vector<OptionSpec>& shadows_options();
 
 std::unique_ptr<Technique> make_shadows(const TechniqueSetup& setup);
+// Its `nbsim bench replay` workload.
+BenchPreset shadows_bench_preset();
 
 }  // namespace nbsim::capture
