@@ -305,29 +305,8 @@ void add_model_commands(CLI::App& app, Action& action) {
             fmt::print("  stencil tests      {} (no '{}' stencil image in the trace to compare with)\n", s.stencil_tests,
                        pipeline::kStencilSnapshotName);
           }
-          if (!s.ldi.is_null()) {
-            const auto& l = s.ldi;
-            fmt::print("  ldi peel           {} passes, fragments model {} GL {}, samples model {} GL {}, {} passes differ\n",
-                       l["peel_passes"].get<std::uint64_t>(), l["peel_fragments"].get<std::uint64_t>(),
-                       l["gl_peel_fragments"].get<std::uint64_t>(), l["peel_samples"].get<std::uint64_t>(),
-                       l["gl_peel_samples"].get<std::uint64_t>(), l["peel_pass_mismatches"].get<std::uint64_t>());
-            fmt::print("  ldi layers         {} texel values differ, {} crop frames differ, {} compressed values differ\n",
-                       l["layer_texel_mismatches"].get<std::uint64_t>(), l["crop_mismatch"].get<std::uint64_t>(),
-                       l["compressed_mismatches"].get<std::uint64_t>());
-            fmt::print("  ldi parity tests   {} points: answers differ {} / {}, misclassified {} / {} of {} (layers / ranges)\n",
-                       l["test_points"].get<std::uint64_t>(), l["parity_mismatches_layers"].get<std::uint64_t>(),
-                       l["parity_mismatches_ranges"].get<std::uint64_t>(), l["misclassified_layers"].get<std::uint64_t>(),
-                       l["misclassified_ranges"].get<std::uint64_t>(), l["classified_points"].get<std::uint64_t>());
-          }
-          if (!s.relief.is_null()) {
-            for (const auto& [name, m] : s.relief["methods"].items())
-              fmt::print("  relief {:<13} fragments model {} GL {}, hits model {} GL {}, walks differing {}, pixels differing {}, "
-                         "{:.2f} lookups/fragment, hit errors {}\n",
-                         name, m["fragments"].get<std::uint64_t>(), m["gl_fragments"].get<std::uint64_t>(), m["samples"].get<std::uint64_t>(),
-                         m["gl_samples"].get<std::uint64_t>(), m["walk_mismatches"].get<std::uint64_t>(),
-                         m["pixel_mismatches"].get<std::uint64_t>(), m["lookups_per_fragment"].is_number() ? m["lookups_per_fragment"].get<double>() : 0.0,
-                         m["errors"].get<std::uint64_t>());
-          }
+          if (const pipeline::ProgramRow* row = pipeline::find_program(s.program_name); row && row->results.describe && !s.program.is_null())
+            fmt::print("{}", row->results.describe(s.program));
           fmt::print("  {}\n", s.within_thresholds() ? "within the thresholds" : "OUTSIDE the thresholds");
         }
         return s.within_thresholds() ? 0 : 1;

@@ -49,6 +49,12 @@ std::string technique_list() {
 }  // namespace
 
 std::span<const ProgramRow> program_table() { return programs(); }
+
+const ProgramRow* find_program(std::string_view technique) {
+  for (const ProgramRow& r : programs())
+    if (r.technique == technique) return &r;
+  return nullptr;
+}
 std::span<const StructureInstance> structure_instances() { return kInstances; }
 
 std::unique_ptr<query::Structure> ProgramContext::structure(std::string_view instance, query::Kind kind, FarOp op) const {

@@ -8,8 +8,11 @@
 #include <memory>
 #include <ostream>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "model/cp/unit.h"
 #include "model/cull/unit.h"
@@ -62,6 +65,45 @@ struct Program {
   std::vector<std::unique_ptr<std::ostream>> logs;  // files the program writes into the output folder
 };
 
+// A statistic of a group's values (0 when the group has none of that name), for results code.
+inline std::uint64_t stat(const nlohmann::ordered_json& group, const char* name) {
+  const auto it = group.find(name);
+  return it == group.end() ? 0 : static_cast<std::uint64_t>(it->get<double>());
+}
+
+// The value of the header property `key` as written, when the header has it, into j[key].
+inline void copy_property(const trace::Header& header, const char* key, nlohmann::ordered_json& j) {
+  if (const std::string* v = header.property(key)) j[key] = *v;
+}
+
+// What a program's results are made from when its run is done (replay.cpp).
+struct SummaryInputs {
+  const nlohmann::ordered_json& group;  // the program's statistics group's values
+  const nlohmann::ordered_json& stats;  // every unit's ("gpu.memory", ...)
+  const GpuConfig& config;
+  const trace::Header& header;
+  const Program& program;  // its query structures' storage
+  std::uint64_t cycles;    // the run's, at its last frame end
+};
+
+// What a program's statistics become in the replay's outputs: its per-frame values in run.json's
+// frames, its totals as summary.<technique> (run.json, `nbsim compare --json`), its own comparison
+// with GL in the thresholds, and its lines in `nbsim compare`'s text. Every member is optional.
+struct ProgramResults {
+  std::string_view group;  // its statistics group ("gpu.<unit>"); no results when the run has none
+  // Adds its values to the frame's object `pf`, from the group's statistics at this frame end
+  // (`now`) and at the last one (`last`).
+  void (*frame_values)(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) = nullptr;
+  // Keys of `pf` (whole numbers) its summary keeps frame by frame: the summary's "per_frame" array
+  // of {"frame", these keys, "cycles"}, kept in memory (so few, small values).
+  std::span<const char* const> per_frame_keys;
+  nlohmann::ordered_json (*summary)(const SummaryInputs& in) = nullptr;
+  // Whether what the program itself compares with GL holds (null: nothing beyond the draws').
+  bool (*exact)(const nlohmann::ordered_json& summary) = nullptr;
+  // `nbsim compare`'s lines for the summary, each ending in a newline (null: none).
+  std::string (*describe)(const nlohmann::ordered_json& summary) = nullptr;
+};
+
 struct ProgramRow {
   std::string_view technique;    // the trace header's "technique"
   std::string_view description;  // for --help and messages
@@ -69,9 +111,12 @@ struct ProgramRow {
   // Throws InputError for a configuration the technique cannot run. Null: a technique the
   // renderer captures but the model does not replay yet; build_program refuses its traces.
   Program (*build)(const ProgramContext& context);
+  ProgramResults results;
 };
 
 std::span<const ProgramRow> program_table();
+// The row of `technique`, or nullptr.
+const ProgramRow* find_program(std::string_view technique);
 
 // A query-structure instance: its name (also its config keys' prefix: "<name>.<field>", declared
 // by GpuConfig::describe), the kind of unit it configures, and what it is for. A program that

@@ -12,7 +12,6 @@
 
 #include "model/common/error.h"
 #include "model/sim/kernel.h"
-#include "model/relief/walk.h"
 #include "model/sim/timeline.h"
 #include "io/json_spill.h"
 #include "traces/format/reader.h"
@@ -29,31 +28,6 @@ constexpr std::array<const char*, 11> kCullFrameCounts = {
     "bounds_tests",    "candidates",        "culled",            "candidates_not_visible",     "false_culls",
     "undrawable",      "primitive_tests",   "primitives_culled", "primitive_lookups",          "primitive_fragments_culled",
     "primitive_false_culls"};
-// The particles program's counters in run.json's per-frame values (differences at frame ends).
-constexpr std::array<const char*, 11> kParticlesFrameCounts = {
-    "particles", "culled", "kept_too_large", "lookups", "particle_fragments", "build_texels", "decision_mismatches",
-    "popping", "false_culls", "exactly_hidden", "hidden_kept"};
-// The shadows program's counters in run.json's per-frame values (differences at frame ends).
-constexpr std::array<const char*, 19> kShadowsFrameCounts = {
-    "casters",     "culled",          "gl_culled",       "outside",    "crossing_near",       "kept_by_slab", "reference_fill",
-    "lookups",     "build_texels",    "litmap_reprojections", "receiver_splats", "volume_draws", "fill", "gl_fill",
-    "stencil_tests", "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches"};
-
-// The ldi program's counters in run.json's per-frame values (differences at frame ends).
-constexpr std::array<const char*, 16> kLdiFrameCounts = {
-    "peel_passes", "peel_fragments", "gl_peel_fragments", "peel_samples", "gl_peel_samples", "peel_pass_mismatches", "layers",
-    "gl_layers", "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "test_points", "parity_mismatches_layers",
-    "parity_mismatches_ranges", "misclassified_layers", "misclassified_ranges"};
-
-// The relief program's counters in run.json's per-frame values, per method (differences at frame ends).
-constexpr std::array<const char*, 9> kReliefFrameCounts = {"fragments", "gl_fragments", "pixel_mismatches", "walk_mismatches",
-                                                            "lookups", "steps", "errors", "reference_hits", "cycles"};
-
-// A statistic of a group's values (0 when the group has none of that name).
-std::uint64_t stat(const nlohmann::ordered_json& group, const char* name) {
-  const auto it = group.find(name);
-  return it == group.end() ? 0 : static_cast<std::uint64_t>(it->get<double>());
-}
 
 // Collects the depth unit's results, compares them with GL's, and writes the CSV files.
 class Collector : public depth::ResultSink {
@@ -77,7 +51,7 @@ class Collector : public depth::ResultSink {
     s_.depth_tests += r.depth.depth_tests;
     frame_.depth_tests += r.depth.depth_tests;
     if (w.own) {
-      // A draw the program made itself (its own query boxes, particle draws it decided otherwise):
+      // A draw the program made itself (query boxes, draws it decided otherwise than GL):
       // GL drew nothing like it, so it is counted apart from the comparison with GL's counters.
       ++s_.own_draws;
     } else {
@@ -159,42 +133,18 @@ class Collector : public depth::ResultSink {
       for (const char* name : kCullFrameCounts) pf[name] = delta(name);
       last_cull_ = now;
     }
-    if (const stats::Group* g = registry_.find("gpu.particles")) {
-      const nlohmann::ordered_json now = g->values();
-      const auto delta = [&](const char* name) { return stat(now, name) - stat(last_particles_, name); };
-      pf["query_depth_tests"] = delta("lookups");
-      pf["total_depth_tests"] = delta("lookups") + delta("particle_fragments") + delta("build_texels");
-      for (const char* name : kParticlesFrameCounts) pf[name] = delta(name);
-      last_particles_ = now;
-    }
-    if (const stats::Group* g = registry_.find("gpu.shadows")) {
-      const nlohmann::ordered_json now = g->values();
-      for (const char* name : kShadowsFrameCounts) pf[name] = stat(now, name) - stat(last_shadows_, name);
-      last_shadows_ = now;
-    }
-    if (const stats::Group* g = registry_.find("gpu.ldi")) {
-      const nlohmann::ordered_json now = g->values();
-      for (const char* name : kLdiFrameCounts) pf[name] = stat(now, name) - stat(last_ldi_, name);
-      last_ldi_ = now;
-    }
-    if (const stats::Group* g = registry_.find("gpu.relief")) {
-      const nlohmann::ordered_json now = g->values();
-      nlohmann::ordered_json methods = nlohmann::ordered_json::object();
-      for (relief::Method m : relief::kAllMethods) {
-        const std::string prefix = std::string(relief::to_string(m)) + "_";
-        if (stat(now, (prefix + "draws").c_str()) == stat(last_relief_, (prefix + "draws").c_str())) continue;
-        nlohmann::ordered_json v;
-        for (const char* name : kReliefFrameCounts) v[name] = stat(now, (prefix + name).c_str()) - stat(last_relief_, (prefix + name).c_str());
-        methods[std::string(relief::to_string(m))] = v;
+    if (results_ && !results_->group.empty()) {
+      if (const stats::Group* g = registry_.find(std::string(results_->group))) {
+        const nlohmann::ordered_json now = g->values();
+        if (results_->frame_values) results_->frame_values(now, last_program_, pf);
+        last_program_ = now;
+        if (!results_->per_frame_keys.empty()) {
+          program_frames_.push_back(w.frame->begin.frame);
+          for (const char* key : results_->per_frame_keys) program_frames_.push_back(pf.value(key, std::uint64_t{0}));
+          program_frames_.push_back(cycle - last_cycle_);
+        }
       }
-      pf["relief"] = methods;
-      last_relief_ = now;
     }
-    if (registry_.find("gpu.shadows"))
-      shadows_frames_.push_back({w.frame->begin.frame, pf.value("fill", std::uint64_t{0}), pf.value("reference_fill", std::uint64_t{0}),
-                                 pf.value("culled", std::uint64_t{0}), pf.value("gl_culled", std::uint64_t{0}),
-                                 pf.value("mask_diff", std::uint64_t{0}), pf.value("mask_diff_infinite", std::uint64_t{0}),
-                                 cycle - last_cycle_});
     if (per_frame_) per_frame_->push_back(pf);
     last_cycle_ = cycle;
     for (const auto& d : w.frame->draws)
@@ -212,14 +162,12 @@ class Collector : public depth::ResultSink {
   // run.json's "frames", one object a frame: spilled to a temporary file as each frame ends (a
   // run with an output folder only), so that memory does not grow with the trace's length.
   std::optional<io::SpilledJsonArray> per_frame_;
-  // The shadows summary's "per_frame" values (shadows traces only): 64 bytes a frame, the one
-  // per-frame record a replay keeps in memory, because ReplaySummary (`nbsim compare --json`)
-  // returns them (320 KiB at 5,000 frames).
-  struct ShadowsFrame {
-    std::uint32_t frame = 0;
-    std::uint64_t fill = 0, reference_fill = 0, culled = 0, gl_culled = 0, mask_diff = 0, mask_diff_infinite = 0, cycles = 0;
-  };
-  std::vector<ShadowsFrame> shadows_frames_;
+  // The program's results (programs.h), set once its program is built; null: none.
+  const ProgramResults* results_ = nullptr;
+  // The values its summary keeps frame by frame (ProgramResults::per_frame_keys): the frame's
+  // number, the keys' values and its cycles, one frame after another; the one per-frame record a
+  // replay keeps in memory (a few words a frame), because ReplaySummary returns them.
+  std::vector<std::uint64_t> program_frames_;
 
  private:
   struct FrameTotals {
@@ -231,10 +179,7 @@ class Collector : public depth::ResultSink {
   const ReplayOptions& o_;
   const stats::Registry& registry_;
   nlohmann::ordered_json last_cull_ = nlohmann::ordered_json::object();  // gpu.cull at the last frame end
-  nlohmann::ordered_json last_particles_ = nlohmann::ordered_json::object();  // gpu.particles at the last frame end
-  nlohmann::ordered_json last_shadows_ = nlohmann::ordered_json::object();    // gpu.shadows at the last frame end
-  nlohmann::ordered_json last_ldi_ = nlohmann::ordered_json::object();        // gpu.ldi at the last frame end
-  nlohmann::ordered_json last_relief_ = nlohmann::ordered_json::object();     // gpu.relief at the last frame end
+  nlohmann::ordered_json last_program_ = nlohmann::ordered_json::object();  // the program's group at the last frame end
   std::ofstream draws_, frames_;
   FrameTotals frame_;
   std::uint64_t last_cycle_ = 0;
@@ -300,167 +245,6 @@ nlohmann::ordered_json cull_summary(const nlohmann::ordered_json& cull, const nl
   return j;
 }
 
-// The particles program's run totals (summary "particles"), from its statistics and its N-buffer's
-// when the run is done. Depth tests as docs/architecture.md ("Definitions") counts them: the
-// queries' texels read, the particle draws' fragments, and the partial build's texels; the scene's
-// own depth tests apart.
-nlohmann::ordered_json particles_summary(const nlohmann::ordered_json& p, std::string_view mode, std::uint64_t cycles) {
-  const std::uint64_t frames = stat(p, "frames");
-  const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
-  const std::uint64_t query = stat(p, "lookups"), raster = stat(p, "particle_fragments"), build = stat(p, "build_texels");
-  const std::uint64_t total = query + raster + build;
-  nlohmann::ordered_json j;
-  j["mode"] = mode;
-  j["frames"] = frames;
-  for (const char* name : {"particles", "tested", "culled", "kept_too_large", "offscreen", "gl_culled"}) {
-    j[name] = stat(p, name);
-    j[std::string(name) + "_per_frame"] = per_frame(stat(p, name));
-  }
-  j["query_depth_tests"] = query;
-  j["query_depth_tests_per_frame"] = per_frame(query);
-  j["gl_lookups"] = stat(p, "gl_lookups");
-  j["raster_depth_tests"] = raster;
-  j["raster_depth_tests_per_frame"] = per_frame(raster);
-  j["raster_passed"] = stat(p, "particle_passed");
-  j["build_texels"] = build;
-  j["build_texels_per_frame"] = per_frame(build);
-  j["total_depth_tests"] = total;
-  j["total_depth_tests_per_frame"] = per_frame(total);
-  j["scene_depth_tests_per_frame"] = per_frame(stat(p, "scene_depth_tests"));
-  j["cycles"] = cycles;
-  j["cycles_per_frame"] = per_frame(cycles);
-  for (const char* name : {"decision_mismatches", "lookup_mismatches", "popping", "false_culls", "exactly_hidden",
-                           "visible_reference", "dropped", "redrawn", "own_draws"})
-    j[name] = stat(p, name);
-  // Culled less than the exact sprite test would (the cost of a conservative test): drawn sprites
-  // with no passing pixel that the model kept.
-  j["culled_below_exact"] = stat(p, "hidden_kept");
-  // As fractions of the sprites the exact test culls (exactly_hidden): the share it culled
-  // (culling_efficiency, 1 when no sprite was hidden) and the share it kept (culled_below_exact_fraction).
-  const std::uint64_t hidden = stat(p, "exactly_hidden"), kept = stat(p, "hidden_kept");
-  j["culling_efficiency"] = hidden ? static_cast<double>(hidden - kept) / static_cast<double>(hidden) : 1.0;
-  j["culled_below_exact_fraction"] = hidden ? static_cast<double>(kept) / static_cast<double>(hidden) : 0.0;
-  return j;
-}
-
-// The shadows program's run totals (summary "shadows"), from its statistics and both N-buffers'
-// when the run is done; the per-frame values (fill, culled casters, cycles) are run.json's frames.
-nlohmann::ordered_json shadows_summary(const nlohmann::ordered_json& p, std::uint64_t cycles) {
-  const std::uint64_t frames = stat(p, "frames");
-  const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
-  nlohmann::ordered_json j;
-  j["frames"] = frames;
-  for (const char* name : {"casters", "measured", "culled", "gl_culled", "outside", "crossing_near", "kept_by_slab", "lookups",
-                           "build_texels", "litmap_draws", "litmap_reprojections", "receiver_splats", "volume_draws", "fill", "gl_fill",
-                           "reference_fill", "stencil_tests", "mask_pixels", "scene_depth_tests"}) {
-    j[name] = stat(p, name);
-    j[std::string(name) + "_per_frame"] = per_frame(stat(p, name));
-  }
-  // The fill against GL's infinite reference of the same frames (null when the trace predates
-  // SHDC's reference_fill on some frame).
-  const std::uint64_t reference = stat(p, "reference_fill");
-  j["fill_ratio_to_infinite"] = stat(p, "reference_frames") == frames && reference > 0
-                                    ? nlohmann::ordered_json(static_cast<double>(stat(p, "fill")) / static_cast<double>(reference))
-                                    : nlohmann::ordered_json(nullptr);
-  j["cycles"] = cycles;
-  j["cycles_per_frame"] = per_frame(cycles);
-  for (const char* name : {"decision_mismatches", "zmin_mismatches", "zmax_mismatches", "not_conservative", "unsafe_culls",
-                           "culls_lost", "lookup_mismatches", "mask_diff", "mask_diff_infinite", "gl_mask_diff", "gl_mask_pixels"})
-    j[name] = stat(p, name);
-  return j;
-}
-
-// The ldi program's run totals (summary "ldi"), from its statistics; the per-frame values are
-// run.json's frames. Rates are null when nothing was classified; cycles are the program's own
-// (peel and parity tests), cycles_total the run's.
-nlohmann::ordered_json ldi_summary(const nlohmann::ordered_json& p, const nlohmann::ordered_json& memory, std::uint64_t cycles) {
-  nlohmann::ordered_json j;
-  for (const char* name : {"frames", "peel_passes", "peel_fragments", "gl_peel_fragments", "peel_samples", "gl_peel_samples",
-                           "peel_reads", "peel_discarded", "peel_pass_mismatches", "layers", "gl_layers", "layer_count_mismatches",
-                           "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "m_crop", "m_comp", "test_points",
-                           "parity_mismatches_layers", "parity_mismatches_ranges", "fetch_mismatches_layers",
-                           "fetch_mismatches_ranges", "fetches_layers", "fetches_ranges", "gl_fetches_layers", "gl_fetches_ranges",
-                           "misclassified_layers", "misclassified_ranges", "classified_points", "near_surface_points"})
-    j[name] = stat(p, name);
-  const std::uint64_t classified = stat(p, "classified_points");
-  const auto rate = [classified](std::uint64_t v) {
-    return classified ? nlohmann::ordered_json(static_cast<double>(v) / static_cast<double>(classified)) : nlohmann::ordered_json(nullptr);
-  };
-  j["misclassification_rate_layers"] = rate(stat(p, "misclassified_layers"));
-  j["misclassification_rate_ranges"] = rate(stat(p, "misclassified_ranges"));
-  const std::uint64_t m_crop = stat(p, "m_crop");
-  j["c_ratio"] = m_crop ? nlohmann::ordered_json(static_cast<double>(stat(p, "m_comp")) / static_cast<double>(m_crop))
-                        : nlohmann::ordered_json(nullptr);
-  nlohmann::ordered_json kinds = nlohmann::ordered_json::object();
-  for (const char* kind : {"random", "crop_boundary", "near_surface", "midway"}) {
-    const std::string k(kind);
-    kinds[k] = {{"points", stat(p, ("points_" + k).c_str())},
-                {"classified", stat(p, ("classified_" + k).c_str())},
-                {"misclassified_layers", stat(p, ("misclassified_layers_" + k).c_str())},
-                {"misclassified_ranges", stat(p, ("misclassified_ranges_" + k).c_str())}};
-  }
-  j["by_kind"] = kinds;
-  j["peel_cycles"] = stat(p, "peel_cycles");
-  j["vpt_cycles"] = stat(p, "vpt_cycles");
-  j["cycles"] = stat(p, "peel_cycles") + stat(p, "vpt_cycles");
-  j["cycles_total"] = cycles;
-  j["memory_bytes"] = stat(memory, "bytes_ldi");
-  j["peel_bytes"] = stat(p, "peel_bytes");
-  j["vpt_bytes"] = stat(p, "vpt_bytes");
-  return j;
-}
-
-// The relief program's run totals (summary "relief"), from its statistics: per method its counts,
-// lookups and steps per fragment, cycles, and hit error against the exact reference.
-nlohmann::ordered_json relief_summary(const nlohmann::ordered_json& p, const nlohmann::ordered_json& memory, std::uint64_t cycles) {
-  nlohmann::ordered_json j;
-  for (const char* name : {"frames", "scene_draws", "scene_depth_tests", "box_draws", "cache_hits", "cache_misses", "memory_bytes",
-                           "memory_stall_cycles", "cycles"})
-    j[name] = stat(p, name);
-  j["cycles_total"] = cycles;
-  j["channel_bytes"] = stat(memory, "bytes_relief");
-  nlohmann::ordered_json methods = nlohmann::ordered_json::object();
-  for (relief::Method m : relief::kAllMethods) {
-    const std::string prefix = std::string(relief::to_string(m)) + "_";
-    const auto v = [&](const char* name) { return stat(p, (prefix + name).c_str()); };
-    if (v("draws") == 0) continue;
-    nlohmann::ordered_json e;
-    for (const char* name : {"draws", "rasterized", "fragments", "gl_fragments", "samples", "gl_samples", "pixel_mismatches", "walk_mismatches", "lookups",
-                             "gl_lookups", "steps", "bisections", "hits", "capped", "reference_hits", "wrong_hit", "wrong_miss",
-                             "far_hit", "errors", "cycles", "cache_misses"})
-      e[name] = v(name);
-    const double fragments = static_cast<double>(v("fragments"));
-    const auto per = [fragments](std::uint64_t x) {
-      return fragments > 0 ? nlohmann::ordered_json(static_cast<double>(x) / fragments) : nlohmann::ordered_json(nullptr);
-    };
-    e["lookups_per_fragment"] = per(v("lookups"));
-    e["steps_per_fragment"] = per(v("steps"));
-    e["error_rate"] = per(v("errors"));
-    const std::uint64_t both = v("hits") - std::min(v("hits"), v("wrong_hit"));
-    e["mean_hit_distance"] = both ? nlohmann::ordered_json(static_cast<double>(v("distance_microtexels")) * 1e-6 / static_cast<double>(both))
-                                  : nlohmann::ordered_json(nullptr);
-    e["cycles_per_frame"] = stat(p, "frames") ? nlohmann::ordered_json(static_cast<double>(v("cycles")) / static_cast<double>(stat(p, "frames")))
-                                              : nlohmann::ordered_json(nullptr);
-    methods[std::string(relief::to_string(m))] = e;
-  }
-  j["methods"] = methods;
-  // Totals over the methods (the results row's metrics).
-  std::uint64_t fragments = 0, lookups = 0, errors = 0, walk_mismatches = 0, pixel_mismatches = 0;
-  for (const auto& [name, e] : methods.items()) {
-    fragments += e["fragments"].get<std::uint64_t>(), lookups += e["lookups"].get<std::uint64_t>();
-    errors += e["errors"].get<std::uint64_t>(), walk_mismatches += e["walk_mismatches"].get<std::uint64_t>();
-    pixel_mismatches += e["pixel_mismatches"].get<std::uint64_t>();
-  }
-  j["fragments"] = fragments;
-  j["lookups"] = lookups;
-  j["lookups_per_fragment"] = fragments ? nlohmann::ordered_json(static_cast<double>(lookups) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
-  j["errors"] = errors;
-  j["error_rate"] = fragments ? nlohmann::ordered_json(static_cast<double>(errors) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
-  j["walk_mismatches"] = walk_mismatches;
-  j["pixel_mismatches"] = pixel_mismatches;
-  return j;
-}
-
 double rel(std::uint64_t a, std::uint64_t b) {
   if (b == 0) return a == 0 ? 0.0 : 1.0;
   return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
@@ -471,28 +255,13 @@ double rel(std::uint64_t a, std::uint64_t b) {
 double ReplaySummary::fragment_error() const { return rel(fragments_model, fragments_gl); }
 double ReplaySummary::passed_error() const { return rel(passed_model, passed_gl); }
 
-const nlohmann::ordered_json& ReplaySummary::program_summary() const {
-  for (const nlohmann::ordered_json* s : {&particles, &shadows, &ldi, &relief})
-    if (!s->is_null()) return *s;
-  return particles;  // null
-}
+const nlohmann::ordered_json& ReplaySummary::program_summary() const { return program; }
 
 bool ReplaySummary::within_thresholds() const {
   const bool draws_ok = draws == 0 || static_cast<double>(draws_exact) >= 0.99 * static_cast<double>(draws);
   const bool depth_ok = depth_pixels == 0 || static_cast<double>(depth_pixels_matching) >= 0.9999 * static_cast<double>(depth_pixels);
   const bool stencil_ok = stencil_pixels_matching == stencil_pixels;
-  // An ldi trace's peel is the program's own replay of GL's peel draws: its fragments and samples
-  // against GL's counters under the same thresholds.
-  const auto counter = [this](const char* name) { return ldi.value(name, std::uint64_t{0}); };
-  const bool ldi_ok = ldi.is_null() || (rel(counter("peel_fragments"), counter("gl_peel_fragments")) <= 1e-4 &&
-                                        rel(counter("peel_samples"), counter("gl_peel_samples")) <= 1e-4);
-  // A relief trace: every method's fragments, samples and walks equal GL's.
-  bool relief_ok = true;
-  if (!relief.is_null())
-    for (const auto& [name, m] : relief["methods"].items())
-      relief_ok = relief_ok && m.value("pixel_mismatches", 0) == 0 && m.value("walk_mismatches", 0) == 0 &&
-                  m.value("fragments", 0) == m.value("gl_fragments", 0) && m.value("samples", 0) == m.value("gl_samples", 0);
-  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok && stencil_ok && ldi_ok && relief_ok;
+  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok && stencil_ok && program_exact;
 }
 
 nlohmann::ordered_json ReplaySummary::to_json() const {
@@ -527,10 +296,7 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   j["cycles_per_host_second"] = host_seconds > 0 ? static_cast<double>(cycles) / host_seconds : 0.0;
   j["within_thresholds"] = within_thresholds();
   if (!cull.is_null()) j["cull"] = cull;
-  if (!particles.is_null()) j["particles"] = particles;
-  if (!shadows.is_null()) j["shadows"] = shadows;
-  if (!ldi.is_null()) j["ldi"] = ldi;
-  if (!relief.is_null()) j["relief"] = relief;
+  if (!program.is_null()) j[program_name] = program;
   return j;
 }
 
@@ -573,6 +339,8 @@ ReplaySummary replay(const ReplayOptions& o) {
   setup.fused_interpolation = o.config.depth.fused_interpolation;
   Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head, setup,
           o.out ? &*o.out : nullptr);
+  if (o.config.program != "off")
+    if (const ProgramRow* row = find_program(head.technique)) sink.results_ = &row->results;
   for (const auto& [k, v] : tr.properties()) {  // DEPTH24_STENCIL8 captures compare 24-bit depths
     if (k != "depth_format") continue;
     const std::optional<raster::DepthFormat> f = raster::parse_depth_format(v);
@@ -609,47 +377,24 @@ ReplaySummary replay(const ReplayOptions& o) {
         structure && structure->structure_kind() == query::Kind::NBuffer ? nlohmann::ordered_json(bytes) : nullptr;
   }
 
-  if (s.stats.contains("gpu.particles")) {
-    std::string capture_mode;
-    for (const auto& [k, v] : tr.properties())
-      if (k == "particle_mode") capture_mode = v;
-    const std::string& mode = o.config.particles.mode == "trace" ? capture_mode : o.config.particles.mode;
-    s.particles = particles_summary(s.stats["gpu.particles"], mode, sink.last_frame_cycle());
-    s.particles["capture_mode"] = capture_mode;
-    const auto& structures = gpu.program().structures;
-    s.particles["nbuffer_memory_bytes"] = structures.empty() ? 0 : structures.front()->storage_bytes();
-  }
-
-  if (s.stats.contains("gpu.shadows")) {
-    s.shadows = shadows_summary(s.stats["gpu.shadows"], sink.last_frame_cycle());
-    for (const char* key : {"shadow_mode", "scene", "litmap_size", "seed"})
-      for (const auto& [k, v] : tr.properties())
-        if (k == key) s.shadows[key] = v;
-    long long bytes = 0;
-    for (const auto& structure : gpu.program().structures) bytes += structure->storage_bytes();
-    s.shadows["nbuffer_memory_bytes"] = bytes;  // both units' levels
-    nlohmann::ordered_json per_frame = nlohmann::ordered_json::array();
-    for (const auto& pf : sink.shadows_frames_)
-      per_frame.push_back({{"frame", pf.frame}, {"fill", pf.fill}, {"reference_fill", pf.reference_fill}, {"culled", pf.culled},
-                           {"gl_culled", pf.gl_culled}, {"mask_diff", pf.mask_diff}, {"mask_diff_infinite", pf.mask_diff_infinite},
-                           {"cycles", pf.cycles}});
-    s.shadows["per_frame"] = per_frame;
-  }
-
-  if (s.stats.contains("gpu.ldi")) {
-    s.ldi = ldi_summary(s.stats["gpu.ldi"], s.stats.contains("gpu.memory") ? s.stats["gpu.memory"] : nlohmann::ordered_json::object(),
-                        sink.last_frame_cycle());
-    for (const char* key : {"shape", "seed"})
-      for (const auto& [k, v] : tr.properties())
-        if (k == key) s.ldi[key] = v;
-  }
-
-  if (s.stats.contains("gpu.relief")) {
-    s.relief = relief_summary(s.stats["gpu.relief"], s.stats.contains("gpu.memory") ? s.stats["gpu.memory"] : nlohmann::ordered_json::object(),
-                              sink.last_frame_cycle());
-    for (const char* key : {"relief_field", "relief_field_size", "relief_box_height", "relief_angles"})
-      for (const auto& [k, v] : tr.properties())
-        if (k == key) s.relief[key] = v;
+  if (sink.results_ && s.stats.contains(std::string(sink.results_->group)) && sink.results_->summary) {
+    const ProgramResults& r = *sink.results_;
+    const SummaryInputs in{s.stats[std::string(r.group)], s.stats, o.config, head, gpu.program(), sink.last_frame_cycle()};
+    s.program = r.summary(in);
+    if (!r.per_frame_keys.empty()) {
+      nlohmann::ordered_json per_frame = nlohmann::ordered_json::array();
+      const std::size_t width = r.per_frame_keys.size() + 2;
+      for (std::size_t at = 0; at + width <= sink.program_frames_.size(); at += width) {
+        nlohmann::ordered_json f;
+        f["frame"] = sink.program_frames_[at];
+        for (std::size_t k = 0; k < r.per_frame_keys.size(); ++k) f[r.per_frame_keys[k]] = sink.program_frames_[at + 1 + k];
+        f["cycles"] = sink.program_frames_[at + width - 1];
+        per_frame.push_back(std::move(f));
+      }
+      s.program["per_frame"] = per_frame;
+    }
+    s.program_name = head.technique;
+    s.program_exact = !r.exact || r.exact(s.program);
   }
 
   if (o.out) {

@@ -43,9 +43,9 @@ struct ReplaySummary {
   std::uint64_t frames = 0;
   std::uint64_t draws = 0;        // GL's draws with geometry, replayed (compared with GL's counters)
   std::uint64_t draws_exact = 0;  // fragments and passed samples equal to GL's
-  // Draws a frame program made itself (occlusion culling's query boxes in a culling mode, particle
-  // draws decided otherwise than GL): replayed and timed, their depth tests counted, but not
-  // compared with GL's counters (GL drew nothing like them). In run.json when non-zero.
+  // Draws a frame program made itself (query boxes of a culling mode, draws it decided otherwise
+  // than GL): replayed and timed, their depth tests counted, but not compared with GL's counters
+  // (GL drew nothing like them). In run.json when non-zero.
   std::uint64_t own_draws = 0;
   std::uint64_t passes_not_replayed = 0;  // GLSL N-buffer passes and lookups (no geometry)
   std::uint64_t fragments_model = 0, fragments_gl = 0;
@@ -66,21 +66,14 @@ struct ReplaySummary {
   // Culling modes (cull.mode other than trace): totals and per-frame averages of the cull stage,
   // Table 2's columns among them (see CullTotals in replay.cpp); null otherwise.
   nlohmann::ordered_json cull;
-  // Particles traces: totals and per-frame averages of the particles program (particles_summary in
-  // replay.cpp); null otherwise.
-  nlohmann::ordered_json particles;
-  // Shadows traces: totals, per-frame averages and per-frame values of the shadows program
-  // (shadows_summary in replay.cpp), the header's shadow_mode and scene; null otherwise.
-  nlohmann::ordered_json shadows;
-  // LDI traces: totals of the ldi program (ldi_summary in replay.cpp: the peel against GL's
-  // counters, the LDI, crop and compressed texture against GL's, the parity tests against GL's
-  // answers and the exact reference, cycles and memory), the header's shape; null otherwise.
-  nlohmann::ordered_json ldi;
-  // Relief traces: totals of the relief program per method (relief_summary in replay.cpp).
-  nlohmann::ordered_json relief;
+  // The technique program's results (programs.h ProgramResults): its technique (the summary's key
+  // in run.json and `compare --json`), its totals (null when no program made results), and whether
+  // what the program itself compares with GL holds (part of within_thresholds()).
+  std::string program_name;
+  nlohmann::ordered_json program;
+  bool program_exact = true;
 
-  // The technique program's summary (whichever member above its program filled), null when no
-  // program summarised the run.
+  // The technique program's totals (`program`), null when no program summarised the run.
   const nlohmann::ordered_json& program_summary() const;
 
   double fragment_error() const;  // |model - gl| / gl over all draws

@@ -1,5 +1,11 @@
-// The ldi technique's frame program; see program.h.
+// The ldi technique's frame program and its results (per-frame values, summary); see program.h.
 #include "pipeline/techniques/ldi/program.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+#include <string>
 
 #include "model/ldi/unit.h"
 #include "pipeline/sim/gpu.h"
@@ -20,6 +26,92 @@ Program build(const ProgramContext& c) {
   return p;
 }
 
+// The ldi program's counters in run.json's per-frame values (differences at frame ends).
+constexpr std::array<const char*, 16> kLdiFrameCounts = {
+    "peel_passes", "peel_fragments", "gl_peel_fragments", "peel_samples", "gl_peel_samples", "peel_pass_mismatches", "layers",
+    "gl_layers", "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "test_points", "parity_mismatches_layers",
+    "parity_mismatches_ranges", "misclassified_layers", "misclassified_ranges"};
+
+void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) {
+  for (const char* name : kLdiFrameCounts) pf[name] = stat(now, name) - stat(last, name);
+}
+
+// The ldi program's run totals (summary "ldi"), from its statistics; the per-frame values are
+// run.json's frames. Rates are null when nothing was classified; cycles are the program's own
+// (peel and parity tests), cycles_total the run's.
+nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::ordered_json& memory, std::uint64_t cycles) {
+  nlohmann::ordered_json j;
+  for (const char* name : {"frames", "peel_passes", "peel_fragments", "gl_peel_fragments", "peel_samples", "gl_peel_samples",
+                           "peel_reads", "peel_discarded", "peel_pass_mismatches", "layers", "gl_layers", "layer_count_mismatches",
+                           "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "m_crop", "m_comp", "test_points",
+                           "parity_mismatches_layers", "parity_mismatches_ranges", "fetch_mismatches_layers",
+                           "fetch_mismatches_ranges", "fetches_layers", "fetches_ranges", "gl_fetches_layers", "gl_fetches_ranges",
+                           "misclassified_layers", "misclassified_ranges", "classified_points", "near_surface_points"})
+    j[name] = stat(p, name);
+  const std::uint64_t classified = stat(p, "classified_points");
+  const auto rate = [classified](std::uint64_t v) {
+    return classified ? nlohmann::ordered_json(static_cast<double>(v) / static_cast<double>(classified)) : nlohmann::ordered_json(nullptr);
+  };
+  j["misclassification_rate_layers"] = rate(stat(p, "misclassified_layers"));
+  j["misclassification_rate_ranges"] = rate(stat(p, "misclassified_ranges"));
+  const std::uint64_t m_crop = stat(p, "m_crop");
+  j["c_ratio"] = m_crop ? nlohmann::ordered_json(static_cast<double>(stat(p, "m_comp")) / static_cast<double>(m_crop))
+                        : nlohmann::ordered_json(nullptr);
+  nlohmann::ordered_json kinds = nlohmann::ordered_json::object();
+  for (const char* kind : {"random", "crop_boundary", "near_surface", "midway"}) {
+    const std::string k(kind);
+    kinds[k] = {{"points", stat(p, ("points_" + k).c_str())},
+                {"classified", stat(p, ("classified_" + k).c_str())},
+                {"misclassified_layers", stat(p, ("misclassified_layers_" + k).c_str())},
+                {"misclassified_ranges", stat(p, ("misclassified_ranges_" + k).c_str())}};
+  }
+  j["by_kind"] = kinds;
+  j["peel_cycles"] = stat(p, "peel_cycles");
+  j["vpt_cycles"] = stat(p, "vpt_cycles");
+  j["cycles"] = stat(p, "peel_cycles") + stat(p, "vpt_cycles");
+  j["cycles_total"] = cycles;
+  j["memory_bytes"] = stat(memory, "bytes_ldi");
+  j["peel_bytes"] = stat(p, "peel_bytes");
+  j["vpt_bytes"] = stat(p, "vpt_bytes");
+  return j;
+}
+
+nlohmann::ordered_json summary(const SummaryInputs& in) {
+  nlohmann::ordered_json j = totals(in.group, in.stats.contains("gpu.memory") ? in.stats["gpu.memory"] : nlohmann::ordered_json::object(), in.cycles);
+  for (const char* key : {"shape", "seed"}) copy_property(in.header, key, j);
+  return j;
+}
+
+// |a - b| / b (1 when b is 0 and a is not).
+double relative(std::uint64_t a, std::uint64_t b) {
+  if (b == 0) return a == 0 ? 0.0 : 1.0;
+  return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
+}
+
+// The peel is the program's own replay of GL's peel draws: its fragments and samples against GL's
+// counters under the draws' thresholds.
+bool exact(const nlohmann::ordered_json& s) {
+  const auto counter = [&s](const char* name) { return s.value(name, std::uint64_t{0}); };
+  return relative(counter("peel_fragments"), counter("gl_peel_fragments")) <= 1e-4 &&
+         relative(counter("peel_samples"), counter("gl_peel_samples")) <= 1e-4;
+}
+
+std::string describe(const nlohmann::ordered_json& l) {
+  std::string s;
+  s += fmt::format("  ldi peel           {} passes, fragments model {} GL {}, samples model {} GL {}, {} passes differ\n",
+                   l["peel_passes"].get<std::uint64_t>(), l["peel_fragments"].get<std::uint64_t>(),
+                   l["gl_peel_fragments"].get<std::uint64_t>(), l["peel_samples"].get<std::uint64_t>(),
+                   l["gl_peel_samples"].get<std::uint64_t>(), l["peel_pass_mismatches"].get<std::uint64_t>());
+  s += fmt::format("  ldi layers         {} texel values differ, {} crop frames differ, {} compressed values differ\n",
+                   l["layer_texel_mismatches"].get<std::uint64_t>(), l["crop_mismatch"].get<std::uint64_t>(),
+                   l["compressed_mismatches"].get<std::uint64_t>());
+  s += fmt::format("  ldi parity tests   {} points: answers differ {} / {}, misclassified {} / {} of {} (layers / ranges)\n",
+                   l["test_points"].get<std::uint64_t>(), l["parity_mismatches_layers"].get<std::uint64_t>(),
+                   l["parity_mismatches_ranges"].get<std::uint64_t>(), l["misclassified_layers"].get<std::uint64_t>(),
+                   l["misclassified_ranges"].get<std::uint64_t>(), l["classified_points"].get<std::uint64_t>());
+  return s;
+}
+
 }  // namespace
 
 ProgramRow ldi_program() {
@@ -27,7 +119,8 @@ ProgramRow ldi_program() {
           "layered depth images and the volumetric parity test: GL's peel passes replayed at the LDI's size with the strict "
           "compare against the previous layer, the model's LDI, crop and compressed texture compared with GL's, and the parity "
           "test (uncompressed and compressed) at GL's test points against GL's answers and the exact reference",
-          build};
+          build,
+          {"gpu.ldi", frame_values, {}, summary, exact, describe}};
 }
 
 }  // namespace nbsim::pipeline

@@ -1,7 +1,9 @@
-// The particles technique's frame program; see program.h.
+// The particles technique's frame program and its results (per-frame values, summary); see program.h.
 #include "pipeline/techniques/particles/program.h"
 
 #include <fmt/format.h>
+
+#include <string>
 
 #include "model/common/error.h"
 #include "model/particles/sprite.h"
@@ -58,13 +60,81 @@ Program build(const ProgramContext& c) {
   return p;
 }
 
+// The particles program's counters in run.json's per-frame values (differences at frame ends).
+constexpr std::array<const char*, 11> kParticlesFrameCounts = {
+    "particles", "culled", "kept_too_large", "lookups", "particle_fragments", "build_texels", "decision_mismatches",
+    "popping", "false_culls", "exactly_hidden", "hidden_kept"};
+
+void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) {
+  const auto delta = [&](const char* name) { return stat(now, name) - stat(last, name); };
+  pf["query_depth_tests"] = delta("lookups");
+  pf["total_depth_tests"] = delta("lookups") + delta("particle_fragments") + delta("build_texels");
+  for (const char* name : kParticlesFrameCounts) pf[name] = delta(name);
+}
+
+// The particles program's run totals (summary "particles"), from its statistics and its N-buffer's
+// when the run is done. Depth tests as docs/architecture.md ("Definitions") counts them: the
+// queries' texels read, the particle draws' fragments, and the partial build's texels; the scene's
+// own depth tests apart.
+nlohmann::ordered_json totals(const nlohmann::ordered_json& p, std::string_view mode, std::uint64_t cycles) {
+  const std::uint64_t frames = stat(p, "frames");
+  const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
+  const std::uint64_t query = stat(p, "lookups"), raster = stat(p, "particle_fragments"), build = stat(p, "build_texels");
+  const std::uint64_t total = query + raster + build;
+  nlohmann::ordered_json j;
+  j["mode"] = mode;
+  j["frames"] = frames;
+  for (const char* name : {"particles", "tested", "culled", "kept_too_large", "offscreen", "gl_culled"}) {
+    j[name] = stat(p, name);
+    j[std::string(name) + "_per_frame"] = per_frame(stat(p, name));
+  }
+  j["query_depth_tests"] = query;
+  j["query_depth_tests_per_frame"] = per_frame(query);
+  j["gl_lookups"] = stat(p, "gl_lookups");
+  j["raster_depth_tests"] = raster;
+  j["raster_depth_tests_per_frame"] = per_frame(raster);
+  j["raster_passed"] = stat(p, "particle_passed");
+  j["build_texels"] = build;
+  j["build_texels_per_frame"] = per_frame(build);
+  j["total_depth_tests"] = total;
+  j["total_depth_tests_per_frame"] = per_frame(total);
+  j["scene_depth_tests_per_frame"] = per_frame(stat(p, "scene_depth_tests"));
+  j["cycles"] = cycles;
+  j["cycles_per_frame"] = per_frame(cycles);
+  for (const char* name : {"decision_mismatches", "lookup_mismatches", "popping", "false_culls", "exactly_hidden",
+                           "visible_reference", "dropped", "redrawn", "own_draws"})
+    j[name] = stat(p, name);
+  // Culled less than the exact sprite test would (the cost of a conservative test): drawn sprites
+  // with no passing pixel that the model kept.
+  j["culled_below_exact"] = stat(p, "hidden_kept");
+  // As fractions of the sprites the exact test culls (exactly_hidden): the share it culled
+  // (culling_efficiency, 1 when no sprite was hidden) and the share it kept (culled_below_exact_fraction).
+  const std::uint64_t hidden = stat(p, "exactly_hidden"), kept = stat(p, "hidden_kept");
+  j["culling_efficiency"] = hidden ? static_cast<double>(hidden - kept) / static_cast<double>(hidden) : 1.0;
+  j["culled_below_exact_fraction"] = hidden ? static_cast<double>(kept) / static_cast<double>(hidden) : 0.0;
+  return j;
+}
+
+// The summary: the totals under the mode the model ran (the capture's unless particles.mode says
+// another), the capture's mode, and the N-buffer's storage (0 in the modes without one).
+nlohmann::ordered_json summary(const SummaryInputs& in) {
+  const std::string* captured = in.header.property("particle_mode");
+  const std::string capture_mode = captured ? *captured : "";
+  const std::string& mode = in.config.particles.mode == "trace" ? capture_mode : in.config.particles.mode;
+  nlohmann::ordered_json j = totals(in.group, mode, in.cycles);
+  j["capture_mode"] = capture_mode;
+  j["nbuffer_memory_bytes"] = in.program.structures.empty() ? 0 : in.program.structures.front()->storage_bytes();
+  return j;
+}
+
 }  // namespace
 
 ProgramRow particles_program() {
   return {"particles",
           "point-sprite particles culled in the vertex stage (the trace's particle_mode: none, center, nb, hiz), each "
           "decision made again by the model and compared with GL's; GL's particle draws rasterized",
-          build};
+          build,
+          {"gpu.particles", frame_values, {}, summary}};
 }
 
 }  // namespace nbsim::pipeline

@@ -1,7 +1,14 @@
-// The relief technique's frame program; see program.h.
+// The relief technique's frame program and its results (per-frame values, summary); see program.h.
 #include "pipeline/techniques/relief/program.h"
 
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <string>
+
 #include "model/relief/unit.h"
+#include "model/relief/walk.h"
 #include "pipeline/sim/gpu.h"
 
 namespace nbsim::pipeline {
@@ -23,6 +30,100 @@ Program build(const ProgramContext& c) {
   return p;
 }
 
+// The relief program's counters in run.json's per-frame values, per method (differences at frame ends).
+constexpr std::array<const char*, 9> kReliefFrameCounts = {"fragments", "gl_fragments", "pixel_mismatches", "walk_mismatches",
+                                                            "lookups", "steps", "errors", "reference_hits", "cycles"};
+
+void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) {
+  nlohmann::ordered_json methods = nlohmann::ordered_json::object();
+  for (relief::Method m : relief::kAllMethods) {
+    const std::string prefix = std::string(relief::to_string(m)) + "_";
+    if (stat(now, (prefix + "draws").c_str()) == stat(last, (prefix + "draws").c_str())) continue;
+    nlohmann::ordered_json v;
+    for (const char* name : kReliefFrameCounts) v[name] = stat(now, (prefix + name).c_str()) - stat(last, (prefix + name).c_str());
+    methods[std::string(relief::to_string(m))] = v;
+  }
+  pf["relief"] = methods;
+}
+
+// The relief program's run totals (summary "relief"), from its statistics: per method its counts,
+// lookups and steps per fragment, cycles, and hit error against the exact reference.
+nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::ordered_json& memory, std::uint64_t cycles) {
+  nlohmann::ordered_json j;
+  for (const char* name : {"frames", "scene_draws", "scene_depth_tests", "box_draws", "cache_hits", "cache_misses", "memory_bytes",
+                           "memory_stall_cycles", "cycles"})
+    j[name] = stat(p, name);
+  j["cycles_total"] = cycles;
+  j["channel_bytes"] = stat(memory, "bytes_relief");
+  nlohmann::ordered_json methods = nlohmann::ordered_json::object();
+  for (relief::Method m : relief::kAllMethods) {
+    const std::string prefix = std::string(relief::to_string(m)) + "_";
+    const auto v = [&](const char* name) { return stat(p, (prefix + name).c_str()); };
+    if (v("draws") == 0) continue;
+    nlohmann::ordered_json e;
+    for (const char* name : {"draws", "rasterized", "fragments", "gl_fragments", "samples", "gl_samples", "pixel_mismatches", "walk_mismatches", "lookups",
+                             "gl_lookups", "steps", "bisections", "hits", "capped", "reference_hits", "wrong_hit", "wrong_miss",
+                             "far_hit", "errors", "cycles", "cache_misses"})
+      e[name] = v(name);
+    const double fragments = static_cast<double>(v("fragments"));
+    const auto per = [fragments](std::uint64_t x) {
+      return fragments > 0 ? nlohmann::ordered_json(static_cast<double>(x) / fragments) : nlohmann::ordered_json(nullptr);
+    };
+    e["lookups_per_fragment"] = per(v("lookups"));
+    e["steps_per_fragment"] = per(v("steps"));
+    e["error_rate"] = per(v("errors"));
+    const std::uint64_t both = v("hits") - std::min(v("hits"), v("wrong_hit"));
+    e["mean_hit_distance"] = both ? nlohmann::ordered_json(static_cast<double>(v("distance_microtexels")) * 1e-6 / static_cast<double>(both))
+                                  : nlohmann::ordered_json(nullptr);
+    e["cycles_per_frame"] = stat(p, "frames") ? nlohmann::ordered_json(static_cast<double>(v("cycles")) / static_cast<double>(stat(p, "frames")))
+                                              : nlohmann::ordered_json(nullptr);
+    methods[std::string(relief::to_string(m))] = e;
+  }
+  j["methods"] = methods;
+  // Totals over the methods (the results row's metrics).
+  std::uint64_t fragments = 0, lookups = 0, errors = 0, walk_mismatches = 0, pixel_mismatches = 0;
+  for (const auto& [name, e] : methods.items()) {
+    fragments += e["fragments"].get<std::uint64_t>(), lookups += e["lookups"].get<std::uint64_t>();
+    errors += e["errors"].get<std::uint64_t>(), walk_mismatches += e["walk_mismatches"].get<std::uint64_t>();
+    pixel_mismatches += e["pixel_mismatches"].get<std::uint64_t>();
+  }
+  j["fragments"] = fragments;
+  j["lookups"] = lookups;
+  j["lookups_per_fragment"] = fragments ? nlohmann::ordered_json(static_cast<double>(lookups) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
+  j["errors"] = errors;
+  j["error_rate"] = fragments ? nlohmann::ordered_json(static_cast<double>(errors) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
+  j["walk_mismatches"] = walk_mismatches;
+  j["pixel_mismatches"] = pixel_mismatches;
+  return j;
+}
+
+nlohmann::ordered_json summary(const SummaryInputs& in) {
+  nlohmann::ordered_json j = totals(in.group, in.stats.contains("gpu.memory") ? in.stats["gpu.memory"] : nlohmann::ordered_json::object(), in.cycles);
+  for (const char* key : {"relief_field", "relief_field_size", "relief_box_height", "relief_angles"}) copy_property(in.header, key, j);
+  return j;
+}
+
+// Every method's fragments, samples and walks equal GL's.
+bool exact(const nlohmann::ordered_json& s) {
+  for (const auto& [name, m] : s["methods"].items())
+    if (m.value("pixel_mismatches", 0) != 0 || m.value("walk_mismatches", 0) != 0 || m.value("fragments", 0) != m.value("gl_fragments", 0) ||
+        m.value("samples", 0) != m.value("gl_samples", 0))
+      return false;
+  return true;
+}
+
+std::string describe(const nlohmann::ordered_json& s) {
+  std::string out;
+  for (const auto& [name, m] : s["methods"].items())
+    out += fmt::format("  relief {:<13} fragments model {} GL {}, hits model {} GL {}, walks differing {}, pixels differing {}, "
+                       "{:.2f} lookups/fragment, hit errors {}\n",
+                       name, m["fragments"].get<std::uint64_t>(), m["gl_fragments"].get<std::uint64_t>(), m["samples"].get<std::uint64_t>(),
+                       m["gl_samples"].get<std::uint64_t>(), m["walk_mismatches"].get<std::uint64_t>(),
+                       m["pixel_mismatches"].get<std::uint64_t>(), m["lookups_per_fragment"].is_number() ? m["lookups_per_fragment"].get<double>() : 0.0,
+                       m["errors"].get<std::uint64_t>());
+  return out;
+}
+
 }  // namespace
 
 ProgramRow relief_program() {
@@ -30,7 +131,8 @@ ProgramRow relief_program() {
           "relief textures: every relief_box draw rasterized with the early depth test, each fragment's ray walk (binary, "
           "exact, robust, robust_clamp or nbuffer, as the draw's RLFF says) run through the ray-walk unit and its texel cache, "
           "compared with GL's per fragment and scored against the exact reference",
-          build};
+          build,
+          {"gpu.relief", frame_values, {}, summary, exact, describe}};
 }
 
 }  // namespace nbsim::pipeline

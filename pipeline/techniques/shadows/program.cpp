@@ -1,5 +1,7 @@
-// The shadows technique's frame program; see program.h.
+// The shadows technique's frame program and its results (per-frame values, summary); see program.h.
 #include "pipeline/techniques/shadows/program.h"
+
+#include <array>
 
 #include "model/shadows/caster.h"
 #include "model/shadows/unit.h"
@@ -38,6 +40,56 @@ Program build(const ProgramContext& c) {
   return p;
 }
 
+// The shadows program's counters in run.json's per-frame values (differences at frame ends).
+constexpr std::array<const char*, 19> kShadowsFrameCounts = {
+    "casters",     "culled",          "gl_culled",       "outside",    "crossing_near",       "kept_by_slab", "reference_fill",
+    "lookups",     "build_texels",    "litmap_reprojections", "receiver_splats", "volume_draws", "fill", "gl_fill",
+    "stencil_tests", "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches"};
+
+// The per-frame values the summary keeps (the shadows table's per-frame fill and culls).
+constexpr std::array<const char*, 6> kPerFrame = {"fill", "reference_fill", "culled", "gl_culled", "mask_diff", "mask_diff_infinite"};
+
+void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) {
+  for (const char* name : kShadowsFrameCounts) pf[name] = stat(now, name) - stat(last, name);
+}
+
+// The shadows program's run totals (summary "shadows"), from its statistics and both N-buffers'
+// when the run is done; the per-frame values (fill, culled casters, cycles) are run.json's frames.
+nlohmann::ordered_json totals(const nlohmann::ordered_json& p, std::uint64_t cycles) {
+  const std::uint64_t frames = stat(p, "frames");
+  const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
+  nlohmann::ordered_json j;
+  j["frames"] = frames;
+  for (const char* name : {"casters", "measured", "culled", "gl_culled", "outside", "crossing_near", "kept_by_slab", "lookups",
+                           "build_texels", "litmap_draws", "litmap_reprojections", "receiver_splats", "volume_draws", "fill", "gl_fill",
+                           "reference_fill", "stencil_tests", "mask_pixels", "scene_depth_tests"}) {
+    j[name] = stat(p, name);
+    j[std::string(name) + "_per_frame"] = per_frame(stat(p, name));
+  }
+  // The fill against GL's infinite reference of the same frames (null when the trace predates
+  // SHDC's reference_fill on some frame).
+  const std::uint64_t reference = stat(p, "reference_fill");
+  j["fill_ratio_to_infinite"] = stat(p, "reference_frames") == frames && reference > 0
+                                    ? nlohmann::ordered_json(static_cast<double>(stat(p, "fill")) / static_cast<double>(reference))
+                                    : nlohmann::ordered_json(nullptr);
+  j["cycles"] = cycles;
+  j["cycles_per_frame"] = per_frame(cycles);
+  for (const char* name : {"decision_mismatches", "zmin_mismatches", "zmax_mismatches", "not_conservative", "unsafe_culls",
+                           "culls_lost", "lookup_mismatches", "mask_diff", "mask_diff_infinite", "gl_mask_diff", "gl_mask_pixels"})
+    j[name] = stat(p, name);
+  return j;
+}
+
+// The summary: the totals, the header's mode, scene, litmap size and seed, and both N-buffers' storage.
+nlohmann::ordered_json summary(const SummaryInputs& in) {
+  nlohmann::ordered_json j = totals(in.group, in.cycles);
+  for (const char* key : {"shadow_mode", "scene", "litmap_size", "seed"}) copy_property(in.header, key, j);
+  long long bytes = 0;
+  for (const auto& structure : in.program.structures) bytes += structure->storage_bytes();
+  j["nbuffer_memory_bytes"] = bytes;  // both units' levels
+  return j;
+}
+
 }  // namespace
 
 ProgramRow shadows_program() {
@@ -45,7 +97,8 @@ ProgramRow shadows_program() {
           "shadow volumes culled and clamped with min/max litmaps (the trace's shadow_mode): GL's scene and volume draws "
           "rasterized with the stencil test, a min and a max N-buffer built over GL's litmaps and queried per caster, the "
           "decisions and the shadow mask compared with GL's",
-          build};
+          build,
+          {"gpu.shadows", frame_values, kPerFrame, summary}};
 }
 
 }  // namespace nbsim::pipeline
