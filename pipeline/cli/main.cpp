@@ -13,6 +13,9 @@
 #include "model/common/error.h"
 #include "model/config/json_input.h"
 #include "pipeline/cli/command.h"
+#include "pipeline/techniques/particles/table_command.h"
+#include "pipeline/techniques/relief/table_command.h"
+#include "pipeline/techniques/shadows/table_command.h"
 #include "io/output_folder.h"
 
 namespace nbsim::cli {
@@ -95,6 +98,10 @@ int main(int argc, char** argv) {
   cli::add_model_commands(app, action);
   cli::add_explore_command(app, action);
   cli::add_report_command(app, action);
+  // Each technique's own table command (pipeline/techniques/<name>/).
+  cli::add_particles_command(app, action);
+  cli::add_shadows_command(app, action);
+  cli::add_relief_command(app, action);
   cli::add_ldi_commands(app, action);
   cli::add_trace_commands(app, action);
   try {

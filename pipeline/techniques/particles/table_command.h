@@ -1,0 +1,10 @@
+// `nbsim particles`: the particles technique's table command.
+#pragma once
+
+#include "pipeline/cli/command.h"
+
+namespace nbsim::cli {
+
+void add_particles_command(CLI::App& app, Action& action);
+
+}  // namespace nbsim::cli

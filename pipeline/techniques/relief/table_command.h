@@ -1,0 +1,10 @@
+// `nbsim relief`: the relief technique's table command.
+#pragma once
+
+#include "pipeline/cli/command.h"
+
+namespace nbsim::cli {
+
+void add_relief_command(CLI::App& app, Action& action);
+
+}  // namespace nbsim::cli
