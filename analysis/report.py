@@ -11,18 +11,18 @@ marks). The inputs, and the nbsim commands that write them:
   DIR/table2/table2.json             nbsim table2 TRACE --out DIR/table2  (and DIR/table2/MODE/run.json)
   DIR/sweeps/NAME/results.csv        nbsim explore SWEEP.json --out DIR/sweeps/NAME  (and sweep.json, technique_results.json)
   DIR/results.csv                    nbsim explore SWEEP.json --out DIR  (DIR is then one sweep, named after it)
-  DIR/particles/particles.json       nbsim particles TRACE... --out DIR/particles  (or DIR/particles.json: --out DIR)
-  DIR/shadows/shadows.json           nbsim shadows TRACE... --out DIR/shadows  (or DIR/shadows.json: --out DIR)
-  DIR/ldi/ldi.json                   nbsim ldi table1 --out DIR/ldi  (or DIR/ldi.json: --out DIR)
-  DIR/relief/relief.json             nbsim relief TRACE... --out DIR/relief  (or DIR/relief.json: --out DIR)
+  DIR/NAME/NAME.json                 a technique's table: nbsim NAME TRACE... --out DIR/NAME  (or DIR/NAME.json: --out DIR;
+                                     the LDI's: nbsim ldi table1 --out DIR/ldi), rendered by analysis/techniques/NAME/section.py
 The data side (reading, Pareto marks, labels, headline.md) is in report_data.py; plot helpers in
-report_plots.py. Every section whose inputs exist is rendered; the page names the inputs the others were missing.
+report_plots.py; each technique's section in analysis/techniques/NAME/section.py. Every section whose
+inputs exist is rendered; the page names the inputs the others were missing.
 Exit 0 when at least one section rendered; 2 when DIR does not exist or holds nothing usable, or when
 an input is malformed (the message names the file; the other sections are still written).
 """
 import argparse
 import csv
 import html
+import importlib.util
 import io
 import math
 import os
@@ -33,21 +33,28 @@ sys.dont_write_bytecode = True  # no __pycache__ next to the scripts
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 # report_plots first: it selects matplotlib's headless backend before pyplot loads.
 from report_plots import (DPI, FIGSIZE, MAX_LABELLED_POINTS, THOUSANDS, freeze_layout, mode_style,  # noqa: E402
-                          place_labels, relief_style, spans_decades)
+                          place_labels, spans_decades)
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 import plot_coverage  # noqa: E402
 import table1  # noqa: E402
-from report_data import (FIDELITY_KNOBS, NUMERIC, BadInput, Missing, fmt, headline_particles,  # noqa: E402
-                         headline_shadows, headline_sweep, headline_table2, kib_key, load_particles, load_shadows,
-                         particles_reading, particles_rows, shadows_reading, shadows_rows,
-                         headline_ldi, ldi_reading, ldi_rows, load_ldi, technique_results,
-                         RELIEF_LISTS, headline_relief, load_relief, relief_lookups_by_field,
-                         relief_paper_rows, relief_ranking, relief_reading,
-                         load_json, mark_pareto, number, pct, read_csv, short_label, sorted_modes, table2_ratios,
-                         trace_name)
+from report_data import (FIDELITY_KNOBS, NUMERIC, BadInput, Missing, fmt, headline_sweep,  # noqa: E402
+                         headline_table2, kib_key, technique_results, load_json, mark_pareto, number, pct, read_csv,
+                         short_label, sorted_modes, table2_ratios, trace_name)
+
+
+def technique_sections():
+    """Every technique's section (analysis/techniques/<name>/section.py: NAME, TITLE, ORDER, section(rep)),
+    in ORDER: a technique adds its section there, without editing this file."""
+    modules = []
+    for path in sorted((Path(__file__).resolve().parent / "techniques").glob("*/section.py")):
+        spec = importlib.util.spec_from_file_location(f"nbsim_report_section_{path.parent.name}", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        modules.append(module)
+    return sorted(modules, key=lambda m: (m.ORDER, m.NAME))
 
 
 class Report:
@@ -60,7 +67,7 @@ class Report:
         self.inputs = []     # (relative path, section)
         self.versions = set()
         self.headline = []   # Markdown blocks for report/headline.md (what scripts/demo prints)
-        self.headline_last = []  # blocks printed after every other one (the particles and shadows tables)
+        self.headline_last = []  # blocks printed after every other one (the techniques' tables)
 
     def rel(self, p):
         return os.path.relpath(p, self.root)
@@ -377,7 +384,6 @@ class Report:
                             "(blue) and the N-buffer modes (red) frame by frame, and which frames of the walk "
                             "cost the most."))
 
-    # ------------------------------------------------------------------------------ particles
     def technique_table_path(self, name):
         """DIR/NAME/NAME.json (the demo's layout) or DIR/NAME.json (nbsim NAME TRACE... --out DIR); None when neither is."""
         for p in (self.root / name / f"{name}.json", self.root / f"{name}.json"):
@@ -385,386 +391,13 @@ class Report:
                 return p
         return None
 
-    def particles_path(self):
-        return self.technique_table_path("particles")
 
-    def particles(self):
-        path = self.particles_path()
-        if path is None:
-            raise Missing(["particles/particles.json"])
-        rows = particles_rows(load_particles(path))
-        self.used(path, "particles")
-        for r in rows:
-            r["trace_name"] = trace_name(str(r.get("trace", "?")))
-        cols = [("mode", "mode", None), ("sprite (px)", "sprite", None), ("trace", "trace_name", None),
-                ("sprites/frame", "particles_per_frame", None),
-                ("paper depth tests/frame", "paper_depth_tests_per_frame", None),
-                ("ours / paper", "ours_over_paper", lambda v: "-" if v is None else f"{v:.3g}"),
-                ("culled/frame", "culled_per_frame", None),
-                ("query depth tests/frame", "query_depth_tests_per_frame", None),
-                ("raster depth tests/frame", "raster_depth_tests_per_frame", None),
-                ("build texels/frame", "build_texels_per_frame", None),
-                ("total depth tests/frame", "total_depth_tests_per_frame", None),
-                ("cycles/frame", "cycles_per_frame", None), ("popping", "popping", None),
-                ("false culls", "false_culls", None), ("decisions unlike GL's", "decision_mismatches", None)]
-        tab = self.table("particles", cols, rows,
-                         row_class=lambda r: "bad" if r["popping"] or r["false_culls"] else "")
-        reading = particles_reading(rows)
-        traces = ", ".join(dict.fromkeys(r["trace_name"] for r in rows))
-        self.headline_last.append(headline_particles(traces, rows, reading))
 
-        # per mode: the paper's claim beside ours, split into queries, sprite fragments and build
-        fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
-        x = np.arange(len(rows))
-        wd = 0.38
-        paper = [r.get("paper_depth_tests_per_frame") or np.nan for r in rows]
-        ax.bar(x - wd / 2, paper, wd, label="paper's claim (16 px: 256 N none, N nb)", color="#999999", hatch="//",
-               edgecolor="white")
-        bottom = np.zeros(len(rows))
-        for key, label, colour in (("query_depth_tests_per_frame", "ours: queries", "#b2182b"),
-                                   ("raster_depth_tests_per_frame", "ours: sprite fragments", "#6fa8dc"),
-                                   ("build_texels_per_frame", "ours: N-buffer / Hi-Z build", "#fdb863")):
-            v = np.array([float(r[key]) for r in rows])
-            ax.bar(x + wd / 2, v, wd, bottom=bottom, label=label, color=colour)
-            bottom += v
-        for i, r in enumerate(rows):  # the queries and the paper's N are too small to see: their numbers
-            note = f"queries {r['query_depth_tests_per_frame']:,.0f}"
-            if r["popping"]:
-                note += f"\npops {r['popping']:,.0f}"
-            ax.annotate(note, (x[i] + wd / 2, bottom[i]), xytext=(0, 3), textcoords="offset points", ha="center",
-                        va="bottom", fontsize=7, color="#a00" if r["popping"] else "#222")
-            if not np.isnan(paper[i]):
-                ax.annotate(f"{paper[i]:,.0f}", (x[i] - wd / 2, paper[i]), xytext=(0, 3), textcoords="offset points",
-                            ha="center", va="bottom", fontsize=7, color="#555")
-        tallest = max([b for b in bottom] + [p for p in paper if not np.isnan(p)] + [1])
-        ax.set_ylim(0, tallest * 1.35)  # headroom: the legend sits above the bars
-        ax.yaxis.set_major_formatter(THOUSANDS)
-        ax.set_xticks(x, [f"{r['mode']}\n{r.get('sprite') or ''} px" if str(r.get("sprite", "")).isdigit()
-                          else f"{r['mode']}\n{r.get('sprite') or ''}" for r in rows])
-        ax.set_xlabel("vertex-stage culling mode")
-        ax.set_ylabel("depth tests per frame")
-        ax.set_title(f"Particles: depth tests per frame, paper vs nbsim ({traces})", fontsize=10)
-        ax.grid(axis="y", alpha=0.3)
-        ax.legend(fontsize=7, loc="upper left", ncols=2)
-        img = self.save(fig, "particles.png")
-        settings = sorted({s for r in rows for s in (r.get("settings") or [])})
-        other_mode = [f"{r['trace_name']} captured in {r['capture_mode']}" for r in rows
-                      if r.get("capture_mode") and r["capture_mode"] != r["mode"]]
-        setting_text = ("settings: <code>" + html.escape(" ".join(f"--set {s}" if not s.startswith("--") else s
-                                                                   for s in settings)) + "</code>") if settings else \
-            ("the model's default settings" if all("settings" in r for r in rows) else "their settings are not recorded there")
-        mode_text = ("each in the culling mode it was captured in on Mesa" if not other_mode else
-                     "in the mode of the row (particles.mode; " + html.escape(", ".join(other_mode)) + ")")
-        return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim particles TRACE... --out</code>: one replay per "
-                f"trace, {mode_text}; traces {html.escape(traces)}; {setting_text}). "
-                "The paper's claim (Décoret 2005, 3.2 and 4.3) is for 16 px sprites: rasterizing N sprites costs "
-                "256 N depth tests, the N-buffer N. Ours / paper compares nb's query depth tests and none's total "
-                "with it. Query: texels the culling test reads; raster: depth tests of GL's sprite fragments (its "
-                "draws replayed); build: N-buffer or Hi-Z texels written; total: their sum. Popping and false "
-                "culls are counted over every frame; rows with any are red (center pops by design).</p>" + tab +
-                "<p><b>What it shows</b> (computed from the table):</p><ul>" +
-                "".join(f"<li>{html.escape(s)}</li>" for s in reading) + "</ul>" +
-                self.figure(img, "Per mode: the paper's claim (grey, 16 px sprites only) and ours, stacked: the "
-                            "culling test's queries (red), the sprite fragments GL drew (blue) and the N-buffer or "
-                            "Hi-Z build (orange). Read off: how small the N-buffer's queries are against "
-                            "rasterizing every sprite, and whether the build eats what culling saves."))
 
-    # ------------------------------------------------------------------------------ layered depth images
-    def ldi_path(self):
-        return self.technique_table_path("ldi")
 
-    def ldi(self):
-        path = self.ldi_path()
-        if path is None:
-            raise Missing(["ldi/ldi.json"])
-        rows = ldi_rows(load_ldi(path))
-        self.used(path, "ldi")
-        num = lambda d: (lambda v: "-" if v is None else f"{v:,.{d}f}")  # noqa: E731
-        cols = [("shape", "shape", None), ("LDI side", "ldi_size", None), ("vertices", "vertices", None),
-                ("d_min", "d_min", None), ("d_max", "d_max", None), ("layers (chosen view)", "layers", None),
-                ("M_crop (values)", "m_crop", None), ("M_comp (values)", "m_comp", None),
-                ("C_ratio", "c_ratio", num(3)), ("paper C_ratio", "paper_c_ratio", num(2)),
-                ("paper row", "paper_text", lambda v: v or "-"),
-                ("viewpoint ms", "ms_viewpoint", num(1)), ("peel ms", "ms_peel", num(1)),
-                ("crop ms", "ms_crop", num(2)), ("compress ms", "ms_compress", num(2)),
-                ("points", "points", None), ("near a surface", "near_surface", None),
-                ("misclassified (layers)", "error_layers", lambda v: pct(v, 3)),
-                ("misclassified (ranges)", "error_ranges", lambda v: pct(v, 3)),
-                ("misclassified anywhere in the texel", "error_anywhere", lambda v: pct(v, 3)),
-                ("fetches/test (layers)", "fetches_per_test_layers", num(2)),
-                ("fetches/test (ranges)", "fetches_per_test_ranges", num(2))]
-        tab = self.table("ldi", cols, rows,
-                         row_class=lambda r: "bad" if r["misclassified_layers"] != r["misclassified_ranges"]
-                         or r.get("gl_parity_mismatches") else "")
-        reading = ldi_reading(rows)
-        shapes = list(dict.fromkeys(r["shape"] for r in rows))
-        self.headline_last.append(headline_ldi(f"{len(shapes)} shapes, {len(rows)} LDIs", rows, reading))
 
-        # cost against error: one line per shape and reader through its LDI sizes; x the texels a test reads
-        # (uncompressed: layer texels, 4 bytes; compressed: RG32UI texels, 8 bytes), y the misclassification
-        fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
-        cmap = plt.get_cmap("tab10")
-        floor = None
-        for i, shape in enumerate(shapes):
-            g = [r for r in rows if r["shape"] == shape and r["error_layers"] is not None]
-            if not g:
-                continue
-            # the LDI's sampling error (uniform points anywhere in their texel) when the rows have it, else the
-            # test points' against their texel-centre reference
-            anywhere = all(r.get("error_anywhere") is not None and r.get("fetches_anywhere_layers") is not None for r in g)
-            series = ((("error_anywhere", "fetches_anywhere_layers", "-o", "layers"),
-                       ("error_anywhere", "fetches_anywhere_ranges", "--s", "ranges")) if anywhere else
-                      (("error_layers", "fetches_per_test_layers", "-o", "layers"),
-                       ("error_ranges", "fetches_per_test_ranges", "--s", "ranges")))
-            for key, fetch, style, reader in series:
-                xs = [r[fetch] for r in g]
-                ys = [100 * r[key] for r in g]
-                positive = [y for y in ys if y > 0]
-                if positive:
-                    floor = min(floor or positive[0], min(positive))
-                ax.plot(xs, ys, style, color=cmap(i % 10), ms=4, lw=1, label=f"{shape} ({reader})")
-                if reader == "layers":
-                    for r, x, y in zip(g, xs, ys):
-                        ax.annotate(str(r["ldi_size"]), (x, y), xytext=(3, 3), textcoords="offset points", fontsize=6)
-        if floor is not None:
-            ax.set_yscale("symlog", linthresh=floor)
-        ax.set_xlabel("texels read per parity test (solid: R32F layers; dashed: compressed RG32UI)")
-        ax.set_ylabel("misclassified points (%)")
-        ax.set_title("Volumetric parity test: cost against error, per shape and LDI side (labels)", fontsize=10)
-        ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=6, ncols=2, loc="best")
-        img = self.save(fig, "ldi.png")
-        return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim ldi table1 --out</code>: each shape peeled on Mesa "
-                "at each LDI side after viewpoint selection over the grid, cropped and compressed on GL, and its test "
-                "points classified by the GLSL parity test with both readers and by the exact reference in double "
-                "precision, along each point's texel-centre line; \"anywhere\": as many points uniform in the unit "
-                "cube, each anywhere in its texel, against the exact crossings on its own line: the LDI's sampling error, "
-                "which the plot shows). Memory in the paper's units: values of 32 bits, M_crop = w_crop x h_crop x d, M_comp = 2 "
-                "w_c^2 (both channels counted, as the paper does). Times: wall clock on llvmpipe, glFinish-bounded. The "
-                "paper's rows beside ours are the two the issue quotes (its other rows were not at hand). Misclassified: "
-                "the parity answer differs from the exact crossing count's parity; points within epsilon of a surface "
-                "are counted apart. Rows where the two readers disagree, or GL and the model do, are red.</p>" + tab +
-                "<p><b>What it shows</b> (computed from the table):</p><ul>" +
-                "".join(f"<li>{html.escape(s)}</li>" for s in reading) + "</ul>" +
-                self.figure(img, "Misclassification (of the uniform points anywhere in their texel when the rows have "
-                            "them, else of the test points) against texels read per test, per shape and reader; the labels "
-                            "are the LDI sides. Read off: how fast the error falls with resolution and what the "
-                            "compressed reader saves per test."))
 
-    # ------------------------------------------------------------------------------ relief textures
-    def relief_path(self):
-        return self.technique_table_path("relief")
 
-    def relief(self):
-        path = self.relief_path()
-        if path is None:
-            raise Missing(["relief/relief.json"])
-        doc = load_relief(path)
-        self.used(path, "relief")
-        rows = doc["rows"]
-        ranking = relief_ranking(doc)
-        paper = relief_paper_rows(doc["paper"])
-        reading = relief_reading(doc, ranking, paper)
-        fields = list(dict.fromkeys(r["field"] for r in rows))
-        sizes = sorted({r["field_size"] for r in rows})
-        at = [f"{n}²" for n in sizes]
-        label = (f"{len({r['trace'] for r in rows})} traces: {len(fields)} heightfields at "
-                 f"{' and '.join([', '.join(at[:-1]), at[-1]] if len(at) > 1 else at)}, "
-                 f"{len({r['frame'] for r in rows})} view angles each")
-        self.headline_last.append(headline_relief(label, ranking, reading))
-        with open(self.out / "relief_rows.csv", "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(RELIEF_LISTS["rows"][0]), extrasaction="ignore")
-            w.writeheader()
-            w.writerows(rows)
-        num = lambda d: (lambda v: "-" if v is None else f"{v:,.{d}f}")  # noqa: E731
-        mismatched = lambda r: r["walk_mismatches"] or r["pixel_mismatches"] or r["fragments_unlike_gl"]  # noqa: E731
-        for r in ranking:
-            r["pareto_mark"] = "yes (front)" if r["pareto"] else "no"
-        rank_tab = self.table(
-            "relief_ranking",
-            [("method", "method", None), ("cycles/box draw (mean)", "cycles_per_frame", num(0)),
-             ("lookups/fragment", "lookups_per_fragment", num(2)), ("steps/fragment", "steps_per_fragment", num(2)),
-             ("fragments", "fragments", None), ("hit errors", "errors", None),
-             ("hit error", "error_rate", lambda v: pct(v, 3)), ("Pareto", "pareto_mark", None),
-             ("walks differing from GL's", "walk_mismatches", None),
-             ("pixels differing from GL's", "pixel_mismatches", None),
-             ("fragments unlike GL's count", "fragments_unlike_gl", None)],
-            ranking, row_class=lambda r: "bad" if mismatched(r) else "pareto" if r["pareto"] else "")
-        nve = doc["nbuffer_vs_exact"]
-        nve_tab = self.table(
-            "relief_nbuffer_vs_exact",
-            [("heightfield", "field", None), ("size", "field_size", None),
-             ("exact: lookups/fragment", "exact_lookups_per_fragment", num(2)),
-             ("N-buffer: lookups/fragment", "nbuffer_lookups_per_fragment", num(2)),
-             ("N-buffer / exact", "lookup_ratio", num(3)), ("exact: hit errors", "exact_errors", None),
-             ("N-buffer: hit errors", "nbuffer_errors", None), ("extra errors", "extra_errors", None)],
-            nve, row_class=lambda r: "bad" if (r["extra_errors"] or 0) > 0 else "") if nve else \
-            "<p>No heightfield has both an exact and an N-buffer walk.</p>"
-        paper_tab = self.table(
-            "relief_paper",
-            [("size", "field_size", None), ("method", "method", None), ("paper (Hz)", "paper_hz", num(0)),
-             ("paper's rank (fastest first)", "paper_rank", None),
-             ("ours: cycles/box draw (fbm)", "cycles_per_frame", num(0)),
-             ("ours: lookups/fragment (fbm)", "lookups_per_fragment", num(2)),
-             ("our rank (fewest cycles first)", "our_rank", None)], paper) if paper else \
-            "<p>relief.json holds no paper rows.</p>"
-        nve_reading = [s for s in reading if s.startswith("The N-buffer walk")]
-        paper_reading = [s for s in reading if s.startswith("The paper ranks")]
-        lead = [s for s in reading if s not in nve_reading + paper_reading]
-
-        # left: cost against error, one point per method (the ranking), the Pareto front as a step line;
-        # right: lookups per fragment per heightfield (field and size) and method, over every view angle
-        fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True,
-                                     gridspec_kw={"width_ratios": [2, 3]})
-        for r in ranking:
-            c, mk = relief_style(r["method"])
-            ax.scatter([r["cycles_per_frame"]], [100 * r["error_rate"]], s=60, marker=mk, color=c,
-                       edgecolors="black" if r["pareto"] else c, linewidths=1.2 if r["pareto"] else 0.5, zorder=3)
-        front = sorted((r for r in ranking if r["pareto"]), key=lambda r: r["cycles_per_frame"])
-        if front:  # the step line runs on to the dearest method: what lies on or above it is dominated
-            dearest = max(r["cycles_per_frame"] for r in ranking)
-            ax.plot([r["cycles_per_frame"] for r in front] + [dearest],
-                    [100 * r["error_rate"] for r in front] + [100 * front[-1]["error_rate"]],
-                    drawstyle="steps-post", color="#b2182b", lw=1.2, alpha=0.7, zorder=1,
-                    label=f"Pareto front ({', '.join(r['method'] for r in front)})")
-        bad = [r for r in ranking if mismatched(r)]
-        if bad:
-            ax.scatter([r["cycles_per_frame"] for r in bad], [100 * r["error_rate"] for r in bad], s=140, marker="x",
-                       color="red", zorder=4, label="walks or pixels unlike GL's")
-        ax.xaxis.set_major_formatter(THOUSANDS)
-        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
-        ax.set_xlabel("modelled cycles per box draw (mean over the frames)")
-        ax.set_ylabel("hit error (% of fragments, against the exact reference)")
-        ax.set_title("Cost against hit error, per method", fontsize=10)
-        ax.grid(alpha=0.3)
-        ax.margins(x=0.2, y=0.15)
-        if front or bad:
-            ax.legend(fontsize=7, loc="upper left")
-        lookups = relief_lookups_by_field(rows)
-        methods = [r["method"] for r in ranking]
-        x = np.arange(len(lookups))
-        wd = 0.8 / max(len(methods), 1)
-        for j, m in enumerate(methods):
-            c, _ = relief_style(m)
-            bx.bar(x - 0.4 + wd * (j + 0.5), [v.get(m) or np.nan for v in lookups.values()], wd, color=c, label=m)
-        # The generator's name alone ("fbm:0 seed 5" -> "fbm"), its size under it: the full description is in the table.
-        bx.set_xticks(x, [f"{f.split(':')[0].split(' ')[0]}\n{n}²" for f, n in lookups], fontsize=7)
-        bx.set_xlabel("heightfield and size")
-        bx.set_ylabel("lookups per fragment")
-        bx.set_title("Lookups per fragment, per heightfield and method", fontsize=10)
-        bx.grid(axis="y", alpha=0.3)
-        bx.legend(fontsize=7, ncols=len(methods), loc="upper left", title="method, cheapest first", title_fontsize=7)
-        bx.set_ylim(0, max([v for d in lookups.values() for v in d.values() if v is not None] + [1]) * 1.2)
-        fig.suptitle("Relief textures: the walks' cost and hit error")
-        freeze_layout(fig)
-        place_labels(ax, [r["cycles_per_frame"] for r in ranking], [100 * r["error_rate"] for r in ranking],
-                     methods, [relief_style(m)[0] for m in methods], fontsize=8)
-        img = self.save(fig, "relief.png")
-        settings = doc["settings"]
-        setting_text = ("settings: <code>" + html.escape(" ".join(settings)) + "</code>") if settings else \
-            "the model's default settings"
-        loud = lambda s: (f'<b class="bad">{html.escape(s)}</b>' if s.startswith("GL AND THE MODEL DISAGREE")  # noqa: E731
-                          else html.escape(s))
-        items = lambda ss: "<ul>" + "".join(f"<li>{loud(s)}</li>" for s in ss) + "</ul>"  # noqa: E731
-        return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim relief TRACE... --out</code>: each relief trace, one "
-                "heightfield at one size with a frame per view angle and a box draw per method, replayed in the model "
-                f"with {setting_text}). Cycles: a method's box draw in the model, the mean over the frames; lookups and "
-                "steps: heightfield texels read and walk steps per fragment; hit errors: fragments whose hit or miss "
-                "differs from the exact reference beyond <code>relief.hit_tolerance_texels</code>. Walks and pixels "
-                "differing: the model's against GL's; any is a bug (rows in red). Every row (trace, view angle, "
-                'method) is in <a href="relief_rows.csv">relief_rows.csv</a>.</p>'
-                "<p><b>What it shows</b> (computed from relief.json):</p>" + items(lead) +
-                self.figure(img, "Left: one point per method, x = modelled cycles per box draw, y = hit error; the "
-                            "Pareto-optimal methods (no other is as cheap and as accurate, and better in one) are "
-                            "outlined and joined by the front; red crosses would mark methods whose walks or pixels are "
-                            "not GL's. Right: lookups per fragment per heightfield and size, one bar per method. Read "
-                            "off: the cheapest method for an accepted hit error, and on which heightfields the N-buffer "
-                            "walk saves lookups over the exact walk.") +
-                "<h3>Ranking: cycles against hit error</h3>" + rank_tab +
-                "<h3>The N-buffer walk against the exact walk, per heightfield</h3>" + items(nve_reading) + nve_tab +
-                "<h3>The paper's Table 1 beside ours</h3>" + items(paper_reading) + paper_tab)
-
-    # ------------------------------------------------------------------------------ shadows
-    def shadows_path(self):
-        return self.technique_table_path("shadows")
-
-    def shadows(self):
-        path = self.shadows_path()
-        if path is None:
-            raise Missing(["shadows/shadows.json"])
-        rows = shadows_rows(load_shadows(path))
-        self.used(path, "shadows")
-        for r in rows:
-            r["trace_name"] = trace_name(str(r.get("trace", "?")))
-        ratio = lambda v: "-" if v is None else f"{100 * v:.1f}%"  # noqa: E731
-        cols = [("scene", "scene", None), ("mode", "shadow_mode", None), ("litmap (lexels)", "litmap_size", None),
-                ("trace", "trace_name", None), ("frames", "frames", None),
-                ("fill/frame", "fill_per_frame", None), ("ratio to infinite", "ratio", ratio),
-                ("paper", "paper_text", lambda v: v or "-"),
-                ("casters/frame", "casters_per_frame", None), ("casters culled/frame", "casters_culled_per_frame", None),
-                ("N-buffer build texels/frame", "build_texels_per_frame", None),
-                ("N-buffer lookups/frame", "lookups_per_frame", None), ("cycles/frame", "cycles_per_frame", None),
-                ("mask px differing (GL's)", "mask_diff", None),
-                ("mask px differing (infinite)", "mask_diff_infinite", None)]
-        tab = self.table("shadows", cols, rows, row_class=lambda r: "bad" if r["mask_pixels_differing"] else "")
-        reading = shadows_reading(rows)
-        traces = ", ".join(dict.fromkeys(r["trace_name"] for r in rows))
-        label = (traces if len(rows) <= 3 else
-                 f"{len(rows)} traces of {', '.join(dict.fromkeys(r['scene'] for r in rows))}")
-        self.headline_last.append(headline_shadows(label, rows, reading))
-
-        # per scene: one bar per mode (and litmap size), log scale; the paper's clamped ratio marked on the
-        # clamped bars as the fill it would give (paper ratio x the trace's infinite reference fill)
-        fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
-        colours = {"infinite": "#999999", "culled": "#6fa8dc", "clamped": "#b2182b"}
-        scenes = list(dict.fromkeys(r["scene"] for r in rows))
-        x, ticks, labels = 0.0, [], []
-        marked = False
-        for scene in scenes:
-            g = [r for r in rows if r["scene"] == scene]
-            start = x
-            for r in g:
-                v = max(float(r["fill_per_frame"]), 1.0)  # log scale: an empty fill sits on the floor
-                ax.bar(x, v, 0.8, color=colours.get(r["shadow_mode"], "#555555"),
-                       label=r["shadow_mode"] if r["shadow_mode"] not in ax.get_legend_handles_labels()[1] else None)
-                text = ratio(r["ratio"]) + (f"\n{r['litmap_size']}" if len(g) > len({x["shadow_mode"] for x in g}) else "")
-                ax.annotate(text, (x, v), xytext=(0, 2), textcoords="offset points", ha="center", va="bottom", fontsize=7)
-                ref = r.get("reference_fill_per_frame")
-                if r["paper_ratio"] is not None and ref:
-                    ax.plot([x - 0.45, x + 0.45], [r["paper_ratio"] * ref] * 2, color="black", lw=2, ls="--",
-                            label=None if marked else "paper's clamped / infinite ratio x our infinite fill")
-                    marked = True
-                x += 1
-            ticks.append((start + x - 1) / 2)
-            labels.append(scene)
-            x += 0.8
-        ax.set_yscale("log")
-        ax.set_ylim(top=ax.get_ylim()[1] * 4)  # headroom for the labels and the legend
-        ax.set_xticks(ticks, labels)
-        ax.set_xlabel("scene")
-        ax.set_ylabel("shadow-volume fill per frame (fragments, log scale)")
-        ax.set_title(f"Shadows: fill per frame by mode, beside the paper's ratio ({len(rows)} traces)", fontsize=10)
-        ax.grid(axis="y", alpha=0.3, which="both")
-        ax.legend(fontsize=7, loc="upper left", ncols=2)
-        img = self.save(fig, "shadows.png")
-        settings = sorted({s for r in rows for s in (r.get("settings") or [])})
-        setting_text = ("settings: <code>" + html.escape(" ".join(f"--set {s}" for s in settings)) + "</code>") if settings \
-            else ("the model's default settings" if all("settings" in r for r in rows) else "their settings are not recorded there")
-        return (f"<p>From <code>{self.rel(path)}</code> (<code>nbsim shadows TRACE... --out</code>: one replay per trace, "
-                f"traces {html.escape(traces)}, each in the shadow mode it was captured in on Mesa; {setting_text}). Fill: rasterized fragments of "
-                "the shadow-volume draws; ratio: the fill over GL's infinite volumes of the same frames (every capture "
-                "also draws them as a reference). The paper (Décoret 2005, 4.4, 640x480) gives clamped / infinite: "
-                "2.5% in its city (20 M -> 512 K pixels) and on its terrain, about 20% on simpler scenes. Casters "
-                "culled: by GL, outside the light's frustum included. N-buffer build and lookups: texels of both "
-                "litmap N-buffers (min and max) built and read per frame. Mask pixels differing: the model's shadow "
-                "mask against GL's and against GL's infinite reference, over every frame; rows with any are red."
-                "</p>" + tab +
-                "<p><b>What it shows</b> (computed from the table):</p><ul>" +
-                "".join(f"<li>{html.escape(s)}</li>" for s in reading) + "</ul>" +
-                self.figure(img, "Per scene: the fill per frame of each mode (log scale: grey infinite, blue culled, red "
-                            "clamped; the number on a bar is its ratio to infinite) and, dashed, the fill the paper's "
-                            "ratio would give on our infinite volumes. Read off: how far clamping goes toward the "
-                            "paper's figure in each scene."))
 
     # ------------------------------------------------------------------------------ sweeps
     def sweep_dirs(self):
@@ -1120,14 +753,10 @@ def main(argv):
     rep.run("figure4", "Figure 4: covering tightness", rep.figure4, root / "figure4_map.csv")
     rep.run("table2", "Table 2: depth tests per frame in the walkthrough", rep.table2, root / "table2/table2.json")
     rep.run("walkthrough", "Depth tests per frame along the walkthrough", rep.walkthrough, root / "table2")
-    rep.run("particles", "Particles: depth tests per frame beside the paper's claim", rep.particles,
-            rep.particles_path() or root / "particles" / "particles.json")
-    rep.run("shadows", "Shadows: fill per frame beside the paper's ratios", rep.shadows,
-            rep.shadows_path() or root / "shadows" / "shadows.json")
-    rep.run("ldi", "Layered depth images: Table 1 and the parity test's misclassification", rep.ldi,
-            rep.ldi_path() or root / "ldi" / "ldi.json")
-    rep.run("relief", "Relief textures: the methods' cost against hit error, the N-buffer walk, the paper's Table 1",
-            rep.relief, rep.relief_path() or root / "relief" / "relief.json")
+    sections = technique_sections()
+    for s in sections:
+        rep.run(s.NAME, s.TITLE, lambda s=s: s.section(rep),
+                rep.technique_table_path(s.NAME) or root / s.NAME / f"{s.NAME}.json")
     dirs = rep.sweep_dirs()
     if not dirs:
         rep.missing.append(("Sweeps (architecture exploration)", ["sweeps/NAME/results.csv"]))
@@ -1141,9 +770,9 @@ def main(argv):
             rep.out.rmdir()  # nothing written into it
         except OSError:
             pass
+        tables = ", ".join(f"{s.NAME}/{s.NAME}.json, {s.NAME}.json" for s in sections)
         print(f"report: nothing usable in {a.dir}: looked for table1.jsonl, figure4_map.csv, table2/table2.json, "
-              "table2/MODE/run.json, particles/particles.json, particles.json, shadows/shadows.json, shadows.json, ldi/ldi.json, ldi.json, "
-              "relief/relief.json, relief.json, sweeps/NAME/results.csv, results.csv", file=sys.stderr)
+              f"table2/MODE/run.json, {tables}, sweeps/NAME/results.csv, results.csv", file=sys.stderr)
         return 2
     rep.write_html()
     print(f"report: wrote {rep.out / 'index.html'} ({rendered} sections"

@@ -19,8 +19,12 @@ SCRIPT = ROOT / "analysis" / "report.py"
 FIXTURE = HERE / "fixture"
 PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
 sys.path.insert(0, str(ROOT / "analysis"))
+import report  # noqa: E402
 import report_data  # noqa: E402
 import table1  # noqa: E402
+
+# Each technique's report section (analysis/techniques/NAME/section.py), by name.
+SECTIONS = {s.NAME: s for s in report.technique_sections()}
 
 
 def run_report(d):
@@ -555,7 +559,7 @@ class ShadowsReading(unittest.TestCase):
     """The shadows section's reading follows the rows it is given, not fixed text."""
 
     def reading(self, rows):
-        return " ".join(report_data.shadows_reading(report_data.shadows_rows(rows)))
+        return " ".join(SECTIONS["shadows"].shadows_reading(SECTIONS["shadows"].shadows_rows(rows)))
 
     def test_ratios_against_the_paper(self):
         # the clamped ratio is compared with the paper's figure of its scene, in either direction
@@ -600,7 +604,7 @@ class LdiReading(unittest.TestCase):
     """The LDI section's reading follows the rows it is given, not fixed text."""
 
     def reading(self, rows):
-        return " ".join(report_data.ldi_reading(report_data.ldi_rows(rows)))
+        return " ".join(SECTIONS["ldi"].ldi_reading(SECTIONS["ldi"].ldi_rows(rows)))
 
     def test_rates_and_the_paper(self):
         text = self.reading([ldi_row("sphere", 256), ldi_row("sphere", 64)])
@@ -657,8 +661,8 @@ class ReliefReading(unittest.TestCase):
     """The relief section's reading follows relief.json, not fixed text."""
 
     def reading(self, doc):
-        return " ".join(report_data.relief_reading(doc, report_data.relief_ranking(doc),
-                                                   report_data.relief_paper_rows(doc["paper"])))
+        return " ".join(SECTIONS["relief"].relief_reading(doc, SECTIONS["relief"].relief_ranking(doc),
+                                                   SECTIONS["relief"].relief_paper_rows(doc["paper"])))
 
     def test_front_nbuffer_against_exact_and_the_paper(self):
         # the front, the N-buffer walk's lookups and errors per heightfield, and the two rankings per size
@@ -693,7 +697,7 @@ class ReliefReading(unittest.TestCase):
                       "pixels differing from GL's in 1 row (fbm_64 frame 0 exact: 3); fragment counts unlike GL's in "
                       "1 row (fbm_64 frame 0 exact: 1,000 against 999)", text)
         self.assertNotIn("walks and pixels are GL's", text)
-        ranking = {r["method"]: r for r in report_data.relief_ranking(doc)}
+        ranking = {r["method"]: r for r in SECTIONS["relief"].relief_ranking(doc)}
         self.assertEqual((ranking["nbuffer"]["walk_mismatches"], ranking["exact"]["pixel_mismatches"]), (12, 3))
 
 
@@ -701,7 +705,7 @@ class ParticlesReading(unittest.TestCase):
     """The particles section's reading follows the rows it is given, not fixed text."""
 
     def reading(self, rows):
-        return " ".join(report_data.particles_reading(report_data.particles_rows(rows)))
+        return " ".join(SECTIONS["particles"].particles_reading(SECTIONS["particles"].particles_rows(rows)))
 
     def test_build_cheaper_than_the_culling_saves(self):
         # nb culls half the fragments with a small build: its build costs less than it saves, and it is cheapest
