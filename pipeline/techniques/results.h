@@ -153,6 +153,15 @@ struct TechniqueResults {
   ReportLabels report;
 };
 
+// Helpers for a technique's declaration (pipeline/techniques/<name>/results.cpp): a metric read from
+// run.json at `source` (a JSON pointer); an Error derived from `source` in the point and in its
+// reference point (the reference's value shown in `reference_column`); the labels of a technique
+// whose headline cost is total depth tests per frame and whose memory cost is the N-buffer's.
+Metric metric(const char* name, const char* unit, const char* description, MetricKind kind, std::string source);
+Metric derived_error(const char* name, const char* unit, const char* description, std::string source, Derivation derivation,
+                     const char* reference_column);
+void depth_test_and_nbuffer_labels(ReportLabels& l);
+
 // Every technique's results, one row each.
 const std::vector<TechniqueResults>& technique_results();
 

@@ -1,0 +1,10 @@
+// The relief technique's declared results (pipeline/techniques/results.h): its row of technique_results().
+#pragma once
+
+#include "pipeline/techniques/results.h"
+
+namespace nbsim::techniques {
+
+TechniqueResults relief_results();
+
+}  // namespace nbsim::techniques

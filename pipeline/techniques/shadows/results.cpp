@@ -1,0 +1,102 @@
+// The shadows technique's declared results; see results.h.
+#include "pipeline/techniques/shadows/results.h"
+
+namespace nbsim::techniques {
+
+// Shadow volumes with litmaps (Décoret 2005, 3.3/4.4): the fill of the shadow volumes and the
+// cycles per frame, the two N-buffers' build and lookups, against the shadow-mask pixels that
+// differ from GL's (the mode's mask and the infinite reference's: both must be 0). GL's volume
+// draws are replayed (the trace holds the mode's geometry); the model's N-buffers (litmap_min.*,
+// litmap_max.*) recompute every caster's z_min/z_max and the cull rule, so a sweep over their
+// resolution, format and level cap shows what a design costs and whether it stays conservative
+// (unsafe_culls: casters the design culls that the rule on GL's values keeps). No TableSpec:
+// `nbsim shadows` prints the per-mode table (one capture each).
+TechniqueResults shadows_results() {
+  TechniqueResults t;
+  t.technique = "shadows";
+  t.description = "Stencil shadow volumes culled and clamped with min/max litmaps and two N-buffers";
+  const auto shd = [](const char* key) { return std::string("/summary/shadows/") + key; };
+  using K = MetricKind;
+  Metric mask_diff = metric("mask_diff", "pixels",
+                            "shadow-mask pixels (light_region and stencil != 0) where the model's mask differs from GL's, over every "
+                            "frame; 0",
+                            K::Error, shd("mask_diff"));
+  mask_diff.must_be_zero = true;
+  Metric mask_diff_infinite = metric("mask_diff_infinite", "pixels",
+                                     "shadow-mask pixels where the model's mask differs from GL's infinite reference, over every "
+                                     "frame; 0 (culling and clamping change no pixel)",
+                                     K::Error, shd("mask_diff_infinite"));
+  mask_diff_infinite.must_be_zero = true;
+  Metric unsafe = metric("unsafe_culls", "casters",
+                         "casters the design's N-buffers cull that the cull rule on GL's full-resolution values keeps; 0 for a "
+                         "conservative design",
+                         K::Error, shd("unsafe_culls"));
+  unsafe.must_be_zero = true;
+  Metric culled_lost = derived_error("culled_lost_per_frame", "casters",
+                                     "casters the reference's cull rule culls per frame minus the point's (culled less than both "
+                                     "N-buffers at full resolution, float32, every level)",
+                                     shd("culled_per_frame"), Derivation::ReferenceMinusPoint, "reference_culled_per_frame");
+  Metric culled_lost_fraction = derived_error("culled_lost_fraction", "fraction",
+                                              "casters culled less than the reference, as a fraction of the reference's culls "
+                                              "(culled_lost_per_frame / reference_culled_per_frame)",
+                                              shd("culled_per_frame"), Derivation::LossRelativeToReference,
+                                              "reference_culled_per_frame");
+  Metric nbuffer_memory = metric("nbuffer_memory_bytes", "bytes", "memory of both N-buffers' levels", K::Cost,
+                                 shd("nbuffer_memory_bytes"));
+  nbuffer_memory.section = Section::Memory;
+  t.metrics = {
+      metric("fill_per_frame", "fragments", "rasterized fragments of the shadow-volume draws (the fill), per frame", K::Cost,
+             shd("fill_per_frame")),
+      metric("cycles_per_frame", "cycles", "model cycles per frame", K::Cost, shd("cycles_per_frame")),
+      metric("build_texels_per_frame", "texels", "texels of both N-buffers built from the litmaps, per frame", K::Cost,
+             shd("build_texels_per_frame")),
+      metric("lookups_per_frame", "texels", "N-buffer texels the casters' queries read (both units), per frame", K::Cost,
+             shd("lookups_per_frame")),
+      metric("stencil_tests_per_frame", "tests", "stencil tests of the shadow-volume draws, per frame", K::Cost,
+             shd("stencil_tests_per_frame")),
+      mask_diff,
+      mask_diff_infinite,
+      unsafe,
+      metric("not_conservative", "casters", "casters whose z_min is above GL's or z_max below GL's, over every frame", K::Error,
+             shd("not_conservative")),
+      metric("culls_lost", "casters", "casters GL culled that the design's N-buffers keep, over every frame", K::Error,
+             shd("culls_lost")),
+      culled_lost,
+      culled_lost_fraction,
+      metric("culled_per_frame", "casters", "casters the cull rule culls on the design's z_min/z_max, per frame", K::Outcome,
+             shd("culled_per_frame")),
+      metric("gl_culled_per_frame", "casters", "casters GL culled, per frame", K::Outcome, shd("gl_culled_per_frame")),
+      metric("decision_mismatches", "casters", "casters GL culled that the cull rule on GL's own values keeps, over every frame",
+             K::Outcome, shd("decision_mismatches")),
+      nbuffer_memory,
+  };
+  ReferenceSetting r;
+  r.column = "shadows_reference";
+  r.description = "both N-buffers at full resolution, float32, every level (what the capture's GLSL N-buffers are)";
+  r.settings = {{"litmap_min.resolution_divisor", 1}, {"litmap_min.format", "f32"}, {"litmap_min.level_cap", -1},
+                {"litmap_max.resolution_divisor", 1}, {"litmap_max.format", "f32"}, {"litmap_max.level_cap", -1}};
+  t.reference = std::move(r);
+  t.headline_cost = "cycles_per_frame";
+  // A fraction (the report plots it in points of %): the mask counts are 0 at every design (the
+  // volumes are GL's), so what a design loses is culls; mask_diff stays the correctness count.
+  t.headline_error = "culled_lost_fraction";
+  t.memory_cost = "nbuffer_memory_bytes";
+  ReportLabels& l = t.report;
+  l.error_axis = "casters culled less than the full-resolution f32 N-buffers (% of their culls)";
+  l.error_text = "casters the cull rule culls less than on both N-buffers at full resolution, float32, every level, in % of "
+                 "the reference's culls (culled_lost_fraction); mask pixels differing are counted apart and must be 0";
+  l.error_column = "culls lost (%)";
+  l.cost_axis = "cycles per frame";
+  l.cost_column = "cycles/frame";
+  l.cost_pareto = "pareto_cycles";
+  l.cost_short = "cycles";
+  l.memory_axis = "N-buffer memory (KiB)";
+  l.memory_pareto = "pareto_memory";
+  l.memory_short = "memory";
+  l.quality_column = "casters culled per frame";
+  l.must_be_zero = "mask pixels differing";
+  l.alike = "culls alike";
+  return t;
+}
+
+}  // namespace nbsim::techniques
