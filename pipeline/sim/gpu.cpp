@@ -51,7 +51,7 @@ void GpuConfig::validate() const {
 
 Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& c, int width_px, int height_px,
          cp::FrameSource source, float clear_depth, depth::ResultSink& sink, const trace::Header& header,
-         const cull::CullSetup& setup, const std::filesystem::path* out)
+         const TraceView& view, const std::filesystem::path* out)
     : sc_core::sc_module(name),
       memory_(c.memory),
       cp_to_geometry_("cp_to_geometry", c.fifo_depth),
@@ -68,7 +68,7 @@ Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const G
   raster_.in(geometry_to_raster_);
   raster_.out(raster_to_depth_);
   depth_.in(raster_to_depth_);
-  program_ = build_program(header.technique, ProgramContext{registry, c, header, setup, depth_.buffer(), depth_.stencil(), memory_, out});
+  program_ = build_program(header.technique, ProgramContext{registry, c, header, view, depth_.buffer(), depth_.stencil(), memory_, out});
   if (program_.frames) cp_.set_program(program_.frames);
   if (program_.depth_listener) depth_.set_listener(program_.depth_listener);
   // Per-primitive culling: the program tests the raster unit's triangles between setup and the tile walk.

@@ -71,11 +71,12 @@ struct GpuConfig {
 
 class Gpu : public sc_core::sc_module {
  public:
-  // The trace's `header` (its technique and the keys the technique declares) and `setup` choose and
-  // feed the frame program (programs.h); both must outlive the construction.
+  // The trace's `header` (its technique and the keys the technique declares) and `view` (viewport,
+  // depth convention, scene) choose and feed the frame program (programs.h); both must outlive the
+  // construction.
   Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& config, int width_px, int height_px,
       cp::FrameSource source, float clear_depth, depth::ResultSink& sink, const trace::Header& header,
-      const cull::CullSetup& setup, const std::filesystem::path* out = nullptr);
+      const TraceView& view, const std::filesystem::path* out = nullptr);
 
   const memory::Channel& memory() const noexcept { return memory_; }
   const Program& program() const noexcept { return program_; }

@@ -59,7 +59,7 @@ std::span<const StructureInstance> structure_instances() { return kInstances; }
 
 std::unique_ptr<query::Structure> ProgramContext::structure(std::string_view instance, query::Kind kind, FarOp op) const {
   const std::string name(instance);
-  const int w = setup.width_px, h = setup.height_px;
+  const int w = view.width_px, h = view.height_px;
   const auto nb = config.nbuffers.find(instance);
   if (nb != config.nbuffers.end() && kind == query::Kind::NBuffer)
     return std::make_unique<query::NBufferStructure>(name.c_str(), registry, nbuffer_config(instance), w, h, op, &memory);

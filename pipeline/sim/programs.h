@@ -26,13 +26,21 @@ namespace nbsim::pipeline {
 
 struct GpuConfig;
 
+// The trace as every program sees it, from its header and scene record.
+struct TraceView {
+  int width_px = 0, height_px = 0;                        // the viewport
+  FarOp op = FarOp::Max;                                  // farthest: Max, or Min under reversed Z
+  scene::DepthFunc depth_func = scene::DepthFunc::Less;   // LESS, or GREATER under reversed Z
+  const scene::SceneObjects* scene = nullptr;             // the scene record (null: the trace has none)
+};
+
 // What a program's factory gets from the top level. Units it builds become children of the top
 // level's module (they are built during its elaboration).
 struct ProgramContext {
   stats::Registry& registry;
   const GpuConfig& config;
   const trace::Header& header;     // the trace's, checked when it was opened: a program reads its technique's keys typed
-  const cull::CullSetup& setup;    // the trace as the programs see it: viewport, depth convention, scene
+  const TraceView& view;           // the trace's viewport, depth convention and scene
   const DepthImage& depth_buffer;  // the depth unit's
   const raster::StencilImage& stencil_buffer;  // the depth unit's (8-bit, y up; cleared to 0 at each frame's start)
   memory::Channel& memory;
@@ -84,6 +92,7 @@ struct SummaryInputs {
   const trace::Header& header;
   const Program& program;  // its query structures' storage
   std::uint64_t cycles;    // the run's, at its last frame end
+  std::uint64_t visible_draws_passed_below_gl;  // drawn visible objects that passed fewer samples than GL's
 };
 
 // What a program's statistics become in the replay's outputs: its per-frame values in run.json's
@@ -91,8 +100,9 @@ struct SummaryInputs {
 // with GL in the thresholds, and its lines in `nbsim compare`'s text. Every member is optional.
 struct ProgramResults {
   std::string_view group;  // its statistics group ("gpu.<unit>"); no results when the run has none
-  // Adds its values to the frame's object `pf`, from the group's statistics at this frame end
-  // (`now`) and at the last one (`last`).
+  std::string_view summary_key;  // its summary's key in run.json's summary ("": the technique's name)
+  // Adds its values to the frame's object `pf` (which holds the frame's "depth_tests" already),
+  // from the group's statistics at this frame end (`now`) and at the last one (`last`).
   void (*frame_values)(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) = nullptr;
   // Keys of `pf` (whole numbers) its summary keeps frame by frame: the summary's "per_frame" array
   // of {"frame", these keys, "cycles"}, kept in memory (so few, small values).

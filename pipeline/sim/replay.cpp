@@ -21,14 +21,6 @@ namespace nbsim::pipeline {
 
 namespace {
 
-// The cull stage's per-frame values (run.json "frames"): differences of its statistics between two
-// frame ends, which are exact because the next frame's tests wait for the frame to leave the
-// pipeline (model/cull/unit.h).
-constexpr std::array<const char*, 11> kCullFrameCounts = {
-    "bounds_tests",    "candidates",        "culled",            "candidates_not_visible",     "false_culls",
-    "undrawable",      "primitive_tests",   "primitives_culled", "primitive_lookups",          "primitive_fragments_culled",
-    "primitive_false_culls"};
-
 // Collects the depth unit's results, compares them with GL's, and writes the CSV files.
 class Collector : public depth::ResultSink {
  public:
@@ -124,15 +116,6 @@ class Collector : public depth::ResultSink {
       pf["stencil_pixels"] = frame_.stencil_pixels;
       pf["stencil_pixels_matching"] = frame_.stencil_matching;
     }
-    if (const stats::Group* g = registry_.find("gpu.cull")) {
-      const nlohmann::ordered_json now = g->values();
-      const auto delta = [&](const char* name) { return stat(now, name) - stat(last_cull_, name); };
-      pf["query_depth_tests"] = delta("query_depth_tests");
-      pf["update_texels"] = delta("update_texels");
-      pf["total_depth_tests"] = delta("query_depth_tests") + delta("update_texels") + (frame_.depth_tests - delta("box_depth_tests"));
-      for (const char* name : kCullFrameCounts) pf[name] = delta(name);
-      last_cull_ = now;
-    }
     if (results_ && !results_->group.empty()) {
       if (const stats::Group* g = registry_.find(std::string(results_->group))) {
         const nlohmann::ordered_json now = g->values();
@@ -178,7 +161,6 @@ class Collector : public depth::ResultSink {
   ReplaySummary& s_;
   const ReplayOptions& o_;
   const stats::Registry& registry_;
-  nlohmann::ordered_json last_cull_ = nlohmann::ordered_json::object();  // gpu.cull at the last frame end
   nlohmann::ordered_json last_program_ = nlohmann::ordered_json::object();  // the program's group at the last frame end
   std::ofstream draws_, frames_;
   FrameTotals frame_;
@@ -204,46 +186,6 @@ class RunOutputs {
   std::vector<std::filesystem::path> files_;
 };
 
-// The cull stage's run totals (summary "cull", the columns of Table 2 and of explore's results),
-// derived from its statistics and the depth unit's when the run is done.
-nlohmann::ordered_json cull_summary(const nlohmann::ordered_json& cull, const nlohmann::ordered_json& depth,
-                                    const cull::CullUnitConfig& config, std::uint64_t cycles,
-                                    std::uint64_t visible_draws_passed_below_gl) {
-  const std::uint64_t frames = stat(cull, "frames");
-  const auto per_frame = [frames](std::uint64_t v) { return frames ? static_cast<double>(v) / static_cast<double>(frames) : 0.0; };
-  const std::uint64_t query = stat(cull, "query_depth_tests"), update = stat(cull, "update_texels");
-  const std::uint64_t drawn = stat(depth, "depth_tests") - stat(cull, "box_depth_tests");  // occluders and visible objects
-  const std::uint64_t total = query + update + drawn;
-  nlohmann::ordered_json j;
-  j["mode"] = config.mode;
-  j["frames"] = frames;
-  j["query_depth_tests"] = query;
-  j["query_depth_tests_per_frame"] = per_frame(query);
-  j["box_depth_tests"] = stat(cull, "box_depth_tests");
-  j["lookups"] = stat(cull, "lookups");
-  j["max_lookups_per_test"] = stat(cull, "max_lookups");
-  j["update_texels"] = update;
-  j["update_texels_per_frame"] = per_frame(update);
-  j["clear_texels_per_frame"] = per_frame(stat(cull, "clear_texels"));
-  j["drawn_depth_tests"] = drawn;
-  j["drawn_depth_tests_per_frame"] = per_frame(drawn);
-  j["total_depth_tests"] = total;
-  j["total_depth_tests_per_frame"] = per_frame(total);
-  j["cycles"] = cycles;
-  j["cycles_per_frame"] = per_frame(cycles);
-  for (const char* name : {"in_frustum", "occluders", "candidates", "bounds_tests", "node_tests", "crossing_near", "found_visible",
-                           "culled", "undrawable", "frames_with_truth", "candidates_not_visible", "false_culls"})
-    j[name] = stat(cull, name);
-  j["culling_efficiency"] = cull["culling_efficiency"];
-  j["granularity"] = config.granularity;
-  for (const char* name : {"primitive_tests", "primitives_culled", "primitive_lookups", "primitive_fragments_culled"}) {
-    j[name] = stat(cull, name);
-    j[std::string(name) + "_per_frame"] = per_frame(stat(cull, name));
-  }
-  j["primitive_false_culls"] = stat(cull, "primitive_false_culls");
-  j["visible_draws_passed_below_gl"] = visible_draws_passed_below_gl;
-  return j;
-}
 
 double rel(std::uint64_t a, std::uint64_t b) {
   if (b == 0) return a == 0 ? 0.0 : 1.0;
@@ -295,7 +237,6 @@ nlohmann::ordered_json ReplaySummary::to_json() const {
   j["depth_tests_per_host_second"] = host_seconds > 0 ? static_cast<double>(depth_tests) / host_seconds : 0.0;
   j["cycles_per_host_second"] = host_seconds > 0 ? static_cast<double>(cycles) / host_seconds : 0.0;
   j["within_thresholds"] = within_thresholds();
-  if (!cull.is_null()) j["cull"] = cull;
   if (!program.is_null()) j[program_name] = program;
   return j;
 }
@@ -326,18 +267,14 @@ ReplaySummary replay(const ReplayOptions& o) {
   Collector sink(s, o, registry);
   if (head.frames) sink.total_frames = *head.frames;
   sim::install_report_handler();
-  // The cull stage's view of the trace (culling modes only read it).
-  cull::CullSetup setup;
-  setup.width_px = w;
-  setup.height_px = h;
-  setup.op = head.far_op();
-  setup.depth_func = setup.op == FarOp::Min ? trace::DepthFunc::Greater : trace::DepthFunc::Less;
-  setup.near_m = head.near_m;
-  setup.nearest_margin = head.nearest_margin;
-  setup.zero_to_one = head.clip_control == trace::ClipControl::ZeroToOne;
-  setup.scene = tr.scene();
-  setup.fused_interpolation = o.config.depth.fused_interpolation;
-  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head, setup,
+  // The trace as the programs see it.
+  TraceView view;
+  view.width_px = w;
+  view.height_px = h;
+  view.op = head.far_op();
+  view.depth_func = view.op == FarOp::Min ? trace::DepthFunc::Greater : trace::DepthFunc::Less;
+  view.scene = tr.scene();
+  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head, view,
           o.out ? &*o.out : nullptr);
   if (o.config.program != "off")
     if (const ProgramRow* row = find_program(head.technique)) sink.results_ = &row->results;
@@ -366,20 +303,10 @@ ReplaySummary replay(const ReplayOptions& o) {
   s.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.stats = registry.values();
   s.stencil_tests = stat(s.stats["gpu.depth"], "stencil_tests");
-  if (s.stats.contains("gpu.cull")) {
-    s.cull = cull_summary(s.stats["gpu.cull"], s.stats["gpu.depth"], o.config.cull, sink.last_frame_cycle(),
-                          sink.visible_draws_passed_below_gl);
-    const auto& structures = gpu.program().structures;
-    const query::Structure* structure = structures.empty() ? nullptr : structures.front().get();
-    const long long bytes = structure ? structure->storage_bytes() : 0;
-    s.cull["structure_memory_bytes"] = bytes;  // N-buffer levels, tile Hi-Z or pyramid
-    s.cull["nbuffer_memory_bytes"] =
-        structure && structure->structure_kind() == query::Kind::NBuffer ? nlohmann::ordered_json(bytes) : nullptr;
-  }
-
   if (sink.results_ && s.stats.contains(std::string(sink.results_->group)) && sink.results_->summary) {
     const ProgramResults& r = *sink.results_;
-    const SummaryInputs in{s.stats[std::string(r.group)], s.stats, o.config, head, gpu.program(), sink.last_frame_cycle()};
+    const SummaryInputs in{s.stats[std::string(r.group)], s.stats, o.config, head, gpu.program(), sink.last_frame_cycle(),
+                            sink.visible_draws_passed_below_gl};
     s.program = r.summary(in);
     if (!r.per_frame_keys.empty()) {
       nlohmann::ordered_json per_frame = nlohmann::ordered_json::array();
@@ -393,7 +320,7 @@ ReplaySummary replay(const ReplayOptions& o) {
       }
       s.program["per_frame"] = per_frame;
     }
-    s.program_name = head.technique;
+    s.program_name = r.summary_key.empty() ? head.technique : std::string(r.summary_key);
     s.program_exact = !r.exact || r.exact(s.program);
   }
 

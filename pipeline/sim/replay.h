@@ -63,11 +63,9 @@ struct ReplaySummary {
   double host_seconds = 0.0;
   std::uint64_t timeline_events = 0, timeline_dropped = 0;  // spans written to / left out of the timeline
   nlohmann::ordered_json stats;  // every unit's statistics
-  // Culling modes (cull.mode other than trace): totals and per-frame averages of the cull stage,
-  // Table 2's columns among them (see CullTotals in replay.cpp); null otherwise.
-  nlohmann::ordered_json cull;
-  // The technique program's results (programs.h ProgramResults): its technique (the summary's key
-  // in run.json and `compare --json`), its totals (null when no program made results), and whether
+  // The technique program's results (programs.h ProgramResults): its summary's key in run.json and
+  // `compare --json` (its technique's name, or the key its results declare: "cull"), its
+  // totals (null when no program made results), and whether
   // what the program itself compares with GL holds (part of within_thresholds()).
   std::string program_name;
   nlohmann::ordered_json program;

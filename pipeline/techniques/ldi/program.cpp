@@ -120,7 +120,7 @@ ProgramRow ldi_program() {
           "compare against the previous layer, the model's LDI, crop and compressed texture compared with GL's, and the parity "
           "test (uncompressed and compressed) at GL's test points against GL's answers and the exact reference",
           build,
-          {"gpu.ldi", frame_values, {}, summary, exact, describe}};
+          {"gpu.ldi", "", frame_values, {}, summary, exact, describe}};
 }
 
 }  // namespace nbsim::pipeline

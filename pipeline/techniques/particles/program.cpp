@@ -20,10 +20,10 @@ namespace {
 Program build(const ProgramContext& c) {
   c.require_no_cull_mode("a particles trace culls with its own particle_mode");
   particles::ParticlesSetup s;
-  s.width_px = c.setup.width_px;
-  s.height_px = c.setup.height_px;
-  s.op = c.setup.op;
-  s.depth_func = c.setup.depth_func;
+  s.width_px = c.view.width_px;
+  s.height_px = c.view.height_px;
+  s.op = c.view.op;
+  s.depth_func = c.view.depth_func;
   // The header's particle keys were checked against their declarations when the trace was opened
   // (traces/format/particles/particles_chunk.cpp): the mode is a known one, the levels 0 .. 31.
   s.mode = *particles::parse_mode(c.header.text("particle_mode"));
@@ -47,8 +47,8 @@ Program build(const ProgramContext& c) {
     if (nb.level_cap < 0) nb.level_cap = s.top_level;  // the partial build the capture made
     nb.direct_squares = true;  // a power-of-two sprite is one lookup (the paper's direct covering, 3.2)
     s.top_level = nb.level_cap;
-    p.structures.push_back(std::make_unique<query::NBufferStructure>("nbuffer", c.registry, nb, c.setup.width_px,
-                                                                     c.setup.height_px, c.setup.op, &c.memory));
+    p.structures.push_back(std::make_unique<query::NBufferStructure>("nbuffer", c.registry, nb, c.view.width_px,
+                                                                     c.view.height_px, c.view.op, &c.memory));
   } else if (s.mode == particles::Mode::HiZ) {
     hiz = &c.config.hiz.at("hiz");
   }
@@ -134,7 +134,7 @@ ProgramRow particles_program() {
           "point-sprite particles culled in the vertex stage (the trace's particle_mode: none, center, nb, hiz), each "
           "decision made again by the model and compared with GL's; GL's particle draws rasterized",
           build,
-          {"gpu.particles", frame_values, {}, summary}};
+          {"gpu.particles", "", frame_values, {}, summary}};
 }
 
 }  // namespace nbsim::pipeline

@@ -17,8 +17,8 @@ namespace {
 Program build(const ProgramContext& c) {
   c.require_no_cull_mode("a shadows trace culls its casters with the litmaps");
   shadows::ShadowsSetup s;
-  s.width_px = c.setup.width_px;
-  s.height_px = c.setup.height_px;
+  s.width_px = c.view.width_px;
+  s.height_px = c.view.height_px;
   // The header's shadows keys were checked against their declarations when the trace was opened
   // (traces/format/shadows/shadows_chunk.cpp).
   s.mode = *shadows::parse_mode(c.header.text("shadow_mode"));
@@ -98,7 +98,7 @@ ProgramRow shadows_program() {
           "rasterized with the stencil test, a min and a max N-buffer built over GL's litmaps and queried per caster, the "
           "decisions and the shadow mask compared with GL's",
           build,
-          {"gpu.shadows", frame_values, kPerFrame, summary}};
+          {"gpu.shadows", "", frame_values, kPerFrame, summary}};
 }
 
 }  // namespace nbsim::pipeline
