@@ -176,6 +176,31 @@ std::string check_exr(File& f, long long max_side, long long max_pixels) {
                              "its {}x{} pixels",
                              printable(*name), at - 4, size, pw, ph);
       }
+      if (*type == "chlist") {
+        // OpenEXR reads a channel list by its structure, not its declared size: channels of a name
+        // (up to 255 characters) and 16 bytes each, until an empty name. A list that ends elsewhere
+        // than the declared size makes OpenEXR read the next attribute from another byte than this
+        // walk (fuzz_depth_image in CI: a channel list running on into the next attributes, then a
+        // 1.85 GB "attribute").
+        const std::uintmax_t end = at + static_cast<std::uintmax_t>(size);
+        std::uintmax_t pos = at;
+        int channels = 0;
+        for (;;) {
+          const auto channel = pos < end ? f.cstring(pos, 255) : std::nullopt;
+          if (!channel || pos + channel->size() + 1 > end)
+            return fmt::format("is a damaged OpenEXR file: channel list attribute '{}' at byte {} declares {} bytes, and its "
+                               "channel {} does not end inside them",
+                               printable(*name), at - 4, size, channels);
+          pos += channel->size() + 1;
+          if (channel->empty()) break;
+          pos += 16;  // pixel type, pLinear, reserved, x and y sampling
+          ++channels;
+        }
+        if (pos != end)
+          return fmt::format("is a damaged OpenEXR file: channel list attribute '{}' at byte {} declares {} bytes, and its "
+                             "{} channels and end take {}",
+                             printable(*name), at - 4, size, channels, pos - at);
+      }
       if (*type == "stringvector") {  // strings of a 32-bit length each, within the value
         for (std::uintmax_t read = 0; read < static_cast<std::uintmax_t>(size);) {
           const auto len = f.read<4>(at + read);

@@ -181,4 +181,29 @@ TEST(ImagePrecheckTest, OpenExrAttributeValuesHoldWhatTheirTypesDeclare) {
   EXPECT_TRUE(has(e, "string vector attribute 'names'") && has(e, "holds a string that does not fit its 10 bytes")) << e;
 }
 
+// OpenEXR reads a channel list by its structure (a name and 16 bytes a channel, until an empty
+// name), not by its declared size (fuzz_depth_image in CI: a list whose end byte was not 0 ran on
+// into the next attributes, then OpenEXR allocated a 1.85 GB "attribute" from inside one).
+TEST(ImagePrecheckTest, OpenExrChannelListEndsAtItsDeclaredSize) {
+  using Attr = std::tuple<std::string, std::string, std::int32_t, std::vector<std::uint8_t>>;
+  const std::vector<std::uint8_t> channel = {'Y', 0, 2, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+  std::vector<std::uint8_t> two = channel;
+  two.insert(two.end(), channel.begin(), channel.end());
+  two[18] = 'Z';
+  two.push_back(0);
+  EXPECT_EQ(check_exr({Attr{"extra", "chlist", 37, two}}), "") << "two channels and the end";
+  std::vector<std::uint8_t> unended = channel;
+  unended.push_back('C');  // no empty name: the list would run on
+  std::string e = check_exr({Attr{"extra", "chlist", 19, unended}});
+  EXPECT_TRUE(has(e, "channel list attribute 'extra'") && has(e, "declares 19 bytes, and its channel 1 does not end inside them"))
+      << e;
+  std::vector<std::uint8_t> early = channel;
+  early.push_back(0);
+  early.push_back(0);  // the list ends one byte before its size
+  e = check_exr({Attr{"extra", "chlist", 20, early}});
+  EXPECT_TRUE(has(e, "declares 20 bytes, and its 1 channels and end take 19")) << e;
+  e = check_exr({Attr{"extra", "chlist", 0, {}}});
+  EXPECT_TRUE(has(e, "declares 0 bytes, and its channel 0 does not end inside them")) << e;
+}
+
 }  // namespace
