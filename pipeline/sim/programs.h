@@ -79,6 +79,16 @@ inline std::uint64_t stat(const nlohmann::ordered_json& group, const char* name)
   return it == group.end() ? 0 : static_cast<std::uint64_t>(it->get<double>());
 }
 
+// |a - b| / b, 1 when b is 0 and a is not: how far a model counter is from GL's.
+inline double relative_error(std::uint64_t a, std::uint64_t b) {
+  if (b == 0) return a == 0 ? 0.0 : 1.0;
+  const double d = static_cast<double>(a) - static_cast<double>(b);
+  return (d < 0 ? -d : d) / static_cast<double>(b);
+}
+// The most relative_error a replay's counters may have against GL's (fragments, passed samples,
+// and what a program compares with GL itself) to be within the thresholds.
+inline constexpr double kCounterErrorLimit = 1e-4;
+
 // The value of the header property `key` as written, when the header has it, into j[key].
 inline void copy_property(const trace::Header& header, const char* key, nlohmann::ordered_json& j) {
   if (const std::string* v = header.property(key)) j[key] = *v;

@@ -187,23 +187,17 @@ class RunOutputs {
 };
 
 
-double rel(std::uint64_t a, std::uint64_t b) {
-  if (b == 0) return a == 0 ? 0.0 : 1.0;
-  return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
-}
 
 }  // namespace
 
-double ReplaySummary::fragment_error() const { return rel(fragments_model, fragments_gl); }
-double ReplaySummary::passed_error() const { return rel(passed_model, passed_gl); }
-
-const nlohmann::ordered_json& ReplaySummary::program_summary() const { return program; }
+double ReplaySummary::fragment_error() const { return relative_error(fragments_model, fragments_gl); }
+double ReplaySummary::passed_error() const { return relative_error(passed_model, passed_gl); }
 
 bool ReplaySummary::within_thresholds() const {
   const bool draws_ok = draws == 0 || static_cast<double>(draws_exact) >= 0.99 * static_cast<double>(draws);
   const bool depth_ok = depth_pixels == 0 || static_cast<double>(depth_pixels_matching) >= 0.9999 * static_cast<double>(depth_pixels);
   const bool stencil_ok = stencil_pixels_matching == stencil_pixels;
-  return fragment_error() <= 1e-4 && passed_error() <= 1e-4 && draws_ok && depth_ok && stencil_ok && program_exact;
+  return fragment_error() <= kCounterErrorLimit && passed_error() <= kCounterErrorLimit && draws_ok && depth_ok && stencil_ok && program_exact;
 }
 
 nlohmann::ordered_json ReplaySummary::to_json() const {

@@ -71,9 +71,6 @@ struct ReplaySummary {
   nlohmann::ordered_json program;
   bool program_exact = true;
 
-  // The technique program's totals (`program`), null when no program summarised the run.
-  const nlohmann::ordered_json& program_summary() const;
-
   double fragment_error() const;  // |model - gl| / gl over all draws
   double passed_error() const;
   // The counter comparison's thresholds: total fragment and passed-sample error at most 0.01%, at

@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 
 #include <array>
-#include <cmath>
 #include <string>
 
 #include "model/ldi/unit.h"
@@ -82,18 +81,12 @@ nlohmann::ordered_json summary(const SummaryInputs& in) {
   return j;
 }
 
-// |a - b| / b (1 when b is 0 and a is not).
-double relative(std::uint64_t a, std::uint64_t b) {
-  if (b == 0) return a == 0 ? 0.0 : 1.0;
-  return std::fabs(static_cast<double>(a) - static_cast<double>(b)) / static_cast<double>(b);
-}
-
 // The peel is the program's own replay of GL's peel draws: its fragments and samples against GL's
 // counters under the draws' thresholds.
 bool exact(const nlohmann::ordered_json& s) {
   const auto counter = [&s](const char* name) { return s.value(name, std::uint64_t{0}); };
-  return relative(counter("peel_fragments"), counter("gl_peel_fragments")) <= 1e-4 &&
-         relative(counter("peel_samples"), counter("gl_peel_samples")) <= 1e-4;
+  return relative_error(counter("peel_fragments"), counter("gl_peel_fragments")) <= kCounterErrorLimit &&
+         relative_error(counter("peel_samples"), counter("gl_peel_samples")) <= kCounterErrorLimit;
 }
 
 std::string describe(const nlohmann::ordered_json& l) {
