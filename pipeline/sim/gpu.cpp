@@ -1,6 +1,7 @@
 // The replay model's top level; see gpu.h.
 #include "pipeline/sim/gpu.h"
 
+#include <stdexcept>
 #include <string>
 
 #include "model/common/error.h"
@@ -17,10 +18,8 @@ void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
         "sustained bandwidth shared by every client", 0.01, 1e6);
   s.add("memory.latency_cycles", c.memory.latency_cycles, "cycles", "from request to data", 0, 100000);
   cull::CullUnitConfig::describe(s, c.cull);
-  particles::ParticlesUnitConfig::describe(s, c.particles);
-  shadows::ShadowsUnitConfig::describe(s, c.shadows);
-  ldi::LdiUnitConfig::describe(s, c.ldi);
-  relief::ReliefUnitConfig::describe(s, c.relief);
+  for (const ProgramRow& row : program_table())
+    if (row.config.describe) row.config.describe(s, c.groups.find(row.config.name)->second);
   for (auto& [name, config] : c.nbuffers) nbuffer::NBufferUnitConfig::describe(s, config, name);
   for (auto& [name, config] : c.hiz) HiZUnitConfig::describe(s, config, name);
   s.add("gpu.fifo_depth", c.fifo_depth, "work items", "depth of the fifos between units", 1, 4096);
@@ -36,6 +35,8 @@ void GpuConfig::describe(config::Schema& s, GpuConfig& c) {
 }
 
 GpuConfig::GpuConfig() {
+  for (const ProgramRow& row : program_table())
+    if (row.config.defaults) groups.emplace(std::string(row.config.name), row.config.defaults());
   for (const StructureInstance& i : structure_instances()) {
     if (i.kind == InstanceKind::NBuffer) nbuffers[std::string(i.name)].key_prefix = i.name;
     if (i.kind == InstanceKind::HiZ) hiz[std::string(i.name)].key_prefix = i.name;
@@ -45,8 +46,14 @@ GpuConfig::GpuConfig() {
 void GpuConfig::validate() const {
   for (const auto& [name, config] : nbuffers) config.validate();
   for (const auto& [name, config] : hiz) config.validate();
-  ldi.validate();
-  relief.validate();
+  for (const ProgramRow& row : program_table())
+    if (row.config.validate) row.config.validate(find_group(row.config.name));
+}
+
+const std::any& GpuConfig::find_group(std::string_view name) const {
+  const auto it = groups.find(name);
+  if (it == groups.end()) throw std::logic_error("no program declares the config group '" + std::string(name) + "'");
+  return it->second;
 }
 
 Gpu::Gpu(const sc_core::sc_module_name& name, stats::Registry& registry, const GpuConfig& c, int width_px, int height_px,

@@ -7,27 +7,24 @@
 //                     |  frame program                 clears, dirty rects,    +- [memory channel]
 //               [program] <------------------------ draw results -----------+        |
 //                     +-- [query structures: nbuffer / hiz] -----------------------------+
-// The frame program comes from the trace's technique and the config (programs.h: occlusion
-// culling's is the cull stage, model/cull/unit.h, none with its cull.mode=trace); with
+// The frame program comes from the trace's technique and the config (programs.h); with
 // gpu.program=off there is none for any technique and the command processor replays the
 // recorded draws.
 #pragma once
 
+#include <any>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "model/config/schema.h"
 #include "model/cp/unit.h"
 #include "model/cull/unit.h"
 #include "model/depth/unit.h"
-#include "model/ldi/unit.h"
-#include "model/relief/unit.h"
 #include "model/geometry/unit.h"
 #include "model/memory/memory.h"
-#include "model/particles/unit.h"
-#include "model/shadows/unit.h"
 #include "model/query/units.h"
 #include "model/raster/unit.h"
 #include "pipeline/sim/programs.h"
@@ -41,12 +38,11 @@ struct GpuConfig {
   depth::DepthUnitConfig depth;
   memory::ChannelConfig memory;
   cull::CullUnitConfig cull;
-  particles::ParticlesUnitConfig particles;
-  shadows::ShadowsUnitConfig shadows;
-  ldi::LdiUnitConfig ldi;
-  relief::ReliefUnitConfig relief;
+  // The programs' own config groups (programs.h ProgramRow::config) by name, each the unit config
+  // type its program declared; read with group<T>(name).
+  std::map<std::string, std::any, std::less<>> groups;
   // The query-structure instances (programs.h structure_instances()) by name, one config each
-  // (keys "<name>.<field>"): "nbuffer" and "hiz" for occlusion culling's modes.
+  // (keys "<name>.<field>").
   std::map<std::string, nbuffer::NBufferUnitConfig, std::less<>> nbuffers;
   std::map<std::string, HiZUnitConfig, std::less<>> hiz;
   int fifo_depth = 4;  // work items between two units; tunable
@@ -59,14 +55,24 @@ struct GpuConfig {
   // draws replay through the pipeline as the generic raster and depth units see them.
   std::string program = "auto";
 
-  // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull.", "particles.",
-  // "shadows.", "ldi.", "relief.", "nbuffer.", "hiz.", "gpu.").
+  // Declares every key of every unit ("cp.", "geometry.", "raster.", "depth.", "memory.", "cull."),
+  // of every program's group and every structure instance, and "gpu.".
   static void describe(config::Schema& s, GpuConfig& c);
   // Throws InputError naming the key when a unit's value is out of its limits or inconsistent
   // (the checks the units make when they are built, for a config checked before any run).
   void validate() const;
 
-  GpuConfig();  // every structure instance at its defaults
+  GpuConfig();  // every program group and structure instance at its defaults
+
+  // The config group `name` of a program (ProgramRow::config), as the type it declared; throws
+  // std::logic_error when no program declared that group (a programming error, not an input's).
+  template <class T>
+  const T& group(std::string_view name) const {
+    return std::any_cast<const T&>(find_group(name));
+  }
+
+ private:
+  const std::any& find_group(std::string_view name) const;
 };
 
 class Gpu : public sc_core::sc_module {

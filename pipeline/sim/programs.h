@@ -4,6 +4,7 @@
 // entry in the registration list in programs.cpp; the top level (gpu.h) only wires what a row builds.
 #pragma once
 
+#include <any>
 #include <filesystem>
 #include <memory>
 #include <ostream>
@@ -14,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "model/config/schema.h"
 #include "model/cp/unit.h"
 #include "model/cull/unit.h"
 #include "model/depth/unit.h"
@@ -124,6 +126,25 @@ struct ProgramResults {
   std::string (*describe)(const nlohmann::ordered_json& summary) = nullptr;
 };
 
+// A program's own config group (keys "<name>.<field>"), which GpuConfig holds by name without
+// knowing its type: the unit config `T` declares its keys (T::describe) and, when it has one, its
+// consistency check (T::validate). config_group<T>("name") makes the row's entry.
+struct ConfigGroup {
+  std::string_view name;  // "" for a program without a group of its own
+  std::any (*defaults)() = nullptr;
+  void (*describe)(config::Schema& s, std::any& value) = nullptr;
+  void (*validate)(const std::any& value) = nullptr;
+};
+
+template <class T>
+ConfigGroup config_group(std::string_view name) {
+  return {name, [] { return std::any(T{}); },
+          [](config::Schema& s, std::any& value) { T::describe(s, std::any_cast<T&>(value)); },
+          [](const std::any& value) {
+            if constexpr (requires(const T& t) { t.validate(); }) std::any_cast<const T&>(value).validate();
+          }};
+}
+
 struct ProgramRow {
   std::string_view technique;    // the trace header's "technique"
   std::string_view description;  // for --help and messages
@@ -132,6 +153,7 @@ struct ProgramRow {
   // renderer captures but the model does not replay yet; build_program refuses its traces.
   Program (*build)(const ProgramContext& context);
   ProgramResults results;
+  ConfigGroup config;  // read by the program as context.config.group<T>(config.name)
 };
 
 std::span<const ProgramRow> program_table();

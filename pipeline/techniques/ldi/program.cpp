@@ -19,7 +19,7 @@ namespace {
 Program build(const ProgramContext& c) {
   c.require_no_cull_mode("an ldi trace peels and tests its own shape");
   Program p;
-  auto unit = std::make_unique<ldi::LdiUnit>("ldi", c.registry, c.config.ldi, c.memory, c.config.depth.fused_interpolation);
+  auto unit = std::make_unique<ldi::LdiUnit>("ldi", c.registry, c.config.group<ldi::LdiUnitConfig>("ldi"), c.memory, c.config.depth.fused_interpolation);
   p.frames = unit.get();
   p.unit = std::move(unit);
   return p;
@@ -113,7 +113,8 @@ ProgramRow ldi_program() {
           "compare against the previous layer, the model's LDI, crop and compressed texture compared with GL's, and the parity "
           "test (uncompressed and compressed) at GL's test points against GL's answers and the exact reference",
           build,
-          {"gpu.ldi", "", frame_values, {}, summary, exact, describe}};
+          {"gpu.ldi", "", frame_values, {}, summary, exact, describe},
+          config_group<ldi::LdiUnitConfig>("ldi")};
 }
 
 }  // namespace nbsim::pipeline

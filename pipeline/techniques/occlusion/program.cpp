@@ -124,7 +124,8 @@ ProgramRow occlusion_culling_program() {
           "occlusion culling of a scene's objects (cull.mode: trace replays the recorded draws; none, oq, oq_hier, nb, "
           "nb_hier, hiz_tile, hiz_pyramid cull every candidate again)",
           build,
-          {"gpu.cull", "cull", frame_values, {}, summary}};
+          {"gpu.cull", "cull", frame_values, {}, summary},
+          {}};  // its config group is the cull unit's ("cull."), which GpuConfig holds itself
 }
 
 }  // namespace nbsim::pipeline

@@ -14,6 +14,8 @@ namespace nbsim::pipeline {
 
 namespace {
 
+const particles::ParticlesUnitConfig& config(const GpuConfig& gpu) { return gpu.group<particles::ParticlesUnitConfig>("particles"); }
+
 // Point-sprite particles (the N-buffer paper, 3.2/4.3): the trace's particle_mode is the test; the
 // N-buffer instance "nbuffer" (mode nb) is built up to the capture's top level (levels_built - 1)
 // unless nbuffer.level_cap sets another; mode hiz reads the "hiz" instance's format and timing.
@@ -29,11 +31,11 @@ Program build(const ProgramContext& c) {
   s.mode = *particles::parse_mode(c.header.text("particle_mode"));
   s.top_level = static_cast<int>(c.header.whole("levels_built")) - 1;
   s.margin = static_cast<float>(c.header.real("cull_margin"));
-  if (c.config.particles.mode != "trace") {
+  if (config(c.config).mode != "trace") {
     // Another test than the capture's: the levels it builds follow from the capture's sprite sizes
     // and level cap, as the capture computes them for that mode.
-    const auto other = particles::parse_mode(c.config.particles.mode);
-    if (!other) throw InputError(fmt::format("particles.mode '{}' is not one of trace, none, center, nb, hiz", c.config.particles.mode));
+    const auto other = particles::parse_mode(config(c.config).mode);
+    if (!other) throw InputError(fmt::format("particles.mode '{}' is not one of trace, none, center, nb, hiz", config(c.config).mode));
     const std::string& sprite = c.header.text("sprite");
     const int largest = sprite == "atten" ? static_cast<int>(particles::kMaxAttenuatedPx) : static_cast<int>(c.header.whole("sprite"));
     const int level_cap = static_cast<int>(c.header.whole("level_cap"));
@@ -52,7 +54,7 @@ Program build(const ProgramContext& c) {
   } else if (s.mode == particles::Mode::HiZ) {
     hiz = &c.config.hiz.at("hiz");
   }
-  auto unit = std::make_unique<particles::ParticlesUnit>("particles", c.registry, c.config.particles, s, c.depth_buffer,
+  auto unit = std::make_unique<particles::ParticlesUnit>("particles", c.registry, config(c.config), s, c.depth_buffer,
                                                          p.structures.empty() ? nullptr : p.structures.front().get(), hiz);
   p.frames = unit.get();
   p.depth_listener = unit.get();
@@ -120,7 +122,8 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, std::string_view 
 nlohmann::ordered_json summary(const SummaryInputs& in) {
   const std::string* captured = in.header.property("particle_mode");
   const std::string capture_mode = captured ? *captured : "";
-  const std::string& mode = in.config.particles.mode == "trace" ? capture_mode : in.config.particles.mode;
+  const std::string& chosen = config(in.config).mode;
+  const std::string& mode = chosen == "trace" ? capture_mode : chosen;
   nlohmann::ordered_json j = totals(in.group, mode, in.cycles);
   j["capture_mode"] = capture_mode;
   j["nbuffer_memory_bytes"] = in.program.structures.empty() ? 0 : in.program.structures.front()->storage_bytes();
@@ -134,7 +137,8 @@ ProgramRow particles_program() {
           "point-sprite particles culled in the vertex stage (the trace's particle_mode: none, center, nb, hiz), each "
           "decision made again by the model and compared with GL's; GL's particle draws rasterized",
           build,
-          {"gpu.particles", "", frame_values, {}, summary}};
+          {"gpu.particles", "", frame_values, {}, summary},
+          config_group<particles::ParticlesUnitConfig>("particles")};
 }
 
 }  // namespace nbsim::pipeline

@@ -23,7 +23,7 @@ Program build(const ProgramContext& c) {
   const double box_height = c.header.real("relief_box_height");  // above 0: checked when the trace was opened
   Program p;
   // The N-buffer walk covers as the capture did (its GL walks are compared one by one).
-  auto unit = std::make_unique<relief::ReliefUnit>("relief", c.registry, c.config.relief, c.memory, c.view.width_px, c.view.height_px,
+  auto unit = std::make_unique<relief::ReliefUnit>("relief", c.registry, c.config.group<relief::ReliefUnitConfig>("relief"), c.memory, c.view.width_px, c.view.height_px,
                                                    box_height, c.config.depth.fused_interpolation, c.capture_covering());
   p.frames = unit.get();
   p.unit = std::move(unit);
@@ -132,7 +132,8 @@ ProgramRow relief_program() {
           "exact, robust, robust_clamp or nbuffer, as the draw's RLFF says) run through the ray-walk unit and its texel cache, "
           "compared with GL's per fragment and scored against the exact reference",
           build,
-          {"gpu.relief", "", frame_values, {}, summary, exact, describe}};
+          {"gpu.relief", "", frame_values, {}, summary, exact, describe},
+          config_group<relief::ReliefUnitConfig>("relief")};
 }
 
 }  // namespace nbsim::pipeline

@@ -31,7 +31,7 @@ Program build(const ProgramContext& c) {
   };
   auto min_nb = nbuffer("litmap_min", FarOp::Min);
   auto max_nb = nbuffer("litmap_max", FarOp::Max);
-  auto unit = std::make_unique<shadows::ShadowsUnit>("shadows", c.registry, c.config.shadows, s, c.stencil_buffer, *min_nb, *max_nb);
+  auto unit = std::make_unique<shadows::ShadowsUnit>("shadows", c.registry, c.config.group<shadows::ShadowsUnitConfig>("shadows"), s, c.stencil_buffer, *min_nb, *max_nb);
   p.structures.push_back(std::move(min_nb));
   p.structures.push_back(std::move(max_nb));
   p.frames = unit.get();
@@ -98,7 +98,8 @@ ProgramRow shadows_program() {
           "rasterized with the stencil test, a min and a max N-buffer built over GL's litmaps and queried per caster, the "
           "decisions and the shadow mask compared with GL's",
           build,
-          {"gpu.shadows", "", frame_values, kPerFrame, summary}};
+          {"gpu.shadows", "", frame_values, kPerFrame, summary},
+          config_group<shadows::ShadowsUnitConfig>("shadows")};
 }
 
 }  // namespace nbsim::pipeline
