@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The exploration report: Table 1, Figure 4, Table 2, the walkthrough and every sweep, as one HTML page.
+"""The exploration report: Table 1, Figure 4, each technique's sections and every sweep, as one HTML page.
 
 Usage: /usr/bin/python3 analysis/report.py DIR
 Reads only the CSV/JSON outputs found under DIR and writes DIR/report/index.html with its PNG plots,
@@ -8,13 +8,13 @@ marks). The inputs, and the nbsim commands that write them:
   DIR/table1.jsonl                   nbsim bench nbuffer --only build --json-out DIR/table1.jsonl  (--only build,update
                                      adds the incremental updates' table: texels/s, against a rebuild)
   DIR/figure4_map.csv                nbsim nbuffer coverage --size 256x256 --out DIR/figure4_map.png
-  DIR/table2/table2.json             nbsim table2 TRACE --out DIR/table2  (and DIR/table2/MODE/run.json)
   DIR/sweeps/NAME/results.csv        nbsim explore SWEEP.json --out DIR/sweeps/NAME  (and sweep.json, technique_results.json)
   DIR/results.csv                    nbsim explore SWEEP.json --out DIR  (DIR is then one sweep, named after it)
-  DIR/NAME/NAME.json                 a technique's table: nbsim NAME TRACE... --out DIR/NAME  (or DIR/NAME.json: --out DIR;
-                                     the LDI's: nbsim ldi table1 --out DIR/ldi), rendered by analysis/techniques/NAME/section.py
+  DIR/NAME/NAME.json                 a technique's table: nbsim NAME TRACE... --out DIR/NAME  (or DIR/NAME.json: --out DIR),
+                                     rendered by analysis/techniques/NAME/section.py; a technique whose inputs differ
+                                     documents them in its section module
 The data side (reading, Pareto marks, labels, headline.md) is in report_data.py; plot helpers in
-report_plots.py; each technique's section in analysis/techniques/NAME/section.py. Every section whose
+report_plots.py; each technique's sections in analysis/techniques/NAME/section.py. Every section whose
 inputs exist is rendered; the page names the inputs the others were missing.
 Exit 0 when at least one section rendered; 2 when DIR does not exist or holds nothing usable, or when
 an input is malformed (the message names the file; the other sections are still written).
@@ -32,7 +32,7 @@ from pathlib import Path
 sys.dont_write_bytecode = True  # no __pycache__ next to the scripts
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 # report_plots first: it selects matplotlib's headless backend before pyplot loads.
-from report_plots import (DPI, FIGSIZE, MAX_LABELLED_POINTS, THOUSANDS, freeze_layout, mode_style,  # noqa: E402
+from report_plots import (DPI, FIGSIZE, MAX_LABELLED_POINTS, THOUSANDS, freeze_layout,  # noqa: E402
                           place_labels, spans_decades)
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
@@ -41,13 +41,17 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 import plot_coverage  # noqa: E402
 import table1  # noqa: E402
 from report_data import (FIDELITY_KNOBS, NUMERIC, BadInput, Missing, fmt, headline_sweep,  # noqa: E402
-                         headline_table2, kib_key, technique_results, load_json, mark_pareto, number, pct, read_csv,
-                         short_label, sorted_modes, table2_ratios, trace_name)
+                         kib_key, technique_results, load_json, mark_pareto, number, pct, read_csv,
+                         short_label, trace_name)
 
 
 def technique_sections():
-    """Every technique's section (analysis/techniques/<name>/section.py: NAME, TITLE, ORDER, section(rep)),
-    in ORDER: a technique adds its section there, without editing this file."""
+    """Every technique's report module (analysis/techniques/<name>/section.py), in ORDER: a technique adds
+    its sections there, without editing this file. A module has NAME and ORDER, and either TITLE and
+    section(rep) (one section, anchor NAME, main input DIR/NAME/NAME.json or DIR/NAME.json) or SECTIONS,
+    its sections in page order: (anchor, title, build(rep), main input relative to DIR). build(rep) and
+    section(rep) return the section's HTML or raise report_data.Missing / BadInput. INPUTS (optional): the
+    paths, relative to DIR, the module looks for (the message when DIR holds nothing usable)."""
     modules = []
     for path in sorted((Path(__file__).resolve().parent / "techniques").glob("*/section.py")):
         spec = importlib.util.spec_from_file_location(f"nbsim_report_section_{path.parent.name}", path)
@@ -55,6 +59,24 @@ def technique_sections():
         spec.loader.exec_module(module)
         modules.append(module)
     return sorted(modules, key=lambda m: (m.ORDER, m.NAME))
+
+
+def section_entries(rep, module):
+    """A technique module's sections as (anchor, title, build, main input path), in page order."""
+    if hasattr(module, "SECTIONS"):
+        return [(anchor, title, lambda build=build: build(rep), rep.root / main)
+                for anchor, title, build, main in module.SECTIONS]
+    return [(module.NAME, module.TITLE, lambda: module.section(rep),
+             rep.technique_table_path(module.NAME) or rep.root / module.NAME / f"{module.NAME}.json")]
+
+
+def section_inputs(module):
+    """The paths (relative to DIR) a technique module looks for."""
+    if hasattr(module, "INPUTS"):
+        return list(module.INPUTS)
+    if hasattr(module, "SECTIONS"):
+        return [main for _, _, _, main in module.SECTIONS]
+    return [f"{module.NAME}/{module.NAME}.json", f"{module.NAME}.json"]
 
 
 class Report:
@@ -221,183 +243,13 @@ class Report:
                             "read squares of a quarter of it; the corner squares overhang by up to a whole square on "
                             "thin boxes; one square is looser everywhere."))
 
-    # ------------------------------------------------------------------------------ Table 2
-    def load_table2(self):
-        path = self.root / "table2" / "table2.json"
-        if not path.exists():
-            return path, None
-        t = load_json(path)
-        if not isinstance(t, dict) or not isinstance(t.get("rows"), list) or not t["rows"]:
-            raise BadInput(f"{path}: expected an object with a non-empty \"rows\" list (nbsim table2 --out)")
-        need = ["mode", "query_depth_tests_per_frame", "total_depth_tests_per_frame", "cycles_per_frame",
-                "false_culls", "culling_efficiency"]
-        for i, r in enumerate(t["rows"]):
-            if not isinstance(r, dict):
-                raise BadInput(f"{path}: rows[{i}] is not an object")
-            lacking = [k for k in need if k not in r]
-            if lacking:
-                raise BadInput(f"{path}: rows[{i}] lacks {', '.join(lacking)}")
-            for k in need[1:] + ["paper_depth_tests_per_frame", "update_texels_per_frame", "undrawable"]:
-                if r.get(k) is not None and not isinstance(r[k], (int, float)):
-                    raise BadInput(f"{path}: rows[{i}].{k} is not a number: {r[k]!r}")
-        return path, t
-
-    def table2(self):
-        path, t = self.load_table2()
-        if t is None:
-            raise Missing(["table2/table2.json"])
-        self.used(path, "Table 2")
-        if t.get("nbsim_version"):
-            self.versions.add(str(t["nbsim_version"]))
-        rows = []
-        for r in t["rows"]:
-            rr = dict(r)
-            p = r.get("paper_depth_tests_per_frame")
-            rr["ours_over_paper"] = r["query_depth_tests_per_frame"] / p if p else None
-            rows.append(rr)
-        cols = [("mode", "mode", None), ("paper row", "paper", lambda v: v or "-"),
-                ("paper depth tests/frame", "paper_depth_tests_per_frame", None),
-                ("query depth tests/frame", "query_depth_tests_per_frame", None),
-                ("ours / paper", "ours_over_paper", lambda v: "-" if v is None else f"{v:.3g}"),
-                ("update texels/frame", "update_texels_per_frame", None),
-                ("total depth tests/frame", "total_depth_tests_per_frame", None),
-                ("cycles/frame", "cycles_per_frame", None), ("false culls", "false_culls", None),
-                ("culling efficiency", "culling_efficiency", pct), ("undrawable", "undrawable", None)]
-        tab = self.table("table2", cols, rows, row_class=lambda r: "bad" if r.get("false_culls") else "")
-        ratios = table2_ratios(t["rows"])
-        rtab = self.table("table2_ratios", [("ratio of query depth tests", "ratio", None),
-                                            ("ours", "ours", lambda v: "-" if v is None else f"{v:,.0f}x"),
-                                            ("paper", "paper", lambda v: "-" if v is None else f"{v:,.0f}x")], ratios)
-        settings = t.get("settings") or []
-        sets = ", ".join(f"<code>{html.escape(str(s))}</code>" for s in settings) or "none (the defaults)"
-        cfg = f", config file <code>{html.escape(str(t['config_file']))}</code>" if t.get("config_file") else ""
-        crc = f" (CRC-32 {html.escape(str(t['trace_crc32']))})" if t.get("trace_crc32") else ""
-        # the paper against ours, per mode
-        modes = [r["mode"] for r in rows]
-        fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
-        x = np.arange(len(rows))
-        wd = 0.27
-        ax.bar(x - wd, [r.get("paper_depth_tests_per_frame") or np.nan for r in rows], wd,
-               label="paper (512x512 city)", color="#999999", hatch="//", edgecolor="white")
-        ax.bar(x, [r["query_depth_tests_per_frame"] for r in rows], wd, label="ours: query depth tests", color="#b2182b")
-        ax.bar(x + wd, [r["total_depth_tests_per_frame"] for r in rows], wd,
-               label="ours: total (+ updates + drawing)", color="#6fa8dc")
-        for i, r in enumerate(rows):
-            if not r.get("paper_depth_tests_per_frame"):
-                ax.annotate("no paper row", (x[i] - wd, 0), xycoords=("data", "axes fraction"), xytext=(0, 4),
-                            textcoords="offset points", rotation=90, ha="center", va="bottom", fontsize=7, color="#777")
-        ax.set_yscale("log")
-        tallest = max(max(r["total_depth_tests_per_frame"], r["query_depth_tests_per_frame"],
-                          r.get("paper_depth_tests_per_frame") or 0) for r in rows)
-        ax.set_ylim(top=tallest * 30)  # headroom: the legend sits above the bars
-        ax.set_xticks(x, modes)
-        ax.set_xlabel("culling mode")
-        ax.set_ylabel("depth tests per frame (log scale)")
-        ax.set_title(f"Depth tests per frame: paper vs nbsim ({trace_name(str(t.get('trace', '?')))})")
-        ax.grid(axis="y", which="both", alpha=0.3)
-        ax.legend(fontsize=8, loc="upper right", ncols=3)
-        img = self.save(fig, "table2.png")
-        rt = "; ".join(f"{r['ratio']}: {'-' if r['ours'] is None else format(r['ours'], ',.0f')}x "
-                       f"(paper {'-' if r['paper'] is None else format(r['paper'], ',.0f')}x)" for r in ratios)
-        fc = sum(int(r.get("false_culls") or 0) for r in rows)
-        self.headline.append(headline_table2(t, rows, ratios))
-        return (f"<p>Trace <code>{html.escape(str(t.get('trace', '?')))}</code>{crc}, settings: {sets}{cfg}; "
-                f"from <code>{self.rel(path)}</code>. Query depth tests are the paper's count; the total adds the "
-                "N-buffer/Hi-Z update texels and the drawn objects' depth tests. "
-                f"{'<b class=bad>' + str(fc) + ' false culls.</b>' if fc else 'No false culls.'} "
-                f"Ratios: {html.escape(rt) or 'none (a mode of each pair is missing)'}.</p>" + tab +
-                "<h3>Occlusion queries over N-buffer</h3>" + rtab +
-                self.figure(img, "Per culling mode, log scale: the paper's depth tests per frame (grey), ours for "
-                            "the queries alone (red, the paper's count) and in total (blue). Read off: the "
-                            "N-buffer modes' query cost is orders of magnitude below the occlusion queries', as in the "
-                            "paper, while their total is dominated by keeping the levels up to date."))
-
-    # ------------------------------------------------------------------------------ walkthrough
-    def walkthrough(self):
-        _, t = self.load_table2() if (self.root / "table2" / "table2.json").exists() else (None, None)
-        base = self.root / "table2"
-        if t is not None:
-            modes = [r["mode"] for r in t["rows"]]
-        elif base.is_dir():
-            modes = sorted_modes(d.name for d in base.iterdir() if (d / "run.json").exists())
-        else:
-            modes = []
-        present = [m for m in modes if (base / m / "run.json").exists()]
-        if not present:
-            raise Missing([f"table2/{m}/run.json" for m in modes] or ["table2/MODE/run.json"])
-        series = {}
-        for m in present:
-            p = base / m / "run.json"
-            run = load_json(p)
-            frames = run.get("frames") if isinstance(run, dict) else None
-            if not isinstance(frames, list) or not frames:
-                raise BadInput(f"{p}: no \"frames\" list (nbsim replay's run.json)")
-            for i, f in enumerate(frames):
-                if not isinstance(f, dict) or not all(isinstance(f.get(k), (int, float))
-                                                      for k in ("frame", "query_depth_tests", "total_depth_tests")):
-                    raise BadInput(f"{p}: frames[{i}] lacks a number for frame, query_depth_tests or total_depth_tests")
-            if isinstance(run.get("nbsim_version"), str):
-                self.versions.add(run["nbsim_version"])
-            self.used(p, "walkthrough")
-            series[m] = frames
-        with open(self.out / "walkthrough.csv", "w", newline="") as f:
-            keys = ["frame", "query_depth_tests", "total_depth_tests", "depth_tests", "update_texels", "cycles"]
-            w = csv.writer(f)
-            w.writerow(["mode"] + keys)
-            for m, frames in series.items():
-                for fr in frames:
-                    w.writerow([m] + [fr.get(k, "") for k in keys])
-        fig, axes = plt.subplots(2, 1, figsize=(8.5, 7), sharex=True, constrained_layout=True)
-        zeros = []
-        for m, frames in series.items():
-            c, ls, mk = mode_style(m)
-            fx = [f["frame"] for f in frames]
-            q = [f["query_depth_tests"] for f in frames]
-            if any(v <= 0 for v in q):
-                zeros.append(m)
-            axes[0].plot(fx, [v if v > 0 else np.nan for v in q], color=c, ls=ls, marker=mk, ms=4, label=m)
-            axes[1].plot(fx, [f["total_depth_tests"] for f in frames], color=c, ls=ls, marker=mk, ms=4, label=m)
-        axes[0].set_yscale("log")
-        axes[0].set_ylabel("query depth tests (log scale)")
-        axes[0].set_title("Visibility queries: the paper's count per frame")
-        if spans_decades([f["total_depth_tests"] for fr in series.values() for f in fr]):
-            axes[1].set_yscale("log")
-            axes[1].set_ylabel("total depth tests (log scale)")
-        else:
-            axes[1].set_ylabel("total depth tests")
-            axes[1].yaxis.set_major_formatter(THOUSANDS)
-        axes[1].set_title("Total: queries + N-buffer/Hi-Z updates + drawn objects")
-        axes[1].set_xlabel("frame of the walkthrough")
-        for ax in axes:
-            ax.grid(which="both", alpha=0.3)
-        axes[0].xaxis.set_major_locator(MaxNLocator(integer=True))
-        axes[0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1), title="culling mode", title_fontsize=8)
-        fig.suptitle("Depth tests per frame along the walkthrough, per culling mode")
-        img = self.save(fig, "walkthrough.png")
-        absent = [m for m in modes if m not in present]
-        note = (f" Missing: {', '.join(f'table2/{m}/run.json' for m in absent)}." if absent else "")
-        note += (f" Frames with no query depth test ({', '.join(zeros)}) are gaps on the log scale." if zeros else "")
-        return (f"<p>Per frame, from <code>table2/MODE/run.json</code> ({len(present)} modes).{html.escape(note)} "
-                'The plotted values are in <a href="walkthrough.csv">walkthrough.csv</a>.</p>' +
-                self.figure(img, "Top: query depth tests per frame (log scale), one line per culling mode; bottom: "
-                            "total depth tests per frame. Read off: the gap between the occlusion-query modes "
-                            "(blue) and the N-buffer modes (red) frame by frame, and which frames of the walk "
-                            "cost the most."))
-
+    # ------------------------------------------------------------------------------ techniques' sections
     def technique_table_path(self, name):
         """DIR/NAME/NAME.json (the demo's layout) or DIR/NAME.json (nbsim NAME TRACE... --out DIR); None when neither is."""
         for p in (self.root / name / f"{name}.json", self.root / f"{name}.json"):
             if p.is_file():
                 return p
         return None
-
-
-
-
-
-
-
-
 
     # ------------------------------------------------------------------------------ sweeps
     def sweep_dirs(self):
@@ -476,7 +328,7 @@ class Report:
             r["label"] = (short_label(r, keys) or "baseline") if varying else r.get("point_id", "")[:8]
             if r["role"] == "reference":
                 r["label"] = "ref " + r["label"]
-        # Error: culling efficiency lost against the reference N-buffer, or the hidden objects not culled.
+        # Error: the technique's headline error (in points of %), or 1 - its fallback quality measure.
         use_eff = has_eff and any(r.get(herr) is not None for r in ok)
         if use_eff:
             for r in rows:
@@ -623,8 +475,8 @@ class Report:
         fig.suptitle(f"Sweep {name}: {label} against error (Pareto front per trace)")
         freeze_layout(fig)
         for ax, pts in label_jobs:
-            # A crowded panel labels only the points worth naming (the front, references, false culls);
-            # the sweep's points table names every point.
+            # A crowded panel labels only the points worth naming (the front, references, points whose
+            # correctness count is not 0); the sweep's points table names every point.
             crowded = len(pts) > MAX_LABELLED_POINTS
             named = [r for r in pts if not crowded or r.get(col) or r["role"] == "reference"
                      or (zero and (r.get(zero) or 0) > 0)]
@@ -751,12 +603,10 @@ def main(argv):
         return 2
     rep.run("table1", "Table 1: N-buffer build cost", rep.table1, root / "table1.jsonl")
     rep.run("figure4", "Figure 4: covering tightness", rep.figure4, root / "figure4_map.csv")
-    rep.run("table2", "Table 2: depth tests per frame in the walkthrough", rep.table2, root / "table2/table2.json")
-    rep.run("walkthrough", "Depth tests per frame along the walkthrough", rep.walkthrough, root / "table2")
     sections = technique_sections()
     for s in sections:
-        rep.run(s.NAME, s.TITLE, lambda s=s: s.section(rep),
-                rep.technique_table_path(s.NAME) or root / s.NAME / f"{s.NAME}.json")
+        for anchor, title, build, main_input in section_entries(rep, s):
+            rep.run(anchor, title, build, main_input)
     dirs = rep.sweep_dirs()
     if not dirs:
         rep.missing.append(("Sweeps (architecture exploration)", ["sweeps/NAME/results.csv"]))
@@ -770,9 +620,9 @@ def main(argv):
             rep.out.rmdir()  # nothing written into it
         except OSError:
             pass
-        tables = ", ".join(f"{s.NAME}/{s.NAME}.json, {s.NAME}.json" for s in sections)
-        print(f"report: nothing usable in {a.dir}: looked for table1.jsonl, figure4_map.csv, table2/table2.json, "
-              f"table2/MODE/run.json, {tables}, sweeps/NAME/results.csv, results.csv", file=sys.stderr)
+        tables = ", ".join(p for s in sections for p in section_inputs(s))
+        print(f"report: nothing usable in {a.dir}: looked for table1.jsonl, figure4_map.csv, "
+              f"{tables}, sweeps/NAME/results.csv, results.csv", file=sys.stderr)
         return 2
     rep.write_html()
     print(f"report: wrote {rep.out / 'index.html'} ({rendered} sections"

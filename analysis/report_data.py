@@ -6,9 +6,6 @@ import json
 import math
 import os
 
-MODE_ORDER = ["oq_hier", "oq", "nb_hier", "nb", "hiz_tile", "hiz_pyramid"]
-# The paper's ratios of depth tests per frame (Table 2: 200 000 / 500 and 1 100 000 / 350).
-RATIO_PAIRS = [("oq", "nb"), ("oq_hier", "nb_hier")]
 # Knobs that change how closely the model follows llvmpipe, not the design under study.
 FIDELITY_KNOBS = ["geometry.batch_triangles", "geometry.fused_viewport", "depth.fused_interpolation",
                   "gpu.quantum_cycles", "gpu.fifo_depth"]
@@ -25,33 +22,11 @@ SHORT = {
 # technique's declared metrics (technique_results.json) are read as numbers too.
 NUMERIC = ["cycles_per_frame", "depth_tests_per_frame", "memory_bytes_per_frame", "nbuffer_bytes_per_frame",
            "fragment_error", "passed_error", "host_seconds", "cycles_per_host_second", "cycle_error", "counter_error"]
-# The declared results of occlusion culling as nbsim wrote them before technique_results.json
-# existed (pipeline/techniques/results.cpp holds the declaration; only what the report reads is
-# here): a sweep folder without that file is read with these. AnalysisTest checks that they agree
-# with the file nbsim explore writes.
-LEGACY_TECHNIQUE = {
-    "technique": "occlusion_culling",
-    "metrics": [{"name": n, "must_be_zero": n == "false_culls"} for n in (
-        "query_depth_tests_per_frame", "update_texels_per_frame", "total_depth_tests_per_frame", "false_culls",
-        "culling_efficiency", "culled", "candidates_not_visible", "max_lookups_per_test", "nbuffer_memory_bytes",
-        "structure_memory_bytes", "efficiency_lost")],
-    "headline_cost": "total_depth_tests_per_frame",
-    "headline_error": "efficiency_lost",
-    "fallback_error": "culling_efficiency",
-    "memory_cost": "nbuffer_memory_bytes",
-    "report": {
-        "error_axis": "culling efficiency lost vs full-res f32 N-buffer (points of %)",
-        "error_text": "culling efficiency lost against the full-resolution float32 N-buffer (efficiency_lost)",
-        "error_column": "efficiency lost (points)",
-        "fallback_axis": "hidden objects not culled (%, = 1 - culling efficiency)",
-        "fallback_text": "hidden objects left unculled, 1 - culling efficiency (no efficiency_lost column)",
-        "fallback_column": "not culled (%)",
-        "cost_axis": "total depth tests per frame", "cost_column": "total depth tests/frame",
-        "cost_pareto": "pareto_depth_tests", "cost_short": "tests",
-        "memory_axis": "N-buffer memory (KiB)", "memory_pareto": "pareto_memory", "memory_short": "memory",
-        "quality_column": "culling efficiency", "must_be_zero": "false culls", "alike": "culls alike",
-    },
-}
+# The labels a technique's declared results must give the report (technique_results.json, "report"):
+# its axes, columns and words, written by nbsim explore from the technique's declaration.
+REPORT_LABELS = ("error_axis", "error_text", "error_column", "fallback_axis", "fallback_text", "fallback_column",
+                 "cost_axis", "cost_column", "cost_pareto", "cost_short", "memory_axis", "memory_pareto",
+                 "memory_short", "quality_column", "must_be_zero", "alike")
 
 
 class BadInput(Exception):
@@ -154,10 +129,6 @@ def short_label(params, keys):
     return " ".join(dict.fromkeys(parts))
 
 
-def sorted_modes(modes):
-    return sorted(modes, key=lambda m: (MODE_ORDER.index(m) if m in MODE_ORDER else len(MODE_ORDER), m))
-
-
 def trace_name(t):
     return os.path.basename(t).removesuffix(".nbt")
 
@@ -198,39 +169,7 @@ def mark_pareto(rows, cost, error):
     return flags
 
 
-def table2_ratios(rows):
-    """Query depth tests per frame of occlusion queries over the N-buffer's, ours beside the paper's."""
-    by = {r["mode"]: r for r in rows}
-    out = []
-    for a, b in RATIO_PAIRS:
-        if a in by and b in by:
-            qa, qb = by[a].get("query_depth_tests_per_frame"), by[b].get("query_depth_tests_per_frame")
-            pa, pb = by[a].get("paper_depth_tests_per_frame"), by[b].get("paper_depth_tests_per_frame")
-            out.append({"ratio": f"{a} / {b}", "ours": qa / qb if qa is not None and qb else None,
-                        "paper": pa / pb if pa is not None and pb else None})
-    return out
-
-
 # -------------------------------------------------------------------------------------- headline
-
-def headline_table2(t, rows, ratios):
-    """Table 2 beside the paper, as Markdown."""
-    lines = [f"Table 2 ({trace_name(str(t.get('trace', '?')))}, settings: {', '.join(t.get('settings') or []) or 'defaults'}): "
-             "depth tests per frame",
-             "",
-             "| mode | paper | query depth tests | total depth tests | cycles | culling efficiency | false culls |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
-    for r in rows:
-        p = r.get("paper_depth_tests_per_frame")
-        lines.append(f"| {r['mode']} | {'-' if not p else format(p, ',.0f')} | {r['query_depth_tests_per_frame']:,.0f} | "
-                     f"{r['total_depth_tests_per_frame']:,.0f} | {r['cycles_per_frame']:,.0f} | "
-                     f"{100 * r['culling_efficiency']:.1f}% | {int(r.get('false_culls') or 0)} |")
-    rt = "; ".join(f"{r['ratio']} {r['ours']:,.0f}x (paper {r['paper']:,.0f}x)" for r in ratios
-                   if r["ours"] is not None and r["paper"] is not None)
-    if rt:
-        lines += ["", f"Occlusion queries over N-buffer, query depth tests: {rt}."]
-    return "\n".join(lines)
-
 
 def cell(r, key, spec):
     """A Markdown table cell: r[key] formatted with `spec`, '-' when absent."""
@@ -240,11 +179,12 @@ def cell(r, key, spec):
 
 def technique_results(d, path):
     """The declared results of the technique of sweep folder d's traces (its technique_results.json,
-    the first technique that declares any), LEGACY_TECHNIQUE when the folder has no such file, or
-    BadInput when its traces' techniques declare no results (no cost or error axis to plot)."""
+    the first technique that declares any); BadInput when the folder has no such file (a sweep run before
+    nbsim explore wrote it) or when its traces' techniques declare no results (no cost or error axis to plot)."""
     f = os.path.join(d, "technique_results.json")
     if not os.path.exists(f):
-        return LEGACY_TECHNIQUE
+        raise BadInput(f"{f}: no such file; nbsim explore writes it beside results.csv (the technique's declared "
+                       "results: its cost, error and labels): re-run the sweep")
     j = load_json(f)
     if not isinstance(j, dict) or not isinstance(j.get("techniques"), list):
         raise BadInput(f"{f}: expected an object with a \"techniques\" list (nbsim explore)")
@@ -257,9 +197,8 @@ def technique_results(d, path):
         raise BadInput(f"{f}: techniques[0] lacks one of {', '.join(need)}")
     if not isinstance(t["metrics"], list) or not all(isinstance(m, dict) and isinstance(m.get("name"), str) for m in t["metrics"]):
         raise BadInput(f"{f}: techniques[0].metrics must be a list of objects with a name")
-    labels = LEGACY_TECHNIQUE["report"].keys()
-    if not isinstance(t["report"], dict) or any(not isinstance(t["report"].get(k), str) for k in labels):
-        raise BadInput(f"{f}: techniques[0].report needs the labels {', '.join(labels)}")
+    if not isinstance(t["report"], dict) or any(not isinstance(t["report"].get(k), str) for k in REPORT_LABELS):
+        raise BadInput(f"{f}: techniques[0].report needs the labels {', '.join(REPORT_LABELS)}")
     return t
 
 
@@ -268,9 +207,9 @@ def kib_key(metric):
     return (metric[:-len("_bytes")] if metric.endswith("_bytes") else metric) + "_kib"
 
 
-def headline_sweep(name, rows, traces, err_label, tech=LEGACY_TECHNIQUE):
+def headline_sweep(name, rows, traces, err_label, tech):
     """The Pareto-optimal points of a sweep (cycles per frame against its error), as a Markdown table;
-    a sweep whose points all cull alike (a fidelity sweep) gets its cycle error and host time instead.
+    a sweep whose points all have one error (a fidelity sweep) gets its cycle error and host time instead.
     tech: the technique's declared results (technique_results)."""
     lab = tech["report"]
     lines = [f"Sweep {name}: Pareto-optimal points, cycles per frame against {err_label}", "",
@@ -280,7 +219,7 @@ def headline_sweep(name, rows, traces, err_label, tech=LEGACY_TECHNIQUE):
     for t in traces:
         ok = [r for r in rows if r["trace"] == t and r["status"] == "ok" and r["role"] == "sweep"]
         errs = {r["error_axis"] for r in ok if r.get("error_axis") is not None}
-        if ok and len(errs) <= 1:  # no culling trade-off here: timing error and speed instead
+        if ok and len(errs) <= 1:  # no trade-off against the error here: timing error and speed instead
             ce = [abs(r["cycle_error"]) for r in ok if r.get("cycle_error") is not None]
             hs = [r["host_seconds"] for r in ok if r.get("host_seconds") is not None]
             alike.append(f"- {trace_name(t)}: every point {lab['alike']}; cycles per frame "

@@ -1,5 +1,6 @@
-"""Plot helpers of nbsim's exploration report (report.py): figure settings, the culling modes' styles,
-and labels placed clear of markers and of each other. Matplotlib runs headless (Agg).
+"""Plot helpers of nbsim's exploration report (report.py): figure settings, and labels placed clear of
+markers and of each other. Matplotlib runs headless (Agg). A technique's own styles live in its section
+module (analysis/techniques/NAME/section.py).
 """
 import math
 
@@ -14,24 +15,6 @@ THOUSANDS = StrMethodFormatter("{x:,.0f}")
 FIGSIZE = (7, 4.5)
 # A cost-against-error panel with more points than this labels only its front (readability).
 MAX_LABELLED_POINTS = 12
-MODE_STYLE = {  # colour, line style, marker: a hierarchical mode is the darker, solid one of its pair
-    "oq_hier": ("#1f4e96", "-", "s"), "oq": ("#6fa8dc", "--", "s"),
-    "nb_hier": ("#b2182b", "-", "o"), "nb": ("#f4a582", "--", "o"),
-    "hiz_tile": ("#1b7837", "-", "^"), "hiz_pyramid": ("#a6dba0", "--", "v"),
-}
-
-RELIEF_STYLE = {  # colour, marker per relief method: the N-buffer walk red as the N-buffer modes, the others apart
-    "binary": ("#7f7f7f", "v"), "exact": ("#1f4e96", "s"), "robust": ("#1b7837", "^"),
-    "robust_clamp": ("#a6dba0", "D"), "nbuffer": ("#b2182b", "o"),
-}
-
-
-def mode_style(mode):
-    return MODE_STYLE.get(mode, ("#555555", "-", "x"))
-
-
-def relief_style(method):
-    return RELIEF_STYLE.get(method, ("#555555", "x"))
 
 
 def spans_decades(values, decades=1.0):

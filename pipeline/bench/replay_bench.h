@@ -11,10 +11,12 @@
 #include <optional>
 #include <string>
 
+#include "traces/capture/technique.h"
+
 namespace nbsim::bench {
 
 struct ReplayBenchOptions {
-  std::string technique = "occlusion_culling";  // a row of the capture's technique table
+  std::string technique = capture::default_technique();  // a row of the capture's technique table
   int frames = 20;
   // Unset: the technique's preset.
   std::optional<std::string> size, scene, path;

@@ -1,8 +1,7 @@
 // `nbsim capture TECHNIQUE --scene NAME --path NAME ...`: record a depth trace with the real GL
 // renderer. One subcommand per row of the technique table; the scene, camera path and technique
-// options come from their tables (traces/capture/technique.h, scenes.h, paths.h). `nbsim capture
-// city ...` is the old spelling of `occlusion_culling --scene city`, kept because recorded command
-// lines (the samples', scripts/golden) use it.
+// options come from their tables (traces/capture/technique.h, scenes.h, paths.h). A row's aliases
+// (CaptureAlias) are subcommands too: another name with the scene fixed.
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -22,8 +21,8 @@ namespace nbsim::cli {
 
 namespace {
 
-// "Scenes (--scene): ...\nCamera paths (--path): ..." from the tables (without the scenes for the
-// old spelling, whose scene is fixed).
+// "Scenes (--scene): ...\nCamera paths (--path): ..." from the tables (without the scenes for an
+// alias, whose scene is fixed).
 std::string tables_footer(bool scenes = true) {
   std::string out;
   if (scenes) {
@@ -65,11 +64,15 @@ void add_plugin_options(CLI::App* cmd, Args& a, const std::vector<std::pair<cons
     }
 }
 
-// One capture subcommand. technique: the row it runs; legacy: the old `city` spelling (scene fixed
-// to city, no --scene).
-void add_capture_subcommand(CLI::App* cap, Action& action, const capture::TechniqueRow& technique, bool legacy) {
+// One capture subcommand. technique: the row it runs; alias: one of its aliases (scene fixed, no
+// --scene), or null for the technique's own subcommand.
+void add_capture_subcommand(CLI::App* cap, Action& action, const capture::TechniqueRow& technique,
+                            const capture::CaptureAlias* alias) {
   auto a = std::make_shared<Args>();
-  CLI::App* cmd = legacy ? cap->add_subcommand("city", "Old spelling of `occlusion_culling --scene city`, kept for recorded command lines")
+  const bool legacy = alias != nullptr;
+  const std::string same = legacy ? fmt::format("nbsim capture {} --scene {}", technique.info.name, alias->scene) : "";
+  if (legacy) a->scene = alias->scene;
+  CLI::App* cmd = legacy ? cap->add_subcommand(alias->name, fmt::format("Old spelling of `{}`, kept for recorded command lines", same))
                          : cap->add_subcommand(technique.info.name, technique.info.description);
   if (!legacy) cmd->add_option("--scene", a->scene, "Scene, by name (below)")->capture_default_str();
   cmd->add_option("--path", a->path, "Camera path, by name (below)")->capture_default_str();
@@ -79,11 +82,11 @@ void add_capture_subcommand(CLI::App* cap, Action& action, const capture::Techni
   cmd->add_option("-o,--out", a->out, "Trace file to write")->required();
   std::vector<std::pair<const capture::PluginInfo*, std::string>> owners;
   for (const auto& s : capture::scene_table())
-    if (!legacy || s.info.name == "city") owners.emplace_back(&s.info, "scene");
+    if (!legacy || s.info.name == alias->scene) owners.emplace_back(&s.info, "scene");
   for (const auto& p : capture::path_table()) owners.emplace_back(&p.info, "path");
   owners.emplace_back(&technique.info, "technique");
   add_plugin_options(cmd, *a, owners);
-  cmd->footer(legacy ? "Same as: nbsim capture occlusion_culling --scene city [options]; traces are identical.\n" + tables_footer(false)
+  cmd->footer(legacy ? "Same as: " + same + " [options]; traces are identical.\n" + tables_footer(false)
                      : tables_footer());
   const std::string technique_name = technique.info.name;
   cmd->callback([&action, a, technique_name] {
@@ -122,11 +125,16 @@ void add_capture_subcommand(CLI::App* cap, Action& action, const capture::Techni
 void add_capture_command(CLI::App& app, Action& action) {
   auto* cap = app.add_subcommand("capture", "Record depth traces with the headless GL renderer on Mesa");
   cap->require_subcommand(1);
-  for (const auto& t : capture::technique_table()) add_capture_subcommand(cap, action, t, false);
-  add_capture_subcommand(cap, action, capture::find_technique("occlusion_culling"), true);
-  cap->footer("Usage: nbsim capture TECHNIQUE [--scene NAME] [--path NAME] [options] -o OUT  (TECHNIQUE --help lists its options)\n"
-              "`nbsim capture city ...` is the old spelling of `nbsim capture occlusion_culling --scene city ...`.\n" +
-              tables_footer());
+  std::string aliases;
+  for (const auto& t : capture::technique_table()) add_capture_subcommand(cap, action, t, nullptr);
+  for (const auto& t : capture::technique_table())
+    for (const capture::CaptureAlias& alias : t.aliases) {
+      add_capture_subcommand(cap, action, t, &alias);
+      aliases += fmt::format("`nbsim capture {} ...` is the old spelling of `nbsim capture {} --scene {} ...`.\n", alias.name,
+                             t.info.name, alias.scene);
+    }
+  cap->footer("Usage: nbsim capture TECHNIQUE [--scene NAME] [--path NAME] [options] -o OUT  (TECHNIQUE --help lists its options)\n" +
+              aliases + tables_footer());
 }
 
 }  // namespace nbsim::cli

@@ -22,7 +22,6 @@ void add_capture_command(CLI::App& app, Action& action);
 void add_model_commands(CLI::App& app, Action& action);
 void add_explore_command(CLI::App& app, Action& action);
 void add_report_command(CLI::App& app, Action& action);
-void add_ldi_commands(CLI::App& app, Action& action);
 
 // "X,Y,W,H" -> Rect; throws InputError naming the text.
 Rect parse_rect(const std::string& text);

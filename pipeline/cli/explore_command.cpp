@@ -24,6 +24,7 @@
 #include "pipeline/explore/runner.h"
 #include "pipeline/explore/slurm.h"
 #include "pipeline/explore/sweep.h"
+#include "pipeline/techniques/results.h"
 #include "pipeline/sim/gpu.h"
 
 namespace nbsim::cli {
@@ -322,11 +323,14 @@ void add_explore_command(CLI::App& app, Action& action) {
                   "points not counted)")
       ->check(CLI::Range(std::uint64_t{1}, std::numeric_limits<std::uint64_t>::max()))
       ->capture_default_str();
+  std::string references = "Each technique's reference (pipeline/techniques/<name>/results.cpp):\n";
+  for (const techniques::TechniqueResults& t : techniques::technique_results())
+    references += t.reference ? fmt::format("  {}: {} against {}\n", t.technique, t.headline_error, t.reference->description)
+                              : fmt::format("  {}: none declared\n", t.technique);
   cmd->footer("Sweep file: {\"traces\": [...], \"set\": {key: value}, \"axes\": {key: [values]}} (every combination)\n"
               "or {\"traces\": [...], \"points\": [{key: value, \"trace\": optional}, ...]}; keys as `nbsim config\n"
               "--defaults` lists them. Exit 0 when every point ran, 1 when some failed (see results.csv), 2 on a bad sweep.\n"
-              "Errors in results.csv: the columns the trace's technique declares (pipeline/techniques/results.cpp;\n"
-              "occlusion_culling: efficiency_lost against nb_hier on the full-resolution float32 N-buffer, every level),\n"
+              "Errors in results.csv: the columns the trace's technique declares against its reference (below),\n"
               "cycle_error against gpu.quantum_cycles=0, batch 85, FMA on, counter_error against GL's counters; a\n"
               "reference the sweep lacks is run as an extra point (role=reference). A trace whose technique declares no\n"
               "results gets the generic columns only (a note says so). Plots and Pareto fronts: nbsim report DIR.\n"
@@ -335,7 +339,8 @@ void add_explore_command(CLI::App& app, Action& action) {
               "states; a task that fails or is cancelled is recorded in results.csv with its reason. DIR, the sweep file,\n"
               "the traces and this nbsim executable must be on a file system every node sees at the same path. Ctrl-C\n"
               "cancels the arrays (scancel) and exits 130. No sbatch, no answer from the cluster or an SLURM_CONF that\n"
-              "does not parse: exit 2. Resume works across engines: points done by either are not run again.");
+              "does not parse: exit 2. Resume works across engines: points done by either are not run again.\n" +
+              references);
   cmd->callback([&action, o, cmd] {
     o->max_points_set = cmd->count("--max-points") > 0;
     o->jobs_set = cmd->count("--jobs") > 0;

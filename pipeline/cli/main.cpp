@@ -13,6 +13,7 @@
 #include "model/common/error.h"
 #include "model/config/json_input.h"
 #include "pipeline/cli/command.h"
+#include "pipeline/techniques/ldi/ldi_command.h"
 #include "pipeline/techniques/particles/table_command.h"
 #include "pipeline/techniques/relief/table_command.h"
 #include "pipeline/techniques/shadows/table_command.h"

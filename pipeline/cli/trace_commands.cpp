@@ -116,7 +116,7 @@ ojson frame_json(const FrameSummary& s) {
   o["gl_ms"] = s.gl_ms;
   o["depth"] = s.depths;
   o["levels"] = s.level_json;
-  // Version 2's records only when the frame has them (occlusion-culling summaries stay as they were).
+  // Version 2's records only when the frame has them (summaries of frames without them stay as they were).
   if (!s.stencils.empty()) o["stencil"] = s.stencils;
   if (s.light) o["light"] = true;
   if (!s.technique_records.empty()) o["technique_records"] = s.technique_records;

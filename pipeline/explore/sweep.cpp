@@ -277,8 +277,8 @@ void add_reference_points(std::vector<Point>& points, const std::vector<std::str
   for (std::size_t i = 0; i < sweep_points; ++i) {
     const techniques::TechniqueResults* t = techniques::find_technique_results(points[i].technique);
     if (t && t->reference && has_reference(*t->reference, points[i].effective)) {
-      // One reference for every variant the setting does not name (for occlusion culling, every
-      // mode: the flat nb query's loss shows too); keys under reset_prefixes mean nothing to it
+      // One reference for every variant the setting does not name (e.g. every test mode, so a
+      // flat query's loss shows too); keys under reset_prefixes mean nothing to it
       // (the Hi-Z keys): they go back to their defaults, one reference for all their variants.
       nlohmann::json overrides = t->reference->settings;
       for (const auto& [k, v] : defaults.items())

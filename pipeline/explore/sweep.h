@@ -43,8 +43,8 @@ struct Point {
   std::string technique;
   // Ids of the points this one's errors are measured against (itself when it is its own
   // reference; empty when there is none): see add_reference_points. technique_reference is the
-  // technique's reference setting (results.csv names its column after the declaration:
-  // culling_reference for occlusion culling), timing_reference the generic timing one.
+  // technique's reference setting (results.csv names its column after the declaration's
+  // ReferenceSetting::column), timing_reference the generic timing one.
   std::string technique_reference, timing_reference;
 };
 
@@ -80,10 +80,10 @@ void check_points(const SweepSpec& spec, std::vector<Point>& points, const Confi
 std::vector<std::string> parameter_keys(const SweepSpec& spec);
 
 // The settings each point's errors are measured against (results.csv):
-//  - the technique's: its declared reference setting (pipeline/techniques/results.h; for occlusion
-//    culling cull.mode=nb_hier on the full-resolution float32 N-buffer with every level, the Hi-Z
-//    keys at their defaults, none in the trace and none modes). A point whose technique declares
-//    no reference has none. Its derived errors (efficiency_lost) compare the two points.
+//  - the technique's: its declared reference setting (pipeline/techniques/results.h
+//    ReferenceSetting; `nbsim explore --help` lists each technique's). A point whose technique
+//    declares no reference, or whose value of the reference's skip_key is one of its skip_values,
+//    has none. Its derived errors (efficiency_lost) compare the two points.
 //  - timing, for every technique: the model's most detailed fidelity (timing_reference_settings():
 //    no temporal decoupling, llvmpipe's batch size, fused multiply-adds as llvmpipe on FMA hosts).
 //    cycle_error = (cycles - reference cycles) / reference cycles.

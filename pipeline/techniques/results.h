@@ -52,8 +52,8 @@ struct Metric {
   Derivation derivation = Derivation::None;
   // For a derived error: the column that shows the reference point's value of `source`.
   std::string reference_column;
-  // A correctness count that must be 0 for a conservative technique (false culls, popping, shadow
-  // mask differences): table2 exits 1 and the report flags the point otherwise.
+  // A correctness count that must be 0 for a conservative technique (false culls, popping, mask
+  // pixels unlike GL's): table2 exits 1 and the report flags the point otherwise.
   bool must_be_zero = false;
 };
 
@@ -76,8 +76,8 @@ struct TableRow {
   std::string value;
   std::string paper_label;
   std::optional<double> paper;
-  // Settings changed for this row only when the user's config has a given value (the occlusion
-  // query rows cannot cull per primitive: cull.granularity=primitive runs them per object).
+  // Settings changed for this row only when the user's config has a given value (e.g. a row
+  // whose test cannot run per primitive sets cull.granularity back to object).
   struct Override {
     std::string key, when, set;
   };

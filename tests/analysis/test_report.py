@@ -42,6 +42,8 @@ def png_size(path):
 
 
 def write_sweep(d, name, header, rows, parameters):
+    """A sweep folder as nbsim explore writes it: results.csv, sweep.json and technique_results.json (the
+    fixture's, occlusion culling's declared results)."""
     s = Path(d) / "sweeps" / name
     s.mkdir(parents=True)
     with open(s / "results.csv", "w", newline="") as f:
@@ -49,6 +51,7 @@ def write_sweep(d, name, header, rows, parameters):
         w.writerow(header)
         w.writerows(rows)
     (s / "sweep.json").write_text(json.dumps({"name": name, "nbsim_version": "test", "parameters": parameters}))
+    shutil.copy(FIXTURE / "sweeps" / "small" / "technique_results.json", s)
     return s
 
 
@@ -348,7 +351,8 @@ class FutureColumns(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d:
             s = Path(d) / "sweeps" / "res"
             s.mkdir(parents=True)
-            shutil.copy(FIXTURE / "sweeps" / "nbuffer_resolution" / "sweep.json", s)
+            for name in ["sweep.json", "technique_results.json"]:
+                shutil.copy(FIXTURE / "sweeps" / "nbuffer_resolution" / name, s)
             with open(s / "results.csv", "w", newline="") as f:
                 w = csv.DictWriter(f, fieldnames=header)
                 w.writeheader()
@@ -424,6 +428,8 @@ class ShortLabels(unittest.TestCase):
 
 
 class Table2Ratio(unittest.TestCase):
+    """table2_ratios of the occlusion culling section (analysis/techniques/occlusion/section.py)."""
+
     def test_ratio_against_paper(self):
         # oq/nb and oq_hier/nb_hier from query depth tests, beside the paper's 400x and 3143x
         rows = [{"mode": "oq", "query_depth_tests_per_frame": 20000.0, "paper_depth_tests_per_frame": 200000.0},
@@ -431,7 +437,7 @@ class Table2Ratio(unittest.TestCase):
                 {"mode": "oq_hier", "query_depth_tests_per_frame": 3000.0, "paper_depth_tests_per_frame": 1100000.0},
                 {"mode": "nb_hier", "query_depth_tests_per_frame": 300.0, "paper_depth_tests_per_frame": 350.0},
                 {"mode": "hiz_tile", "query_depth_tests_per_frame": 700.0, "paper_depth_tests_per_frame": None}]
-        r = {x["ratio"]: x for x in report_data.table2_ratios(rows)}
+        r = {x["ratio"]: x for x in SECTIONS["occlusion"].table2_ratios(rows)}
         self.assertAlmostEqual(r["oq / nb"]["ours"], 50.0)
         self.assertAlmostEqual(r["oq / nb"]["paper"], 400.0)
         self.assertAlmostEqual(r["oq_hier / nb_hier"]["ours"], 10.0)
@@ -439,7 +445,7 @@ class Table2Ratio(unittest.TestCase):
 
     def test_ratio_needs_both_modes(self):
         # without nb there is no oq/nb ratio (not a division by a missing row)
-        self.assertEqual(report_data.table2_ratios([{"mode": "oq", "query_depth_tests_per_frame": 1.0}]), [])
+        self.assertEqual(SECTIONS["occlusion"].table2_ratios([{"mode": "oq", "query_depth_tests_per_frame": 1.0}]), [])
 
 
 class TechniqueDeclarations(unittest.TestCase):
@@ -453,17 +459,19 @@ class TechniqueDeclarations(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
-    def test_legacy_declaration_matches_what_explore_writes(self):
-        # folders without the file are read with LEGACY_TECHNIQUE: it must say what nbsim declares
-        legacy = report_data.LEGACY_TECHNIQUE
-        for name in ["small", "nbuffer_resolution", "fidelity"]:
-            j = json.loads((FIXTURE / "sweeps" / name / "technique_results.json").read_text())
-            self.assertEqual(len(j["techniques"]), 1, name)
-            t = j["techniques"][0]
-            for k in ["technique", "headline_cost", "headline_error", "fallback_error", "memory_cost", "report"]:
-                self.assertEqual(t[k], legacy[k], f"{name}: {k} differs from LEGACY_TECHNIQUE")
-            self.assertEqual([(m["name"], m["must_be_zero"]) for m in t["metrics"]],
-                             [(m["name"], m["must_be_zero"]) for m in legacy["metrics"]], name)
+    def test_sweep_without_declaration_exit_2(self):
+        # a sweep folder without technique_results.json (run before nbsim explore wrote it): exit 2 naming the
+        # file and what writes it; the other sweeps are still rendered
+        for name in ["small", "fidelity"]:
+            shutil.copytree(FIXTURE / "sweeps" / name, self.dir / "sweeps" / name)
+        (self.dir / "sweeps" / "small" / "technique_results.json").unlink()
+        rc, _, err = run_report(self.dir)
+        self.assertBroken(rc, err, str(Path("sweeps") / "small" / "technique_results.json"))
+        self.assertIn("nbsim explore writes it", err)
+        self.assertIn("re-run the sweep", err)
+        html = (self.dir / "report" / "index.html").read_text()
+        self.assertIn("fidelity_cycles_vs_error.png", html, "the sweep with its declaration is still rendered")
+        self.assertNotIn("small_cycles_vs_error.png", html)
 
     def test_metric_names_come_from_the_declaration(self):
         # a made-up technique with its own names: its columns are plotted, labelled and flagged

@@ -1,70 +1,58 @@
 #!/usr/bin/env python3
-"""Shared code names no technique: a ratchet on the way there.
+"""Shared code names no technique.
 
 The shared folders (the replay's top level, the command line, benches, sweeps, the results
-declarations, the report, the trace format's core and the capture's core) should not name a
-technique (particles, shadows, LDIs, relief, occlusion culling); a technique's code lives in its
-own folders. Today they still do. technique_names_baseline.json holds, per shared file, how many
-mentions it has; this check fails when a file has more than its baseline (a new mention), when a
-shared file that is not in the baseline names a technique, and when a file has fewer (the baseline
-must follow the progress down: run this script with --update and commit the baseline).
+declarations, the report, the trace format's core and the capture's core) do not name a technique
+(particles, shadows, LDIs, relief, occlusion culling): a technique's code lives in its own folders
+(a folder named after it, below any of them), and each layer lists its techniques in one
+registration file, the only shared file allowed to name them:
 
-Usage: check_technique_names.py ROOT [--update]
+  traces/format/technique_chunks.cpp   chunk types and header keys
+  traces/capture/techniques.cpp        captures, bench presets, capture aliases
+  pipeline/sim/programs.cpp            frame programs, their config groups, structure instances
+  pipeline/techniques/results.cpp      results declarations
+  pipeline/cli/main.cpp                table commands
+
+The report's sections need no list: analysis/report.py discovers analysis/techniques/<name>/.
+Exits 1 naming every other shared file that names a technique, with the line.
+
+Usage: check_technique_names.py ROOT
 """
-import json
 import pathlib
 import re
 import sys
 
-root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 and not sys.argv[1].startswith("--") else ".")
-update = "--update" in sys.argv[1:]
-baseline_path = pathlib.Path(__file__).with_name("technique_names_baseline.json")
+root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
 
-# Shared folders: every file below them, except the technique folders named in TECHNIQUE_DIRS.
 SHARED = ["pipeline/sim", "pipeline/cli", "pipeline/bench", "pipeline/explore", "pipeline/techniques",
           "analysis", "traces/format", "traces/capture"]
 TECHNIQUE_DIRS = {"occlusion", "particles", "shadows", "ldi", "relief"}
+REGISTRATION = {"traces/format/technique_chunks.cpp", "traces/capture/techniques.cpp", "pipeline/sim/programs.cpp",
+                "pipeline/techniques/results.cpp", "pipeline/cli/main.cpp"}
 SUFFIXES = {".h", ".cpp", ".py"}
 # "ldi" only at the start of a word or identifier part (LdiUnit, model::ldi, ldi_table), not in "building".
 MENTION = re.compile(r"particle|shadow|relief|occlusion|(?<![a-z])ldi", re.IGNORECASE)
 
-
-def counts():
-    found = {}
-    for top in SHARED:
-        for path in sorted((root / top).rglob("*")):
-            if path.suffix not in SUFFIXES or not path.is_file():
-                continue
-            rel = path.relative_to(root)
-            if any(part in TECHNIQUE_DIRS for part in rel.parts[len(pathlib.Path(top).parts):-1]):
-                continue
-            n = len(MENTION.findall(path.read_text(errors="replace")))
-            if n:
-                found[rel.as_posix()] = n
-    return found
-
-
-now = counts()
-if update:
-    baseline_path.write_text(json.dumps(dict(sorted(now.items())), indent=1) + "\n")
-    print(f"{baseline_path.name}: {sum(now.values())} mentions in {len(now)} shared files")
-    sys.exit(0)
-
-baseline = json.loads(baseline_path.read_text())
 offences = []
-for name, n in sorted(now.items()):
-    was = baseline.get(name, 0)
-    if n > was:
-        offences.append(f"{name}: names a technique {n} times, {was} in the baseline: "
-                        "a technique's code goes into its own folder, registered in one list")
-    elif n < was:
-        offences.append(f"{name}: {n} mentions, {was} in the baseline: lower the baseline "
-                        f"(python3 {pathlib.Path(__file__).name} ROOT --update)")
-for name, was in sorted(baseline.items()):
-    if name not in now:
-        offences.append(f"{name}: no mentions left (or gone), {was} in the baseline: lower the baseline "
-                        f"(python3 {pathlib.Path(__file__).name} ROOT --update)")
+listed = 0
+for top in SHARED:
+    for path in sorted((root / top).rglob("*")):
+        if path.suffix not in SUFFIXES or not path.is_file():
+            continue
+        rel = path.relative_to(root)
+        if any(part in TECHNIQUE_DIRS for part in rel.parts[len(pathlib.Path(top).parts):-1]):
+            continue
+        lines = path.read_text(errors="replace").splitlines()
+        hits = [(i + 1, line.strip()) for i, line in enumerate(lines) if MENTION.search(line)]
+        if rel.as_posix() in REGISTRATION:
+            listed += len(hits)
+            continue
+        offences += [f"{rel.as_posix()}:{n}: names a technique: {text[:120]}" for n, text in hits]
+missing = [r for r in sorted(REGISTRATION) if not (root / r).is_file()]
+for r in missing:
+    offences.append(f"{r}: the registration file is gone: move the list or update REGISTRATION in this script")
 for o in offences:
     print(o)
-print(f"shared code names a technique {sum(now.values())} times in {len(now)} files (goal: only the registration list)")
+print(f"shared code: {len(offences)} mentions of a technique outside the registration lists "
+      f"({listed} lines in the {len(REGISTRATION)} lists)")
 sys.exit(1 if offences else 0)

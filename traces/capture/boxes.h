@@ -1,4 +1,4 @@
-// The simple scene of the shadow-volume experiments (the paper's "simpler scenes", 4.4): boxes of
+// The N-buffer paper's "simpler scenes" (4.4): boxes of
 // random size standing on a square plane (one open quad, a receiver only). Deterministic for a seed.
 #pragma once
 

@@ -12,11 +12,12 @@
 
 #include "traces/capture/camera.h"
 #include "traces/capture/plugin.h"
+#include "traces/capture/technique.h"
 
 namespace nbsim::capture {
 
 struct CaptureOptions {
-  std::string technique = "occlusion_culling";
+  std::string technique = default_technique();
   std::string scene = "city";
   std::string path = "walk";
   int width = 512;

@@ -50,7 +50,7 @@ class DrawRecorder {
   scene::DrawRecord& record(std::size_t slot) { return draws_[slot]; }
   std::size_t size() const noexcept { return draws_.size(); }
 
-  // GL_SAMPLES_PASSED of a slot's draw, waiting for it (the round trip occlusion queries stall on).
+  // GL_SAMPLES_PASSED of a slot's draw, waiting for it (the GPU-to-CPU round trip a query result costs).
   std::uint64_t samples_passed(std::size_t slot) const;
 
   // A counter slot past every recorded one, for passes whose counts are not recorded.

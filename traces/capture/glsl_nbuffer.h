@@ -1,10 +1,10 @@
 // The GLSL N-buffer the capture techniques share (N-buffer paper, Fig. 2 and section 3.2): built
 // from a depth texture by one full-screen pass per level (shaders/common/nbuffer_build.frag, each
-// pass a recorded draw), up to a level cap (the paper's partial build for particles: only the
-// levels the largest sprite needs); queried in batches of rectangles by a compute shader
-// (shaders/common/nbuffer_query.comp, occlusion culling's bounds tests) or sampled by a technique's
-// own shaders (texture()), read back as the trace's level record. Levels are R32F; max under LESS,
-// min under reversed Z, and one of each over the shadows technique's max and min litmaps. Texels
+// pass a recorded draw), up to a level cap (the paper's partial build: only the levels the largest
+// query needs); queried in batches of rectangles by a compute shader
+// (shaders/common/nbuffer_query.comp: bounds tests) or sampled by a technique's own shaders
+// (texture()), read back as the trace's level record. Levels are R32F; max under LESS, min under
+// reversed Z, or either over any depth-like texture a technique renders. Texels
 // outside the image are skipped, never read (the paper's border value: +inf for a min N-buffer,
 // -inf for a max one), so the same level chain serves both ops.
 #pragma once

@@ -1,5 +1,5 @@
 // A chain of R32F levels that full-screen passes build one level at a time from a depth texture
-// (the GLSL N-buffer, the particles' Hi-Z pyramid): level k is rendered into its own 2D texture and
+// (the GLSL N-buffer, a Hi-Z pyramid): level k is rendered into its own 2D texture and
 // then copied into layer k of one 2D array texture, which the next pass and the technique's
 // queries read, so no pass reads the texture it writes. Each pass is a recorded draw.
 #pragma once

@@ -16,7 +16,7 @@
 namespace nbsim::capture {
 
 struct RendererOptions {
-  std::string technique = "occlusion_culling";
+  std::string technique = default_technique();
   int width = 512;
   int height = 512;
   Projection projection;

@@ -59,7 +59,7 @@ const std::vector<SceneRow>& scene_table() {
       {{"terrain", "Heightfield terrain with towers and many small flying casters (birds), most out of view (N-buffer paper, 4.4)",
         {seed_option(), kTowers, kBirds}},
        make_terrain_scene},
-      {{"boxes", "Boxes on a plane: the simple scene of the shadow-volume experiments (N-buffer paper, 4.4)", {seed_option(), kBoxes}},
+      {{"boxes", "Boxes on a plane: the N-buffer paper's simpler scenes (4.4)", {seed_option(), kBoxes}},
        make_boxes_scene},
   };
   return table;

@@ -38,7 +38,7 @@ struct CapturedFrame {
   // For techniques that cull objects: every object they drew, sorted. The capture checks that
   // each object the ground truth sees is among them (a conservative technique culls none).
   std::optional<std::vector<std::uint32_t>> rendered_objects;
-  // Counts the technique reports for the frame by name (particles: culled, popping, ...), summed
+  // Counts the technique reports for the frame by name (e.g. culled, popping), summed
   // over the capture into CaptureSummary::technique_counts and printed by `nbsim capture`.
   std::vector<std::pair<std::string, std::uint64_t>> counts;
 };
@@ -68,14 +68,25 @@ struct BenchPreset {
   std::string mode_option;  // the capture option the bench's --mode sets ("": --mode is refused)
 };
 
+// Another name of a technique's capture with its scene fixed: `nbsim capture ALIAS ...` is
+// `nbsim capture TECHNIQUE --scene SCENE ...`, kept where recorded command lines use the old name.
+struct CaptureAlias {
+  std::string name;
+  std::string scene;
+};
+
 struct TechniqueRow {
   PluginInfo info;
   // Throws InputError on bad option values.
   std::function<std::unique_ptr<Technique>(const TechniqueSetup&)> make;
   BenchPreset bench;
+  std::vector<CaptureAlias> aliases;
 };
 
+// The registration list (techniques.cpp); its first row is the default technique.
 const std::vector<TechniqueRow>& technique_table();
+// The name of the table's first row: what a capture or bench runs when no technique is named.
+const std::string& default_technique();
 // Throws InputError listing the known techniques.
 const TechniqueRow& find_technique(std::string_view name);
 

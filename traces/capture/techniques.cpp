@@ -14,7 +14,7 @@ const std::vector<TechniqueRow>& technique_table() {
       {{"occlusion_culling",
         "Occlusion culling with occlusion queries or the GLSL N-buffer, flat or over the BVH (N-buffer paper, 3.1 and 4.2)",
         occlusion_culling_options()},
-       make_occlusion_culling, occlusion_culling_bench_preset()},
+       make_occlusion_culling, occlusion_culling_bench_preset(), {{"city", "city"}}},
       {{"particles",
         "Point-sprite particles culled in the vertex stage: none, centre lookup, partial N-buffer or Hi-Z, with a "
         "reference pass for popping (N-buffer paper, 3.2 and 4.3)",
@@ -39,6 +39,8 @@ const std::vector<TechniqueRow>& technique_table() {
   };
   return table;
 }
+
+const std::string& default_technique() { return technique_table().front().info.name; }
 
 const TechniqueRow& find_technique(std::string_view name) { return find_row(technique_table(), name, "technique"); }
 

@@ -1,4 +1,4 @@
-// The terrain of the shadow-volume experiments (N-buffer paper, 4.4): a heightfield ground (one
+// The N-buffer paper's terrain scene (4.4): a heightfield ground (one
 // open object, a receiver only) with towers standing on it and many small flying casters (birds,
 // closed octahedra) at 15 to 60 m above it, scattered over an area nine times the terrain's, so
 // most of them are out of the camera's and the light's view. Deterministic for a seed.

@@ -117,13 +117,8 @@ const std::vector<Key>& keys() {
        [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
          h.depth_clear = static_cast<float>(real(k, v, e, 0.0, 1.0, false));
        }},
-      {"technique", "text", "occlusion_culling", "the technique the capture ran",
+      {"technique", "text", "{technique}", "the technique the capture ran",
        [](Header& h, std::string_view, std::string_view v, std::string_view) { h.technique = std::string(v); }},
-      {"test_mode", "one of oq, oq_hier, nb, nb_hier, none", "nb_hier", "occlusion culling's test mode",
-       [](Header& h, std::string_view k, std::string_view v, std::string_view e) {
-         h.test_mode = scene::parse_test_mode(v);
-         if (!h.test_mode) refuse(k, v, e);
-       }},
       {"scene", "text", "city", "the scene",
        [](Header& h, std::string_view, std::string_view v, std::string_view) { h.scene = std::string(v); }},
       {"seed", "a whole number, at least 0", "1", "the scene's and path's random seed",
@@ -157,7 +152,7 @@ const std::vector<Key>& keys() {
          if (!h.covering) refuse(k, v, e);
        }},
       {"nbsim_version", "text", "0.1.0", "the capturing nbsim's version", nullptr},
-      {"command_line", "text", "nbsim capture occlusion_culling --scene city --frames 60 -o walk.nbtrace", "the capture's command line", nullptr},
+      {"command_line", "text", "nbsim capture {technique} --scene city --frames 60 -o walk.nbtrace", "the capture's command line", nullptr},
   };
   return table;
 }
@@ -250,8 +245,15 @@ Header parse_header(const Properties& properties) {
 }
 
 std::string header_keys_table() {
+  // "{technique}" in a core key's example: the first technique that declares keys.
+  const std::string technique = technique_header_keys().empty() ? "NAME" : technique_header_keys().front().technique;
+  const auto example = [&](std::string_view e) {
+    std::string s(e);
+    if (const auto at = s.find("{technique}"); at != std::string::npos) s.replace(at, 11, technique);
+    return s;
+  };
   std::string t = "| Key | Values | Example | Meaning |\n|-----|--------|---------|---------|\n";
-  for (const Key& k : keys()) t += fmt::format("| `{}` | {} | `{}` | {} |\n", k.name, k.values, k.example, k.meaning);
+  for (const Key& k : keys()) t += fmt::format("| `{}` | {} | `{}` | {} |\n", k.name, k.values, example(k.example), k.meaning);
   t += "\nThe keys each technique declares, checked only in a trace of that technique (a trace of another "
        "technique, or one without a technique, keeps them as free text):\n\n"
        "| Technique | Key | Values | Example | Meaning |\n|-----------|-----|--------|---------|---------|\n";

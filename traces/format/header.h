@@ -27,8 +27,7 @@ struct Header {
   DepthFunc depth_func = DepthFunc::Less;       // "depth_func": GL name, "LESS", "GREATER", ...
   ClipControl clip_control = ClipControl::NegativeOneToOne;  // "clip_control": "NEGATIVE_ONE_TO_ONE" or "ZERO_TO_ONE"
   float depth_clear = 1.0f;                     // "depth_clear": 0 .. 1
-  std::string technique;                        // "technique": "occlusion_culling"
-  std::optional<TestMode> test_mode;            // "test_mode": "oq", "oq_hier", "nb", "nb_hier", "none"
+  std::string technique;                        // "technique": a capture technique's name
   std::string scene;                            // "scene": "city"
   std::string path;                             // "path": the camera path, "walk"
   std::optional<std::uint64_t> seed;            // "seed"

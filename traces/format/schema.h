@@ -41,7 +41,7 @@ inline constexpr std::int32_t kMaxLevels = 32;
 // (FRAM excluded, FEND included) decode to at most kFrameBaseBytes plus kFrameBytesPerPixel bytes
 // a pixel of the header's viewport (Header::frame_byte_limit; a 1024x1024 viewport when the
 // header has none), and hold at most kMaxDrawsPerFrame draws. Derived from the largest real
-// frames: a 2048x2048 occlusion-culling frame holds two depth images (8 bytes a pixel), 11 N-buffer
+// frames: a 2048x2048 frame with a bounds-test pass holds two depth images (8 bytes a pixel), 11 N-buffer
 // planes (44), an ID buffer (4) and a few MiB of draws, about 60 bytes a pixel; the city's frames
 // have about 15,000 draws of 1 KiB or less. Twice that leaves room for a stencil image or a
 // second level set.

@@ -15,6 +15,7 @@
 #include "traces/format/bytes.h"
 #include "traces/format/codec.h"
 #include "traces/format/ldi/ldi_chunk.h"
+#include "traces/format/occlusion/occlusion_keys.h"
 #include "traces/format/particles/particles_chunk.h"
 #include "traces/format/relief/relief_chunk.h"
 #include "traces/format/shadows/shadows_chunk.h"
@@ -43,7 +44,8 @@ std::vector<ChunkSpec> built_in_chunks() {
 // Their header keys, in the same order.
 std::vector<HeaderKeySpec> built_in_header_keys() {
   std::vector<HeaderKeySpec> keys;
-  for (std::vector<HeaderKeySpec> (*of)() : {particles_header_keys, shadows_header_keys, ldi_header_keys, relief_header_keys})
+  for (std::vector<HeaderKeySpec> (*of)() : {occlusion_culling_header_keys, particles_header_keys, shadows_header_keys, ldi_header_keys,
+                                                     relief_header_keys})
     for (HeaderKeySpec& k : of()) keys.push_back(std::move(k));
   return keys;
 }

@@ -29,8 +29,8 @@ struct FieldSpec {
 
 struct ChunkSpec {
   std::uint32_t type = 0;    // fourcc("PRTC"): four printable ASCII characters, not a core type
-  std::string technique;     // "particles"
-  std::string record;        // "ParticleCulling"
+  std::string technique;     // the trace header's "technique" of the traces that hold it
+  std::string record;        // the record's name in FORMAT.md and messages
   std::vector<FieldSpec> fields;
   // A rule the decoded fields keep beyond their types (e.g. vectors of one length), or null: why a
   // record breaks it, empty when it keeps it. The reader refuses a record that breaks it
@@ -42,8 +42,8 @@ struct ChunkSpec {
 const TechniqueField* find_field(const TechniqueRecord& record, std::string_view name);
 
 // For a spec's rule: why a vector field of `record` (other than the fields named in `scalars`) does
-// not have `count` elements ("field 'x' has 2 elements, but count is 3 (one a particle)", with
-// `one_a` = "particle"), or empty when every one has.
+// not have `count` elements ("field 'x' has 2 elements, but count is 3 (one a sprite)", with
+// `one_a` = "sprite"), or empty when every one has.
 std::string vector_lengths_problem(const TechniqueRecord& record, std::uint64_t count, std::initializer_list<std::string_view> scalars,
                                    std::string_view one_a);
 

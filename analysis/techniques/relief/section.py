@@ -9,7 +9,7 @@ puts analysis/ on the import path first.
 import csv
 import html
 
-from report_plots import (THOUSANDS, freeze_layout, place_labels, relief_style)  # first: it selects the headless backend
+from report_plots import (THOUSANDS, freeze_layout, place_labels)  # first: it selects the headless backend
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.ticker import MaxNLocator
@@ -21,6 +21,14 @@ ORDER = 4  # the sections' order on the page and in headline.md
 
 
 RELIEF_METHODS = ["binary", "exact", "robust", "robust_clamp", "nbuffer"]
+RELIEF_STYLE = {  # colour, marker per relief method: the N-buffer walk red as the N-buffer modes, the others apart
+    "binary": ("#7f7f7f", "v"), "exact": ("#1f4e96", "s"), "robust": ("#1b7837", "^"),
+    "robust_clamp": ("#a6dba0", "D"), "nbuffer": ("#b2182b", "o"),
+}
+
+
+def relief_style(method):
+    return RELIEF_STYLE.get(method, ("#555555", "x"))
 
 
 # relief.json (nbsim relief TRACE... --out; pipeline/techniques/relief/relief_table.h): an object of these lists. Per

@@ -557,4 +557,14 @@ inline std::vector<std::size_t> chunk_offsets(const Bytes& b) {
   return at;
 }
 
+// A trace holding only a header with these properties (and its end), in memory.
+inline Bytes header_only(const Properties& props) {
+  Bytes b;
+  const auto pre = encode_preamble(kFormatVersion);
+  b.assign(pre.begin(), pre.end());
+  for (const Bytes& c : {encode_chunk(ChunkType::Header, encode(props)), encode_chunk(ChunkType::End, encode(EndMarker{1, 0}))})
+    b.insert(b.end(), c.begin(), c.end());
+  return b;
+}
+
 }  // namespace nbsim::trace::testing
