@@ -13,6 +13,7 @@
 #include "model/common/error.h"
 #include "model/ldi/vpt.h"
 #include "model/scene/technique_record.h"
+#include "model/ldi/roles.h"
 
 namespace nbsim::ldi {
 
@@ -207,7 +208,7 @@ LdiFrameCounts run_frame(const scene::Frame& f, PeelReplay& peel) {
   // 1. The peel, pass by pass.
   peel.begin_frame();
   for (const scene::DrawRecord& d : f.draws) {
-    if (d.role != scene::DrawRole::LdiPeel) continue;
+    if (d.role != kLdiPeelRole) continue;
     if (d.topology != scene::Topology::Triangles || d.clip_positions.size() % 3 != 0)
       throw InputError(fmt::format("frame {}: peel draw {} is not a list of triangles", frame, d.index));
     const PeelPassCounts p = peel.pass(d.clip_positions, draw_state(d.state));

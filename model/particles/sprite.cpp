@@ -12,6 +12,7 @@
 #include "model/common/names.h"
 #include "model/raster/point_setup.h"
 #include "model/scene/technique_record.h"
+#include "model/particles/roles.h"
 
 namespace nbsim::particles {
 
@@ -160,7 +161,7 @@ FrameParticles read_particles(const scene::Frame& f) {
   std::size_t p = 0;
   for (std::size_t i = 0; i < f.draws.size(); ++i) {
     const scene::DrawRecord& d = f.draws[i];
-    if (d.role != scene::DrawRole::Particles) continue;
+    if (d.role != kParticlesRole) continue;
     const std::size_t n = d.clip_positions.size();
     points += n;
     for (std::size_t k = 0; k < n; ++k, ++p)

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "model/common/error.h"
+#include "model/particles/roles.h"
 
 namespace nbsim::particles {
 
@@ -110,7 +111,7 @@ void ParticlesUnit::depth_written(const cp::Work& w, const DepthImage& depth, co
 void ParticlesUnit::draw_finished(const cp::Work& w, const depth::DrawResult& r) {
   ++completed_;
   const scene::DrawRecord& d = w.record();
-  if (d.role == scene::DrawRole::Particles) {
+  if (d.role == kParticlesRole) {
     particle_fragments_ += r.depth.depth_tests;
     particle_passed_ += r.depth.passed;
   } else if (d.role == scene::DrawRole::Scene) {
@@ -284,7 +285,7 @@ void ParticlesUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::
   std::size_t first = 0;  // the draw's first particle
   for (std::size_t i = 0; i < f->draws.size(); ++i) {
     const scene::DrawRecord& d = f->draws[i];
-    if (d.role == scene::DrawRole::Particles) {
+    if (d.role == kParticlesRole) {
       ++particle_draws_;
       issue_particle_draw(f, static_cast<std::uint32_t>(i), fp, first, cp);
       first += d.clip_positions.size();

@@ -15,6 +15,7 @@
 #include "model/common/error.h"
 #include "model/nbuffer/nbuffer.h"
 #include "model/scene/technique_record.h"
+#include "model/relief/roles.h"
 
 namespace nbsim::relief {
 
@@ -170,7 +171,7 @@ std::vector<GlReliefFragments> read_relief_fragments(const scene::Frame& f, std:
     std::size_t d = 0;
     while (d < f.draws.size() && f.draws[d].index != draw) ++d;
     if (d == f.draws.size()) throw bad(fmt::format("draw {} is not a draw of the frame ({} draws)", draw, f.draws.size()));
-    if (f.draws[d].role != scene::DrawRole::ReliefBox)
+    if (f.draws[d].role != kReliefBoxRole)
       throw bad(fmt::format("draw {} is a {} draw, not a relief_box draw", draw, scene::to_string(f.draws[d].role)));
     if (record_of_draw[d] != f.technique_records.size()) throw bad(fmt::format("draw {} already has its fragments in an earlier record", draw));
     record_of_draw[d] = r;
@@ -196,7 +197,7 @@ std::vector<GlReliefFragments> read_relief_fragments(const scene::Frame& f, std:
     out.push_back(std::move(g));
   }
   for (std::size_t d = 0; d < f.draws.size(); ++d)
-    if (f.draws[d].role == scene::DrawRole::ReliefBox && record_of_draw[d] == f.technique_records.size())
+    if (f.draws[d].role == kReliefBoxRole && record_of_draw[d] == f.technique_records.size())
       throw InputError(fmt::format("frame {}: relief_box draw {} has no {} record", frame, f.draws[d].index, kFragmentsLabel));
   return out;
 }

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "model/common/error.h"
+#include "model/relief/roles.h"
 
 namespace nbsim::relief {
 
@@ -58,7 +59,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       ++out.scene_draws;
       continue;
     }
-    if (d.role != scene::DrawRole::ReliefBox) continue;
+    if (d.role != kReliefBoxRole) continue;
     if (d.topology != scene::Topology::Triangles || d.clip_positions.size() % 3 != 0)
       throw InputError(fmt::format("frame {}: relief_box draw {} is not a list of triangles", f.begin.frame, d.index));
     if (next_record >= records.size() || records[next_record].draw != d.index)

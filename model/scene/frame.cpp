@@ -2,15 +2,15 @@
 #include "model/scene/frame.h"
 
 #include "model/common/names.h"
+#include "model/scene/technique_roles.h"
 
 namespace nbsim::scene {
 
 namespace {
 
 // One name table per enum, indexed by the enum's fixed value.
-constexpr std::array<std::string_view, 15> kRoleNames = {"occluder",      "bounds_query", "node_query",    "nbuffer_build", "nbuffer_query",
-                                                         "visible",       "id_buffer",    "scene",         "particles",     "hiz_build",
-                                                         "shadow_volume", "litmap",       "receiver_splat", "ldi_peel", "relief_box"};
+constexpr std::array<std::string_view, kFirstTechniqueRole> kRoleNames = {
+    "occluder", "bounds_query", "node_query", "nbuffer_build", "nbuffer_query", "visible", "id_buffer", "scene"};
 constexpr std::array<std::string_view, 2> kDepthWhichNames = {"after_occluders", "final"};
 constexpr std::array<std::string_view, 8> kDepthFuncNames = {"never",   "less",     "equal",  "lequal",
                                                              "greater", "notequal", "gequal", "always"};
@@ -48,7 +48,12 @@ const NBufferLevels* Frame::nbuffer(std::string_view source, FarOp op) const noe
   return nullptr;
 }
 
-std::string_view to_string(DrawRole role) noexcept { return enum_name(kRoleNames, role); }
+std::string_view to_string(DrawRole role) noexcept {
+  if (static_cast<std::uint8_t>(role) < kFirstTechniqueRole) return enum_name(kRoleNames, role);
+  for (const RoleName& r : kTechniqueRoles)
+    if (r.role == role) return r.name;
+  return "?";
+}
 std::string_view to_string(TestMode mode) noexcept { return enum_name(kTestModeNames, mode); }
 std::optional<TestMode> parse_test_mode(std::string_view s) noexcept { return parse_enum_name<TestMode>(kTestModeNames, s); }
 std::string_view to_string(DepthWhich which) noexcept { return enum_name(kDepthWhichNames, which); }

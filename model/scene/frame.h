@@ -41,7 +41,9 @@ enum class DepthFunc : std::uint8_t { Never = 0, Less = 1, Equal = 2, Lequal = 3
 enum class CullFace : std::uint8_t { None = 0, Back = 1, Front = 2, FrontAndBack = 3 };
 enum class ClipControl : std::uint8_t { NegativeOneToOne = 0, ZeroToOne = 1 };
 
-// What a draw is for, in the frame's technique.
+// What a draw is for, in the frame's technique. The core roles below are fixed; a technique
+// declares its own (values from kFirstTechniqueRole on) in its folder (model/<name>/roles.h), and
+// model/scene/technique_roles.h lists them all: the DRAW record's role is any of both.
 enum class DrawRole : std::uint8_t {
   Occluder = 0,       // objects visible last frame, drawn first to fill the depth buffer
   BoundsQuery = 1,    // an object's bounding box rasterized inside an occlusion query
@@ -50,14 +52,14 @@ enum class DrawRole : std::uint8_t {
   NBufferQuery = 4,   // bounds tested against the N-buffer (4 lookups each) in a shader
   Visible = 5,        // an object the technique found visible, drawn for the final image
   IdBuffer = 6,       // the ground-truth ID-buffer pass (every object in the frustum, nothing culled)
-  Scene = 7,          // a scene object drawn to fill the depth buffer, nothing culled (particles)
-  Particles = 8,      // point sprites, depth test on, depth write off, culled in the vertex stage (particles)
-  HiZBuild = 9,       // a full-screen pass building one level of a Hi-Z max/min mip pyramid (particles' hiz mode)
-  ShadowVolume = 10,  // a caster's stencil shadow volume (shadows): z-fail, two-sided, depth write off, depth clamp
-  Litmap = 11,        // a scene object drawn from the light into a litmap, observer-hidden fragments discarded (shadows)
-  ReceiverSplat = 12, // the observer's receivers as one-pixel points from the light into a litmap (shadows)
-  LdiPeel = 13,       // one depth-peeling pass of a shape into an LDI layer (ldi): orthographic, LEQUAL, strict test against the previous layer in the shader
-  ReliefBox = 14,     // a relief box drawn with one ray-walk method (relief): early fragment tests, depth write off, every fragment casts its ray, a miss discards
+  Scene = 7,          // a scene object drawn to fill the depth buffer, nothing culled
+};
+inline constexpr std::uint8_t kFirstTechniqueRole = 8;
+
+// A technique's draw role and its name (in traces, dumps and messages).
+struct RoleName {
+  DrawRole role;
+  std::string_view name;
 };
 
 // The culling technique a frame ran: the Table 2 modes (docs/architecture.md, "Definitions").

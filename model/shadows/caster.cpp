@@ -11,6 +11,7 @@
 #include "model/common/error.h"
 #include "model/common/names.h"
 #include "model/scene/technique_record.h"
+#include "model/shadows/roles.h"
 
 namespace nbsim::shadows {
 
@@ -113,7 +114,7 @@ FrameCasters read_casters(const scene::Frame& f) {
       throw InputError(fmt::format("frame {}: caster {}'s rectangle ({}, {}) {}x{} is not inside the {}x{} litmap", frame, i, c.x[i],
                                    c.y[i], c.w[i], c.h[i], size, size));
     if (c.draw[i] >= 0 && (static_cast<std::size_t>(c.draw[i]) >= f.draws.size() ||
-                           f.draws[static_cast<std::size_t>(c.draw[i])].role != scene::DrawRole::ShadowVolume))
+                           f.draws[static_cast<std::size_t>(c.draw[i])].role != kShadowVolumeRole))
       throw InputError(fmt::format("frame {}: caster {} names draw {}, which is not a shadow_volume draw of the frame", frame, i,
                                    c.draw[i]));
     if (c.draw[i] < -1) throw InputError(fmt::format("frame {}: caster {}'s draw {} is below -1", frame, i, c.draw[i]));

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "model/common/error.h"
+#include "model/shadows/roles.h"
 
 namespace nbsim::shadows {
 
@@ -89,7 +90,7 @@ void ShadowsUnit::depth_cleared(float) {
 void ShadowsUnit::draw_finished(const cp::Work& w, const depth::DrawResult& r) {
   ++completed_;
   const scene::DrawRecord& d = w.record();
-  if (d.role == scene::DrawRole::ShadowVolume) {
+  if (d.role == kShadowVolumeRole) {
     fill_ += r.depth.fragments;
     gl_fill_ += d.gl.fragments;
     stencil_tests_ += r.stencil.tests;
@@ -108,7 +109,7 @@ void ShadowsUnit::issue_role(const std::shared_ptr<const scene::Frame>& f, scene
     w->frame = f;
     w->draw = static_cast<std::uint32_t>(i);
     ++issued_;
-    if (role == scene::DrawRole::ShadowVolume) ++volume_draws_;
+    if (role == kShadowVolumeRole) ++volume_draws_;
     cp.issue_draw(std::move(w));
   }
 }
@@ -223,8 +224,8 @@ void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Co
   // 2. The litmap pass: GL's images; its reprojections are its fragments (no clip positions), and
   //    the receiver splat's points (one observer texel read each) are its fragments.
   for (const scene::DrawRecord& d : f->draws)
-    if (d.role == scene::DrawRole::Litmap) ++litmap_draws_, litmap_reprojections_ += d.gl.fragments;
-    else if (d.role == scene::DrawRole::ReceiverSplat) receiver_splats_ += d.gl.fragments;
+    if (d.role == kLitmapRole) ++litmap_draws_, litmap_reprojections_ += d.gl.fragments;
+    else if (d.role == kReceiverSplatRole) receiver_splats_ += d.gl.fragments;
   // 3. Both N-buffers from the litmaps (each unit's engine builds while the scene is drawn).
   build_texels_ += build(min_nb_, *f, "litmap_min");
   build_texels_ += build(max_nb_, *f, "litmap_max");
@@ -235,7 +236,7 @@ void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Co
   max_nb_.unit().drain();
   ++frames_;
   // 5. The volumes, after the scene's depth (the draws keep their order in the pipeline).
-  issue_role(f, scene::DrawRole::ShadowVolume, cp);
+  issue_role(f, kShadowVolumeRole, cp);
   wait_all();
   // 6. The shadow mask from the model's stencil buffer.
   compare_masks(*f);

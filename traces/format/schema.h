@@ -24,6 +24,7 @@
 #include <string_view>
 
 #include "model/common/depth.h"
+#include "model/scene/technique_roles.h"
 #include "traces/format/records.h"
 
 namespace nbsim::trace {
@@ -62,7 +63,7 @@ struct Element {
 // come from the model's one name table per enum (to_string).
 template <class E> struct EnumInfo;
 template <> struct EnumInfo<TestMode> { static constexpr const char* name = "TestMode"; static constexpr unsigned max = 4; };
-template <> struct EnumInfo<DrawRole> { static constexpr const char* name = "DrawRole"; static constexpr unsigned max = 14; };
+template <> struct EnumInfo<DrawRole> { static constexpr const char* name = "DrawRole"; static constexpr unsigned max = scene::kMaxDrawRole; };
 template <> struct EnumInfo<DepthFunc> { static constexpr const char* name = "DepthFunc"; static constexpr unsigned max = 7; };
 template <> struct EnumInfo<CullFace> { static constexpr const char* name = "CullFace"; static constexpr unsigned max = 3; };
 template <> struct EnumInfo<ClipControl> { static constexpr const char* name = "ClipControl"; static constexpr unsigned max = 1; };

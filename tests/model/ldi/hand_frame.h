@@ -20,6 +20,7 @@
 #include "model/mesh/crossings.h"
 #include "model/mesh/mesh.h"
 #include "model/scene/frame.h"
+#include "model/ldi/roles.h"
 
 namespace nbsim::ldi::testing {
 
@@ -45,7 +46,7 @@ inline mesh::Vec3d texel_point(int x, int y, int w, int h, double d) {
 inline scene::DrawRecord peel_draw(const std::vector<std::array<float, 4>>& clip, std::uint32_t index) {
   scene::DrawRecord d;
   d.index = index;
-  d.role = scene::DrawRole::LdiPeel;
+  d.role = nbsim::ldi::kLdiPeelRole;
   d.state.func = scene::DepthFunc::Lequal;
   d.state.cull = scene::CullFace::None;
   d.state.clip = scene::ClipControl::ZeroToOne;

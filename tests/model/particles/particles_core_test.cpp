@@ -6,6 +6,7 @@
 
 #include "model/common/error.h"
 #include "model/particles/sprite.h"
+#include "model/particles/roles.h"
 
 namespace nbsim::particles {
 namespace {
@@ -107,7 +108,7 @@ TEST(ParticlesCoreTest, NBufferTestableUpToTheTopLevel) {
 scene::Frame particle_frame(std::uint32_t points, std::uint64_t count) {
   scene::Frame f;
   scene::DrawRecord d;
-  d.role = scene::DrawRole::Particles;
+  d.role = nbsim::particles::kParticlesRole;
   d.topology = scene::Topology::Points;
   d.clip_positions.assign(points, {0.0f, 0.0f, 0.5f, 1.0f});
   d.point_sizes.assign(points, 16.0f);

@@ -14,6 +14,7 @@
 #include "model/common/error.h"
 #include "model/nbuffer/nbuffer.h"
 #include "model/relief/records.h"
+#include "model/relief/roles.h"
 
 namespace nbsim::relief {
 namespace {
@@ -98,7 +99,7 @@ scene::Frame sample_frame() {
   scene::Frame f;
   f.begin.frame = kFrame;
   f.end.frame = kFrame;
-  f.draws = {draw(0, scene::DrawRole::Scene), draw(1, scene::DrawRole::ReliefBox), draw(2, scene::DrawRole::ReliefBox)};
+  f.draws = {draw(0, scene::DrawRole::Scene), draw(1, nbsim::relief::kReliefBoxRole), draw(2, nbsim::relief::kReliefBoxRole)};
   f.end.draws = 3;
   f.technique_records = {field_record(), fragments_record(1, 0), fragments_record(2, 4)};
   return f;

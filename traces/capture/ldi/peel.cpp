@@ -13,6 +13,7 @@
 #include "nbsim_shaders.h"
 #include "traces/capture/draw_recorder.h"
 #include "traces/capture/gl_program.h"
+#include "model/ldi/roles.h"
 
 namespace nbsim::capture {
 namespace {
@@ -167,7 +168,7 @@ PeelResult peel_ldi(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, const
     GLuint64 passed = 0;
     if (recorder) {
       scene::DrawRecord d;
-      d.role = scene::DrawRole::LdiPeel;
+      d.role = nbsim::ldi::kLdiPeelRole;
       d.state.func = scene::DepthFunc::Lequal;
       d.state.test = true;
       d.state.write = true;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "nbsim_shaders.h"
+#include "model/particles/roles.h"
 
 namespace nbsim::capture {
 
@@ -37,7 +38,7 @@ GlslHiZ::~GlslHiZ() { glDeleteProgram(build_prog_); }
 void GlslHiZ::build(GLuint depth_texture, DrawRecorder& recorder, const scene::DepthState& state) {
   // Level k reads level k - 1, whose size the shader needs for its edge texels.
   const GLint u_size = glGetUniformLocation(build_prog_, "source_size");
-  chain_.build(build_prog_, depth_texture, recorder, scene::DrawRole::HiZBuild, state, [&](int k) {
+  chain_.build(build_prog_, depth_texture, recorder, nbsim::particles::kHiZBuildRole, state, [&](int k) {
     glUniform2i(u_size, level_side(width_, std::max(k - 1, 0)), level_side(height_, std::max(k - 1, 0)));
   });
 }

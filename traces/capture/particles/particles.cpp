@@ -25,6 +25,7 @@
 #include "traces/capture/render_target.h"
 #include "traces/capture/scene_pass.h"
 #include "traces/format/particles/particles_chunk.h"
+#include "model/particles/roles.h"
 
 namespace nbsim::capture {
 
@@ -319,7 +320,7 @@ CapturedFrame Particles::render(std::uint32_t index, const CameraPose& pose) {
   for (const Emitter& e : emitters_) {
     if (e.count == 0) continue;
     DrawRecord d;
-    d.role = DrawRole::Particles;
+    d.role = nbsim::particles::kParticlesRole;
     d.state = depth_state(reversed_, false, true);
     d.state.cull = scene::CullFace::None;  // points have no faces
     const std::size_t slot = recorder_.begin_draw(std::move(d), e.count, GL_POINTS);

@@ -8,6 +8,7 @@
 #include "traces/capture/glsl_nbuffer.h"
 #include "traces/capture/gl_program.h"
 #include "nbsim_shaders.h"
+#include "model/relief/roles.h"
 
 namespace nbsim::capture {
 
@@ -164,7 +165,7 @@ GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, 
   glUniform4fv(glGetUniformLocation(p, "ray_qc"), 1, view.ray.qc.data());
 
   scene::DrawRecord d;
-  d.role = scene::DrawRole::ReliefBox;
+  d.role = nbsim::relief::kReliefBoxRole;
   d.state.func = scene::DepthFunc::Less;
   d.state.test = true;
   d.state.write = false;

@@ -31,6 +31,7 @@
 #include "traces/capture/render_target.h"
 #include "traces/capture/scene_pass.h"
 #include "traces/format/relief/relief_chunk.h"
+#include "model/relief/roles.h"
 
 namespace nbsim::capture {
 namespace {
@@ -376,7 +377,7 @@ class Relief final : public Technique {
     std::map<std::uint32_t, relief::ReferenceHit> references;
     std::size_t box = 0;
     for (const scene::DrawRecord& d : f.draws) {
-      if (d.role != scene::DrawRole::ReliefBox) continue;
+      if (d.role != nbsim::relief::kReliefBoxRole) continue;
       const relief::Method m = methods_[box];
       const GlFragments& g = gl[box++];
       std::uint64_t errors = 0, lookups = 0, hits = 0;

@@ -28,6 +28,7 @@
 #include "traces/capture/shadows/volumes.h"
 #include "traces/format/header.h"
 #include "traces/format/shadows/shadows_chunk.h"
+#include "model/shadows/roles.h"
 
 namespace nbsim::capture {
 
@@ -482,7 +483,7 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
     glDepthMask(GL_TRUE);
     for (auto o : lit_and_seen) {
       DrawRecord d;
-      d.role = DrawRole::Litmap;
+      d.role = nbsim::shadows::kLitmapRole;
       d.object = static_cast<std::int32_t>(o);
       d.state = depth_state(false, true, true);
       d.state.func = max ? scene::DepthFunc::Gequal : scene::DepthFunc::Lequal;
@@ -499,7 +500,7 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
     // light's frustum as a one-pixel point, same depth func; back to the litmap program after.
     glUseProgram(splat_prog_);
     DrawRecord d;
-    d.role = DrawRole::ReceiverSplat;
+    d.role = nbsim::shadows::kReceiverSplatRole;
     d.state = depth_state(false, true, true);
     d.state.func = max ? scene::DepthFunc::Gequal : scene::DepthFunc::Lequal;
     d.state.cull = scene::CullFace::None;
@@ -567,7 +568,7 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   for (std::size_t c = 0; c < casters_.size(); ++c) {
     if (ranges[c].second == 0) continue;
     DrawRecord d;
-    d.role = DrawRole::ShadowVolume;
+    d.role = nbsim::shadows::kShadowVolumeRole;
     d.object = static_cast<std::int32_t>(casters_[c].object);
     d.state = depth_state(false, false, true);
     d.state.cull = scene::CullFace::None;
@@ -650,7 +651,7 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
 
   std::uint64_t fill = 0, drawn = 0, culled = 0, lookups = 0;
   for (const DrawRecord& d : f.draws)
-    if (d.role == DrawRole::ShadowVolume) fill += d.gl.fragments, ++drawn;
+    if (d.role == nbsim::shadows::kShadowVolumeRole) fill += d.gl.fragments, ++drawn;
   if (mode_ == Mode::Infinite) reference_fill = fill;
   const auto n = casters_.size();
   std::vector<std::uint32_t> object(n), lk(n), decision(n);

@@ -24,6 +24,7 @@
 #include "traces/capture/ldi/test_points.h"
 #include "traces/format/ldi/ldi_chunk.h"
 #include "tests/common/gl_context_suite.h"
+#include "model/ldi/roles.h"
 
 namespace nbsim::capture {
 namespace {
@@ -160,7 +161,7 @@ TEST_F(LdiBuildTest, PeelPassesAreRecorded) {
   ASSERT_EQ(b.peel.ldi.layer_count(), 4) << "two shells: d = 4";
   for (std::size_t k = 0; k < draws.size(); ++k) {
     const scene::DrawRecord& d = draws[k];
-    EXPECT_EQ(d.role, scene::DrawRole::LdiPeel);
+    EXPECT_EQ(d.role, nbsim::ldi::kLdiPeelRole);
     EXPECT_EQ(d.clip_positions.size(), 3 * m.triangles.size()) << "pass " << k;
     EXPECT_EQ(d.state.func, scene::DepthFunc::Lequal);
     EXPECT_EQ(d.state.cull, scene::CullFace::None);

@@ -21,6 +21,7 @@
 #include "traces/format/particles/particles_chunk.h"
 #include "traces/format/reader.h"
 #include "tests/common/scratch.h"
+#include "model/particles/roles.h"
 
 namespace nbsim::capture {
 namespace {
@@ -103,7 +104,7 @@ Totals check_trace(const fs::path& file, const std::string& mode, std::uint32_t 
     }
     for (const auto& d : f->draws) {
       EXPECT_LE(d.gl.samples_passed, d.gl.fragments) << "draw " << d.index;
-      if (d.role != trace::DrawRole::Particles) continue;
+      if (d.role != nbsim::particles::kParticlesRole) continue;
       EXPECT_EQ(d.topology, trace::Topology::Points);
       EXPECT_EQ(d.clip_positions.size(), d.point_sizes.size()) << "gl_Position and gl_PointSize a vertex";
       EXPECT_EQ(d.gl.clip_prims_in, d.clip_positions.size()) << "one point a vertex";

@@ -23,6 +23,7 @@
 #include "traces/format/reader.h"
 #include "traces/format/shadows/shadows_chunk.h"
 #include "tests/common/scratch.h"
+#include "model/shadows/roles.h"
 
 namespace nbsim::capture {
 namespace {
@@ -92,7 +93,7 @@ std::vector<FrameResult> check_trace(const fs::path& file, const std::string& mo
     for (std::uint8_t t : f->stencil("light_region")->texels) region_pixels += t;
     std::vector<std::uint64_t> splats;
     for (const auto& d : f->draws)
-      if (d.role == trace::DrawRole::ReceiverSplat) {
+      if (d.role == nbsim::shadows::kReceiverSplatRole) {
         splats.push_back(d.gl.fragments);
         EXPECT_EQ(d.topology, trace::Topology::Points);
         EXPECT_TRUE(d.state.write) << "the splat writes the litmap's depth";
@@ -100,7 +101,7 @@ std::vector<FrameResult> check_trace(const fs::path& file, const std::string& mo
     EXPECT_EQ(splats, std::vector<std::uint64_t>(2, region_pixels)) << "frame " << f->begin.frame << ": one point per receiver, per litmap";
     for (const auto& d : f->draws) {
       EXPECT_LE(d.gl.samples_passed, d.gl.fragments) << "draw " << d.index;
-      if (d.role != trace::DrawRole::ShadowVolume) continue;
+      if (d.role != nbsim::shadows::kShadowVolumeRole) continue;
       r.fill += d.gl.fragments;
       volume_draws[static_cast<std::int32_t>(d.index)] = true;
       EXPECT_TRUE(d.stencil.test && d.state.depth_clamp && !d.state.write) << "z-fail volumes: stencil, depth clamp, no depth writes";

@@ -9,6 +9,7 @@
 #include "model/relief/records.h"
 #include "tests/traces/format/chunk_builder.h"
 #include "traces/format/relief/relief_chunk.h"
+#include "model/relief/roles.h"
 
 namespace {
 
@@ -79,7 +80,7 @@ TEST(ReliefChunkTest, DecodedAndDamageRefused) {
   EXPECT_EQ(kReliefFragmentsChunk, nbsim::relief::kReliefFragmentsRecordType) << "model/relief/records.h names RLFF by its fourcc";
   const Properties P;
   DrawRecord box = sample_draw(0, 6);
-  box.role = DrawRole::ReliefBox;
+  box.role = nbsim::relief::kReliefBoxRole;
   box.state.write = false;
   box.discards = true;
   // HEAD, FRAM, DRAW (the relief box), RLFH, RLFF, FEND, END: a relief frame as the capture writes it.
