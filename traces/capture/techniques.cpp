@@ -19,23 +19,23 @@ const std::vector<TechniqueRow>& technique_table() {
         "Point-sprite particles culled in the vertex stage: none, centre lookup, partial N-buffer or Hi-Z, with a "
         "reference pass for popping (N-buffer paper, 3.2 and 4.3)",
         particles_options()},
-       make_particles, particles_bench_preset()},
+       make_particles, particles_bench_preset(), {}},
       {{"shadows",
         "Stencil shadow volumes of a spot light (z-fail, two-sided): infinite, culled or clamped with min/max litmaps and "
         "two N-buffers, with an infinite reference pass for the mask (N-buffer paper, 3.3 and 4.4)",
         shadows_options()},
-       make_shadows, shadows_bench_preset()},
+       make_shadows, shadows_bench_preset(), {}},
       {{"ldi",
         "Layered depth images of a closed shape: viewpoint selection, depth peeling, crop, RG32UI depth-range compression and "
         "the volumetric parity test with both readers against an exact reference (Trapp & Doellner)",
         ldi_options()},
-       make_ldi, ldi_bench_preset()},
+       make_ldi, ldi_bench_preset(), {}},
       {{"relief",
         "Relief textures: a heightfield in a box, each fragment's ray walked by binary search, the exact cell walk, the "
         "robust search with safety radii (two zero-radius variants) or the N-buffer empty-space walk, scored against an "
         "exact reference (Baboud & Decoret; the N-buffer paper's future work)",
         relief_options()},
-       make_relief, relief_bench_preset()},
+       make_relief, relief_bench_preset(), {}},
   };
   return table;
 }

@@ -184,7 +184,10 @@ relief::Heightfield read_square(const std::string& file, const char* what) {
 
 std::string join(const std::vector<double>& v) {
   std::string s;
-  for (double a : v) s += (s.empty() ? "" : ",") + fmt::format("{}", a);
+  for (double a : v) {
+    if (!s.empty()) s += ',';
+    s += fmt::format("{}", a);  // appended, not "," + ...: GCC 12's -Wstringop-overflow misreads that form
+  }
   return s;
 }
 
@@ -267,7 +270,10 @@ class Relief final : public Technique {
 
   trace::Properties variant_properties() const override {
     std::string methods;
-    for (relief::Method m : methods_) methods += (methods.empty() ? "" : ",") + std::string(relief::to_string(m));
+    for (relief::Method m : methods_) {
+      if (!methods.empty()) methods += ',';
+      methods += relief::to_string(m);
+    }
     return {{"relief_field", description_}, {"relief_methods", methods}, {"relief_placement", city_ ? "city" : "own"}};
   }
   trace::Properties setting_properties() const override {
