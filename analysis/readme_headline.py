@@ -34,8 +34,10 @@ SAMPLES = "traces/samples"
 
 
 def technique_modules():
-    """Every analysis/techniques/<name>/headline.py (ORDER, collect(run), rows(data)), in ORDER: a
-    technique adds its README rows there, without editing this file."""
+    """Every analysis/techniques/<name>/headline.py, in ORDER: a technique adds its README rows there,
+    without editing this file. A module has ORDER; collect(run), where run(*nbsim arguments) returns
+    the command's JSON output (run from the repository's root), returning the data its rows need;
+    and rows(data), returning its rows as (what, result, command, link)."""
     modules = []
     for path in sorted((Path(__file__).resolve().parent / "techniques").glob("*/headline.py")):
         spec = importlib.util.spec_from_file_location(f"nbsim_headline_{path.parent.name}", path)

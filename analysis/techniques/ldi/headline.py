@@ -1,8 +1,6 @@
 """The layered depth images' row of README.md's headline table: the sphere of the paper's Table 1, on GL.
 
-Loaded by analysis/readme_headline.py with every analysis/techniques/<name>/headline.py: ORDER,
-collect(run) (run(*nbsim arguments) returns the command's JSON output) and rows(data) (the README
-rows: what, result, command, link).
+The module protocol (ORDER, collect, rows) is in analysis/readme_headline.py.
 """
 
 ORDER = 3

@@ -1,8 +1,6 @@
 """Occlusion culling's rows of README.md's headline table: Table 2 and the culling ladder, on the walkthrough sample.
 
-Loaded by analysis/readme_headline.py with every analysis/techniques/<name>/headline.py: ORDER,
-collect(run) (run(*nbsim arguments) returns the command's JSON output) and rows(data) (the README
-rows: what, result, command, link).
+The module protocol (ORDER, collect, rows) is in analysis/readme_headline.py.
 """
 
 ORDER = 0
