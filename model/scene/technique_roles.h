@@ -1,16 +1,15 @@
-// The registration list of the techniques' draw roles (each declared in model/<name>/roles.h),
-// after the core roles of frame.h: their names, and the largest role value a DRAW record may hold.
+// The techniques' draw roles (each declared in model/<name>/roles.h as kRoles), after the core
+// roles of frame.h, in the registration list's order: their names, and the largest role value a
+// DRAW record may hold.
 #pragma once
 
 #include <algorithm>
 #include <array>
 #include <cstddef>
 
-#include "model/ldi/roles.h"
-#include "model/particles/roles.h"
-#include "model/relief/roles.h"
 #include "model/scene/frame.h"
-#include "model/shadows/roles.h"
+#include "nbsim/technique_list.h"
+#include "nbsim/technique_roles_list.h"
 
 namespace nbsim::scene {
 
@@ -26,7 +25,9 @@ constexpr auto join_roles(const std::array<RoleName, N>&... lists) {
 
 }  // namespace detail
 
-inline constexpr auto kTechniqueRoles = detail::join_roles(particles::kRoles, shadows::kRoles, ldi::kRoles, relief::kRoles);
+#define NBSIM_TECHNIQUE_ROLES(name) name::kRoles,
+inline constexpr auto kTechniqueRoles = detail::join_roles(NBSIM_EACH_TECHNIQUE(NBSIM_TECHNIQUE_ROLES) std::array<RoleName, 0>{});
+#undef NBSIM_TECHNIQUE_ROLES
 
 // The technique roles take the values after the core ones, each once, in the list's order.
 constexpr bool technique_roles_contiguous() {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "model/common/rect.h"
+#include "nbsim/technique_list.h"
 
 namespace nbsim::cli {
 
@@ -22,6 +23,12 @@ void add_capture_command(CLI::App& app, Action& action);
 void add_model_commands(CLI::App& app, Action& action);
 void add_explore_command(CLI::App& app, Action& action);
 void add_report_command(CLI::App& app, Action& action);
+
+// Each technique of the registration list (cmake/NbsimTechniques.cmake) defines
+// add_<name>_commands(), its own commands (e.g. its table), in pipeline/techniques/<name>/.
+#define NBSIM_DECLARE_TECHNIQUE_COMMANDS(name) void add_##name##_commands(CLI::App& app, Action& action);
+NBSIM_EACH_TECHNIQUE(NBSIM_DECLARE_TECHNIQUE_COMMANDS)
+#undef NBSIM_DECLARE_TECHNIQUE_COMMANDS
 
 // "X,Y,W,H" -> Rect; throws InputError naming the text.
 Rect parse_rect(const std::string& text);

@@ -13,10 +13,6 @@
 #include "model/common/error.h"
 #include "model/config/json_input.h"
 #include "pipeline/cli/command.h"
-#include "pipeline/techniques/ldi/ldi_command.h"
-#include "pipeline/techniques/particles/table_command.h"
-#include "pipeline/techniques/relief/table_command.h"
-#include "pipeline/techniques/shadows/table_command.h"
 #include "io/output_folder.h"
 
 namespace nbsim::cli {
@@ -99,11 +95,10 @@ int main(int argc, char** argv) {
   cli::add_model_commands(app, action);
   cli::add_explore_command(app, action);
   cli::add_report_command(app, action);
-  // Each technique's own table command (pipeline/techniques/<name>/).
-  cli::add_particles_command(app, action);
-  cli::add_shadows_command(app, action);
-  cli::add_relief_command(app, action);
-  cli::add_ldi_commands(app, action);
+  // Each technique's own commands (pipeline/techniques/<name>/), in the registration list's order.
+#define NBSIM_TECHNIQUE_COMMANDS(name) cli::add_##name##_commands(app, action);
+  NBSIM_EACH_TECHNIQUE(NBSIM_TECHNIQUE_COMMANDS)
+#undef NBSIM_TECHNIQUE_COMMANDS
   cli::add_trace_commands(app, action);
   try {
     app.parse(argc, argv);

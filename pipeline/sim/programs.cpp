@@ -3,47 +3,39 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "model/common/error.h"
 #include "pipeline/sim/gpu.h"
-#include "pipeline/techniques/ldi/program.h"
-#include "pipeline/techniques/occlusion/program.h"
-#include "pipeline/techniques/particles/program.h"
-#include "pipeline/techniques/relief/program.h"
-#include "pipeline/techniques/shadows/program.h"
 
 namespace nbsim::pipeline {
 
 namespace {
 
-// The registration list: one row per technique with a program (pipeline/techniques/<name>/).
+// One row per technique of the registration list (pipeline/techniques/<name>/program.cpp).
 const std::vector<ProgramRow>& programs() {
-  static const std::vector<ProgramRow> rows = {occlusion_culling_program(), particles_program(), shadows_program(), ldi_program(),
-                                               relief_program()};
+#define NBSIM_TECHNIQUE_PROGRAM(name) name##_program(),
+  static const std::vector<ProgramRow> rows = {NBSIM_EACH_TECHNIQUE(NBSIM_TECHNIQUE_PROGRAM)};
+#undef NBSIM_TECHNIQUE_PROGRAM
   return rows;
 }
-
-constexpr std::array<StructureInstance, 4> kInstances = {{
-    {"nbuffer", InstanceKind::NBuffer,
-     "occlusion culling's N-buffer unit (cull.mode nb, nb_hier); the particles' max N-buffer (particle_mode nb, level_cap -1: "
-     "the capture's levels)"},
-    {"hiz", InstanceKind::HiZ,
-     "occlusion culling's Hi-Z baselines (cull.mode hiz_tile, hiz_pyramid); the particles' Hi-Z pyramid format and timing "
-     "(particle_mode hiz)"},
-    {"litmap_min", InstanceKind::NBuffer,
-     "shadows: the min N-buffer over the min litmap (litmap_size square), queried for each caster's z_min"},
-    {"litmap_max", InstanceKind::NBuffer,
-     "shadows: the max N-buffer over the max litmap (litmap_size square), queried for each caster's z_max"},
-}};
 
 std::string technique_list() {
   std::string s;
   for (const ProgramRow& r : programs())
     if (r.build) s += (s.empty() ? "" : ", ") + std::string(r.technique);
   return s;
+}
+
+// The program a cull.mode other than trace runs, as messages name it.
+std::string cull_mode_owner() {
+  for (const ProgramRow& r : programs())
+    if (r.runs_cull_mode) return fmt::format("the {} program", r.technique);
+  return "no program";
 }
 
 }  // namespace
@@ -55,7 +47,26 @@ const ProgramRow* find_program(std::string_view technique) {
     if (r.technique == technique) return &r;
   return nullptr;
 }
-std::span<const StructureInstance> structure_instances() { return kInstances; }
+
+std::span<const StructureInstance> structure_instances() {
+  static const std::vector<StructureInstance> instances = [] {
+    std::vector<StructureInstance> all;
+    for (const ProgramRow& r : programs())
+      for (const StructureInstance& i : r.instances) {
+        const std::string what = fmt::format("{}: {}", r.technique, i.description);
+        const auto it = std::find_if(all.begin(), all.end(), [&](const StructureInstance& a) { return a.name == i.name; });
+        if (it == all.end()) {
+          all.push_back({i.name, i.kind, what});
+        } else if (it->kind != i.kind) {
+          throw std::logic_error(fmt::format("structure instance '{}' declared with two kinds (technique {})", i.name, r.technique));
+        } else {
+          it->description += "; " + what;
+        }
+      }
+    return all;
+  }();
+  return instances;
+}
 
 std::unique_ptr<query::Structure> ProgramContext::structure(std::string_view instance, query::Kind kind, FarOp op) const {
   const std::string name(instance);
@@ -73,7 +84,7 @@ std::unique_ptr<query::Structure> ProgramContext::structure(std::string_view ins
 
 void ProgramContext::require_no_cull_mode(std::string_view how) const {
   if (config.cull.parsed_mode() != cull::CullMode::Trace)
-    throw InputError(fmt::format("cull.mode={} is occlusion culling's; {} (leave cull.mode at trace)", config.cull.mode, how));
+    throw InputError(fmt::format("cull.mode={} culls with {}; {} (leave cull.mode at trace)", config.cull.mode, cull_mode_owner(), how));
   config.cull.parsed_granularity();
 }
 
@@ -108,9 +119,9 @@ Program build_program(std::string_view technique, const ProgramContext& context)
   }
   if (context.config.cull.parsed_mode() != cull::CullMode::Trace)
     throw InputError(fmt::format(
-        "cull.mode={} culls with occlusion culling's program, but the trace's technique is '{}' (programs exist for: "
+        "cull.mode={} culls with {}, but the trace's technique is '{}' (programs exist for: "
         "{}); cull.mode=trace replays the recorded draws of any technique",
-        context.config.cull.mode, technique.empty() ? "(none)" : std::string(technique), technique_list()));
+        context.config.cull.mode, cull_mode_owner(), technique.empty() ? "(none)" : std::string(technique), technique_list()));
   context.config.cull.parsed_granularity();
   return {};
 }

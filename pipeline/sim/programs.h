@@ -1,7 +1,8 @@
 // The frame programs that replay a technique's traces, one row per technique, chosen by the name
 // the trace header carries ("technique"), and the query-structure instances a program may own.
-// A technique's program is a row in its own folder (pipeline/techniques/<name>/program.h) and an
-// entry in the registration list in programs.cpp; the top level (gpu.h) only wires what a row builds.
+// A technique's program is a row defined in its own folder (pipeline/techniques/<name>/program.cpp)
+// for the technique's entry in the registration list; the top level (gpu.h) only wires what a row
+// builds.
 #pragma once
 
 #include <any>
@@ -22,6 +23,7 @@
 #include "model/memory/memory.h"
 #include "model/query/units.h"
 #include "model/raster/primitive_tester.h"
+#include "nbsim/technique_list.h"
 #include "traces/format/header.h"
 
 namespace nbsim::pipeline {
@@ -145,6 +147,15 @@ ConfigGroup config_group(std::string_view name) {
           }};
 }
 
+// A query-structure instance: its name (also its config keys' prefix: "<name>.<field>", declared
+// by GpuConfig::describe), the kind of unit it configures, and what it is for. A program that
+// owns several structures of one kind (a min and a max N-buffer) has one row for each.
+enum class InstanceKind : std::uint8_t { NBuffer = 0, HiZ = 1 };
+struct StructureInstance {
+  std::string_view name;
+  InstanceKind kind;
+  std::string description;
+};
 struct ProgramRow {
   std::string_view technique;    // the trace header's "technique"
   std::string_view description;  // for --help and messages
@@ -154,21 +165,27 @@ struct ProgramRow {
   Program (*build)(const ProgramContext& context);
   ProgramResults results;
   ConfigGroup config;  // read by the program as context.config.group<T>(config.name)
+  // The query-structure instances the program builds (ProgramContext::structure); programs may
+  // share one (the same name and kind).
+  std::vector<StructureInstance> instances;
+  // Whether a cull.mode other than trace (the cull unit's: cull every candidate again) is this
+  // program's to run; every other program refuses such a mode.
+  bool runs_cull_mode;
 };
 
+// Each technique of the registration list (cmake/NbsimTechniques.cmake) defines its row,
+// ProgramRow <name>_program(), in pipeline/techniques/<name>/program.cpp.
+#define NBSIM_DECLARE_TECHNIQUE_PROGRAM(name) ProgramRow name##_program();
+NBSIM_EACH_TECHNIQUE(NBSIM_DECLARE_TECHNIQUE_PROGRAM)
+#undef NBSIM_DECLARE_TECHNIQUE_PROGRAM
+
+// The rows in the registration list's order.
 std::span<const ProgramRow> program_table();
 // The row of `technique`, or nullptr.
 const ProgramRow* find_program(std::string_view technique);
 
-// A query-structure instance: its name (also its config keys' prefix: "<name>.<field>", declared
-// by GpuConfig::describe), the kind of unit it configures, and what it is for. A program that
-// owns several structures of one kind (a min and a max N-buffer) has one row for each.
-enum class InstanceKind : std::uint8_t { NBuffer = 0, HiZ = 1 };
-struct StructureInstance {
-  std::string_view name;
-  InstanceKind kind;
-  std::string_view description;
-};
+// Every program's instances, each name once (in the list's order; the descriptions of a shared one
+// joined).
 std::span<const StructureInstance> structure_instances();
 
 // The program for a trace of `technique` under `config`: none with gpu.program=off (which refuses

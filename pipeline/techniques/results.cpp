@@ -1,13 +1,8 @@
-// The registration list of the results each technique declares, and their helpers; see results.h.
+// The table of the results each technique declares, and their helpers; see results.h.
 #include "pipeline/techniques/results.h"
 
 #include <algorithm>
 
-#include "pipeline/techniques/ldi/results.h"
-#include "pipeline/techniques/occlusion/results.h"
-#include "pipeline/techniques/particles/results.h"
-#include "pipeline/techniques/relief/results.h"
-#include "pipeline/techniques/shadows/results.h"
 
 namespace nbsim::techniques {
 
@@ -32,7 +27,7 @@ Metric derived_error(const char* name, const char* unit, const char* description
 }
 
 // The labels of a technique whose headline cost is total depth tests per frame and whose memory
-// cost is the N-buffer's (occlusion culling, particles).
+// cost is the N-buffer's (e.g. the techniques that cull primitives with an N-buffer).
 void depth_test_and_nbuffer_labels(ReportLabels& l) {
   l.cost_axis = "total depth tests per frame";
   l.cost_column = "total depth tests/frame";
@@ -44,9 +39,10 @@ void depth_test_and_nbuffer_labels(ReportLabels& l) {
 }
 
 const std::vector<TechniqueResults>& technique_results() {
-  // The registration list: one row per technique, declared in its folder (pipeline/techniques/<name>/results.*).
-  static const std::vector<TechniqueResults> table = {occlusion_culling_results(), particles_results(), shadows_results(), ldi_results(),
-                                                      relief_results()};
+  // One row per technique of the registration list, declared in its folder (pipeline/techniques/<name>/).
+#define NBSIM_TECHNIQUE_RESULTS(name) name##_results(),
+  static const std::vector<TechniqueResults> table = {NBSIM_EACH_TECHNIQUE(NBSIM_TECHNIQUE_RESULTS)};
+#undef NBSIM_TECHNIQUE_RESULTS
   return table;
 }
 

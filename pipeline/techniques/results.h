@@ -3,7 +3,7 @@
 // reference setting (the exact point its relative errors are measured against), its paper-style
 // table if it has one, and its headline cost and error for Pareto plots. `nbsim explore`
 // (results.csv, technique_results.json), `nbsim table2` and analysis/report.py read this one table;
-// a new technique adds one row to technique_results(). Plain C++ (no SystemC).
+// each technique of the registration list defines its row. Plain C++ (no SystemC).
 //
 // The technique-independent results stay with their readers: the timing reference (cycle_error
 // against gpu.quantum_cycles=0 ...) in pipeline/explore/sweep.h, counter_error against GL's
@@ -16,6 +16,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "nbsim/technique_list.h"
 
 namespace nbsim::techniques {
 
@@ -162,7 +164,13 @@ Metric derived_error(const char* name, const char* unit, const char* description
                      const char* reference_column);
 void depth_test_and_nbuffer_labels(ReportLabels& l);
 
-// Every technique's results, one row each.
+// Each technique of the registration list (cmake/NbsimTechniques.cmake) defines its row,
+// TechniqueResults <name>_results(), in its folder pipeline/techniques/<name>/.
+#define NBSIM_DECLARE_TECHNIQUE_RESULTS(name) TechniqueResults name##_results();
+NBSIM_EACH_TECHNIQUE(NBSIM_DECLARE_TECHNIQUE_RESULTS)
+#undef NBSIM_DECLARE_TECHNIQUE_RESULTS
+
+// Every technique's results, one row each, in the registration list's order.
 const std::vector<TechniqueResults>& technique_results();
 
 // The row of `technique`, or nullptr when it declares none.

@@ -2,18 +2,17 @@
 """Shared code names no technique.
 
 The shared folders (the replay's top level, the command line, benches, sweeps, the results
-declarations, the report, the trace format's core and the capture's core) do not name a technique
-(particles, shadows, LDIs, relief, occlusion culling): a technique's code lives in its own folders
-(a folder named after it, below any of them), and each layer lists its techniques in one
-registration file, the only shared file allowed to name them:
+declarations, the report, the trace format's core and the capture's core) and the build files of
+the layers do not name a technique (particles, shadows, LDIs, relief, occlusion culling): a
+technique's code lives in its own folders (a folder named after it, below any of them), and the one
+registration list names them all:
 
-  traces/format/technique_chunks.cpp   chunk types and header keys
-  traces/capture/techniques.cpp        captures, bench presets, capture aliases
-  pipeline/sim/programs.cpp            frame programs, their config groups, structure instances
-  pipeline/techniques/results.cpp      results declarations
-  pipeline/cli/main.cpp                table commands
+  cmake/NbsimTechniques.cmake   NBSIM_TECHNIQUES, expanded in C++ as NBSIM_EACH_TECHNIQUE(X)
 
-The report's sections need no list: analysis/report.py discovers analysis/techniques/<name>/.
+Each layer's table expands that list (traces/format/technique_chunks.cpp, traces/capture/
+techniques.cpp, pipeline/sim/programs.cpp, pipeline/techniques/results.cpp, pipeline/cli/main.cpp,
+model/scene/technique_roles.h) and each CMakeLists.txt loops over it; the report's sections need
+no list: analysis/report.py discovers analysis/techniques/<name>/.
 Exits 1 naming every other shared file that names a technique, with the line.
 
 Usage: check_technique_names.py ROOT
@@ -26,33 +25,45 @@ root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
 
 SHARED = ["pipeline/sim", "pipeline/cli", "pipeline/bench", "pipeline/explore", "pipeline/techniques",
           "analysis", "traces/format", "traces/capture"]
+# Shared files outside those folders: the layers' build files and the draw roles' table.
+SHARED_FILES = ["CMakeLists.txt", "model/CMakeLists.txt", "model/sim/CMakeLists.txt", "traces/CMakeLists.txt",
+                "pipeline/CMakeLists.txt", "model/scene/technique_roles.h"]
 TECHNIQUE_DIRS = {"occlusion", "particles", "shadows", "ldi", "relief"}
-REGISTRATION = {"traces/format/technique_chunks.cpp", "traces/capture/techniques.cpp", "pipeline/sim/programs.cpp",
-                "pipeline/techniques/results.cpp", "pipeline/cli/main.cpp"}
-SUFFIXES = {".h", ".cpp", ".py"}
+REGISTRATION = {"cmake/NbsimTechniques.cmake"}
+SUFFIXES = {".h", ".cpp", ".py", ".txt", ".cmake"}
 # "ldi" only at the start of a word or identifier part (LdiUnit, model::ldi, ldi_table), not in "building".
 MENTION = re.compile(r"particle|shadow|relief|occlusion|(?<![a-z])ldi", re.IGNORECASE)
 
 offences = []
 listed = 0
-for top in SHARED:
-    for path in sorted((root / top).rglob("*")):
-        if path.suffix not in SUFFIXES or not path.is_file():
-            continue
-        rel = path.relative_to(root)
-        if any(part in TECHNIQUE_DIRS for part in rel.parts[len(pathlib.Path(top).parts):-1]):
-            continue
-        lines = path.read_text(errors="replace").splitlines()
-        hits = [(i + 1, line.strip()) for i, line in enumerate(lines) if MENTION.search(line)]
-        if rel.as_posix() in REGISTRATION:
-            listed += len(hits)
-            continue
-        offences += [f"{rel.as_posix()}:{n}: names a technique: {text[:120]}" for n, text in hits]
+
+def shared_files():
+    """(path, relative path) of every shared file, the registration list included."""
+    for top in SHARED:
+        for path in sorted((root / top).rglob("*")):
+            if path.suffix not in SUFFIXES or not path.is_file():
+                continue
+            rel = path.relative_to(root)
+            if any(part in TECHNIQUE_DIRS for part in rel.parts[len(pathlib.Path(top).parts):-1]):
+                continue
+            yield path, rel
+    for name in SHARED_FILES + sorted(REGISTRATION):
+        if (root / name).is_file():
+            yield root / name, pathlib.Path(name)
+
+
+for path, rel in shared_files():
+    lines = path.read_text(errors="replace").splitlines()
+    hits = [(i + 1, line.strip()) for i, line in enumerate(lines) if MENTION.search(line)]
+    if rel.as_posix() in REGISTRATION:
+        listed += len(hits)
+        continue
+    offences += [f"{rel.as_posix()}:{n}: names a technique: {text[:120]}" for n, text in hits]
 missing = [r for r in sorted(REGISTRATION) if not (root / r).is_file()]
 for r in missing:
-    offences.append(f"{r}: the registration file is gone: move the list or update REGISTRATION in this script")
+    offences.append(f"{r}: the registration file is gone: move it or update REGISTRATION in this script")
 for o in offences:
     print(o)
-print(f"shared code: {len(offences)} mentions of a technique outside the registration lists "
-      f"({listed} lines in the {len(REGISTRATION)} lists)")
+print(f"shared code: {len(offences)} mentions of a technique outside the registration list "
+      f"({listed} lines in {', '.join(sorted(REGISTRATION))})")
 sys.exit(1 if offences else 0)

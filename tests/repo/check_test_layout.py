@@ -27,6 +27,8 @@ untested = {
     "model/depth": "the depth unit's SystemC wrapper needs a raster unit in front of it; its cores "
     "(model/raster/depth_test.h, stencil_test.h) are tests/model/raster's, and every `nbsim compare` "
     "(tests/pipeline/sim, tests/model/<technique>) checks its counters and depth against GL's",
+    "model/occlusion": "holds only roles.h, an empty list (occlusion culling draws with the core roles); "
+    "tests/model/scene's TechniqueRolesTest checks the joined table",
 }
 code = {".cpp", ".h"}
 

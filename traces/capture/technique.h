@@ -1,9 +1,9 @@
-// The capture side of the technique seam (docs/architecture.md, "Adding a technique: the renderer
-// side"): a technique is a class that owns its GL resources and passes and renders one frame at a
+// The capture side of the technique seam (docs/adding-a-technique.md, "The renderer side"): a
+// technique is a class that owns its GL resources and passes and renders one frame at a
 // time into a frame record, built from the shared pieces (gl_program.h, draw_recorder.h,
 // scene_pass.h, render_target.h, readback.h, ground_truth.h). Techniques are chosen by name from
-// one table (techniques.cpp): the name, a one-line description, the options the technique reads
-// and its factory. The header's "technique" property is the row's name.
+// one table (techniques.cpp), a row per technique of the registration list: the name, a one-line
+// description, the options the technique reads and its factory. The header's "technique" property is the row's name.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "model/scene/frame.h"
+#include "nbsim/technique_list.h"
 #include "traces/capture/camera.h"
 #include "traces/capture/plugin.h"
 #include "traces/capture/scenes.h"
@@ -83,7 +84,13 @@ struct TechniqueRow {
   std::vector<CaptureAlias> aliases;
 };
 
-// The registration list (techniques.cpp); its first row is the default technique.
+// Each technique of the registration list (cmake/NbsimTechniques.cmake) defines its row,
+// TechniqueRow <name>_technique(), in its folder traces/capture/<name>/.
+#define NBSIM_DECLARE_TECHNIQUE_ROW(name) TechniqueRow name##_technique();
+NBSIM_EACH_TECHNIQUE(NBSIM_DECLARE_TECHNIQUE_ROW)
+#undef NBSIM_DECLARE_TECHNIQUE_ROW
+
+// The rows in the registration list's order (techniques.cpp); the first is the default technique.
 const std::vector<TechniqueRow>& technique_table();
 // The name of the table's first row: what a capture or bench runs when no technique is named.
 const std::string& default_technique();

@@ -14,11 +14,6 @@
 #include "model/common/error.h"
 #include "traces/format/bytes.h"
 #include "traces/format/codec.h"
-#include "traces/format/ldi/ldi_chunk.h"
-#include "traces/format/occlusion/occlusion_keys.h"
-#include "traces/format/particles/particles_chunk.h"
-#include "traces/format/relief/relief_chunk.h"
-#include "traces/format/shadows/shadows_chunk.h"
 
 namespace nbsim::trace {
 
@@ -34,19 +29,27 @@ struct Registry {
   std::vector<ChunkSpec> specs;
 };
 
-// The chunk types of the techniques this build knows, registered before anything else so that
-// every reader decodes them (a technique's own test types register later, at run time).
+// What the techniques of the registration list add to the format, in the list's order.
+std::vector<TechniqueFormat> built_in_formats() {
+#define NBSIM_TECHNIQUE_FORMAT(name) name##_format(),
+  return {NBSIM_EACH_TECHNIQUE(NBSIM_TECHNIQUE_FORMAT)};
+#undef NBSIM_TECHNIQUE_FORMAT
+}
+
+// Their chunk types, registered before anything else so that every reader decodes them (a
+// technique's own test types register later, at run time).
 std::vector<ChunkSpec> built_in_chunks() {
-  return {particles_chunk_spec(), shadows_chunk_spec(),      ldi_image_chunk_spec(),
-          ldi_tests_chunk_spec(), relief_field_chunk_spec(), relief_fragments_chunk_spec()};
+  std::vector<ChunkSpec> chunks;
+  for (TechniqueFormat& f : built_in_formats())
+    for (ChunkSpec& c : f.chunks) chunks.push_back(std::move(c));
+  return chunks;
 }
 
 // Their header keys, in the same order.
 std::vector<HeaderKeySpec> built_in_header_keys() {
   std::vector<HeaderKeySpec> keys;
-  for (std::vector<HeaderKeySpec> (*of)() : {occlusion_culling_header_keys, particles_header_keys, shadows_header_keys, ldi_header_keys,
-                                                     relief_header_keys})
-    for (HeaderKeySpec& k : of()) keys.push_back(std::move(k));
+  for (TechniqueFormat& f : built_in_formats())
+    for (HeaderKeySpec& k : f.header_keys) keys.push_back(std::move(k));
   return keys;
 }
 

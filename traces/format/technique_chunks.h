@@ -1,6 +1,6 @@
 // Chunk types a technique adds to a trace (format version 2): a small registry of fourcc, record
-// name and field description. A technique registers its chunk types once (capture and replay
-// both link the registration); the writer encodes a TechniqueRecord from its fields, the reader
+// name and field description. Each technique's types come from its <name>_format() (below) and are
+// registered before any trace is read (tests may register more); the writer encodes a TechniqueRecord from its fields, the reader
 // decodes a registered type's payload into fields and keeps an unregistered one raw, and `nbsim
 // trace format` / `dump --records` show them. Technique chunks carry the chunk flag
 // kFlagTechnique (FORMAT.md "Chunks"), which is what lets a reader keep an unknown one instead of
@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "nbsim/technique_list.h"
 #include "traces/format/records.h"
 
 namespace nbsim::trace {
@@ -101,5 +102,16 @@ HeaderKeySpec custom_key(std::string technique, std::string name, bool (*valid)(
 // The header keys of the techniques this build knows, in registration order (the same list as
 // their chunk types).
 const std::vector<HeaderKeySpec>& technique_header_keys();
+
+// What a technique adds to the format: its chunk types and its header keys. Each technique of the
+// registration list (cmake/NbsimTechniques.cmake) defines TechniqueFormat <name>_format() in its
+// folder, traces/format/<name>/.
+struct TechniqueFormat {
+  std::vector<ChunkSpec> chunks;
+  std::vector<HeaderKeySpec> header_keys;
+};
+#define NBSIM_DECLARE_TECHNIQUE_FORMAT(name) TechniqueFormat name##_format();
+NBSIM_EACH_TECHNIQUE(NBSIM_DECLARE_TECHNIQUE_FORMAT)
+#undef NBSIM_DECLARE_TECHNIQUE_FORMAT
 
 }  // namespace nbsim::trace

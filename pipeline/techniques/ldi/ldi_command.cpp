@@ -28,7 +28,7 @@
 #include "model/ldi/vpt.h"
 #include "model/mesh/mesh.h"
 #include "model/mesh/shapes.h"
-#include "pipeline/techniques/ldi/ldi_command.h"
+#include "pipeline/cli/command.h"
 #include "pipeline/cli/progress.h"
 #include "traces/capture/ldi/build.h"
 #include "traces/capture/ldi/mesh_loader.h"

@@ -1,5 +1,5 @@
-// The ldi technique's frame program and its results (per-frame values, summary); see program.h.
-#include "pipeline/techniques/ldi/program.h"
+// The ldi technique's frame program and its results (per-frame values, summary); its row of pipeline/sim/programs.h.
+#include "pipeline/sim/programs.h"
 
 #include <fmt/format.h>
 
@@ -114,7 +114,9 @@ ProgramRow ldi_program() {
           "test (uncompressed and compressed) at GL's test points against GL's answers and the exact reference",
           build,
           {"gpu.ldi", "", frame_values, {}, summary, exact, describe},
-          config_group<ldi::LdiUnitConfig>("ldi")};
+          config_group<ldi::LdiUnitConfig>("ldi"),
+          {},
+          false};
 }
 
 }  // namespace nbsim::pipeline

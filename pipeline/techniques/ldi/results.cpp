@@ -1,5 +1,5 @@
-// The ldi technique's declared results; see results.h.
-#include "pipeline/techniques/ldi/results.h"
+// The ldi technique's declared results; its row of pipeline/techniques/results.h.
+#include "pipeline/techniques/results.h"
 
 namespace nbsim::techniques {
 

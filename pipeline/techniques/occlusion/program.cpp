@@ -1,5 +1,5 @@
-// The occlusion_culling technique's frame program, the cull stage, and its results; see program.h.
-#include "pipeline/techniques/occlusion/program.h"
+// The occlusion_culling technique's frame program, the cull stage, and its results; its row of pipeline/sim/programs.h.
+#include "pipeline/sim/programs.h"
 
 #include <fmt/format.h>
 
@@ -119,13 +119,16 @@ nlohmann::ordered_json summary(const SummaryInputs& in) {
 
 }  // namespace
 
-ProgramRow occlusion_culling_program() {
+ProgramRow occlusion_program() {
   return {"occlusion_culling",
           "occlusion culling of a scene's objects (cull.mode: trace replays the recorded draws; none, oq, oq_hier, nb, "
           "nb_hier, hiz_tile, hiz_pyramid cull every candidate again)",
           build,
           {"gpu.cull", "cull", frame_values, {}, summary},
-          {}};  // its config group is the cull unit's ("cull."), which GpuConfig holds itself
+          {},  // its config group is the cull unit's ("cull."), which GpuConfig holds itself
+          {{"nbuffer", InstanceKind::NBuffer, "the N-buffer unit (cull.mode nb, nb_hier)"},
+           {"hiz", InstanceKind::HiZ, "the Hi-Z baselines (cull.mode hiz_tile, hiz_pyramid)"}},
+          true};
 }
 
 }  // namespace nbsim::pipeline

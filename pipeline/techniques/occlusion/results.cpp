@@ -1,11 +1,11 @@
-// The occlusion_culling technique's declared results; see results.h.
-#include "pipeline/techniques/occlusion/results.h"
+// The occlusion_culling technique's declared results; its row of pipeline/techniques/results.h.
+#include "pipeline/techniques/results.h"
 
 namespace nbsim::techniques {
 
 // Occlusion culling (Décoret 2005, 4.2; docs/architecture.md, "Definitions"): depth tests per
 // frame against culling efficiency, with false culls as the correctness count (must be 0).
-TechniqueResults occlusion_culling_results() {
+TechniqueResults occlusion_results() {
   TechniqueResults t;
   t.technique = "occlusion_culling";
   t.description = "Object (or primitive) culling by depth queries: occlusion queries, N-buffer, Hi-Z";

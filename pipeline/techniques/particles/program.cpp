@@ -1,5 +1,5 @@
-// The particles technique's frame program and its results (per-frame values, summary); see program.h.
-#include "pipeline/techniques/particles/program.h"
+// The particles technique's frame program and its results (per-frame values, summary); its row of pipeline/sim/programs.h.
+#include "pipeline/sim/programs.h"
 
 #include <fmt/format.h>
 
@@ -138,7 +138,10 @@ ProgramRow particles_program() {
           "decision made again by the model and compared with GL's; GL's particle draws rasterized",
           build,
           {"gpu.particles", "", frame_values, {}, summary},
-          config_group<particles::ParticlesUnitConfig>("particles")};
+          config_group<particles::ParticlesUnitConfig>("particles"),
+          {{"nbuffer", InstanceKind::NBuffer, "the max N-buffer (particle_mode nb, level_cap -1: the capture's levels)"},
+           {"hiz", InstanceKind::HiZ, "the Hi-Z pyramid's format and timing (particle_mode hiz)"}},
+          false};
 }
 
 }  // namespace nbsim::pipeline

@@ -1,5 +1,5 @@
 // `nbsim particles`: the particles table, from one replay of each trace (pipeline/cli/table_command.h).
-#include "pipeline/techniques/particles/table_command.h"
+#include "pipeline/cli/command.h"
 
 #include <fmt/format.h>
 
@@ -17,7 +17,7 @@
 
 namespace nbsim::cli {
 
-void add_particles_command(CLI::App& app, Action& action) {
+void add_particles_commands(CLI::App& app, Action& action) {
   // One replay per particles trace (one capture per mode: GL's draws depend on it), in child
   // processes, and a row each from its run.json's /summary/particles beside the paper's claim
   // (16 px sprites: 256 N depth tests by rasterization, N with the N-buffer).

@@ -1,5 +1,5 @@
-// The relief technique's frame program and its results (per-frame values, summary); see program.h.
-#include "pipeline/techniques/relief/program.h"
+// The relief technique's frame program and its results (per-frame values, summary); its row of pipeline/sim/programs.h.
+#include "pipeline/sim/programs.h"
 
 #include <fmt/format.h>
 
@@ -133,7 +133,9 @@ ProgramRow relief_program() {
           "compared with GL's per fragment and scored against the exact reference",
           build,
           {"gpu.relief", "", frame_values, {}, summary, exact, describe},
-          config_group<relief::ReliefUnitConfig>("relief")};
+          config_group<relief::ReliefUnitConfig>("relief"),
+          {},
+          false};
 }
 
 }  // namespace nbsim::pipeline

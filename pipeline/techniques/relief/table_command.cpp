@@ -1,5 +1,5 @@
 // `nbsim relief`: the relief table, from one replay of each trace (pipeline/cli/table_command.h).
-#include "pipeline/techniques/relief/table_command.h"
+#include "pipeline/cli/command.h"
 
 #include <fmt/format.h>
 
@@ -18,7 +18,7 @@
 
 namespace nbsim::cli {
 
-void add_relief_command(CLI::App& app, Action& action) {
+void add_relief_commands(CLI::App& app, Action& action) {
   // One replay per relief trace (a heightfield and size each; a frame per view angle, a box draw per
   // method), in child processes; a row per trace, frame and method from run.json's frames, then the
   // ranking with the Pareto front, the N-buffer walk against the exact walk, and the paper's Table 1.

@@ -1,5 +1,5 @@
-// The shadows technique's frame program and its results (per-frame values, summary); see program.h.
-#include "pipeline/techniques/shadows/program.h"
+// The shadows technique's frame program and its results (per-frame values, summary); its row of pipeline/sim/programs.h.
+#include "pipeline/sim/programs.h"
 
 #include <array>
 
@@ -99,7 +99,12 @@ ProgramRow shadows_program() {
           "decisions and the shadow mask compared with GL's",
           build,
           {"gpu.shadows", "", frame_values, kPerFrame, summary},
-          config_group<shadows::ShadowsUnitConfig>("shadows")};
+          config_group<shadows::ShadowsUnitConfig>("shadows"),
+          {{"litmap_min", InstanceKind::NBuffer,
+            "the min N-buffer over the min litmap (litmap_size square), queried for each caster's z_min"},
+           {"litmap_max", InstanceKind::NBuffer,
+            "the max N-buffer over the max litmap (litmap_size square), queried for each caster's z_max"}},
+          false};
 }
 
 }  // namespace nbsim::pipeline

@@ -1,5 +1,5 @@
-// The shadows technique's declared results; see results.h.
-#include "pipeline/techniques/shadows/results.h"
+// The shadows technique's declared results; its row of pipeline/techniques/results.h.
+#include "pipeline/techniques/results.h"
 
 namespace nbsim::techniques {
 

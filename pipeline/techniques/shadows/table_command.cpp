@@ -1,5 +1,5 @@
 // `nbsim shadows`: the shadows table, from one replay of each trace (pipeline/cli/table_command.h).
-#include "pipeline/techniques/shadows/table_command.h"
+#include "pipeline/cli/command.h"
 
 #include <fmt/format.h>
 
@@ -17,7 +17,7 @@
 
 namespace nbsim::cli {
 
-void add_shadows_command(CLI::App& app, Action& action) {
+void add_shadows_commands(CLI::App& app, Action& action) {
   // One replay per shadows trace (one capture per shadow_mode: GL's volumes depend on it), in
   // child processes, and a row each from its run.json's /summary/shadows beside the paper's
   // figures (fill 20 M -> 512 K px in the city, 2.5%; about 20% on simpler scenes). The ratio to

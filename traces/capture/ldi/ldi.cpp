@@ -270,4 +270,15 @@ BenchPreset ldi_bench_preset() {
 
 std::unique_ptr<Technique> make_ldi(const TechniqueSetup& setup) { return std::make_unique<Ldi>(setup); }
 
+// This technique's row of the capture's table (technique.h).
+TechniqueRow ldi_technique() {
+  return {{"ldi",
+           "Layered depth images of a closed shape: viewpoint selection, depth peeling, crop, RG32UI depth-range compression and "
+           "the volumetric parity test with both readers against an exact reference (Trapp & Doellner)",
+           ldi_options()},
+          make_ldi,
+          ldi_bench_preset(),
+          {}};
+}
+
 }  // namespace nbsim::capture

@@ -253,4 +253,14 @@ BenchPreset occlusion_culling_bench_preset() {
 
 std::unique_ptr<Technique> make_occlusion_culling(const TechniqueSetup& setup) { return std::make_unique<OcclusionCulling>(setup); }
 
+// This technique's row of the capture's table (technique.h).
+TechniqueRow occlusion_technique() {
+  return {{"occlusion_culling",
+           "Occlusion culling with occlusion queries or the GLSL N-buffer, flat or over the BVH (N-buffer paper, 3.1 and 4.2)",
+           occlusion_culling_options()},
+          make_occlusion_culling,
+          occlusion_culling_bench_preset(),
+          {{"city", "city"}}};
+}
+
 }  // namespace nbsim::capture

@@ -400,4 +400,15 @@ BenchPreset particles_bench_preset() {
 
 std::unique_ptr<Technique> make_particles(const TechniqueSetup& setup) { return std::make_unique<Particles>(setup); }
 
+// This technique's row of the capture's table (technique.h).
+TechniqueRow particles_technique() {
+  return {{"particles",
+           "Point-sprite particles culled in the vertex stage: none, centre lookup, partial N-buffer or Hi-Z, with a "
+           "reference pass for popping (N-buffer paper, 3.2 and 4.3)",
+           particles_options()},
+          make_particles,
+          particles_bench_preset(),
+          {}};
+}
+
 }  // namespace nbsim::capture

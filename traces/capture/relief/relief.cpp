@@ -493,4 +493,16 @@ BenchPreset relief_bench_preset() {
 
 std::unique_ptr<Technique> make_relief(const TechniqueSetup& setup) { return std::make_unique<Relief>(setup); }
 
+// This technique's row of the capture's table (technique.h).
+TechniqueRow relief_technique() {
+  return {{"relief",
+           "Relief textures: a heightfield in a box, each fragment's ray walked by binary search, the exact cell walk, the "
+           "robust search with safety radii (two zero-radius variants) or the N-buffer empty-space walk, scored against an "
+           "exact reference (Baboud & Decoret; the N-buffer paper's future work)",
+           relief_options()},
+          make_relief,
+          relief_bench_preset(),
+          {}};
+}
+
 }  // namespace nbsim::capture

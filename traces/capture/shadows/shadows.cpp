@@ -720,4 +720,15 @@ std::unique_ptr<Technique> make_shadows(const TechniqueSetup& setup) {
   return std::make_unique<Shadows>(setup);
 }
 
+// This technique's row of the capture's table (technique.h).
+TechniqueRow shadows_technique() {
+  return {{"shadows",
+           "Stencil shadow volumes of a spot light (z-fail, two-sided): infinite, culled or clamped with min/max litmaps and "
+           "two N-buffers, with an infinite reference pass for the mask (N-buffer paper, 3.3 and 4.4)",
+           shadows_options()},
+          make_shadows,
+          shadows_bench_preset(),
+          {}};
+}
+
 }  // namespace nbsim::capture

@@ -163,4 +163,7 @@ std::vector<HeaderKeySpec> ldi_header_keys() {
           text_key(t, "ldi_depth", "peel: clip control ZERO_TO_ONE, ...", "the peel's depth convention")};
 }
 
+// This technique's part of the format (technique_chunks.h): the image and test-point chunks and the header keys.
+TechniqueFormat ldi_format() { return {{ldi_image_chunk_spec(), ldi_tests_chunk_spec()}, ldi_header_keys()}; }
+
 }  // namespace nbsim::trace

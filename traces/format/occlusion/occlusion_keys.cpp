@@ -12,4 +12,8 @@ std::vector<HeaderKeySpec> occlusion_culling_header_keys() {
                      "nb_hier", "the test mode the capture's GL ran")};
 }
 
+// This technique's part of the format (technique_chunks.h): its header keys; no chunk types of its
+// own (its draws and queries are core records).
+TechniqueFormat occlusion_format() { return {{}, occlusion_culling_header_keys()}; }
+
 }  // namespace nbsim::trace

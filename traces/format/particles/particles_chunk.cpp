@@ -72,4 +72,7 @@ std::vector<HeaderKeySpec> particles_header_keys() {
           real_key(t, "cull_margin", 0.0, 0.01, false, "1e-06", "depth margin of the vertex stage's test")};
 }
 
+// This technique's part of the format (technique_chunks.h): its chunk type and header keys.
+TechniqueFormat particles_format() { return {{particles_chunk_spec()}, particles_header_keys()}; }
+
 }  // namespace nbsim::trace

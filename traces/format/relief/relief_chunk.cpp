@@ -209,4 +209,7 @@ std::vector<HeaderKeySpec> relief_header_keys() {
           text_key(t, "relief_view", "the box [0,1]^2 x ...", "how the box is viewed")};
 }
 
+// This technique's part of the format (technique_chunks.h): the field and fragment chunks and the header keys.
+TechniqueFormat relief_format() { return {{relief_field_chunk_spec(), relief_fragments_chunk_spec()}, relief_header_keys()}; }
+
 }  // namespace nbsim::trace

@@ -100,4 +100,7 @@ std::vector<HeaderKeySpec> shadows_header_keys() {
                      "how far a clamped volume's slab is pushed back before the cull test")};
 }
 
+// This technique's part of the format (technique_chunks.h): its chunk type and header keys.
+TechniqueFormat shadows_format() { return {{shadows_chunk_spec()}, shadows_header_keys()}; }
+
 }  // namespace nbsim::trace
