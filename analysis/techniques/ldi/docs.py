@@ -1,0 +1,94 @@
+"""The layered depth images' results in docs/ldi.md, generated (the protocol: analysis/doc_results.py)."""
+from doc_results import Block
+
+PAGE = "ldi.md"
+MODELS = "/usr/share/assimp/models"
+FRESH = [("duck.dae", ["--mesh", f"{MODELS}/Collada/duck.dae"]),
+         ("HUMAN.blend", ["--mesh", f"{MODELS}/BLEND/HUMAN.blend"]),
+         ("knot", ["--shape", "knot"]),
+         ("coil, 7 turns", ["--shape", "coil", "--shape-param", "7"])]
+
+
+def n(v):
+    return f"{v:,}"
+
+
+def fresh_capture(i, shape):
+    return ["capture", "ldi", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "8x8", "--frames", "3", "--seed", "7",
+            *shape, "--ldi-size", "200", "--points", "5000", "-o", f"f{i}.nbt"]
+
+
+def equal_or_both(model, gl):
+    return n(model) if model == gl else f"model {n(model)}, GL {n(gl)}"
+
+
+def render_fresh(outputs):
+    lines = ["| capture | peel passes | fragments, model = GL | samples passed, model = GL | layer texels, crops, compressed "
+             "values differing | parity answers differing (layers / ranges) | misclassified against the exact reference |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for (label, _), c in zip(FRESH, outputs[len(FRESH):]):
+        s = c["ldi"]
+        lines.append(f"| {label} | {s['peel_passes']} | {equal_or_both(s['peel_fragments'], s['gl_peel_fragments'])} | "
+                     f"{equal_or_both(s['peel_samples'], s['gl_peel_samples'])} | {s['layer_texel_mismatches']}, "
+                     f"{s['crop_mismatch']}, {s['compressed_mismatches']} | {s['parity_mismatches_layers']} / "
+                     f"{s['parity_mismatches_ranges']} | {s['misclassified_layers']} of {n(s['classified_points'])} |")
+    within = sum(1 for c in outputs[len(FRESH):] if c["within_thresholds"])
+    return "\n".join(lines) + f"\n\n{within} of the {len(FRESH)} captures replay within `nbsim compare`'s thresholds."
+
+
+def render_sample(outputs):
+    (c,) = outputs
+    s = c["ldi"]
+    return (f"The sample replays the same way: {s['peel_passes']} peel passes, {n(s['peel_fragments'])} fragments and "
+            f"{n(s['peel_samples'])} samples ({'equal to' if (s['peel_fragments'], s['peel_samples']) == (s['gl_peel_fragments'], s['gl_peel_samples']) else 'unlike'} "
+            f"GL's), {s['layer_texel_mismatches']} layer texels differing, {s['parity_mismatches_layers'] + s['parity_mismatches_ranges']} "
+            f"of {n(2 * s['test_points'])} parity answers (both readers) differing from GL's; C_ratio {s['c_ratio']:.3f}.")
+
+
+def render_table1(outputs):
+    (rows,) = outputs
+    lines = ["| shape | vertices | d_min / d_max | d | M_crop | M_comp | C_ratio | paper |",
+             "|---|---:|---:|---:|---:|---:|---:|---|"]
+    for r in rows:
+        paper = f"{r['paper_c_ratio']} ({r['paper_row']})" if r.get("paper_c_ratio") is not None else ""
+        lines.append(f"| {r['shape']} | {n(r['vertices'])} | {r['d_min']} / {r['d_max']} | {r['layers']} | {n(r['m_crop'])} | "
+                     f"{n(r['m_comp'])} | {r['c_ratio']:.3f} | {paper} |")
+    with_paper = [r for r in rows if r.get("paper_c_ratio") is not None]
+    reading = "; ".join(f"{r['shape']}: {r['c_ratio']:.3f} against the paper's {r['paper_c_ratio']} ({r['paper_row']})"
+                        for r in with_paper)
+    mismatches = sum(r["gl_parity_mismatches"] + r["readers_disagree"] for r in rows)
+    return ("\n".join(lines) + f"\n\nBeside the paper: {reading}. Over the rows, {mismatches} parity answers differ between "
+            "the model and GL or between the two readers.")
+
+
+def render_sizes(outputs):
+    (rows,) = outputs
+    sizes = sorted({r["ldi_size"] for r in rows})
+    shapes = list(dict.fromkeys(r["shape"] for r in rows))
+    at = {(r["shape"], r["ldi_size"]): r for r in rows}
+    lines = ["Points uniform in the cube misclassified by their texel (4,096 a row), and GL's misclassified points "
+             "against the exact reference (of about 3,072 farther than epsilon from a surface), by LDI side:", "",
+             "| shape | " + " | ".join(f"{s}: uniform / GL" for s in sizes) + " | texels a test reads, layers / ranges (largest side) |",
+             "|---|" + "---:|" * (len(sizes) + 1)]
+    for sh in shapes:
+        big = at[(sh, sizes[-1])]
+        lines.append(f"| {sh} | " + " | ".join(f"{at[(sh, s)]['misclassified_anywhere']} / {at[(sh, s)]['misclassified_layers']}"
+                                            for s in sizes) +
+                     f" | {big['fetches_anywhere_layers']:.2f} / {big['fetches_anywhere_ranges']:.2f} |")
+    disagree = sum(r["readers_disagree"] + r["gl_parity_mismatches"] for r in rows)
+    fl = [r["fetches_anywhere_layers"] for r in rows]
+    fr = [r["fetches_anywhere_ranges"] for r in rows]
+    agree = "on every point" if disagree == 0 else f"on every point but {disagree}"
+    lines += ["", f"Both readers, and the model's parity test on GL's LDI, give GL's answers {agree}. "
+              f"A test reads {min(fl):.2f} to {max(fl):.2f} layer texels uncompressed against {min(fr):.2f} to {max(fr):.2f} "
+              "compressed texels (RG32UI, 8 bytes each) for uniform points."]
+    return "\n".join(lines)
+
+
+BLOCKS = [
+    Block("fresh", [fresh_capture(i, s) for i, (_, s) in enumerate(FRESH)] +
+          [["compare", f"f{i}.nbt", "--json"] for i in range(len(FRESH))], render_fresh),
+    Block("sample", [["compare", "traces/samples/ldi_nested_128.nbt", "--json"]], render_sample),
+    Block("table1", [["ldi", "table1", "--mesh", f"{MODELS}/Collada/duck.dae", "--json"]], render_table1),
+    Block("sizes", [["ldi", "table1", "--sizes", "64,128,256,512,1024", "--json"]], render_sizes),
+]
