@@ -16,8 +16,8 @@ Usage:
 outputs as one JSON object; AnalysisTest.DocResultsCurrent pipes it into --check.
 
 A docs.py module has PAGE (the file name under docs/) and BLOCKS, a list of Block: NAME (the marker
-name), COMMANDS (lists of nbsim arguments; an argument ending in .json or containing --json marks a
-command whose standard output is JSON), and render(outputs) returning the block's Markdown below
+name), COMMANDS (lists of nbsim arguments, or of a tool's of TOOLS with its name first; a command
+with --json prints JSON), and render(outputs) returning the block's Markdown below
 the commands (outputs: one entry per command, in order: parsed JSON, or the text printed; then the
 text of each of FILES, files the commands wrote).
 """
@@ -70,12 +70,17 @@ def technique_modules():
     return modules
 
 
+# Programs other than nbsim a block may run (to make an input file), with their arguments.
+TOOLS = {"oiiotool"}
+
+
 def wants_json(args):
     return "--json" in args
 
 
 def shown(args):
-    return "nbsim " + " ".join(shlex.quote(a) for a in args)
+    words = " ".join(shlex.quote(a) for a in args)
+    return words if args[0] in TOOLS else "nbsim " + words
 
 
 def collect(nbsim, only):
@@ -92,7 +97,8 @@ def collect(nbsim, only):
                 os.symlink(ROOT / "traces", Path(tmp) / "traces")
                 os.symlink(ROOT / "pipeline", Path(tmp) / "pipeline")
                 for args in block.commands:
-                    p = subprocess.run([nbsim, *args], cwd=tmp, capture_output=True, text=True)
+                    argv = list(args) if args[0] in TOOLS else [nbsim, *args]
+                    p = subprocess.run(argv, cwd=tmp, capture_output=True, text=True)
                     if p.returncode != 0 and not (p.returncode == 1 and block.allow_exit_1):
                         raise RuntimeError(f"{name}/{block.name}: {shown(args)}: exit {p.returncode}: "
                                            f"{p.stderr.strip()[-400:]}")
@@ -180,7 +186,7 @@ def main():
             return 0
         print(f"doc_results: unknown arguments {' '.join(args)} (--help)", file=sys.stderr)
         return 2
-    except (RuntimeError, OSError, json.JSONDecodeError, KeyError, ValueError, TypeError, IndexError) as e:
+    except (RuntimeError, OSError, json.JSONDecodeError, KeyError, ValueError, TypeError, IndexError, SyntaxError) as e:
         print(f"doc_results: {e}", file=sys.stderr)
         return 2
 

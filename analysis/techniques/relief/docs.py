@@ -1,0 +1,150 @@
+"""The relief textures' results in docs/relief.md, generated (the protocol: analysis/doc_results.py)."""
+from collections import defaultdict
+
+from doc_results import Block
+
+PAGE = "relief.md"
+MODELS = "/usr/share/assimp/models"
+METHODS = ("binary", "exact", "robust_clamp", "robust", "nbuffer")
+FRESH = [
+    (["--field-mesh", f"{MODELS}/Collada/duck.dae", "--field-size", "120"], "duck.dae, 120 texels"),
+    (["--field-mesh", f"{MODELS}/BLEND/HUMAN.blend", "--field-size", "150"], "HUMAN.blend, 150 texels"),
+    (["--field", "fbm", "--field-size", "200", "--seed", "11"], "fbm, 200 texels (not a power of two)"),
+    (["--field", "walls", "--field-param", "7", "--field-size", "100", "--seed", "2"], "walls every 7 texels, 100 texels"),
+    (["--field-file", "checker.exr"], "a 9x9 checker image, 72 texels"),
+    (["--field-mesh", f"{MODELS}/Collada/duck.dae", "--field-size", "120", "--frustum", "1", "--angles", "15,65,120"],
+     "duck.dae in a reverse-perspective frustum, the last view from below"),
+]
+FIELDS = ("fbm", "saddle", "spikes", "step", "walls")
+SIZES = (32, 64, 128, 256)
+
+
+def n(v, digits=0):
+    return f"{v:,.{digits}f}"
+
+
+def fresh_capture(i, args):
+    angles = [] if "--angles" in args else ["--angles", "15,65,86"]
+    return ["capture", "relief", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "160x160", "--frames", "3",
+            *angles, *args, "-o", f"t{i}.nbt"]
+
+
+def per_trace(rows):
+    """{trace: {method: totals}} from `nbsim relief --json`'s rows."""
+    out = defaultdict(lambda: defaultdict(lambda: defaultdict(int)))
+    for r in rows:
+        t = out[r["trace"]][r["method"]]
+        for k in ("fragments", "gl_fragments", "lookups", "steps", "errors", "cycles", "pixel_mismatches", "walk_mismatches"):
+            t[k] += r[k]
+    return out
+
+
+def render_fresh(outputs):
+    table = per_trace(outputs[-1]["rows"])
+    lines = ["| heightfield | fragments a method | lookups/fragment: exact, nbuffer, robust | "
+             "hit errors: " + ", ".join(METHODS) + " |", "|---|---:|---|---|"]
+    differ = 0
+    for i, (_, label) in enumerate(FRESH):
+        m = table[f"t{i}.nbt"]
+        differ += sum(m[k]["pixel_mismatches"] + m[k]["walk_mismatches"] + (m[k]["fragments"] != m[k]["gl_fragments"])
+                      for k in METHODS)
+        lpf = ", ".join(f"{m[k]['lookups'] / m[k]['fragments']:.1f}" for k in ("exact", "nbuffer", "robust"))
+        errors = ", ".join(f"{m[k]['errors']:,}" for k in METHODS)
+        lines.append(f"| {label} | {m['exact']['fragments']:,} | {lpf} | {errors} |")
+    verdict = ("every method's fragments and hits equal GL's, 0 walks and 0 pixels differing" if differ == 0
+               else f"{differ} methods with fragments, walks or pixels unlike GL's")
+    return "\n".join(lines) + f"\n\nIn every capture, {verdict}."
+
+
+def reference_captures(extra=(), prefix=""):
+    return [["capture", "relief", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "128x128", "--frames", "4",
+             "--seed", "5", "--field", f, "--field-size", str(s), *extra, "-o", f"{prefix}{f}_{s}.nbt"]
+            for f in FIELDS for s in SIZES]
+
+
+def all_traces(prefix=""):
+    return [f"{prefix}{f}_{s}.nbt" for f in FIELDS for s in SIZES]
+
+
+def render_reference(outputs):
+    d = outputs[-1]
+    fragments = sum(r["fragments"] for r in d["rows"] if r["method"] == "exact")
+    lines = [f"{fragments:,} fragments a method in all.", "",
+             "| method | cycles per box draw | lookups/fragment | steps/fragment | hit errors | hit error | Pareto |",
+             "|---|---:|---:|---:|---:|---:|---|"]
+    for r in d["ranking"]:
+        lines.append(f"| {r['method']} | {n(r['cycles_per_frame'])} | {r['lookups_per_fragment']:.1f} | "
+                     f"{r['steps_per_fragment']:.2f} | {r['errors']:,} | {100 * r['error_rate']:.3f}% | "
+                     f"{'yes' if r['pareto'] else ''} |")
+    lines += ["", "The N-buffer walk against the exact walk, lookups per fragment (same runs):", "",
+              "| heightfield | " + " | ".join(str(s) for s in SIZES) + " | extra errors |", "|---|" + "---|" * (len(SIZES) + 1)]
+    by_field = defaultdict(dict)
+    for r in d["nbuffer_vs_exact"]:
+        by_field[r["field"].split(":")[0]][r["field_size"]] = r
+    fewer, more = [], []
+    for f in FIELDS:
+        cells = []
+        for s in SIZES:
+            r = by_field[f][s]
+            cells.append(f"{r['exact_lookups_per_fragment']:.1f} → {r['nbuffer_lookups_per_fragment']:.1f} ({r['lookup_ratio']:.2f})")
+        extra = sum(max(0, by_field[f][s]["extra_errors"]) for s in SIZES)
+        exact_errors = sum(by_field[f][s]["exact_errors"] for s in SIZES)
+        lines.append(f"| {f} | " + " | ".join(cells) + f" | {extra} (exact: {exact_errors}) |")
+        (fewer if all(by_field[f][s]["lookup_ratio"] < 1 for s in SIZES) else more).append(f)
+    ratios = [r["lookup_ratio"] for r in d["nbuffer_vs_exact"] if r["field"].split(":")[0] in fewer]
+    lines += ["", f"Fewer lookups than the exact walk at every size on {', '.join(fewer)} "
+              f"({min(ratios):.2f} to {max(ratios):.2f} of its lookups)" +
+              (f"; more on {', '.join(more)}." if more else ".")]
+    lines += ["", "Beside the paper's Table 1 (terrain, frames per second on a GeForce 6800 GT; ours: the fbm rows, cycles "
+              "per box draw, lookups per fragment):", "", "| method | " + " | ".join(str(s) for s in SIZES) + " |",
+              "|---|" + "---|" * len(SIZES)]
+    paper = defaultdict(dict)
+    for r in d["paper"]:
+        paper[r["method"]][r["field_size"]] = r
+    for m in sorted(paper):
+        lines.append(f"| {m} | " + " | ".join(f"{paper[m][s]['paper_hz']:.0f} Hz; {n(paper[m][s]['cycles_per_frame'])} cycles, "
+                                             f"{paper[m][s]['lookups_per_fragment']:.1f}" for s in SIZES) + " |")
+    return "\n".join(lines)
+
+
+def render_covering(outputs):
+    (paper,) = [r for r in outputs[len(FIELDS) * len(SIZES)]["ranking"] if r["method"] == "nbuffer"]
+    corners_run = outputs[-1]
+    (nb,) = [r for r in corners_run["ranking"] if r["method"] == "nbuffer"]
+    differ = sum(r["walk_mismatches"] for r in corners_run["rows"])
+
+    def change(a, b):
+        return f"{100 * (a / b - 1):+.0f}%"
+    return (f"With the corner covering the N-buffer walk reads {nb['lookups_per_fragment']:.1f} texels and takes "
+            f"{nb['steps_per_fragment']:.2f} steps a fragment for {n(nb['cycles_per_frame'])} cycles a box draw, with "
+            f"{nb['errors']} hit errors and {differ} walks differing from GL's. The paper's covering, against it: "
+            f"{change(paper['steps_per_fragment'], nb['steps_per_fragment'])} steps, "
+            f"{change(paper['lookups_per_fragment'], nb['lookups_per_fragment'])} texels read, "
+            f"{change(paper['cycles_per_frame'], nb['cycles_per_frame'])} cycles.")
+
+
+def render_city(outputs):
+    compare = outputs[1]
+    r = compare["relief"]
+    m = r["methods"]
+    walks = sum(m[k]["walk_mismatches"] + m[k]["pixel_mismatches"] for k in METHODS)
+    same = all(m[k]["fragments"] == m[k]["gl_fragments"] for k in METHODS)
+    errors = ", ".join(f"{k} {m[k]['errors']:,}" for k in METHODS)
+    return (f"{r['scene_draws']:,} scene draws; per method {m['exact']['rasterized']:,} box fragments rasterized, "
+            f"{m['exact']['fragments']:,} passing the early depth test in the model "
+            f"({'as in GL' if same else 'unlike GL'}); {walks} walks or pixels differing from GL's; hit errors {errors}; "
+            f"{'within' if compare['within_thresholds'] else 'OUTSIDE'} `nbsim compare`'s thresholds.")
+
+
+BLOCKS = [
+    Block("fresh", [["oiiotool", "--pattern", "checker:width=9:height=9:color1=0.15:color2=0.85", "72x72", "1", "-d", "float",
+                     "-o", "checker.exr"]] + [fresh_capture(i, a) for i, (a, _) in enumerate(FRESH)] +
+          [["relief", *[f"t{i}.nbt" for i in range(len(FRESH))], "--json"]], render_fresh),
+    Block("reference", reference_captures() + [["relief", *all_traces(), "--json"]], render_reference),
+    Block("covering", reference_captures() + [["relief", *all_traces(), "--json"]] +
+          reference_captures(("--covering", "corners", "--align", "bottom"), "corners_") +
+          [["relief", *all_traces("corners_"), "--json"]], render_covering),
+    Block("city", [["capture", "relief", "--scene", "city", "--objects", "2000", "--path", "walk", "--size", "320x240", "--frames",
+                    "8", "--seed", "4", "--placement", "city", "--field", "walls", "--field-size", "64", "-o", "c.nbt"],
+                   ["compare", "c.nbt", "--json"]], render_city),
+]
