@@ -1,0 +1,161 @@
+"""The shadow volumes' results in docs/shadows.md, generated (the protocol: analysis/doc_results.py)."""
+import csv
+import io
+
+from doc_results import Block
+
+PAGE = "shadows.md"
+SCENES = ("boxes", "terrain", "city")
+MODES = ("infinite", "culled", "clamped")
+PAPER = {"boxes": "~20 %", "terrain": "2.5 %", "city": "2.5 % (20 M -> 512 K)"}
+LOSSY = [("f32, divisor 1, every level (reference)", []),
+         ("u16", ["--set", "litmap_min.format=u16", "--set", "litmap_max.format=u16"]),
+         ("divisor 2", ["--set", "litmap_min.resolution_divisor=2", "--set", "litmap_max.resolution_divisor=2"]),
+         ("level cap 4", ["--set", "litmap_min.level_cap=4", "--set", "litmap_max.level_cap=4"])]
+
+
+def n(v, digits=0):
+    return f"{v:,.{digits}f}"
+
+
+def caster_count(v):
+    return n(v, 0) if float(v).is_integer() else f"{v:,.2f}".rstrip("0")
+
+
+def mib(b):
+    return f"{b / 2**20:,.0f} MiB" if b >= 2**20 and b % 2**20 == 0 else f"{b / 1024:,.0f} KiB"
+
+
+def conservative(r):
+    return r["not_conservative"] == 0 and r["unsafe_culls"] == 0 and r["mask_diff"] == 0 and r["mask_diff_infinite"] == 0
+
+
+def render_modes(outputs):
+    rows = outputs[len(SCENES) * len(MODES)]
+    lossy = outputs[len(SCENES) * len(MODES) + 1:]
+    lines = ["| scene | mode | fill / frame | ratio to infinite | paper | casters culled by GL / frame (incl. outside) | "
+             "build texels / frame | lookups / frame | cycles / frame | mask pixels differing (GL's, infinite) |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        paper = PAPER[r["scene"]] if r["shadow_mode"] == "clamped" else ""
+        lines.append(f"| {r['scene']} | {r['shadow_mode']} | {n(r['fill_per_frame'])} | {100 * r['ratio_to_infinite']:.1f} % | "
+                     f"{paper} | {caster_count(r['gl_culled_per_frame'] + r['outside_per_frame'])} of {n(r['casters_per_frame'])} | "
+                     f"{n(r['build_texels_per_frame'])} | {n(r['lookups_per_frame'])} | {n(r['cycles_per_frame'])} | "
+                     f"{r['mask_diff']}, {r['mask_diff_infinite']} |")
+    exact = all(r["draws_exact"] == r["draws"] and r["stencil_pixels_matching"] == r["stencil_pixels"] for r in rows)
+    mism = sum(r["zmin_mismatches"] + r["zmax_mismatches"] + r["decision_mismatches"] for r in rows)
+    by = {(r["scene"], r["shadow_mode"]): r for r in rows}
+    city_inf, city_cl = by[("city", "infinite")], by[("city", "clamped")]
+    lines += ["", (f"{'Every draw of every trace replays exact and every stencil buffer equals GL' + chr(39) + 's' if exact else 'Some draws or stencil pixels differ from GL' + chr(39) + 's'} "
+                   f"({', '.join(n(r['draws']) for r in rows)} draws); {mism} z_min/z_max and decision mismatches. "
+                   f"Clamping cuts the city's cycles a frame {city_inf['cycles_per_frame'] / city_cl['cycles_per_frame']:.1f}x. "
+                   "The rule on the litmaps alone culls a little more than GL (the capture's slab also keeps a seen caster's "
+                   "own bounds and near-plane crossings): " +
+                   "; ".join(f"{s} {caster_count(by[(s, 'clamped')]['culled_per_frame'])} casters a frame against GL's "
+                             f"{caster_count(by[(s, 'clamped')]['gl_culled_per_frame'])}" for s in SCENES) + ".")]
+    lines += ["", "Lossy designs of both N-buffers on the city's clamped trace:", "",
+              "| design (both units) | casters culled by the rule / frame | build texels / frame | lookups / frame | "
+              "cycles / frame | memory | conservative |", "|---|---:|---:|---:|---:|---:|---|"]
+    for (label, _), (r,) in zip(LOSSY, lossy):
+        lines.append(f"| {label} | {caster_count(r['culled_per_frame'])} | {n(r['build_texels_per_frame'])} | "
+                     f"{n(r['lookups_per_frame'])} | {n(r['cycles_per_frame'])} | {mib(r['nbuffer_memory_bytes'])} | "
+                     f"{'yes' if conservative(r) else 'NO'} |")
+    return "\n".join(lines)
+
+
+def modes_commands():
+    caps = [["capture", "shadows", "--scene", s, "--path", "fly", "--size", "640x480", "--frames", "4", "--shadow-mode", m,
+             "-o", f"{s}_{m}.nbt"] for s in SCENES for m in MODES]
+    return caps + [["shadows", *[f"{s}_{m}.nbt" for s in SCENES for m in MODES], "--json"]] + \
+        [["shadows", "city_clamped.nbt", *sets, "--json"] for _, sets in LOSSY]
+
+
+def render_street(outputs):
+    (r,) = outputs[-1]
+    return (f"At street level, the camera often inside volumes: fill {n(r['fill_per_frame'])} a frame against GL's infinite "
+            f"volumes' {n(r['reference_fill_per_frame'])}, a ratio of {100 * r['ratio_to_infinite']:.1f} %, with "
+            f"{r['mask_diff']} and {r['mask_diff_infinite']} mask pixels differing from GL's mask and from the infinite one.")
+
+
+FRESH = [["--scene", "city", "--seed", "7", "--objects", "2500", "--path", "fly", "--size", "300x220", "--frames", "3", "--litmap", "256",
+          "--light-fov", "75", "--shadow-mode", "infinite", "-o", "fresh_infinite.nbt"],
+         ["--scene", "city", "--seed", "7", "--objects", "2500", "--path", "fly", "--size", "300x220", "--frames", "3", "--litmap", "256",
+          "--light-fov", "75", "--shadow-mode", "clamped", "-o", "fresh_clamped.nbt"],
+         ["--scene", "terrain", "--seed", "11", "--towers", "25", "--birds", "600", "--path", "fly", "--size", "200x150", "--frames", "3",
+          "--litmap", "128", "--light-fov", "50", "--shadow-mode", "culled", "-o", "fresh_terrain.nbt"],
+         ["--scene", "boxes", "--seed", "5", "--path", "fly", "--size", "160x120", "--frames", "5", "--litmap", "300", "--light-fov", "40",
+          "--levels-every", "2", "--shadow-mode", "clamped", "-o", "fresh_boxes.nbt"]]
+
+
+def render_table(rows):
+    lines = ["| trace | scene | mode | litmap | ratio to infinite | draws exact | stencil equal | mask pixels differing | "
+             "z, decision and unsafe-cull mismatches |", "|---|---|---|---:|---:|---:|---|---:|---:|"]
+    for r in rows:
+        mism = r["zmin_mismatches"] + r["zmax_mismatches"] + r["decision_mismatches"] + r["unsafe_culls"]
+        lines.append(f"| {r['trace']} | {r['scene']} | {r['shadow_mode']} | {r['litmap_size']} | {100 * r['ratio_to_infinite']:.1f} % | "
+                     f"{r['draws_exact']:,} of {r['draws']:,} | {'yes' if r['stencil_pixels_matching'] == r['stencil_pixels'] else 'NO'} | "
+                     f"{r['mask_diff']}, {r['mask_diff_infinite']} | {mism} |")
+    return "\n".join(lines)
+
+
+def render_fresh(outputs):
+    return render_table(outputs[-1])
+
+
+def render_samples(outputs):
+    (rows,) = outputs
+    lines = [render_table(rows), ""]
+    lines.append("; ".join(f"litmap {r['litmap_size']}: fill {n(r['fill_per_frame'])} a frame against "
+                           f"{n(r['reference_fill_per_frame'])} infinite, GL culled {caster_count(r['gl_culled_per_frame'])} "
+                           f"of {n(r['casters_per_frame'])} casters a frame (and {caster_count(r['outside_per_frame'])} "
+                           f"outside the light), the rule {caster_count(r['culled_per_frame'])}" for r in rows) + ".")
+    return "\n".join(lines)
+
+
+def render_sweep(outputs):
+    rows = [r for r in csv.DictReader(io.StringIO(outputs[-1])) if r["status"] == "ok"]
+
+    def f(r, k):
+        return float(r[k])
+
+    def label(r):
+        cap = int(r["litmap_min.level_cap"])
+        return f"divisor {r['litmap_min.resolution_divisor']}, {r['litmap_min.format']}, {'every level' if cap < 0 else f'cap {cap}'}"
+
+    lines = [f"{len(rows)} points. The Pareto front of cycles per frame against culls lost, per trace, and each trace's "
+             "reference (divisor 1, f32, every level):", "",
+             "| trace | design (both units) | cycles / frame | casters culled by the rule / frame | culls lost | "
+             "build texels / frame | lookups / frame | memory |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    unsafe = 0
+    for trace in dict.fromkeys(r["trace"] for r in rows):
+        pts = [r for r in rows if r["trace"] == trace]
+        unsafe += sum(int(r["unsafe_culls"]) + int(r["mask_diff"]) + int(r["mask_diff_infinite"]) + int(r["not_conservative"])
+                      for r in pts)
+        front = [r for r in pts if not any(
+            f(o, "cycles_per_frame") <= f(r, "cycles_per_frame") and f(o, "culled_lost_fraction") <= f(r, "culled_lost_fraction")
+            and (f(o, "cycles_per_frame") < f(r, "cycles_per_frame") or f(o, "culled_lost_fraction") < f(r, "culled_lost_fraction"))
+            for o in pts)]
+        ref = next(r for r in pts if r["litmap_min.resolution_divisor"] == "1" and r["litmap_min.format"] == "f32"
+                   and int(r["litmap_min.level_cap"]) < 0)
+        name = trace.rsplit("/", 1)[-1].removesuffix(".nbt")
+        for r in sorted(front, key=lambda r: f(r, "cycles_per_frame")) + [ref]:
+            lost = f(r, "culled_lost_fraction")
+            lines.append(f"| {name if r is not ref else '(' + name + ')'} | {label(r) if r is not ref else '(reference)'} | "
+                         f"{n(f(r, 'cycles_per_frame'))} | {caster_count(f(r, 'culled_per_frame'))} | "
+                         f"{'0' if lost == 0 else f'{100 * lost:.2f} %'} | {n(f(r, 'build_texels_per_frame'))} | "
+                         f"{caster_count(f(r, 'lookups_per_frame'))} | {mib(f(r, 'nbuffer_memory_bytes'))} |")
+    lines += ["", f"Unsafe culls, non-conservative ranges and mask pixels differing, over every point: {unsafe}."]
+    return "\n".join(lines)
+
+
+BLOCKS = [
+    Block("modes", modes_commands(), render_modes),
+    Block("street", [["capture", "shadows", "--scene", "city", "--path", "walk", "--size", "640x480", "--frames", "8", "-o", "walk.nbt"],
+                     ["shadows", "walk.nbt", "--json"]], render_street),
+    Block("fresh", [["capture", "shadows", *a] for a in FRESH] +
+          [["shadows", "fresh_infinite.nbt", "fresh_clamped.nbt", "fresh_terrain.nbt", "fresh_boxes.nbt", "--json"]], render_fresh),
+    Block("samples", [["shadows", "traces/samples/shadows_city_fly_320_litmap256.nbt",
+                       "traces/samples/shadows_city_fly_320_litmap128.nbt", "--json"]], render_samples),
+    Block("sweep", [["explore", "pipeline/sweeps/shadows.json", "--out", "sweep", "--jobs", "2"]], render_sweep,
+          files=("sweep/results.csv",)),
+]
