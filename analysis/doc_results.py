@@ -8,12 +8,13 @@ readings rendered from their outputs. So a page's numbers are as current as the 
 them, and a reader can run the commands shown to get them.
 
 Usage:
-  /usr/bin/python3 analysis/doc_results.py --collect [--nbsim NBSIM] [--only NAME[/BLOCK]] > runs.json
+  /usr/bin/python3 analysis/doc_results.py --collect [--nbsim NBSIM] [--only NAME[/BLOCK]] [--jobs N] > runs.json
   /usr/bin/python3 analysis/doc_results.py --update docs < runs.json   # rewrite every collected block
   /usr/bin/python3 analysis/doc_results.py --check docs < runs.json    # exit 1 naming each stale block
   /usr/bin/python3 analysis/doc_results.py --list                      # the blocks and their commands
---collect runs every block's commands (in a temporary folder: captures write there) and prints their
-outputs as one JSON object; AnalysisTest.DocResultsCurrent pipes it into --check.
+--collect runs every block's commands (each block in a temporary folder of its own, where its
+captures write; N blocks at a time, default one per core) and prints their outputs as one JSON
+object; AnalysisTest.DocResultsCurrent pipes it into --check.
 
 A docs.py module has PAGE (the file name under docs/) and BLOCKS, a list of Block: NAME (the marker
 name), COMMANDS (lists of nbsim arguments, or of a tool's of TOOLS with its name first; a command
@@ -21,6 +22,7 @@ with --json prints JSON), and render(outputs) returning the block's Markdown bel
 the commands (outputs: one entry per command, in order: parsed JSON, or the text printed; then the
 text of each of FILES, files the commands wrote).
 """
+import concurrent.futures
 import importlib.util
 import json
 import os
@@ -83,29 +85,34 @@ def shown(args):
     return words if args[0] in TOOLS else "nbsim " + words
 
 
-def collect(nbsim, only):
-    """Runs the commands of every block (or of `only`: NAME or NAME/BLOCK); returns
-    {technique: {block: [outputs]}}."""
+def run_block(nbsim, name, block):
+    """Runs one block's commands in a folder of its own; returns their outputs."""
+    outputs = []
+    with tempfile.TemporaryDirectory(prefix="nbsim_docs_") as tmp:
+        # Paths under the repository (samples, sweep files) resolve from its root.
+        os.symlink(ROOT / "traces", Path(tmp) / "traces")
+        os.symlink(ROOT / "pipeline", Path(tmp) / "pipeline")
+        for args in block.commands:
+            argv = list(args) if args[0] in TOOLS else [nbsim, *args]
+            p = subprocess.run(argv, cwd=tmp, capture_output=True, text=True)
+            if p.returncode != 0 and not (p.returncode == 1 and block.allow_exit_1):
+                raise RuntimeError(f"{name}/{block.name}: {shown(args)}: exit {p.returncode}: {p.stderr.strip()[-400:]}")
+            outputs.append(json.loads(p.stdout) if wants_json(args) else p.stdout)
+        for f in block.files:
+            outputs.append((Path(tmp) / f).read_text(encoding="utf-8"))
+    return outputs
+
+
+def collect(nbsim, only, jobs):
+    """Runs the commands of every block (or of `only`: NAME or NAME/BLOCK), `jobs` blocks at a time;
+    returns {technique: {block: [outputs]}}."""
+    todo = [(name, block) for name, module in technique_modules() for block in module.BLOCKS
+            if not only or only in (name, f"{name}/{block.name}")]
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+        results = list(pool.map(lambda t: run_block(nbsim, *t), todo))
     out = {}
-    for name, module in technique_modules():
-        for block in module.BLOCKS:
-            if only and only not in (name, f"{name}/{block.name}"):
-                continue
-            outputs = []
-            with tempfile.TemporaryDirectory(prefix="nbsim_docs_") as tmp:
-                # Paths under the repository (samples, sweep files) resolve from its root.
-                os.symlink(ROOT / "traces", Path(tmp) / "traces")
-                os.symlink(ROOT / "pipeline", Path(tmp) / "pipeline")
-                for args in block.commands:
-                    argv = list(args) if args[0] in TOOLS else [nbsim, *args]
-                    p = subprocess.run(argv, cwd=tmp, capture_output=True, text=True)
-                    if p.returncode != 0 and not (p.returncode == 1 and block.allow_exit_1):
-                        raise RuntimeError(f"{name}/{block.name}: {shown(args)}: exit {p.returncode}: "
-                                           f"{p.stderr.strip()[-400:]}")
-                    outputs.append(json.loads(p.stdout) if wants_json(args) else p.stdout)
-                for f in block.files:
-                    outputs.append((Path(tmp) / f).read_text(encoding="utf-8"))
-            out.setdefault(name, {})[block.name] = outputs
+    for (name, block), outputs in zip(todo, results):
+        out.setdefault(name, {})[block.name] = outputs
     return out
 
 
@@ -168,7 +175,8 @@ def main():
         if args[0] == "--collect":
             nbsim = args[args.index("--nbsim") + 1] if "--nbsim" in args else str(ROOT / "build" / "pipeline" / "nbsim")
             only = args[args.index("--only") + 1] if "--only" in args else None
-            data = collect(os.path.abspath(nbsim), only)
+            jobs = int(args[args.index("--jobs") + 1]) if "--jobs" in args else (os.cpu_count() or 1)
+            data = collect(os.path.abspath(nbsim), only, jobs)
             if only and not data:
                 raise ValueError(f"--only {only}: no such technique or block (--list lists them)")
             json.dump(data, sys.stdout)
