@@ -17,7 +17,7 @@ captures write; N blocks at a time, default one per core) and prints their outpu
 object; AnalysisTest.DocResultsCurrent pipes it into --check.
 
 A docs.py module has PAGE (the file name under docs/) and BLOCKS, a list of Block: NAME (the marker
-name), COMMANDS (lists of nbsim arguments, or of a tool's of TOOLS with its name first; a command
+name), PAGE when the block is in another page than the module's, COMMANDS (lists of nbsim arguments, or of a tool's of TOOLS with its name first; a command
 with --json prints JSON), and render(outputs) returning the block's Markdown below
 the commands (outputs: one entry per command, in order: parsed JSON, or the text printed; then the
 text of each of FILES, files the commands wrote).
@@ -49,6 +49,8 @@ class Block:
     # Files the commands wrote (relative to their folder), read after them: their text is appended
     # to the outputs, in this order.
     files: tuple = ()
+    # The page the block is in, when not the module's PAGE.
+    page: str = ""
 
 
 def begin_marker(technique, block):
@@ -135,13 +137,11 @@ def write_or_check(data, docs, check):
     """Rewrites (or, with check, compares) every collected block; returns the stale ones."""
     stale = []
     modules = dict(technique_modules())
+    texts = {}  # page path -> (text read, text with the blocks replaced)
     for name, blocks in data.items():
         if name not in modules:
             raise ValueError(f"the collected runs name technique '{name}', which has no analysis/techniques/{name}/docs.py")
         module = modules[name]
-        path = Path(docs) / module.PAGE
-        text = path.read_text(encoding="utf-8")
-        new = text
         by_name = {b.name: b for b in module.BLOCKS}
         for block_name, outputs in blocks.items():
             if block_name not in by_name:
@@ -150,12 +150,19 @@ def write_or_check(data, docs, check):
             if len(outputs) != len(block.commands) + len(block.files):
                 raise ValueError(f"{name}/{block_name}: {len(outputs)} outputs for {len(block.commands)} commands and "
                                  f"{len(block.files)} files: collect again")
-            before = new
-            new = replace(new, name, block_name, render_block(block, outputs), path)
-            if new != before:
+            path = Path(docs) / (block.page or module.PAGE)
+            if path not in texts:
+                text = path.read_text(encoding="utf-8")
+                texts[path] = (text, text)
+            before = texts[path][1]
+            after = replace(before, name, block_name, render_block(block, outputs), path)
+            if after != before:
                 stale.append(f"{name}/{block_name} ({path})")
-        if not check and new != text:
-            path.write_text(new, encoding="utf-8")
+            texts[path] = (texts[path][0], after)
+    if not check:
+        for path, (text, new) in texts.items():
+            if new != text:
+                path.write_text(new, encoding="utf-8")
     return stale
 
 
@@ -168,7 +175,7 @@ def main():
         if args[0] == "--list":
             for name, module in technique_modules():
                 for block in module.BLOCKS:
-                    print(f"{name}/{block.name} (docs/{module.PAGE}):")
+                    print(f"{name}/{block.name} (docs/{block.page or module.PAGE}):")
                     for a in block.commands:
                         print(f"  {shown(a)}")
             return 0

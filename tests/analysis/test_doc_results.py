@@ -92,10 +92,10 @@ class DocResultsCliTest(unittest.TestCase):
     def test_every_technique_page_holds_its_blocks(self):
         # Each declared block has its markers in its page once, in order (what --update needs).
         for name, module in doc_results.technique_modules():
-            text = (ROOT / "docs" / module.PAGE).read_text(encoding="utf-8")
             for block in module.BLOCKS:
+                text = (ROOT / "docs" / (block.page or module.PAGE)).read_text(encoding="utf-8")
                 begin, end = doc_results.begin_marker(name, block.name), doc_results.end_marker(name, block.name)
-                self.assertEqual((text.count(begin), text.count(end)), (1, 1), f"{name}/{block.name} in {module.PAGE}")
+                self.assertEqual((text.count(begin), text.count(end)), (1, 1), f"{name}/{block.name}")
                 self.assertLess(text.index(begin), text.index(end))
 
     def test_list_prints_every_block(self):
@@ -103,7 +103,7 @@ class DocResultsCliTest(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         for name, module in doc_results.technique_modules():
             for block in module.BLOCKS:
-                self.assertIn(f"{name}/{block.name} (docs/{module.PAGE})", p.stdout)
+                self.assertIn(f"{name}/{block.name} (docs/{block.page or module.PAGE})", p.stdout)
 
 
 if __name__ == "__main__":
