@@ -18,7 +18,7 @@ object; AnalysisTest.DocResultsCurrent pipes it into --check.
 
 A docs.py module has PAGE (the file name under docs/) and BLOCKS, a list of Block: NAME (the marker
 name), PAGE when the block is in another page than the module's, COMMANDS (lists of nbsim arguments, or of a tool's of TOOLS with its name first; a command
-with --json prints JSON), and render(outputs) returning the block's Markdown below
+with --json, or one that prints a JSON object, gives its parsed JSON), and render(outputs) returning the block's Markdown below
 the commands (outputs: one entry per command, in order: parsed JSON, or the text printed; then the
 text of each of FILES, files the commands wrote).
 """
@@ -78,8 +78,17 @@ def technique_modules():
 TOOLS = {"oiiotool"}
 
 
-def wants_json(args):
-    return "--json" in args
+def parsed(args, stdout):
+    """A command's output: parsed JSON when it asked for JSON (--json) or printed one JSON object
+    (e.g. `nbsim nbuffer memory`), else the text."""
+    if "--json" in args:
+        return json.loads(stdout)
+    if stdout.lstrip().startswith("{"):
+        try:
+            return json.loads(stdout)
+        except json.JSONDecodeError:
+            pass
+    return stdout
 
 
 def shown(args):
@@ -99,7 +108,7 @@ def run_block(nbsim, name, block):
             p = subprocess.run(argv, cwd=tmp, capture_output=True, text=True)
             if p.returncode != 0 and not (p.returncode == 1 and block.allow_exit_1):
                 raise RuntimeError(f"{name}/{block.name}: {shown(args)}: exit {p.returncode}: {p.stderr.strip()[-400:]}")
-            outputs.append(json.loads(p.stdout) if wants_json(args) else p.stdout)
+            outputs.append(parsed(args, p.stdout))
         for f in block.files:
             outputs.append((Path(tmp) / f).read_text(encoding="utf-8"))
     return outputs

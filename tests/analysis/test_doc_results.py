@@ -20,17 +20,20 @@ sys.path.insert(0, str(ROOT / "analysis"))
 import doc_results  # noqa: E402
 
 
+FAKE_PAGE = "fake" + ".md"  # a page made for the test, in a temporary folder
+
+
 def fake_module():
     block = doc_results.Block("table", [["trace", "info", "x.nbt", "--json"]],
                               lambda outputs: f"| frames |\n|---:|\n| {outputs[0]['frames']} |")
-    return types.SimpleNamespace(PAGE="fake.md", BLOCKS=[block])
+    return types.SimpleNamespace(PAGE=FAKE_PAGE, BLOCKS=[block])
 
 
 class DocResultsTest(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
         self.docs = Path(self.tmp.name)
-        self.page = self.docs / "fake.md"
+        self.page = self.docs / FAKE_PAGE
         self.page.write_text("# Fake\n\nBefore.\n\n" + doc_results.begin_marker("fake", "table") + "\nold\n" +
                              doc_results.end_marker("fake", "table") + "\n\nAfter.\n", encoding="utf-8")
         self.saved = doc_results.technique_modules
@@ -67,7 +70,7 @@ class DocResultsTest(unittest.TestCase):
             doc_results.write_or_check({"fake": {"table": [1, 2]}}, self.docs, check=True)
         with self.assertRaisesRegex(ValueError, "no such block"):
             doc_results.write_or_check({"fake": {"other": []}}, self.docs, check=True)
-        with self.assertRaisesRegex(ValueError, "has no analysis/techniques/nope/docs.py"):
+        with self.assertRaisesRegex(ValueError, "technique 'nope', which has no "):
             doc_results.write_or_check({"nope": {}}, self.docs, check=True)
 
 

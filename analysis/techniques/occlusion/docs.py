@@ -83,3 +83,111 @@ BLOCKS = [
     Block("samples", [["trace", "info", f"traces/samples/{s}", "--json"] for s in SAMPLES] +
           [["compare", f"traces/samples/{s}", "--json"] for s in SAMPLES], render_samples),
 ]
+
+
+COVERINGS = {"paper": "paper", "corners": "corners", "one": "one", "rect": "rectangle levels, every one",
+             "rect_aspect1": "rectangle levels, sides at most 2x apart"}
+
+
+def coverage(outputs):
+    import plot_coverage  # matplotlib, headless: only when rendering
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "fig4.csv")
+        Path(path).write_text(outputs[-1], encoding="utf-8")
+        _, _, maps, lookups, cases = plot_coverage.load(path)
+    return plot_coverage, maps, lookups, cases
+
+
+def render_covering_figure4(outputs):
+    pc, maps, lookups, cases = coverage(outputs)
+    s = pc.summary(maps, lookups)
+    lines = ["| covering | mean extra pixels (% of the box) | worst (x the box) | exact for (% of sizes) | lookups a box |",
+             "|---|---:|---:|---:|---:|"]
+    for key, c in s.items():
+        lookups_text = f"{c['mean_lookups']:.2f}" if c["mean_lookups"] is not None else "-"
+        lines.append(f"| {COVERINGS.get(key, key)} | {100 * c['mean_extra']:.1f}% | {c['worst_extra']:.0f}x | "
+                     f"{100 * c['exact_fraction']:.1f}% | {lookups_text} |")
+    shares = pc.case_shares(maps, cases)
+    keys = list(s)
+    lines += ["", "By the paper's five cases (each case's share of the box sizes, and each covering's mean extra area "
+              "in it):", "", "| case | share | " + " | ".join(COVERINGS.get(k, k) for k in keys) + " |",
+              "|---|---:|" + "---:|" * len(keys)]
+    for c in shares:
+        lines.append(f"| `{c['case']}` | {100 * c['share']:.1f}% | " +
+                     " | ".join(f"{100 * c['extra'][k]:.1f}%" for k in keys) + " |")
+    return "\n".join(lines)
+
+
+def ladder_label(r):
+    if r["cull.mode"] in ("oq", "oq_hier"):
+        return f"occlusion queries (`{r['cull.mode']}`, the box itself)"
+    if r["nbuffer.levels"] == "rect":
+        k = int(r["nbuffer.max_aspect_log2"])
+        return "rectangle levels, every one (the ideal rectangle test)" if k < 0 else \
+            f"rectangle levels, sides at most {2 ** k}x apart"
+    return f"{r['nbuffer.covering']}/{r['nbuffer.align']}"
+
+
+def render_ladder(outputs):
+    import csv
+    import io
+    rows = [r for r in csv.DictReader(io.StringIO(outputs[-1])) if r["status"] == "ok" and r["role"] == "sweep"]
+    out = []
+    for trace, scene in (("city_walk_512", "Walkthrough"), ("city_fly_512", "Flyover")):
+        for mode, grain in (("nb_hier", "over the BVH"), ("nb", "every object flat")):
+            pts = [r for r in rows if trace in r["trace"] and r["cull.mode"] == mode]
+            oq = next(r for r in rows if trace in r["trace"] and r["cull.mode"] == f"oq{'_hier' if mode == 'nb_hier' else ''}")
+            corners = next(r for r in pts if r["nbuffer.covering"] == "corners" and r["nbuffer.align"] == "bottom")
+            ideal = next(r for r in pts if r["nbuffer.levels"] == "rect" and int(r["nbuffer.max_aspect_log2"]) < 0)
+            lo, hi = float(corners["culling_efficiency"]), float(ideal["culling_efficiency"])
+            out += [f"**{scene}, `{mode}`** ({grain}):", "",
+                    "| covering | culling efficiency | gap closed | false culls | query depth tests / frame | "
+                    "level update texels / frame | cycles / frame | level memory |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
+            for r in pts + [oq]:
+                e = float(r["culling_efficiency"])
+                gap = f"{100 * (e - lo) / (hi - lo):.0f}%" if r is not oq and hi > lo else ""
+                mem = float(r["nbuffer_memory_bytes"] or 0)
+                out.append(f"| {ladder_label(r)} | {100 * e:.2f}% | {gap} | {r['false_culls']} | "
+                           f"{n(float(r['query_depth_tests_per_frame']))} | {n(float(r['update_texels_per_frame']))} | "
+                           f"{n(float(r['cycles_per_frame']))} | {f'{mem / 2**20:,.0f} MiB' if mem else '-'} |")
+            out.append("")
+    return "\n".join(out)
+
+
+def render_lazy(outputs):
+    runs = [json.loads(t)["summary"]["cull"] for t in outputs[len(LAZY):]]
+    return "\n".join(["| levels | level update texels / frame | cycles / frame | culling efficiency |", "|---|---:|---:|---:|"] +
+                     [f"| {label} | {n(r['update_texels_per_frame'])} | {n(r['cycles_per_frame'])} | "
+                      f"{100 * r['culling_efficiency']:.2f}% |" for (label, _), r in zip(LAZY, runs)])
+
+
+def render_memory(outputs):
+    lines = ["| viewport | square levels | rectangle levels (every one) | rectangle, sides at most 2x apart | "
+             "rectangle, at most 4x |", "|---|---:|---:|---:|---:|"]
+    per = len(MEMORY_KINDS)
+    for i, size in enumerate(MEMORY_SIZES):
+        cells = []
+        for o in outputs[i * per:(i + 1) * per]:
+            cells.append(f"{o['level_count']} levels, {o['memory_bytes'] / 2**20:,.1f} MiB")
+        lines.append(f"| {size} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+LAZY = [("square levels", []), ("rectangle levels, sides at most 2x apart",
+                                ["--set", "nbuffer.levels=rect", "--set", "nbuffer.max_aspect_log2=1"]),
+        ("rectangle levels, every one", ["--set", "nbuffer.levels=rect", "--set", "nbuffer.max_aspect_log2=-1"])]
+MEMORY_SIZES = ("256x256", "512x512", "640x480", "1024x1024")
+MEMORY_KINDS = ([], ["--levels", "rect"], ["--levels", "rect", "--max-aspect-log2", "1"],
+                ["--levels", "rect", "--max-aspect-log2", "2"])
+
+BLOCKS += [
+    Block("covering-figure4", [["nbuffer", "coverage", "--size", "256x256", "--out", "fig4.png"]], render_covering_figure4,
+          files=("fig4.csv",), page="covering.md"),
+    Block("ladder", [["explore", "pipeline/sweeps/nbuffer_covering.json", "--out", "ladder", "--jobs", "2"]], render_ladder,
+          files=("ladder/results.csv",), page="covering.md"),
+    Block("lazy", [["replay", WALK, "--set", "cull.mode=nb_hier", "--set", "nbuffer.update_policy=lazy", *sets, "--out", f"lazy{i}"]
+                   for i, (_, sets) in enumerate(LAZY)], render_lazy, files=tuple(f"lazy{i}/run.json" for i in range(len(LAZY))),
+          page="covering.md"),
+    Block("memory", [["nbuffer", "memory", "--size", s, *k] for s in MEMORY_SIZES for k in MEMORY_KINDS], render_memory,
+          page="covering.md"),
+]
