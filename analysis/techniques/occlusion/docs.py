@@ -191,3 +191,82 @@ BLOCKS += [
     Block("memory", [["nbuffer", "memory", "--size", s, *k] for s in MEMORY_SIZES for k in MEMORY_KINDS], render_memory,
           page="covering.md"),
 ]
+
+
+def sweep_rows(text):
+    import csv
+    import io
+    return [r for r in csv.DictReader(io.StringIO(text)) if r["status"] == "ok" and r["role"] == "sweep"]
+
+
+def front(rows, cost, error):
+    def f(r, k):
+        return float(r[k])
+    return sorted((r for r in rows if not any(f(o, cost) <= f(r, cost) and f(o, error) <= f(r, error) and
+                                              (f(o, cost) < f(r, cost) or f(o, error) < f(r, error)) for o in rows)),
+                  key=lambda r: f(r, cost))
+
+
+def render_design(outputs):
+    rows = sweep_rows(outputs[-1])
+
+    def label(r):
+        return f"div={r['nbuffer.resolution_divisor']} {r['nbuffer.format']} {r['nbuffer.update_policy']}"
+
+    def line(r, note=""):
+        return (f"| {note or label(r)} | {n(float(r['cycles_per_frame']))} | {100 * float(r['efficiency_lost']):.2f} | "
+                f"{n(float(r['total_depth_tests_per_frame']))} | {n(float(r['nbuffer_memory_bytes']) / 1024)} |")
+    best = front(rows, "cycles_per_frame", "efficiency_lost")
+    lines = [f"{len(rows)} points. The Pareto front of cycles per frame against culling efficiency lost:", "",
+             "| point | cycles per frame | efficiency lost (points of %) | total depth tests per frame | N-buffer memory (KiB) |",
+             "|---|---:|---:|---:|---:|"] + [line(r) for r in best]
+    full = {r["nbuffer.update_policy"]: r for r in rows if r["nbuffer.resolution_divisor"] == "1" and r["nbuffer.format"] == "f32"}
+    for policy in ("batched", "eager"):
+        if full[policy] not in best:
+            lines.append(line(full[policy], f"({label(full[policy])}{', the default' if policy == 'eager' else ''}, dominated)"))
+    false_culls = sum(int(r["false_culls"]) for r in rows)
+    upd = {p: float(full[p]["update_texels_per_frame"]) / 1e6 for p in full}
+    lost = {d: min(float(r["efficiency_lost"]) for r in rows if r["nbuffer.resolution_divisor"] == d) for d in ("2", "4", "8")}
+    lines += ["", f"At full resolution, eager updates (every occluder's changes at once) cost {upd['eager']:.1f} M level texels a "
+              f"frame, batched (once per pass) {upd['batched']:.1f} M and lazy (when a query reads the levels) {upd['lazy']:.1f} M, "
+              f"for the same culling. The least a resolution divisor loses: 2, {100 * lost['2']:.2f} points; 4, "
+              f"{100 * lost['4']:.2f}; 8, {100 * lost['8']:.2f}. False culls over every point: {false_culls}."]
+    return "\n".join(lines)
+
+
+def render_hiz(outputs):
+    rows = sweep_rows(outputs[-1])
+    lines = ["| trace | mode | Hi-Z tile, format | culling efficiency | efficiency lost (points of %) | cycles per frame | false culls |",
+             "|---|---|---|---:|---:|---:|---:|"]
+    for r in rows:
+        hiz = f"{r['hiz.tile_px']} px, {r['hiz.format']}" if r["cull.mode"] == "hiz_tile" else \
+            (r["hiz.format"] if r["cull.mode"] == "hiz_pyramid" else "")
+        lines.append(f"| {r['trace'].rsplit('/', 1)[-1]} | {r['cull.mode']} | {hiz} | {100 * float(r['culling_efficiency']):.1f}% | "
+                     f"{100 * float(r['efficiency_lost']):.2f} | {n(float(r['cycles_per_frame']))} | {r['false_culls']} |")
+    return "\n".join(lines)
+
+
+def render_fidelity(outputs):
+    rows = sweep_rows(outputs[-1])
+    out = []
+    for trace in dict.fromkeys(r["trace"] for r in rows):
+        pts = [r for r in rows if r["trace"] == trace]
+        worst = max(pts, key=lambda r: abs(float(r["cycle_error"])))
+        quantum = [r for r in pts if r["gpu.quantum_cycles"] == "0"]
+        others = max(abs(float(r["cycle_error"])) for r in quantum)
+        same = len({r["culling_efficiency"] for r in pts}) == 1
+        out.append(f"`{trace.rsplit('/', 1)[-1]}`: {'every point culls alike' if same else 'the points cull differently'}; "
+                   f"the largest cycle error {100 * abs(float(worst['cycle_error'])):.3f}% "
+                   f"(`gpu.quantum_cycles={worst['gpu.quantum_cycles']}`); the batch size and the FMA switches change cycles by "
+                   f"at most {100 * others:.4f}%.")
+    return "\n\n".join(out)
+
+
+BLOCKS += [
+    Block("design", [["explore", "pipeline/sweeps/nbuffer_design.json", "--out", "design", "--jobs", "2"]], render_design,
+          files=("design/results.csv",), page="exploration.md"),
+    Block("hiz", [["explore", "pipeline/sweeps/hiz_baselines.json", "--out", "hiz", "--jobs", "2"]], render_hiz,
+          files=("hiz/results.csv",), page="exploration.md"),
+    Block("fidelity", [["explore", "pipeline/sweeps/fidelity.json", "--out", "fidelity", "--jobs", "2"]], render_fidelity,
+          files=("fidelity/results.csv",), page="exploration.md"),
+]
