@@ -2,8 +2,8 @@
 """Shared code names no technique.
 
 The shared folders (the replay's top level, the command line, benches, sweeps, the results
-declarations, the report, the trace format's core and the capture's core) and the build files of
-the layers do not name a technique (particles, shadows, LDIs, relief, occlusion culling): a
+declarations, the report, the trace format's core and the capture's core), the build files of
+the layers and of the tests do not name a technique (particles, shadows, LDIs, relief, occlusion culling): a
 technique's code lives in its own folders (a folder named after it, below any of them), and the one
 registration list names them all:
 
@@ -50,6 +50,12 @@ def shared_files():
     for name in SHARED_FILES + sorted(REGISTRATION):
         if (root / name).is_file():
             yield root / name, pathlib.Path(name)
+    # The tests' build files outside the technique folders: a technique's tests join the suites
+    # from its own tests/<layer>/<name>/CMakeLists.txt (nbsim_add_technique_tests).
+    for path in sorted((root / "tests").rglob("CMakeLists.txt")):
+        rel = path.relative_to(root)
+        if not any(part in TECHNIQUE_DIRS for part in rel.parts[1:-1]):
+            yield path, rel
 
 
 for path, rel in shared_files():
