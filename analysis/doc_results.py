@@ -23,7 +23,6 @@ the commands (outputs: one entry per command, in order: parsed JSON, or the text
 text of each of FILES, files the commands wrote).
 """
 import concurrent.futures
-import importlib.util
 import json
 import os
 import shlex
@@ -35,6 +34,8 @@ from pathlib import Path
 from typing import Callable
 
 sys.dont_write_bytecode = True
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import technique_folders  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -65,13 +66,7 @@ def end_marker(technique, block):
 def technique_modules():
     """Every analysis/techniques/<name>/docs.py, by name: a technique adds its page's blocks there,
     without editing this file."""
-    modules = []
-    for path in sorted((Path(__file__).resolve().parent / "techniques").glob("*/docs.py")):
-        spec = importlib.util.spec_from_file_location(f"nbsim_docs_{path.parent.name}", path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        modules.append((path.parent.name, module))
-    return modules
+    return technique_folders.load("docs.py")
 
 
 # Programs other than nbsim a block may run (to make an input file), with their arguments.
@@ -125,6 +120,15 @@ def collect(nbsim, only, jobs):
     for (name, block), outputs in zip(todo, results):
         out.setdefault(name, {})[block.name] = outputs
     return out
+
+
+def pareto_front(rows, cost, error):
+    """The rows no other row beats on both `cost` and `error` (columns read as numbers), by cost."""
+    def f(r, k):
+        return float(r[k])
+    return sorted((r for r in rows if not any(f(o, cost) <= f(r, cost) and f(o, error) <= f(r, error) and
+                                              (f(o, cost) < f(r, cost) or f(o, error) < f(r, error)) for o in rows)),
+                  key=lambda r: f(r, cost))
 
 
 def render_block(block, outputs):

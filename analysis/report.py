@@ -22,7 +22,6 @@ an input is malformed (the message names the file; the other sections are still 
 import argparse
 import csv
 import html
-import importlib.util
 import io
 import math
 import os
@@ -40,6 +39,7 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 import plot_coverage  # noqa: E402
 import table1  # noqa: E402
+import technique_folders  # noqa: E402
 from report_data import (FIDELITY_KNOBS, NUMERIC, BadInput, Missing, fmt, headline_sweep,  # noqa: E402
                          kib_key, technique_results, load_json, mark_pareto, number, pct, read_csv,
                          short_label, trace_name)
@@ -52,13 +52,7 @@ def technique_sections():
     its sections in page order: (anchor, title, build(rep), main input relative to DIR). build(rep) and
     section(rep) return the section's HTML or raise report_data.Missing / BadInput. INPUTS (optional): the
     paths, relative to DIR, the module looks for (the message when DIR holds nothing usable)."""
-    modules = []
-    for path in sorted((Path(__file__).resolve().parent / "techniques").glob("*/section.py")):
-        spec = importlib.util.spec_from_file_location(f"nbsim_report_section_{path.parent.name}", path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        modules.append(module)
-    return sorted(modules, key=lambda m: (m.ORDER, m.NAME))
+    return sorted((m for _, m in technique_folders.load("section.py")), key=lambda m: (m.ORDER, m.NAME))
 
 
 def section_entries(rep, module):

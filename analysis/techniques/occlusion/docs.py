@@ -5,7 +5,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from doc_results import Block
+from doc_results import Block, pareto_front
 
 PAGE = "results.md"
 WALK = "traces/samples/city_walk_512.nbt"
@@ -199,14 +199,6 @@ def sweep_rows(text):
     return [r for r in csv.DictReader(io.StringIO(text)) if r["status"] == "ok" and r["role"] == "sweep"]
 
 
-def front(rows, cost, error):
-    def f(r, k):
-        return float(r[k])
-    return sorted((r for r in rows if not any(f(o, cost) <= f(r, cost) and f(o, error) <= f(r, error) and
-                                              (f(o, cost) < f(r, cost) or f(o, error) < f(r, error)) for o in rows)),
-                  key=lambda r: f(r, cost))
-
-
 def render_design(outputs):
     rows = sweep_rows(outputs[-1])
 
@@ -216,7 +208,7 @@ def render_design(outputs):
     def line(r, note=""):
         return (f"| {note or label(r)} | {n(float(r['cycles_per_frame']))} | {100 * float(r['efficiency_lost']):.2f} | "
                 f"{n(float(r['total_depth_tests_per_frame']))} | {n(float(r['nbuffer_memory_bytes']) / 1024)} |")
-    best = front(rows, "cycles_per_frame", "efficiency_lost")
+    best = pareto_front(rows, "cycles_per_frame", "efficiency_lost")
     lines = [f"{len(rows)} points. The Pareto front of cycles per frame against culling efficiency lost:", "",
              "| point | cycles per frame | efficiency lost (points of %) | total depth tests per frame | N-buffer memory (KiB) |",
              "|---|---:|---:|---:|---:|"] + [line(r) for r in best]

@@ -1,5 +1,5 @@
 """The particles' results in docs/particles.md, generated (the protocol: analysis/doc_results.py)."""
-from doc_results import Block
+from doc_results import Block, pareto_front
 
 PAGE = "particles.md"
 MODES = ("none", "center", "nb", "hiz")
@@ -106,12 +106,7 @@ def render_sweep(outputs):
     import io
     rows = [r for r in csv.DictReader(io.StringIO(outputs[-1])) if r["status"] == "ok"]
     f = lambda r, k: float(r[k])  # noqa: E731
-    front = [r for r in rows if not any(f(o, "cycles_per_frame") <= f(r, "cycles_per_frame") and
-                                        f(o, "culled_below_exact_fraction") <= f(r, "culled_below_exact_fraction") and
-                                        (f(o, "cycles_per_frame") < f(r, "cycles_per_frame") or
-                                         f(o, "culled_below_exact_fraction") < f(r, "culled_below_exact_fraction"))
-                                        for o in rows)]
-    front.sort(key=lambda r: f(r, "cycles_per_frame"))
+    front = pareto_front(rows, "cycles_per_frame", "culled_below_exact_fraction")
 
     def label(r):
         cap = int(r["nbuffer.level_cap"])

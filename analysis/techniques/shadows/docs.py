@@ -2,7 +2,7 @@
 import csv
 import io
 
-from doc_results import Block
+from doc_results import Block, pareto_front
 
 PAGE = "shadows.md"
 SCENES = ("boxes", "terrain", "city")
@@ -131,14 +131,11 @@ def render_sweep(outputs):
         pts = [r for r in rows if r["trace"] == trace]
         unsafe += sum(int(r["unsafe_culls"]) + int(r["mask_diff"]) + int(r["mask_diff_infinite"]) + int(r["not_conservative"])
                       for r in pts)
-        front = [r for r in pts if not any(
-            f(o, "cycles_per_frame") <= f(r, "cycles_per_frame") and f(o, "culled_lost_fraction") <= f(r, "culled_lost_fraction")
-            and (f(o, "cycles_per_frame") < f(r, "cycles_per_frame") or f(o, "culled_lost_fraction") < f(r, "culled_lost_fraction"))
-            for o in pts)]
+        front = pareto_front(pts, "cycles_per_frame", "culled_lost_fraction")
         ref = next(r for r in pts if r["litmap_min.resolution_divisor"] == "1" and r["litmap_min.format"] == "f32"
                    and int(r["litmap_min.level_cap"]) < 0)
         name = trace.rsplit("/", 1)[-1].removesuffix(".nbt")
-        for r in sorted(front, key=lambda r: f(r, "cycles_per_frame")) + [ref]:
+        for r in front + [ref]:
             lost = f(r, "culled_lost_fraction")
             lines.append(f"| {name if r is not ref else '(' + name + ')'} | {label(r) if r is not ref else '(reference)'} | "
                          f"{n(f(r, 'cycles_per_frame'))} | {caster_count(f(r, 'culled_per_frame'))} | "
