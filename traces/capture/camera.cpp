@@ -4,6 +4,7 @@
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/gtc/constants.hpp>
+#include <glm/vec2.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -60,6 +61,24 @@ std::vector<CameraPose> walk_path(const PathSite& site, int frames, std::uint32_
     const glm::vec3 want(dx[dir], 0, dz[dir]);
     look = glm::normalize(glm::mix(look, want, 0.2f) + glm::vec3(1e-6f));
     poses.push_back({pos, pos + glm::vec3(look.x, -0.02f, look.z)});
+  }
+  return poses;
+}
+
+std::vector<CameraPose> ground_path(const PathSite& site, int frames, std::uint32_t seed) {
+  std::vector<CameraPose> poses;
+  poses.reserve(static_cast<std::size_t>(frames));
+  const float ext = static_cast<float>(site.extent_m), c = 0.5f * ext, step = 1.2f, eye_height = 1.7f;
+  std::mt19937 rng(seed ^ 0x9a0d11u);
+  const float heading = std::uniform_real_distribution<float>(0.0f, glm::two_pi<float>())(rng);
+  const glm::vec2 dir(std::cos(heading), std::sin(heading));
+  // Centred on the site's centre, the walk's middle frame passes it; the walk stays on the site.
+  const float half = std::min(0.5f * step * static_cast<float>(std::max(frames - 1, 0)), 0.45f * ext);
+  const float pace = frames > 1 ? 2.0f * half / static_cast<float>(frames - 1) : 0.0f;
+  for (int f = 0; f < frames; ++f) {
+    const glm::vec2 p = glm::vec2(c) + dir * (-half + pace * static_cast<float>(f));
+    const glm::vec3 eye(p.x, site.ground_at(p.x, p.y) + eye_height, p.y);
+    poses.push_back({eye, eye + glm::vec3(dir.x, 0.0f, dir.y)});
   }
   return poses;
 }

@@ -8,19 +8,22 @@
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <string_view>
 #include <vector>
 
 namespace nbsim::capture {
 
-// Where a camera path may go: the scene's ground square [0, extent_m] x [0, extent_m] on y = 0 and,
-// when the scene has streets, the grid of street crossings at multiples of street_pitch_m
-// (crossings 0..blocks_per_side on x and on z).
+// Where a camera path may go: the scene's ground square [0, extent_m] x [0, extent_m], at the
+// height `ground` gives (y = 0 when it is empty) and, when the scene has streets, the grid of
+// street crossings at multiples of street_pitch_m (crossings 0..blocks_per_side on x and on z).
 struct PathSite {
   double extent_m = 0.0;
   double street_pitch_m = 0.0;  // distance between street centre lines; 0 when there are no streets
   int blocks_per_side = 0;
+  std::function<float(float x, float z)> ground;  // the ground's height at (x, z), m
   bool has_streets() const noexcept { return street_pitch_m > 0.0 && blocks_per_side > 0; }
+  float ground_at(float x, float z) const { return ground ? ground(x, z) : 0.0f; }
 };
 
 struct CameraPose {
@@ -40,6 +43,11 @@ struct Projection {
 // (the site must have streets); the flyover circles the site once, looking at its centre.
 std::vector<CameraPose> walk_path(const PathSite& site, int frames, std::uint32_t seed);
 std::vector<CameraPose> fly_path(const PathSite& site, int frames);
+// An observer on foot: eye height (1.7 m) above the ground, 1.2 m a frame along a straight line
+// through the site's centre (its heading from the seed), looking ahead level, so that what flies
+// or stands well above the eye is mostly out of view while the ground around is in it (the set-up
+// the N-buffer paper's terrain experiment assumes: birds above the observer, the ground in view).
+std::vector<CameraPose> ground_path(const PathSite& site, int frames, std::uint32_t seed);
 
 glm::mat4 view_matrix(const CameraPose& pose);
 // GL projection for the depth convention: [-1, 1] clip z (LESS) or reversed Z in [0, 1] (GREATER).

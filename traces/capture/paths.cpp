@@ -14,12 +14,21 @@ std::vector<CameraPose> walk(const CaptureScene& s, int frames, const OptionValu
 
 std::vector<CameraPose> fly(const CaptureScene& s, int frames, const OptionValues&) { return fly_path(s.site, frames); }
 
+std::vector<CameraPose> ground(const CaptureScene& s, int frames, const OptionValues& options) {
+  return ground_path(s.site, frames, static_cast<std::uint32_t>(options.integer(seed_option())));
+}
+
 }  // namespace
 
 const std::vector<PathRow>& path_table() {
   static const std::vector<PathRow> table = {
       {{"walk", "Street-level walkthrough, 1.2 m a frame, turning at random crossings (needs streets)", {seed_option()}}, walk},
       {{"fly", "Flyover circling the scene once, looking at its centre", {}}, fly},
+      {{"ground",
+        "An observer on foot: 1.7 m above the ground, 1.2 m a frame on a straight line through the site's centre, "
+        "looking ahead level (what is well above the eye is mostly out of view)",
+        {seed_option()}},
+       ground},
   };
   return table;
 }

@@ -95,6 +95,7 @@ CaptureScene make_terrain(const TerrainParams& p) {
   }
   b.finish();
   s.site.extent_m = p.extent_m;
+  s.site.ground = [hills](float x, float z) { return hills.height(x, z); };
   s.properties = {{"seed", std::to_string(p.seed)},
                   {"towers", std::to_string(p.towers)},
                   {"birds", std::to_string(p.birds)},

@@ -156,3 +156,23 @@ BLOCKS = [
     Block("sweep", [["explore", "pipeline/sweeps/shadows.json", "--out", "sweep", "--jobs", "2"]], render_sweep,
           files=("sweep/results.csv",)),
 ]
+
+
+GROUND_SCENES = ("terrain", "city", "boxes")
+
+
+def render_ground(outputs):
+    rows = {r["scene"]: r for r in outputs[-1]}
+    lines = ["| scene | fill / frame | infinite volumes' fill / frame | ratio to infinite | paper | casters culled by GL / frame "
+             "(incl. outside) | draws exact | mask pixels differing (GL's, infinite) |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for s in GROUND_SCENES:
+        r = rows[s]
+        lines.append(f"| {s} | {n(r['fill_per_frame'])} | {n(r['reference_fill_per_frame'])} | {100 * r['ratio_to_infinite']:.1f} % | "
+                     f"{PAPER[s]} | {caster_count(r['gl_culled_per_frame'] + r['outside_per_frame'])} of "
+                     f"{n(r['casters_per_frame'])} | {r['draws_exact']:,} of {r['draws']:,} | {r['mask_diff']}, {r['mask_diff_infinite']} |")
+    return "\n".join(lines)
+
+
+BLOCKS.append(Block("ground", [["capture", "shadows", "--scene", s, "--path", "ground", "--size", "640x480", "--frames", "10",
+                                "--shadow-mode", "clamped", "-o", f"ground_{s}.nbt"] for s in GROUND_SCENES] +
+                    [["shadows", *[f"ground_{s}.nbt" for s in GROUND_SCENES], "--json"]], render_ground))

@@ -3,6 +3,10 @@
 // declared with valid defaults and checked, and scenes and paths combine through the site.
 #include <gtest/gtest.h>
 
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+
+#include <algorithm>
 #include <set>
 #include <string>
 
@@ -156,6 +160,42 @@ TEST(CaptureRegistryTest, PathsWorkOnAnySite) {
   EXPECT_EQ(city.scene.objects.size(), 50u);
   EXPECT_TRUE(city.site.has_streets());
   EXPECT_EQ(find_path("walk").make(city, 5, {{"seed", "4"}}).size(), 5u);
+}
+
+// The observer on foot: eye height above the scene's own ground (the terrain's hills), level gaze,
+// 1.2 m a frame on a straight line through the site's centre, never off the site.
+TEST(CaptureRegistryTest, GroundPathWalksAtEyeHeightOverTheGround) {
+  const CaptureScene terrain = find_scene("terrain").make({{"seed", "9"}, {"towers", "3"}, {"birds", "5"}});
+  ASSERT_TRUE(terrain.site.ground);
+  const auto poses = find_path("ground").make(terrain, 40, {{"seed", "9"}});
+  ASSERT_EQ(poses.size(), 40u);
+  const float ext = static_cast<float>(terrain.site.extent_m);
+  float lowest = 1e9f, highest = -1e9f;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const CameraPose& p = poses[i];
+    const float ground = terrain.site.ground_at(p.eye.x, p.eye.z);
+    lowest = std::min(lowest, ground), highest = std::max(highest, ground);
+    EXPECT_NEAR(p.eye.y - ground, 1.7f, 1e-4f) << "frame " << i;
+    EXPECT_FLOAT_EQ(p.target.y, p.eye.y) << "looks ahead level";
+    EXPECT_GE(p.eye.x, 0.0f);
+    EXPECT_LE(p.eye.x, ext);
+    EXPECT_GE(p.eye.z, 0.0f);
+    EXPECT_LE(p.eye.z, ext);
+    if (i > 0) {
+      EXPECT_NEAR(glm::length(glm::vec2(p.eye.x - poses[i - 1].eye.x, p.eye.z - poses[i - 1].eye.z)), 1.2f, 1e-3f);
+    }
+  }
+  EXPECT_GT(highest - lowest, 0.01f) << "the walk follows the hills, not a plane";
+  // The middle of the walk passes the site's centre.
+  const CameraPose& mid = poses[poses.size() / 2];
+  EXPECT_NEAR(glm::length(glm::vec2(mid.eye.x, mid.eye.z) - glm::vec2(0.5f * ext)), 0.6f, 0.61f);
+  // A flat site: eye height above y = 0; another seed, another heading.
+  CaptureScene open;
+  open.site.extent_m = 100.0;
+  const auto flat = find_path("ground").make(open, 3, {{"seed", "2"}});
+  for (const CameraPose& p : flat) EXPECT_FLOAT_EQ(p.eye.y, 1.7f);
+  const auto other = find_path("ground").make(terrain, 40, {{"seed", "10"}});
+  EXPECT_NE(other.front().eye.x, poses.front().eye.x);
 }
 
 // The recorded command line spells out every option of the chosen rows in the current spelling.
