@@ -112,14 +112,19 @@ def run_block(nbsim, name, block):
 def collect(nbsim, only, jobs):
     """Runs the commands of every block (or of `only`: NAME or NAME/BLOCK), `jobs` blocks at a time;
     returns {technique: {block: [outputs]}}."""
-    todo = [(name, block) for name, module in technique_modules() for block in module.BLOCKS
-            if not only or only in (name, f"{name}/{block.name}")]
+    chosen = [(name, block) for name, module in technique_modules() for block in module.BLOCKS
+              if not only or only in (name, f"{name}/{block.name}")]
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        results = list(pool.map(lambda t: run_block(nbsim, *t), todo))
+        results = list(pool.map(lambda t: run_block(nbsim, *t), chosen))
     out = {}
-    for (name, block), outputs in zip(todo, results):
+    for (name, block), outputs in zip(chosen, results):
         out.setdefault(name, {})[block.name] = outputs
     return out
+
+
+def thousands(v, digits=0):
+    """A number as the pages print it: thousands separated by commas, `digits` decimals."""
+    return f"{v:,.{digits}f}"
 
 
 def pareto_front(rows, cost, error):

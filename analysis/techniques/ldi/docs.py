@@ -1,5 +1,5 @@
 """The layered depth images' results in docs/ldi.md, generated (the protocol: analysis/doc_results.py)."""
-from doc_results import Block
+from doc_results import Block, thousands as n
 
 PAGE = "ldi.md"
 MODELS = "/usr/share/assimp/models"
@@ -8,9 +8,6 @@ FRESH = [("duck.dae", ["--mesh", f"{MODELS}/Collada/duck.dae"]),
          ("knot", ["--shape", "knot"]),
          ("coil, 7 turns", ["--shape", "coil", "--shape-param", "7"])]
 
-
-def n(v):
-    return f"{v:,}"
 
 
 def fresh_capture(i, shape):

@@ -1,5 +1,5 @@
 """The particles' results in docs/particles.md, generated (the protocol: analysis/doc_results.py)."""
-from doc_results import Block, pareto_front
+from doc_results import Block, pareto_front, thousands as n
 
 PAGE = "particles.md"
 MODES = ("none", "center", "nb", "hiz")
@@ -9,9 +9,6 @@ def capture(mode, out, extra=()):
     return ["capture", "particles", "--scene", "city", "--path", "walk", "--size", "512x512", "--frames", "10",
             "--particles", "10000", "--sprite", "16", "--mode", mode, *extra, "-o", out]
 
-
-def n(v):
-    return f"{v:,.0f}"
 
 
 def render_modes(outputs):

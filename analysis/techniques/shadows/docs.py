@@ -2,7 +2,7 @@
 import csv
 import io
 
-from doc_results import Block, pareto_front
+from doc_results import Block, pareto_front, thousands as n
 
 PAGE = "shadows.md"
 SCENES = ("boxes", "terrain", "city")
@@ -13,9 +13,6 @@ LOSSY = [("f32, divisor 1, every level (reference)", []),
          ("divisor 2", ["--set", "litmap_min.resolution_divisor=2", "--set", "litmap_max.resolution_divisor=2"]),
          ("level cap 4", ["--set", "litmap_min.level_cap=4", "--set", "litmap_max.level_cap=4"])]
 
-
-def n(v, digits=0):
-    return f"{v:,.{digits}f}"
 
 
 def caster_count(v):
