@@ -71,6 +71,17 @@ std::uint64_t scalar(const scene::TechniqueRecord& rec, std::string_view name, s
   throw InputError(fmt::format("frame {}: the ShadowCasters (SHDC) record has no '{}'", frame, name));
 }
 
+// "ground,tower,bird" -> its names.
+std::vector<std::string> split_names(const std::string& text) {
+  std::vector<std::string> out;
+  for (std::size_t pos = 0; pos <= text.size() && !text.empty();) {
+    const std::size_t comma = std::min(text.find(',', pos), text.size());
+    out.push_back(text.substr(pos, comma - pos));
+    pos = comma + 1;
+  }
+  return out;
+}
+
 }  // namespace
 
 FrameCasters read_casters(const scene::Frame& f) {
@@ -99,9 +110,14 @@ FrameCasters read_casters(const scene::Frame& f) {
   c.clamp_far = field<float>(*rec, "clamp_far", frame);
   c.reference_fill = optional_scalar(*rec, "reference_fill");
   c.mask_diff_pixels = optional_scalar(*rec, "mask_diff_pixels");
+  c.cls = field<std::uint32_t>(*rec, "class", frame);
+  c.kept = field<std::uint32_t>(*rec, "kept", frame);
+  c.fill_infinite = field<std::uint32_t>(*rec, "fill_infinite", frame);
+  for (const scene::TechniqueField& value : rec->fields)
+    if (const auto* names = value.name == "class_names" ? std::get_if<std::string>(&value.value) : nullptr) c.class_names = split_names(*names);
   for (std::size_t n : {c.lookups.size(), c.decision.size(), c.x.size(), c.y.size(), c.w.size(), c.h.size(), c.draw.size(),
                         c.caster_near.size(), c.caster_far.size(), c.z_min.size(), c.z_max.size(), c.clamp_near.size(),
-                        c.clamp_far.size(), c.object.size()})
+                        c.clamp_far.size(), c.object.size(), c.cls.size(), c.kept.size(), c.fill_infinite.size()})
     if (n != count)
       throw InputError(fmt::format("frame {}: the ShadowCasters record's count is {} but a field has {} elements", frame, count, n));
   const auto side = static_cast<std::int64_t>(size);
@@ -117,6 +133,11 @@ FrameCasters read_casters(const scene::Frame& f) {
                            f.draws[static_cast<std::size_t>(c.draw[i])].role != kShadowVolumeRole))
       throw InputError(fmt::format("frame {}: caster {} names draw {}, which is not a shadow_volume draw of the frame", frame, i,
                                    c.draw[i]));
+    if (c.kept[i] >= kKeptNames.size())
+      throw InputError(fmt::format("frame {}: caster {}'s kept {} is not 0 to {}", frame, i, c.kept[i], kKeptNames.size() - 1));
+    if (c.cls[i] >= c.class_names.size())
+      throw InputError(fmt::format("frame {}: caster {}'s class {} is not one of the record's {} class names", frame, i, c.cls[i],
+                                   c.class_names.size()));
     if (c.draw[i] < -1) throw InputError(fmt::format("frame {}: caster {}'s draw {} is below -1", frame, i, c.draw[i]));
   }
   return c;

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -24,6 +25,17 @@ std::optional<Mode> parse_mode(std::string_view s) noexcept;
 
 // SHDC's `decision`. Fixed values (they are in files; traces/FORMAT.md).
 enum class Decision : std::uint8_t { Volume = 0, Culled = 1, OutsideLight = 2, CrossesNear = 3 };
+
+// SHDC's `kept`: why a culled or clamped capture keeps a caster's volume (the same in every mode;
+// fixed values, they are in files).
+enum class KeptBy : std::uint8_t {
+  Dropped = 0,      // culled, or outside the light's frustum: no volume in culled and clamped
+  Receivers = 1,    // the litmaps' slab has a visible receiver behind it
+  SeenCaster = 2,   // the observer sees the caster itself (its own bounds join its slab)
+  Widened = 3,      // only the slab's widening keeps it (a seen caster crossing the light's near plane)
+  CrossesNear = 4,  // it crosses the light's near plane: never culled or clamped
+};
+inline constexpr std::array<std::string_view, 5> kKeptNames = {"dropped", "receivers", "seen_caster", "widened", "crosses_near"};
 
 // The clamp margin of the header ("0.01 + 0.1 m"): the slab's far end is pushed back by
 // rel * distance + metres before the cull test (the capture's kClampRel, kClampM).
@@ -60,6 +72,10 @@ struct FrameCasters {
   // GL's reference pass (every caster's infinite volume, not recorded as draws): its fill and the
   // pixels where the mode's mask differs from its mask; empty when the record does not hold them.
   std::optional<std::uint64_t> reference_fill, mask_diff_pixels;
+  // Each caster's class (an index into class_names: "bird", "building"), why it is kept (KeptBy)
+  // and the fill of its infinite volume (GL's reference pass, or its own draw in mode infinite).
+  std::vector<std::string> class_names;
+  std::vector<std::uint32_t> cls, kept, fill_infinite;
   std::size_t size() const noexcept { return object.size(); }
   Rect rect(std::size_t i) const noexcept { return Rect{x[i], y[i], w[i], h[i]}; }
 };

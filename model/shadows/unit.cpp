@@ -91,6 +91,10 @@ void ShadowsUnit::draw_finished(const cp::Work& w, const depth::DrawResult& r) {
   ++completed_;
   const scene::DrawRecord& d = w.record();
   if (d.role == kShadowVolumeRole) {
+    if (w.draw < volume_share_.size() && volume_share_[w.draw]) {
+      FillShare& share = *volume_share_[w.draw];
+      ++share.volumes, share.fill += r.depth.fragments, share.gl_fill += d.gl.fragments;
+    }
     fill_ += r.depth.fragments;
     gl_fill_ += d.gl.fragments;
     stencil_tests_ += r.stencil.tests;
@@ -153,6 +157,13 @@ void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, co
   casters_ += n;
   measured_ += index_.size();
   if (c.reference_fill) reference_fill_ += *c.reference_fill, ++reference_frames_;
+  volume_share_.assign(f.draws.size(), nullptr);
+  for (std::size_t i = 0; i < n; ++i) {
+    FillShare& share = breakdown_[{c.class_names[c.cls[i]], std::string(kKeptNames[c.kept[i]])}];
+    ++share.casters;
+    share.fill_infinite += c.fill_infinite[i];
+    if (c.draw[i] >= 0) volume_share_[static_cast<std::size_t>(c.draw[i])] = &share;
+  }
   for (std::size_t k = 0; k < index_.size(); ++k) {
     const std::size_t i = index_[k];
     const nbuffer::QueryAnswer& lo = min_answers_[k];

@@ -21,8 +21,10 @@
 // drawn (another mode needs the casters' meshes to regenerate volumes; the trace does not hold them).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "model/config/schema.h"
@@ -50,6 +52,17 @@ struct ShadowsSetup {
   ClampMargin margin;
 };
 
+// Where the volumes' fill goes: the casters of one class ("bird") kept for one reason (KeptBy),
+// summed over the run.
+struct FillShare {
+  std::uint64_t casters = 0;        // caster-frames
+  std::uint64_t volumes = 0;        // volumes drawn
+  std::uint64_t fill = 0;           // the model's fill of their volumes
+  std::uint64_t gl_fill = 0;        // GL's
+  std::uint64_t fill_infinite = 0;  // GL's fill of their infinite volumes (SHDC fill_infinite)
+};
+using FillBreakdown = std::map<std::pair<std::string, std::string>, FillShare>;  // (class, kept)
+
 class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthListener {
  public:
   // `min_nb` (op min, over litmap_min) and `max_nb` (op max, over litmap_max), litmap_size square.
@@ -62,6 +75,9 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
   void depth_cleared(float depth) override;
   void depth_written(const cp::Work&, const DepthImage&, const Rect&) override {}
   void draw_finished(const cp::Work& w, const depth::DrawResult& r) override;
+
+  // The run's fill per caster class and reason kept.
+  const FillBreakdown& breakdown() const noexcept { return breakdown_; }
 
  private:
   void issue_role(const std::shared_ptr<const scene::Frame>& f, scene::DrawRole role, cp::CommandProcessor& cp);
@@ -86,6 +102,8 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
       &volume_draws_, &fill_, &gl_fill_, &reference_fill_, &reference_frames_, &stencil_tests_, &mask_pixels_, &gl_mask_pixels_, &mask_diff_, &mask_diff_infinite_,
       &gl_mask_diff_;
 
+  FillBreakdown breakdown_;
+  std::vector<FillShare*> volume_share_;  // this frame's draw index -> its caster's share (null: none)
   std::vector<Rect> rects_;
   std::vector<float> nearest_;
   std::vector<std::size_t> index_;

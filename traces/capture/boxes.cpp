@@ -14,7 +14,7 @@ CaptureScene make_boxes(const BoxesParams& p) {
   const float ext = static_cast<float>(p.extent_m);
   MeshBuilder b(s);
   // The plane y = 0: one quad, open (a receiver only), counter-clockwise seen from above.
-  b.begin();
+  b.begin("ground");
   const std::uint32_t v = b.vertex({0, 0, 0});
   b.vertex({0, 0, ext});
   b.vertex({ext, 0, ext});
@@ -25,7 +25,7 @@ CaptureScene make_boxes(const BoxesParams& p) {
   // Boxes 2 to 10 m a side and 2 to 14 m tall, standing on the plane (their bottom face at y = 0).
   for (int k = 0; k < p.boxes; ++k) {
     const float w = uni(2.0, 10.0), d = uni(2.0, 10.0), x = uni(0.1 * ext, 0.9 * ext - w), z = uni(0.1 * ext, 0.9 * ext - d);
-    b.begin();
+    b.begin("box");
     b.box({x, 0.0f, z}, {x + w, uni(2.0, 14.0), z + d});
     b.end();
   }

@@ -10,7 +10,10 @@
 
 namespace nbsim::capture {
 
-void MeshBuilder::begin() { scene_.objects.push_back({static_cast<std::uint32_t>(scene_.indices.size()), 0}); }
+void MeshBuilder::begin(std::string_view cls) {
+  scene_.objects.push_back({static_cast<std::uint32_t>(scene_.indices.size()), 0});
+  scene_.object_class.push_back(scene_class(scene_, cls));
+}
 
 void MeshBuilder::end() {
   MeshRange& m = scene_.objects.back();

@@ -7,6 +7,7 @@
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "traces/capture/scenes.h"
@@ -17,7 +18,8 @@ class MeshBuilder {
  public:
   explicit MeshBuilder(CaptureScene& scene) : scene_(scene) {}
 
-  void begin();  // starts the next object (its id is the number of objects so far)
+  // Starts the next object (its id is the number of objects so far) of class `cls` ("tower").
+  void begin(std::string_view cls);
   void end();    // closes it (at least one triangle)
 
   // An axis-aligned box [lo, hi]: 12 triangles sharing 8 corners (a closed surface).

@@ -3,6 +3,12 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
+#include <string_view>
+
+#include "model/common/error.h"
+
 #include "traces/capture/boxes.h"
 #include "traces/capture/city.h"
 #include "traces/capture/terrain.h"
@@ -22,7 +28,11 @@ CaptureScene make_city_scene(const OptionValues& options) {
   s.vertices = std::move(city.vertices);
   s.indices = std::move(city.indices);
   s.objects.reserve(city.objects.size());
-  for (const Object& o : city.objects) s.objects.push_back({o.first_index, o.index_count});
+  static constexpr std::array<std::string_view, 6> kKinds = {"ground", "building", "car", "lamp", "tree", "kiosk"};
+  for (const Object& o : city.objects) {
+    s.objects.push_back({o.first_index, o.index_count});
+    s.object_class.push_back(scene_class(s, kKinds.at(static_cast<std::size_t>(o.kind))));
+  }
   s.scene = std::move(city.scene);
   s.site.extent_m = city.extent_m();
   s.site.street_pitch_m = city.pitch_m();
@@ -51,6 +61,14 @@ CaptureScene make_boxes_scene(const OptionValues& options) {
 }
 
 }  // namespace
+
+std::uint16_t scene_class(CaptureScene& scene, std::string_view name) {
+  const auto it = std::find(scene.class_names.begin(), scene.class_names.end(), name);
+  if (it != scene.class_names.end()) return static_cast<std::uint16_t>(it - scene.class_names.begin());
+  NBSIM_CHECK(scene.class_names.size() < 0xFFFFu, "too many object classes");
+  scene.class_names.emplace_back(name);
+  return static_cast<std::uint16_t>(scene.class_names.size() - 1);
+}
 
 const std::vector<SceneRow>& scene_table() {
   static const std::vector<SceneRow> table = {

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -29,11 +30,18 @@ struct CaptureScene {
   std::vector<glm::vec3> vertices;     // world space, y up, metres
   std::vector<std::uint32_t> indices;  // triangles, counter-clockwise seen from outside
   std::vector<MeshRange> objects;      // index = object id
+  // What each object is (index into class_names, one per object), for reports that split a count
+  // by kind of object: the terrain's "ground", "tower" and "bird", the city's "building", "car"...
+  std::vector<std::uint16_t> object_class;
+  std::vector<std::string> class_names;
   scene::SceneObjects scene;           // bounds, triangle counts and BVH of the objects
   PathSite site;
   // Header properties written right after "scene" = the scene's name (e.g. seed, objects).
   trace::Properties properties;
 };
+
+// The index of class `name` in scene.class_names, added when new.
+std::uint16_t scene_class(CaptureScene& scene, std::string_view name);
 
 struct SceneRow {
   PluginInfo info;

@@ -44,7 +44,7 @@ CaptureScene make_terrain(const TerrainParams& p) {
   MeshBuilder b(s);
 
   // The ground: a (cells + 1)^2 grid of heights, two triangles a cell, open (a receiver only).
-  b.begin();
+  b.begin("ground");
   const auto row = static_cast<std::uint32_t>(p.cells + 1);
   const std::uint32_t first = b.vertex({0.0f, hills.height(0.0f, 0.0f), 0.0f});
   for (std::uint32_t k = 1; k < row * row; ++k) {
@@ -66,7 +66,7 @@ CaptureScene make_terrain(const TerrainParams& p) {
     for (float u : {0.0f, side})
       for (float v : {0.0f, side}) low = std::min(low, hills.height(x + u, z + v));
     low = std::min(low, hills.height(x + 0.5f * side, z + 0.5f * side)) - 0.5f;
-    b.begin();
+    b.begin("tower");
     b.box({x, low, z}, {x + side, low + uni(25.0, 70.0), z + side});
     b.end();
   }
@@ -76,7 +76,7 @@ CaptureScene make_terrain(const TerrainParams& p) {
     const float x = uni(-ext, 2.0 * ext), z = uni(-ext, 2.0 * ext);
     const glm::vec3 c{x, hills.height(x, z) + uni(15.0, 60.0), z};
     const float r = uni(0.3, 0.8);
-    b.begin();
+    b.begin("bird");
     // Corners +x, -x, +y, -y, +z, -z; a face per octant, counter-clockwise seen from outside.
     const std::uint32_t v0 = b.vertex(c + glm::vec3(r, 0, 0));
     b.vertex(c - glm::vec3(r, 0, 0));

@@ -1,7 +1,11 @@
 // The shadows technique's frame program and its results (per-frame values, summary); its row of pipeline/sim/programs.h.
 #include "pipeline/sim/programs.h"
 
+#include <algorithm>
 #include <array>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "model/shadows/caster.h"
 #include "model/shadows/unit.h"
@@ -83,10 +87,30 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, std::uint64_t cyc
 // The summary: the totals, the header's mode, scene, litmap size and seed, and both N-buffers' storage.
 nlohmann::ordered_json summary(const SummaryInputs& in) {
   nlohmann::ordered_json j = totals(in.group, in.cycles);
-  for (const char* key : {"shadow_mode", "scene", "litmap_size", "seed"}) copy_property(in.header, key, j);
+  for (const char* key : {"shadow_mode", "clamp_rule", "scene", "path", "litmap_size", "seed"}) copy_property(in.header, key, j);
   long long bytes = 0;
   for (const auto& structure : in.program.structures) bytes += structure->storage_bytes();
   j["nbuffer_memory_bytes"] = bytes;  // both units' levels
+  // Where the fill goes: per caster class and reason kept, per frame, largest fill first.
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  if (const auto* unit = dynamic_cast<const shadows::ShadowsUnit*>(in.program.unit.get())) {
+    const double frames = std::max<double>(1.0, static_cast<double>(stat(in.group, "frames")));
+    std::vector<std::pair<const std::pair<std::string, std::string>*, const shadows::FillShare*>> shares;
+    for (const auto& [key, share] : unit->breakdown()) shares.emplace_back(&key, &share);
+    std::stable_sort(shares.begin(), shares.end(), [](const auto& a, const auto& b) { return a.second->fill > b.second->fill; });
+    for (const auto& [key, share] : shares) {
+      nlohmann::ordered_json r;
+      r["class"] = key->first;
+      r["kept"] = key->second;
+      r["casters_per_frame"] = static_cast<double>(share->casters) / frames;
+      r["volumes_per_frame"] = static_cast<double>(share->volumes) / frames;
+      r["fill_per_frame"] = static_cast<double>(share->fill) / frames;
+      r["gl_fill_per_frame"] = static_cast<double>(share->gl_fill) / frames;
+      r["fill_infinite_per_frame"] = static_cast<double>(share->fill_infinite) / frames;
+      rows.push_back(std::move(r));
+    }
+  }
+  j["fill_breakdown"] = std::move(rows);
   return j;
 }
 

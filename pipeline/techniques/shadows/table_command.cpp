@@ -29,8 +29,11 @@ void add_shadows_commands(CLI::App& app, Action& action) {
       "shadows", "Replay shadows traces (one per shadow mode) and print the shadows table; exit 1 when a mask pixel differs");
   auto a = std::make_shared<TableCommandArgs>();
   a->add_options(cmd, "Shadows traces (nbsim capture shadows), e.g. one per --shadow-mode", "shadows.json");
-  cmd->callback([&action, a] {
-    action = [a] {
+  auto breakdown = std::make_shared<bool>(false);
+  cmd->add_flag("--breakdown", *breakdown,
+                "Also print where each trace's fill goes: per caster class and reason kept (the JSON rows always hold it as fill_breakdown)");
+  cmd->callback([&action, a, breakdown] {
+    action = [a, breakdown] {
       std::vector<std::string> keys;  // scene, seed, viewport and frames: rows comparable for the ratio
       a->check("shadows", [&](const trace::TraceReader& reader) {
         std::string key;
@@ -49,7 +52,7 @@ void add_shadows_commands(CLI::App& app, Action& action) {
         const nlohmann::json* sum = techniques::at_pointer(runs[i], "/summary");
         nlohmann::ordered_json r;
         r["trace"] = (a->traces)[i];
-        for (const char* k : {"scene", "shadow_mode", "litmap_size"}) r[k] = p->contains(k) ? (*p)[k] : nlohmann::json("");
+        for (const char* k : {"scene", "path", "shadow_mode", "clamp_rule", "litmap_size"}) r[k] = p->contains(k) ? (*p)[k] : nlohmann::json("");
         r["settings"] = settings_of(a->mo);
         for (const char* k : {"frames", "casters_per_frame", "culled_per_frame", "gl_culled_per_frame", "outside_per_frame", "fill_per_frame",
                               "gl_fill_per_frame", "reference_fill_per_frame", "fill_ratio_to_infinite", "build_texels_per_frame", "lookups_per_frame", "stencil_tests_per_frame",
@@ -57,6 +60,7 @@ void add_shadows_commands(CLI::App& app, Action& action) {
                               "mask_diff_infinite", "decision_mismatches", "zmin_mismatches", "zmax_mismatches",
                               "not_conservative", "unsafe_culls", "kept_by_slab"})
           r[k] = (*p)[k];
+        r["fill_breakdown"] = p->value("fill_breakdown", nlohmann::json::array());
         r["draws"] = (*sum)["draws"];
         r["draws_exact"] = (*sum)["draws_exact"];
         r["stencil_pixels_matching"] = sum->value("stencil_pixels_matching", 0);
@@ -105,6 +109,18 @@ void add_shadows_commands(CLI::App& app, Action& action) {
                    r["decision_mismatches"].get<std::uint64_t>() + r["zmin_mismatches"].get<std::uint64_t>() +
                        r["zmax_mismatches"].get<std::uint64_t>());
       }
+      if (*breakdown)
+        for (const auto& r : list) {
+          fmt::print("\n{} ({} {}, rule {}): fill per frame by caster class and reason kept\n", r["trace"].get<std::string>(),
+                     r["scene"].get<std::string>(), r["shadow_mode"].get<std::string>(), r["clamp_rule"].get<std::string>());
+          fmt::print("  {:<10} {:<13} {:>10} {:>12} {:>14} {:>8}\n", "class", "kept", "casters", "fill", "fill infinite", "share");
+          double total = 0.0;
+          for (const auto& b : r["fill_breakdown"]) total += b["fill_per_frame"].get<double>();
+          for (const auto& b : r["fill_breakdown"])
+            fmt::print("  {:<10} {:<13} {:>10.1f} {:>12.0f} {:>14.0f} {:>7.1f}%\n", b["class"].get<std::string>(), b["kept"].get<std::string>(),
+                       b["casters_per_frame"].get<double>(), b["fill_per_frame"].get<double>(), b["fill_infinite_per_frame"].get<double>(),
+                       total > 0.0 ? 100.0 * b["fill_per_frame"].get<double>() / total : 0.0);
+        }
       if (differing) fmt::print("mask pixels differing from GL's: {}\n", differing);
       return differing == 0 ? 0 : 1;
     };

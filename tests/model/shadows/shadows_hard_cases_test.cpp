@@ -31,6 +31,7 @@
 #include "traces/capture/scenes.h"
 #include "traces/format/reader.h"
 #include "traces/format/shadows/shadows_chunk.h"
+#include "model/shadows/caster.h"
 
 namespace nbsim::capture {
 namespace {
@@ -59,6 +60,7 @@ struct ModeRun {
   nlohmann::json shadows;
 };
 
+// `mode` is a shadow mode, or "clamped/caster": mode clamped with the clamp rule "caster".
 ModeRun run_mode(const Case& c, const std::string& tag, const std::string& mode) {
   ModeRun out;
   CaptureOptions o;
@@ -70,9 +72,12 @@ ModeRun run_mode(const Case& c, const std::string& tag, const std::string& mode)
   o.frames = static_cast<int>(c.poses.size());
   o.poses = c.poses;
   o.options = c.options;
-  o.options.set("shadow-mode", mode);
+  const bool caster_rule = mode == "clamped/caster";
+  o.options.set("shadow-mode", caster_rule ? "clamped" : mode);
+  if (caster_rule) o.options.set("clamp-rule", "caster");
   o.options.set("levels-every", "1");
-  const fs::path file = scratch(tag + "_" + mode + ".nbt");
+  const std::string name = caster_rule ? "clamped_caster" : mode;
+  const fs::path file = scratch(tag + "_" + name + ".nbt");
   const CaptureSummary sum = capture(o, file.string());
   std::map<std::string, std::uint64_t> counts(sum.technique_counts.begin(), sum.technique_counts.end());
   EXPECT_EQ(counts["mask_diff_pixels"], 0u) << "GL's count of mask pixels unlike the infinite reference";
@@ -89,7 +94,7 @@ ModeRun run_mode(const Case& c, const std::string& tag, const std::string& mode)
   }
   EXPECT_EQ(out.frames.size(), c.poses.size());
 
-  const fs::path dir = scratch(tag + "_" + mode + "_run");
+  const fs::path dir = scratch(tag + "_" + name + "_run");
   const auto r = nbsim::testing::run_nbsim("replay " + file.string() + " --out " + dir.string());
   EXPECT_EQ(r.status, 0) << r.out << r.err;
   std::ifstream in(dir / "run.json");
@@ -113,16 +118,16 @@ ModeRun run_mode(const Case& c, const std::string& tag, const std::string& mode)
   return out;
 }
 
-// The three modes of a case: each checked by run_mode, the masks equal across modes frame by
-// frame, fill clamped <= culled <= infinite. Returns the runs by mode.
+// The three modes of a case and the clamp rule "caster": each checked by run_mode, the masks
+// equal across modes frame by frame, fill clamped <= culled <= infinite. Returns the runs by mode.
 std::map<std::string, ModeRun> run_case(const Case& c, const std::string& tag) {
   std::map<std::string, ModeRun> runs;
-  for (const std::string mode : {"infinite", "culled", "clamped"}) {
+  for (const std::string mode : {"infinite", "culled", "clamped", "clamped/caster"}) {
     SCOPED_TRACE(tag + " " + mode);
     runs[mode] = run_mode(c, tag, mode);
   }
   const auto& inf = runs["infinite"];
-  for (const std::string mode : {"culled", "clamped"}) {
+  for (const std::string mode : {"culled", "clamped", "clamped/caster"}) {
     const auto& m = runs[mode];
     EXPECT_EQ(m.frames.size(), inf.frames.size());
     for (std::size_t f = 0; f < std::min(m.frames.size(), inf.frames.size()); ++f) {
@@ -137,11 +142,13 @@ std::map<std::string, ModeRun> run_case(const Case& c, const std::string& tag) {
     }
   }
   EXPECT_LE(runs["clamped"].fill, runs["culled"].fill);
+  EXPECT_LE(runs["clamped/caster"].fill, runs["culled"].fill);
   EXPECT_LE(runs["culled"].fill, runs["infinite"].fill);
   EXPECT_GT(inf.mask_pixels, 0u) << tag << ": the case casts a visible shadow";
-  std::printf("[ %s ] mask pixels %llu; fill infinite %llu, culled %llu, clamped %llu\n", tag.c_str(),
+  std::printf("[ %s ] mask pixels %llu; fill infinite %llu, culled %llu, clamped %llu (rule caster %llu)\n", tag.c_str(),
               static_cast<unsigned long long>(inf.mask_pixels), static_cast<unsigned long long>(inf.fill),
-              static_cast<unsigned long long>(runs["culled"].fill), static_cast<unsigned long long>(runs["clamped"].fill));
+              static_cast<unsigned long long>(runs["culled"].fill), static_cast<unsigned long long>(runs["clamped"].fill),
+              static_cast<unsigned long long>(runs["clamped/caster"].fill));
   return runs;
 }
 
@@ -280,6 +287,68 @@ TEST(ShadowsHardCasesTest, IntermediateOccluder) {
   EXPECT_EQ(field<std::uint32_t>(rec, "decision")[ub], static_cast<std::uint32_t>(CasterDecision::Volume)) << "B is not culled";
   EXPECT_EQ(field<float>(rec, "clamp_near")[ub], 0.0f) << "loose: no near plane";
   EXPECT_GE(field<std::int32_t>(rec, "draw")[ub], 0);
+}
+
+// The paper's Figure 5 (a) to (d), one frame each, with one box lit from the -x side 45 degrees up
+// (its shadow falls on +x): (a) the observer sees the box and its shadow: kept as a seen caster;
+// (b) it sees the shadow, not the box: kept for its receivers, the volume starting at the min
+// plane, in front of the ground and behind the box's top (the paper's tight volume around the
+// shadow); (c) it sees the box from the light's side, which hides the shadow: kept as a seen caster,
+// its far plane before the shadow's far end; (d) it looks away from both: culled. Case (e) is
+// IntermediateOccluder.
+TEST(ShadowsHardCasesTest, Figure5Configurations) {
+  Case c;
+  c.options = {{"boxes", "1"}, {"seed", "5"}, {"litmap", "256"}};
+  const CaptureScene scene = find_scene("boxes").make(c.options);
+  const scene::Aabb& b = scene.scene.objects[1];
+  const glm::vec3 lo = lo_of(b), hi = hi_of(b);
+  const float cz = 0.5f * (lo.z + hi.z);
+  const glm::vec3 light{lo.x - 40.0f, 40.0f + hi.y, cz};
+  c.options.set("light", nbsim::testing::light_text(light, {hi.x, 0.0f, cz}));
+  // The shadow's far end: the light ray over the box's far top edge meets the ground.
+  const glm::vec3 top{hi.x, hi.y, cz};
+  const glm::vec3 tip = light + (top - light) * (light.y / (light.y - top.y));
+  const float d = 0.5f * (tip.x - hi.x);  // from the box's +x face to the shadow's middle
+  c.poses = {{{hi.x + 10.0f, hi.y, lo.z - 25.0f}, {hi.x + 0.5f * d, 0.0f, cz}},                 // (a)
+             {{hi.x + d, 0.9f * d, cz}, {hi.x + d + 0.3f * 0.9f * d, 0.0f, cz}},                    // (b)
+             {{lo.x - 15.0f, 0.5f * hi.y, cz}, {hi.x, 0.4f * hi.y, cz}},                           // (c)
+             {{lo.x - 10.0f, 2.0f, cz}, {lo.x - 30.0f, 0.0f, cz}}};                                 // (d)
+  const auto runs = run_case(c, "figure5");
+  const auto& frames = runs.at("clamped").frames;
+  ASSERT_EQ(frames.size(), 4u);
+  const auto caster = [&](std::size_t frame) {
+    const auto& rec = frames[frame].technique_records.at(0);
+    const int k = caster_of(rec, 1);
+    EXPECT_GE(k, 0);
+    return std::pair{&rec, static_cast<std::size_t>(std::max(k, 0))};
+  };
+  using nbsim::shadows::KeptBy;
+  const auto kept = [&](std::size_t frame) {
+    const auto [rec, k] = caster(frame);
+    return static_cast<KeptBy>(field<std::uint32_t>(*rec, "kept")[k]);
+  };
+  EXPECT_EQ(kept(0), KeptBy::SeenCaster) << "(a)";
+  EXPECT_EQ(kept(1), KeptBy::Receivers) << "(b)";
+  EXPECT_EQ(kept(2), KeptBy::SeenCaster) << "(c)";
+  EXPECT_EQ(kept(3), KeptBy::Dropped) << "(d)";
+  {
+    const auto [rec, k] = caster(1);
+    const float near = field<float>(*rec, "clamp_near")[k];
+    EXPECT_GT(near, field<float>(*rec, "caster_near")[k]) << "(b): the volume starts behind the box's top, at the min plane";
+    EXPECT_LT(near, field<float>(*rec, "z_min")[k]) << "(b): in front of the shadowed ground";
+    EXPECT_GE(field<std::int32_t>(*rec, "draw")[k], 0);
+  }
+  {
+    const auto [rec, k] = caster(2);
+    const glm::mat4 view = glm::make_mat4(frames[2].light->view.data()), proj = glm::make_mat4(frames[2].light->proj.data());
+    const glm::vec4 q = proj * view * glm::vec4(tip, 1.0f);
+    EXPECT_LT(field<float>(*rec, "clamp_far")[k], 0.5f * q.z / q.w + 0.5f) << "(c): the volume ends before the hidden shadow's far end";
+  }
+  {
+    const auto [rec, k] = caster(3);
+    EXPECT_EQ(field<std::uint32_t>(*rec, "decision")[k], static_cast<std::uint32_t>(CasterDecision::Culled)) << "(d)";
+    EXPECT_EQ(field<std::int32_t>(*rec, "draw")[k], -1) << "(d): no volume";
+  }
 }
 
 // Reprojection at depth discontinuities: a box's shadow on the ground seen by the observer right

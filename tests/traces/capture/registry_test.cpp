@@ -7,6 +7,7 @@
 #include <glm/vec2.hpp>
 
 #include <algorithm>
+#include <map>
 #include <set>
 #include <string>
 
@@ -160,6 +161,23 @@ TEST(CaptureRegistryTest, PathsWorkOnAnySite) {
   EXPECT_EQ(city.scene.objects.size(), 50u);
   EXPECT_TRUE(city.site.has_streets());
   EXPECT_EQ(find_path("walk").make(city, 5, {{"seed", "4"}}).size(), 5u);
+}
+
+// Every scene names each object's class, for the reports that split a count by kind of object.
+TEST(CaptureRegistryTest, ScenesNameEveryObjectsClass) {
+  const std::map<std::string, std::set<std::string>> expected = {
+      {"city", {"ground", "building", "car", "lamp", "tree", "kiosk"}}, {"terrain", {"ground", "tower", "bird"}}, {"boxes", {"ground", "box"}}};
+  for (const auto& [name, classes] : expected) {
+    const CaptureScene s = find_scene(name).make({{"seed", "3"}, {"objects", "400"}, {"towers", "4"}, {"birds", "6"}, {"boxes", "5"}});
+    ASSERT_EQ(s.object_class.size(), s.objects.size()) << name;
+    std::set<std::string> used;
+    for (std::uint16_t c : s.object_class) {
+      ASSERT_LT(c, s.class_names.size()) << name;
+      used.insert(s.class_names[c]);
+    }
+    EXPECT_EQ(used, classes) << name;
+    EXPECT_EQ(s.class_names[s.object_class[0]], "ground") << name << ": object 0 is the ground";
+  }
 }
 
 // The observer on foot: eye height above the scene's own ground (the terrain's hills), level gaze,

@@ -28,6 +28,7 @@
 #include "traces/capture/shadows/volumes.h"
 #include "traces/format/header.h"
 #include "traces/format/shadows/shadows_chunk.h"
+#include "model/shadows/caster.h"
 #include "model/shadows/roles.h"
 
 namespace nbsim::capture {
@@ -41,14 +42,12 @@ using trace::CasterDecision;
 enum class Mode : std::uint8_t { Infinite = 0, Culled = 1, Clamped = 2 };
 constexpr std::array<const char*, 3> kModeNames = {"infinite", "culled", "clamped"};
 
-// The litmap pass keeps a fragment the observer may see: not farther than the farthest observer
-// depth of its 3x3 pixels by more than 1% + 5 cm of view distance (tunable; larger is more
-// conservative and only loosens [z_min, z_max]).
-constexpr float kReprojectRel = 0.01f, kReprojectM = 0.05f;
-// Clamp planes and the cull decision are widened by 1% + 10 cm of light distance (tunable): a clamp
-// plane through a receiver would make its stencil count a depth tie, and the mask's receivers are
-// unprojected from 24-bit depth and rounded to f32.
-constexpr double kClampRel = 0.01, kClampM = 0.1;
+// How a clamped volume starts: "edge", the paper's rule (every point of the caster's silhouette
+// edges and lit faces nearer the light than the min plane is projected onto it, the rest start at
+// the caster: the faces and edges that cross the plane are split there), or "caster" (the min plane
+// only when the whole caster is nearer the light than it, else the volume starts at the caster).
+constexpr std::array<const char*, 2> kClampRules = {"edge", "caster"};
+enum class ClampRule : std::uint8_t { Edge = 0, Caster = 1 };
 // The auto light: this far above the scene's top, as a fraction of the site's side (tunable).
 constexpr double kLightHeight = 0.5;
 
@@ -60,6 +59,41 @@ const OptionSpec& shadow_mode_option() {
                     "clamped", {kModeNames.begin(), kModeNames.end()});
   return spec;
 }
+const OptionSpec& clamp_rule_option() {
+  static const OptionSpec spec =
+      choice_option("clamp-rule",
+                    "Where a clamped volume starts: edge (the paper's: each silhouette edge and lit face projected on the min plane "
+                    "unless farther from the light than it, split where it crosses it) or caster (the min plane only when the whole "
+                    "caster is in front of it)",
+                    "edge", {kClampRules.begin(), kClampRules.end()});
+  return spec;
+}
+// The litmap pass keeps a fragment the observer may see: not farther than the farthest observer
+// depth of its 3x3 pixels by more than this share of view distance plus metres (larger is more
+// conservative and only loosens [z_min, z_max]).
+const OptionSpec& reproject_option() {
+  static const OptionSpec spec = text_option(
+      "reproject-tolerance", "How far behind the observer's depth a litmap fragment still counts as seen: SHARE,METRES (of view distance)",
+      "0.01,0.05");
+  return spec;
+}
+// Clamp planes and the cull decision are widened by this share of light distance plus metres: a
+// clamp plane through a receiver would make its stencil count a depth tie, and the mask's receivers
+// are unprojected from 24-bit depth and rounded to f32.
+const OptionSpec& clamp_margin_option() {
+  static const OptionSpec spec = text_option(
+      "clamp-margin", "How far each slab is widened beyond its visible receivers: SHARE,METRES (of light distance)", "0.01,0.1");
+  return spec;
+}
+nbsim::shadows::ClampMargin read_margin(const OptionValues& options, const OptionSpec& spec) {
+  const std::string text = options.text(spec);
+  const std::size_t comma = text.find(',');
+  const auto m = comma == std::string::npos ? std::nullopt
+                                            : nbsim::shadows::parse_clamp_margin(text.substr(0, comma) + " + " + text.substr(comma + 1) + " m");
+  if (!m) throw InputError(fmt::format("--{} '{}' is not SHARE,METRES with the share in 0 .. 1 and the metres in 0 .. 1000", spec.name, text));
+  return *m;
+}
+
 const OptionSpec& litmap_option() {
   static const OptionSpec spec = integer_option("litmap", "Side of the square litmaps and their N-buffers, lexels", 512, 16, 4096);
   return spec;
@@ -137,6 +171,7 @@ struct CasterResult {
   float caster_near = 0, caster_far = 0, z_min = 1, z_max = 0;
   std::uint32_t lookups = 0;
   CasterDecision decision = CasterDecision::Volume;
+  nbsim::shadows::KeptBy kept = nbsim::shadows::KeptBy::Dropped;
   float clamp_near = 0, clamp_far = std::numeric_limits<float>::infinity();
   std::int32_t draw = -1;
 };
@@ -155,8 +190,9 @@ class Shadows final : public Technique {
             {"light_fov_deg", std::to_string(light_fov_)},
             {"casters", std::to_string(casters_.size())},
             {"stencil_volumes", "zfail_caps_two_sided_depth_clamp"},
-            {"reproject_tolerance", fmt::format("{} + {} m", kReprojectRel, kReprojectM)},
-            {"clamp_margin", fmt::format("{} + {} m", kClampRel, kClampM)},
+            {"reproject_tolerance", fmt::format("{} + {} m", reproject_.rel, reproject_.metres)},
+            {"clamp_margin", fmt::format("{} + {} m", margin_.rel, margin_.metres)},
+            {"clamp_rule", kClampRules[static_cast<std::size_t>(rule_)]},
             {"levels_every", std::to_string(levels_every_)},
             covering_property(covering_)};
   }
@@ -174,6 +210,11 @@ class Shadows final : public Technique {
   // in its rectangle, [slab_min, slab_max].
   void decide(CasterResult& r, const LightCamera& light, double slab_min, double slab_max) const;
   VolumeEnds ends_of(const CasterResult& r, bool clamped) const;
+  // The far end of a slab whose farthest receiver is at light window depth `slab_max`: pushed back
+  // by the clamp margin. A caster is culled when it is nearer than max(slab_min, caster_near).
+  double far_end(const LightCamera& light, double slab_max) const {
+    return light.depth_of_distance(light.distance_of_depth(slab_max) * (1.0 + margin_.rel) + margin_.metres);
+  }
   // Uploads `positions` (three a triangle) to the volume buffer.
   void upload(const std::vector<glm::vec4>& positions);
   std::vector<std::uint8_t> read_stencil() const;
@@ -182,6 +223,8 @@ class Shadows final : public Technique {
   int width_, height_;
   Projection projection_;
   Mode mode_;
+  ClampRule rule_;
+  nbsim::shadows::ClampMargin reproject_, margin_;
   int litmap_, light_fov_, levels_every_;
   CoveringSpec covering_;  // of the eight lookups a caster makes
   std::string light_text_;
@@ -196,7 +239,8 @@ class Shadows final : public Technique {
   GLuint litmap_prog_ = 0, splat_prog_ = 0, volume_prog_ = 0;
   GLuint splat_vao_ = 0;  // no attributes: the splat's vertices come from gl_VertexID
   GLuint volume_vao_ = 0, volume_vbo_ = 0, reference_count_ = 0;
-  std::size_t volume_capacity_ = 0;  // bytes
+  std::size_t volume_capacity_ = 0, reference_capacity_ = 4;  // bytes
+  std::string class_names_;  // the scene's object classes, comma-separated (SHDC class_names)
 };
 
 Shadows::Shadows(const TechniqueSetup& s)
@@ -207,6 +251,9 @@ Shadows::Shadows(const TechniqueSetup& s)
       mode_(static_cast<Mode>(std::find(shadow_mode_option().choices.begin(), shadow_mode_option().choices.end(),
                                         s.options.text(shadow_mode_option())) -
                               shadow_mode_option().choices.begin())),
+      rule_(s.options.text(clamp_rule_option()) == "caster" ? ClampRule::Caster : ClampRule::Edge),
+      reproject_(read_margin(s.options, reproject_option())),
+      margin_(read_margin(s.options, clamp_margin_option())),
       litmap_(static_cast<int>(s.options.integer(litmap_option()))),
       light_fov_(static_cast<int>(s.options.integer(light_fov_option()))),
       levels_every_(static_cast<int>(s.options.integer(levels_every_option()))),
@@ -227,6 +274,7 @@ Shadows::Shadows(const TechniqueSetup& s)
   for (const scene::Aabb& b : scene_.scene.objects)
     for (std::size_t k = 0; k < 3; ++k) bounds_.lo[k] = std::min(bounds_.lo[k], b.lo[k]), bounds_.hi[k] = std::max(bounds_.hi[k], b.hi[k]);
   if (light_text_ != "auto") parse_light(light_text_);
+  for (const std::string& name : scene_.class_names) class_names_ += (class_names_.empty() ? "" : ",") + name;
   light_at(0);  // a fixed light is checked here (degenerate frustum, inside a caster), before any frame
 
   litmap_prog_ = link_program({compile_shader(GL_VERTEX_SHADER, shaders::shadows_litmap_vert, "shadows/litmap.vert"),
@@ -303,9 +351,20 @@ CasterResult Shadows::measure(const CasterMesh& c, const LightCamera& light, con
   CasterResult r;
   const scene::Aabb& b = scene_.scene.objects[c.object];
   double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, d0 = INFINITY, d1 = -INFINITY;
-  for (int k = 0; k < 8; ++k) {
-    const glm::dvec3 p{k & 1 ? b.hi[0] : b.lo[0], k & 2 ? b.hi[1] : b.lo[1], k & 4 ? b.hi[2] : b.lo[2]};
-    const glm::dvec4 q = light.clip(p);
+  std::array<glm::dvec4, 8> corners;
+  for (int k = 0; k < 8; ++k)
+    corners[static_cast<std::size_t>(k)] = light.clip({k & 1 ? b.hi[0] : b.lo[0], k & 2 ? b.hi[1] : b.lo[1], k & 4 ? b.hi[2] : b.lo[2]});
+  // Bounds wholly outside one side plane of the light's frustum (a plane through the light) or
+  // beyond its far plane: every light ray through the caster stays outside the frustum, so its
+  // volume holds no lit receiver, even when the bounds reach behind the near plane.
+  const auto all = [&](auto outside) { return std::all_of(corners.begin(), corners.end(), outside); };
+  if (all([](const glm::dvec4& q) { return q.x > q.w; }) || all([](const glm::dvec4& q) { return q.x < -q.w; }) ||
+      all([](const glm::dvec4& q) { return q.y > q.w; }) || all([](const glm::dvec4& q) { return q.y < -q.w; }) ||
+      all([](const glm::dvec4& q) { return q.z > q.w; })) {
+    r.decision = CasterDecision::OutsideLight;
+    return r;
+  }
+  for (const glm::dvec4& q : corners) {
     if (q.w < light.near_m) {  // behind the near plane: never culled or clamped
       r.decision = CasterDecision::CrossesNear;
       r.caster_near = 0.0f, r.caster_far = 1.0f;
@@ -341,18 +400,19 @@ CasterResult Shadows::measure(const CasterMesh& c, const LightCamera& light, con
 
 void Shadows::decide(CasterResult& r, const LightCamera& light, double slab_min, double slab_max) const {
   // The slab of visible receivers, widened: [near, far] in light window depth.
-  const double far = light.depth_of_distance(light.distance_of_depth(slab_max) * (1.0 + kClampRel) + kClampM);
+  const double far = far_end(light, slab_max);
   if (far < std::max(slab_min, static_cast<double>(r.caster_near))) {
     r.decision = CasterDecision::Culled;
     return;
   }
   // The planes: clamped mode ends its volume there, the others cut its sides there.
   r.clamp_far = static_cast<float>(far);
-  const double near_m = light.distance_of_depth(slab_min) * (1.0 - kClampRel) - kClampM;
+  const double near_m = light.distance_of_depth(slab_min) * (1.0 - margin_.rel) - margin_.metres;
   const double near = near_m > light.near_m ? light.depth_of_distance(near_m) : 0.0;
-  // Only when every receiver is behind the whole caster: a plane through the caster would cut its
-  // lit faces off the volume's near cap.
-  if (near >= r.caster_far) r.clamp_near = static_cast<float>(near);
+  // The paper's rule sets the plane whenever it is in front of some of the caster (the volume is
+  // split where the caster crosses it); the other only when every receiver is behind the whole
+  // caster.
+  if (rule_ == ClampRule::Edge ? near > r.caster_near : near >= r.caster_far) r.clamp_near = static_cast<float>(near);
 }
 
 VolumeEnds Shadows::ends_of(const CasterResult& r, bool clamped) const {
@@ -456,8 +516,8 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   glUniformMatrix4fv(glGetUniformLocation(litmap_prog_, "light_view_proj"), 1, GL_FALSE, glm::value_ptr(light_view_proj));
   glUniformMatrix4fv(glGetUniformLocation(litmap_prog_, "view_proj"), 1, GL_FALSE, glm::value_ptr(view_proj));
   glUniform2f(glGetUniformLocation(litmap_prog_, "near_far"), static_cast<float>(projection_.near_m), static_cast<float>(projection_.far_m));
-  glUniform1f(glGetUniformLocation(litmap_prog_, "tolerance_rel"), kReprojectRel);
-  glUniform1f(glGetUniformLocation(litmap_prog_, "tolerance_m"), kReprojectM);
+  glUniform1f(glGetUniformLocation(litmap_prog_, "tolerance_rel"), static_cast<float>(reproject_.rel));
+  glUniform1f(glGetUniformLocation(litmap_prog_, "tolerance_m"), static_cast<float>(reproject_.metres));
   glUniform1i(glGetUniformLocation(litmap_prog_, "observer_depth"), 1);
   const GLint u_slot = glGetUniformLocation(litmap_prog_, "draw_slot");
   glUseProgram(splat_prog_);
@@ -527,9 +587,9 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   std::vector<std::pair<std::size_t, std::size_t>> ranges(casters_.size());  // first vertex, count
   for (std::size_t c = 0; c < casters_.size(); ++c) results[c] = measure(casters_[c], light, min_levels, max_levels);
   // Each slab: the litmaps' [z_min, z_max] (with the receiver splat, every receiver the mask samples
-  // in the rectangle lies inside it); a seen caster's own bounds join its own slab, and a seen
-  // caster crossing the light's near plane makes every slab [0, 1] (both older widenings, kept:
-  // they only loosen the slab).
+  // in the rectangle lies inside it). The rule "caster" also widens it as before the splat: a seen
+  // caster's own bounds join its own slab, and a seen caster crossing the light's near plane makes
+  // every slab [0, 1] (they only loosen the slab).
   bool near_crossing_seen = false;
   for (std::size_t c = 0; c < casters_.size(); ++c)
     near_crossing_seen = near_crossing_seen || (seen[casters_[c].object] && results[c].decision == CasterDecision::CrossesNear);
@@ -537,10 +597,19 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
     CasterResult& r = results[c];
     if (r.decision == CasterDecision::Volume) {
       double slab_min = r.z_min, slab_max = r.z_max;
-      if (seen[casters_[c].object]) slab_min = std::min(slab_min, static_cast<double>(r.caster_near)), slab_max = std::max(slab_max, static_cast<double>(r.caster_far));
-      if (near_crossing_seen) slab_min = 0.0, slab_max = 1.0;
+      if (rule_ == ClampRule::Caster && seen[casters_[c].object])
+        slab_min = std::min(slab_min, static_cast<double>(r.caster_near)), slab_max = std::max(slab_max, static_cast<double>(r.caster_far));
+      if (rule_ == ClampRule::Caster && near_crossing_seen) slab_min = 0.0, slab_max = 1.0;
       decide(r, light, slab_min, slab_max);
+      // Why it is kept: its slab has a visible receiver behind it, it is seen itself, or only the
+      // widening keeps it.
+      using nbsim::shadows::KeptBy;
+      if (r.decision == CasterDecision::Volume)
+        r.kept = seen[casters_[c].object] ? KeptBy::SeenCaster
+                 : far_end(light, r.z_max) >= std::max<double>(r.z_min, r.caster_near) ? KeptBy::Receivers
+                                                                                                            : KeptBy::Widened;
     }
+    if (r.decision == CasterDecision::CrossesNear) r.kept = nbsim::shadows::KeptBy::CrossesNear;
     const bool dropped = results[c].decision == CasterDecision::Culled || results[c].decision == CasterDecision::OutsideLight;
     if (mode_ != Mode::Infinite && dropped) continue;
     const std::size_t first = positions.size();
@@ -585,23 +654,37 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   f.end.gl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const std::vector<std::uint8_t> stencil = read_stencil();
 
-  // 6. The reference: every caster's infinite volume into a cleared stencil, its fill counted apart.
+  // 6. The reference: every caster's infinite volume into a cleared stencil, its fill counted apart
+  // per caster.
   std::vector<std::uint8_t> reference = stencil;
-  std::uint64_t reference_fill = 0;
+  std::vector<std::uint32_t> fill_infinite(casters_.size(), 0);
   if (mode_ != Mode::Infinite) {
     positions.clear();
-    for (std::size_t c = 0; c < casters_.size(); ++c) append_volume(scene_, casters_[c], light, ends_of(results[c], false), positions);
+    for (std::size_t c = 0; c < casters_.size(); ++c) {
+      const std::size_t first = positions.size();
+      append_volume(scene_, casters_[c], light, ends_of(results[c], false), positions);
+      ranges[c] = {first, positions.size() - first};
+    }
     upload(positions);
     target_.clear_stencil(0);
+    const std::size_t bytes = std::max<std::size_t>(4, 4 * casters_.size());
+    if (bytes > reference_capacity_) {
+      glDeleteBuffers(1, &reference_count_);
+      glCreateBuffers(1, &reference_count_);
+      glNamedBufferStorage(reference_count_, static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
+      reference_capacity_ = bytes;
+    }
     const GLuint zero = 0;
     glClearNamedBufferData(reference_count_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, reference_count_);
-    glUniform1ui(u_vslot, 0);
-    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(positions.size()));
+    for (std::size_t c = 0; c < casters_.size(); ++c) {
+      if (ranges[c].second == 0) continue;
+      glUniform1ui(u_vslot, static_cast<GLuint>(c));
+      glDrawArrays(GL_TRIANGLES, static_cast<GLint>(ranges[c].first), static_cast<GLsizei>(ranges[c].second));
+    }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    GLuint count = 0;
-    glGetNamedBufferSubData(reference_count_, 0, 4, &count);
-    reference_fill = count;
+    if (!casters_.empty())
+      glGetNamedBufferSubData(reference_count_, 0, static_cast<GLsizeiptr>(4 * casters_.size()), fill_infinite.data());
     reference = read_stencil();
     recorder_.bind();
   }
@@ -652,9 +735,13 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   std::uint64_t fill = 0, drawn = 0, culled = 0, lookups = 0;
   for (const DrawRecord& d : f.draws)
     if (d.role == nbsim::shadows::kShadowVolumeRole) fill += d.gl.fragments, ++drawn;
-  if (mode_ == Mode::Infinite) reference_fill = fill;
+  if (mode_ == Mode::Infinite)
+    for (std::size_t c = 0; c < casters_.size(); ++c)
+      if (results[c].draw >= 0) fill_infinite[c] = static_cast<std::uint32_t>(f.draws[static_cast<std::size_t>(results[c].draw)].gl.fragments);
+  std::uint64_t reference_fill = 0;
+  for (std::uint32_t k : fill_infinite) reference_fill += k;
   const auto n = casters_.size();
-  std::vector<std::uint32_t> object(n), lk(n), decision(n);
+  std::vector<std::uint32_t> object(n), lk(n), decision(n), cls(n), kept(n);
   std::vector<std::int32_t> rx(n), ry(n), rw(n), rh(n), draw(n);
   std::vector<float> cn(n), cf(n), zmin(n), zmax(n), clamp_near(n), clamp_far(n);
   for (std::size_t c = 0; c < n; ++c) {
@@ -663,6 +750,7 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
     rx[c] = r.x, ry[c] = r.y, rw[c] = r.w, rh[c] = r.h, draw[c] = r.draw;
     cn[c] = r.caster_near, cf[c] = r.caster_far, zmin[c] = r.z_min, zmax[c] = r.z_max;
     clamp_near[c] = r.clamp_near, clamp_far[c] = r.clamp_far;
+    cls[c] = scene_.object_class.at(casters_[c].object), kept[c] = static_cast<std::uint32_t>(r.kept);
     culled += r.decision == CasterDecision::Culled || r.decision == CasterDecision::OutsideLight;
     lookups += r.lookups;
   }
@@ -686,7 +774,11 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
                 {"clamp_far", std::move(clamp_far)},
                 {"draw", std::move(draw)},
                 {"reference_fill", reference_fill},
-                {"mask_diff_pixels", diff}};
+                {"mask_diff_pixels", diff},
+                {"class_names", class_names_},
+                {"class", std::move(cls)},
+                {"kept", std::move(kept)},
+                {"fill_infinite", std::move(fill_infinite)}};
   f.technique_records.push_back(std::move(rec));
   out.counts = {{"fill", fill},
                 {"fill_infinite", reference_fill},
@@ -704,8 +796,9 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
 }  // namespace
 
 const std::vector<OptionSpec>& shadows_options() {
-  static const std::vector<OptionSpec> options = {shadow_mode_option(), litmap_option(),    light_option(),
-                                                  light_fov_option(),   levels_every_option(), shadows_covering_option(),
+  static const std::vector<OptionSpec> options = {shadow_mode_option(), clamp_rule_option(),    clamp_margin_option(),
+                                                  reproject_option(),   litmap_option(),        light_option(),
+                                                  light_fov_option(),   levels_every_option(),  shadows_covering_option(),
                                                   align_option(),       seed_option()};
   return options;
 }

@@ -86,49 +86,110 @@ glm::dvec3 LightCamera::light_ray_point(const glm::dvec3& p, double depth) const
   return eye + (p - eye) * (distance_of_depth(depth) / along);
 }
 
+namespace {
+
+// A point of a lit triangle's cap polygon: a caster vertex, or the point where one of its edges
+// crosses the near plane (on the plane, its own projection there).
+struct CapPoint {
+  glm::dvec3 p;
+  bool front = false;  // nearer the light than the near plane (projected there by a clamped volume)
+};
+
+// Where edge a-b of the caster crosses the light's plane at view distance `plane_m`, computed from
+// the edge's endpoints in index order so that both triangles sharing the edge get the same point.
+glm::dvec3 crossing(const CaptureScene& scene, std::uint32_t a, std::uint32_t b, const LightCamera& light, double plane_m) {
+  if (b < a) std::swap(a, b);
+  const glm::dvec3 pa = vertex(scene, a), pb = vertex(scene, b);
+  const double za = -(light.view * glm::dvec4(pa, 1.0)).z, zb = -(light.view * glm::dvec4(pb, 1.0)).z;
+  return pa + (pb - pa) * ((plane_m - za) / (zb - za));
+}
+
+}  // namespace
+
 void append_volume(const CaptureScene& scene, const CasterMesh& caster, const LightCamera& light, const VolumeEnds& ends,
                    std::vector<glm::vec4>& out) {
-  // The points of vertex i at each level of its light ray: the vertex, the near plane, the far
-  // plane, infinity; `levels` lists the ones this volume uses, in order from the light.
+  // The points of a cap point at each level of its light ray: the point, the near plane, the far
+  // plane, infinity. A point behind the near plane has no near-plane level (its volume starts at
+  // the caster); a front point has both, and a clamped volume starts it at the near plane.
   enum Level { Vertex, NearPlane, FarPlane, Infinity };
-  auto point = [&](Level level, std::uint32_t i) -> glm::dvec4 {
-    const glm::dvec3 p = vertex(scene, i);
+  auto point = [&](Level level, const CapPoint& c) -> glm::dvec4 {
     switch (level) {
-      case Vertex: return glm::dvec4(p, 1.0);
-      case NearPlane: return glm::dvec4(light.light_ray_point(p, ends.near_depth), 1.0);
+      case Vertex: return glm::dvec4(c.p, 1.0);
+      case NearPlane: return glm::dvec4(c.front ? light.light_ray_point(c.p, ends.near_depth) : c.p, 1.0);
       case FarPlane: {
-        const double d = light.window_depth(p);
-        return glm::dvec4(d >= ends.far_depth ? p : light.light_ray_point(p, ends.far_depth), 1.0);
+        const double d = light.window_depth(c.p);
+        return glm::dvec4(d >= ends.far_depth ? c.p : light.light_ray_point(c.p, ends.far_depth), 1.0);
       }
       case Infinity: break;
     }
-    return glm::dvec4(p - light.eye, 0.0);
+    return glm::dvec4(c.p - light.eye, 0.0);
   };
-  std::vector<Level> levels;
-  if (!ends.clamped || !ends.near_plane) levels.push_back(Vertex);
-  if (ends.near_plane) levels.push_back(NearPlane);
-  if (ends.far_plane) levels.push_back(FarPlane);
-  if (!ends.clamped || !ends.far_plane) levels.push_back(Infinity);
+  auto levels_of = [&](bool front) {
+    std::vector<Level> levels;
+    if (!(ends.clamped && front)) levels.push_back(Vertex);
+    if (front) levels.push_back(NearPlane);
+    if (ends.far_plane) levels.push_back(FarPlane);
+    if (!ends.clamped || !ends.far_plane) levels.push_back(Infinity);
+    return levels;
+  };
   auto emit = [&](const glm::dvec4& a, const glm::dvec4& b, const glm::dvec4& c) {
-    out.emplace_back(glm::vec4(a));
-    out.emplace_back(glm::vec4(b));
-    out.emplace_back(glm::vec4(c));
+    const glm::vec4 fa(a), fb(b), fc(c);
+    if (fa == fb || fb == fc || fc == fa) return;  // no area: a split point's piece of zero length
+    out.push_back(fa);
+    out.push_back(fb);
+    out.push_back(fc);
   };
+  const double plane_m = ends.near_plane ? light.distance_of_depth(ends.near_depth) : 0.0;
+  auto is_front = [&](std::uint32_t i) { return ends.near_plane && light.window_depth(vertex(scene, i)) < ends.near_depth; };
   std::vector<char> lit(caster.triangles.size());
   for (std::size_t t = 0; t < caster.triangles.size(); ++t) lit[t] = faces_light(scene, caster.triangles[t], light.eye);
-  const Level first = levels.front(), last = levels.back();
+  const std::vector<Level> front_levels = levels_of(true), back_levels = levels_of(false);
+  std::vector<CapPoint> parts[2];  // the triangle's piece in front of the near plane, and behind it
   for (std::size_t t = 0; t < caster.triangles.size(); ++t) {
     if (!lit[t]) continue;
     const auto& v = caster.triangles[t];
-    emit(point(first, v[0]), point(first, v[1]), point(first, v[2]));  // front cap
-    emit(point(last, v[0]), point(last, v[2]), point(last, v[1]));     // back cap, reversed
+    const std::array<bool, 3> front = {is_front(v[0]), is_front(v[1]), is_front(v[2])};
+    // The caps: each piece a convex polygon in the triangle's winding, fanned from its first point;
+    // the front piece at its first level (the near plane when clamped), both at the last, reversed.
+    parts[0].clear(), parts[1].clear();
+    for (int k = 0; k < 3; ++k) {
+      const int n = (k + 1) % 3;
+      parts[front[k] ? 0 : 1].push_back({vertex(scene, v[k]), front[k]});
+      if (front[k] != front[n]) {
+        const CapPoint m{crossing(scene, v[k], v[n], light, plane_m), false};
+        parts[0].push_back(m), parts[1].push_back(m);
+      }
+    }
+    for (int side = 0; side < 2; ++side) {
+      const std::vector<CapPoint>& poly = parts[side];
+      const std::vector<Level>& levels = side == 0 ? front_levels : back_levels;
+      for (std::size_t i = 1; i + 1 < poly.size(); ++i) {
+        const CapPoint& f = poly[0];
+        emit(point(levels.front(), f), point(levels.front(), poly[i]), point(levels.front(), poly[i + 1]));  // near cap
+        emit(point(levels.back(), f), point(levels.back(), poly[i + 1]), point(levels.back(), poly[i]));    // far cap, reversed
+      }
+    }
+    // The sides: one strip of quads per silhouette edge (as the lit triangle winds it), split where
+    // it crosses the near plane.
     for (int k = 0; k < 3; ++k) {
       if (lit[static_cast<std::size_t>(caster.neighbour[t][k])]) continue;
-      const std::uint32_t a = v[k], b = v[(k + 1) % 3];  // a silhouette edge, as the lit triangle winds it
-      for (std::size_t l = 0; l + 1 < levels.size(); ++l) {
-        const Level from = levels[l], to = levels[l + 1];
-        emit(point(from, a), point(to, a), point(to, b));
-        emit(point(from, a), point(to, b), point(from, b));
+      const int n = (k + 1) % 3;
+      const CapPoint a{vertex(scene, v[k]), front[k]}, b{vertex(scene, v[n]), front[n]};
+      std::array<std::pair<CapPoint, CapPoint>, 2> pieces{{{a, b}, {}}};
+      std::size_t count = 1;
+      if (front[k] != front[n]) {
+        const CapPoint m{crossing(scene, v[k], v[n], light, plane_m), false};
+        pieces = {{{a, m}, {m, b}}};
+        count = 2;
+      }
+      for (std::size_t p = 0; p < count; ++p) {
+        const auto& [pa, pb] = pieces[p];
+        const std::vector<Level>& levels = pa.front || pb.front ? front_levels : back_levels;
+        for (std::size_t l = 0; l + 1 < levels.size(); ++l) {
+          const Level from = levels[l], to = levels[l + 1];
+          emit(point(from, pa), point(to, pa), point(to, pb));
+          emit(point(from, pa), point(to, pb), point(from, pb));
+        }
       }
     }
   }

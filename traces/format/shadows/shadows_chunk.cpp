@@ -29,11 +29,15 @@ std::uint64_t scalar(const TechniqueRecord& r, const char* name) {
 // The rule of shadows_chunk_spec(): what a reader refuses beyond the field types.
 std::string shadows_rule(const TechniqueRecord& r) {
   const std::uint64_t count = scalar(r, "count"), size = scalar(r, "litmap_size");
-  if (std::string problem = vector_lengths_problem(r, count, {"count", "litmap_size", "reference_fill", "mask_diff_pixels"}, "caster"); !problem.empty()) return problem;
+  if (std::string problem = vector_lengths_problem(r, count, {"count", "litmap_size", "reference_fill", "mask_diff_pixels", "class_names"}, "caster");
+      !problem.empty())
+    return problem;
+  const auto& kept = vec<std::uint32_t>(r, "kept");
   const auto& decision = vec<std::uint32_t>(r, "decision");
   const auto &x = vec<std::int32_t>(r, "x"), &y = vec<std::int32_t>(r, "y"), &w = vec<std::int32_t>(r, "w"), &h = vec<std::int32_t>(r, "h");
   const auto& draw = vec<std::int32_t>(r, "draw");
   for (std::size_t c = 0; c < count; ++c) {
+    if (kept[c] > 4) return fmt::format("field 'kept' of caster {} is {}, above 4", c, kept[c]);
     if (decision[c] > 3) return fmt::format("field 'decision' of caster {} is {}, above 3", c, decision[c]);
     const auto s = static_cast<std::int64_t>(size);
     if (x[c] < 0 || y[c] < 0 || w[c] < 0 || h[c] < 0 || x[c] + static_cast<std::int64_t>(w[c]) > s ||
@@ -74,7 +78,12 @@ ChunkSpec shadows_chunk_spec() {
        {"reference_fill", FieldKind::U64,
         "rasterized fragments of the reference pass: every caster's infinite volume (not recorded as draws)"},
        {"mask_diff_pixels", FieldKind::U64,
-        "pixels where the STNC shadow_mask differs from shadow_mask_infinite (0 for a correct frame)"}}};
+        "pixels where the STNC shadow_mask differs from shadow_mask_infinite (0 for a correct frame)"},
+       {"class_names", FieldKind::String, "the scene's object classes, comma-separated (\"ground,tower,bird\")"},
+       {"class", FieldKind::VecU32, "the caster's class: an index into class_names"},
+       {"kept", FieldKind::VecU32, "why a culled or clamped capture keeps its volume, in every mode: 0 dropped (decision 1 or 2), 1 a visible "
+        "receiver in its slab, 2 the observer sees the caster, 3 only the slab's widening keeps it, 4 it crosses the light's near plane"},
+       {"fill_infinite", FieldKind::VecU32, "rasterized fragments of its infinite volume (its share of reference_fill)"}}};
   spec.rule = shadows_rule;
   return spec;
 }
@@ -97,7 +106,10 @@ std::vector<HeaderKeySpec> shadows_header_keys() {
           custom_key(t, "reproject_tolerance", valid_margin, margin, "0.01 + 0.05 m",
                      "tolerance of the observer depth reprojected into the litmaps"),
           custom_key(t, "clamp_margin", valid_margin, margin, "0.01 + 0.1 m",
-                     "how far a clamped volume's slab is pushed back before the cull test")};
+                     "how far a clamped volume's slab is pushed back before the cull test"),
+          choice_key(t, "clamp_rule", {"edge", "caster"}, "caster",
+                     "where a clamped volume starts: edge (the paper's: each edge and lit face on the min plane unless farther than it) "
+                     "or caster (the min plane only when the whole caster is in front of it)")};
 }
 
 // This technique's part of the format (technique_chunks.h): its chunk type and header keys.

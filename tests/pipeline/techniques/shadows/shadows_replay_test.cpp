@@ -247,6 +247,23 @@ TEST(ShadowsTableTest, JsonRowsWithRatioToInfinite) {
   const CliResult text = run_nbsim("shadows " + cl.string());
   EXPECT_EQ(text.status, 0);
   EXPECT_TRUE(has(text.out, "Shadows: fill per frame")) << text.out;
+  // Where the fill goes: the rows by class and reason kept add up to the fill and to the infinite
+  // volumes' fill, in both modes; the boxes scene's casters are all "box".
+  for (const auto& row : rows) {
+    double fill = 0.0, infinite = 0.0, casters = 0.0;
+    for (const auto& b : row["fill_breakdown"]) {
+      EXPECT_EQ(b["class"], "box");
+      fill += b["fill_per_frame"].get<double>(), infinite += b["fill_infinite_per_frame"].get<double>();
+      casters += b["casters_per_frame"].get<double>();
+      if (b["kept"] == "dropped") EXPECT_EQ(b["fill_per_frame"].get<double>(), row["shadow_mode"] == "infinite" ? b["fill_infinite_per_frame"].get<double>() : 0.0);
+    }
+    EXPECT_NEAR(fill, row["fill_per_frame"].get<double>(), 1e-6 * fill) << row["shadow_mode"];
+    EXPECT_NEAR(infinite, row["reference_fill_per_frame"].get<double>(), 1e-6 * infinite) << row["shadow_mode"];
+    EXPECT_NEAR(casters, row["casters_per_frame"].get<double>(), 1e-9) << row["shadow_mode"];
+  }
+  const CliResult split = run_nbsim("shadows " + cl.string() + " --breakdown");
+  EXPECT_EQ(split.status, 0);
+  EXPECT_TRUE(has(split.out, "fill per frame by caster class and reason kept") && has(split.out, "box")) << split.out;
 }
 
 }  // namespace

@@ -21,6 +21,7 @@ TEST(ShadowsChunkTest, DecodedAndDamageRefused) {
     std::vector<std::int32_t> x{0, 10, 0}, w{0, 6, 64};
     std::vector<std::uint32_t> decision{2, 0, 3};
     std::vector<std::int32_t> draw{-1, 7, 8};
+    std::vector<std::uint32_t> cls{0, 1, 1}, kept{0, 1, 4};
   };
   auto payload = [](const Fields& f) {
     bytes::Out o;
@@ -39,6 +40,10 @@ TEST(ShadowsChunkTest, DecodedAndDamageRefused) {
     o.counted_words(f.draw);
     o.u64(1234567);  // reference_fill
     o.u64(0);        // mask_diff_pixels
+    o.str("tower,bird");  // class_names
+    o.counted_words(f.cls);
+    o.counted_words(f.kept);
+    o.counted_words(std::vector<std::uint32_t>{500, 70, 9000});  // fill_infinite
     return o.take();
   };
   TechniqueRecord raw;
@@ -56,12 +61,12 @@ TEST(ShadowsChunkTest, DecodedAndDamageRefused) {
   longer.push_back(0);
   e = record_error(kShadowsChunk, longer);
   EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "decodes long")) << e;
-  // The layout without the last two fields, reference_fill and mask_diff_pixels: refused naming the
-  // type, the missing field and where this nbsim's fields are listed.
-  std::vector<std::uint8_t> old_layout(raw.payload.begin(), raw.payload.end() - 16);
-  e = record_error(kShadowsChunk, old_layout);
+  // The layout before the per-caster breakdown (class_names, class, kept, fill_infinite): refused
+  // naming the type, the missing field and where this nbsim's fields are listed.
+  const std::ptrdiff_t breakdown_bytes = (4 + 10) + 3 * (4 + 3 * 4);
+  e = record_error(kShadowsChunk, std::vector<std::uint8_t>(raw.payload.begin(), raw.payload.end() - breakdown_bytes));
   EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "technique chunk SHDC (ShadowCasters, technique shadows) does not have this nbsim's layout") &&
-              has(e, "'reference_fill'") && has(e, "16 fields of 18 read") && has(e, "`nbsim trace format SHDC`"))
+              has(e, "'class_names'") && has(e, "18 fields of 22 read") && has(e, "`nbsim trace format SHDC`"))
       << e;
   std::vector<std::uint8_t> hostile = raw.payload;
   put_le32(hostile, 8, 0xFFFFFFFFu);  // the object vector's count
@@ -75,12 +80,14 @@ TEST(ShadowsChunkTest, DecodedAndDamageRefused) {
                    {Fields{}, "field 'decision' of caster 1 is 4, above 3"},
                    {Fields{}, "caster 2's rectangle (0, 0, 65x64) is not inside the 64x64 litmap"},
                    {Fields{}, "caster 1's rectangle (-1, 20, 6x5) is not inside"},
-                   {Fields{}, "field 'draw' of caster 0 is -2, below -1"}};
+                   {Fields{}, "field 'draw' of caster 0 is -2, below -1"},
+                   {Fields{}, "field 'kept' of caster 2 is 5, above 4"}};
   rows[0].f.x = {0, 10};
   rows[1].f.decision = {2, 4, 3};
   rows[2].f.w = {0, 6, 65};
   rows[3].f.x = {0, -1, 0};
   rows[4].f.draw = {-2, 7, 8};
+  rows[5].f.kept = {0, 1, 5};
   for (const Broken& b : rows) {
     e = record_error(kShadowsChunk, payload(b.f));
     EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, b.message)) << b.message << ": " << e;
