@@ -46,8 +46,7 @@ constexpr std::array<const char*, 3> kModeNames = {"infinite", "culled", "clampe
 // edges and lit faces nearer the light than the min plane is projected onto it, the rest start at
 // the caster: the faces and edges that cross the plane are split there), or "caster" (the min plane
 // only when the whole caster is nearer the light than it, else the volume starts at the caster).
-constexpr std::array<const char*, 2> kClampRules = {"edge", "caster"};
-enum class ClampRule : std::uint8_t { Edge = 0, Caster = 1 };
+using nbsim::shadows::ClampRule;
 // The auto light: this far above the scene's top, as a fraction of the site's side (tunable).
 constexpr double kLightHeight = 0.5;
 
@@ -65,7 +64,7 @@ const OptionSpec& clamp_rule_option() {
                     "Where a clamped volume starts: edge (the paper's: each silhouette edge and lit face projected on the min plane "
                     "unless farther from the light than it, split where it crosses it) or caster (the min plane only when the whole "
                     "caster is in front of it)",
-                    "edge", {kClampRules.begin(), kClampRules.end()});
+                    "edge", {std::string(nbsim::shadows::kClampRuleNames[0]), std::string(nbsim::shadows::kClampRuleNames[1])});
   return spec;
 }
 // The litmap pass keeps a fragment the observer may see: not farther than the farthest observer
@@ -192,7 +191,7 @@ class Shadows final : public Technique {
             {"stencil_volumes", "zfail_caps_two_sided_depth_clamp"},
             {"reproject_tolerance", fmt::format("{} + {} m", reproject_.rel, reproject_.metres)},
             {"clamp_margin", fmt::format("{} + {} m", margin_.rel, margin_.metres)},
-            {"clamp_rule", kClampRules[static_cast<std::size_t>(rule_)]},
+            {"clamp_rule", std::string(nbsim::shadows::kClampRuleNames[static_cast<std::size_t>(rule_)])},
             {"levels_every", std::to_string(levels_every_)},
             covering_property(covering_)};
   }
@@ -210,11 +209,7 @@ class Shadows final : public Technique {
   // in its rectangle, [slab_min, slab_max].
   void decide(CasterResult& r, const LightCamera& light, double slab_min, double slab_max) const;
   VolumeEnds ends_of(const CasterResult& r, bool clamped) const;
-  // The far end of a slab whose farthest receiver is at light window depth `slab_max`: pushed back
-  // by the clamp margin. A caster is culled when it is nearer than max(slab_min, caster_near).
-  double far_end(const LightCamera& light, double slab_max) const {
-    return light.depth_of_distance(light.distance_of_depth(slab_max) * (1.0 + margin_.rel) + margin_.metres);
-  }
+  double far_end(const LightCamera& light, double slab_max) const { return nbsim::shadows::slab_far_end(light, slab_max, margin_); }
   // Uploads `positions` (three a triangle) to the volume buffer.
   void upload(const std::vector<glm::vec4>& positions);
   std::vector<std::uint8_t> read_stencil() const;
@@ -349,42 +344,13 @@ LightCamera Shadows::light_at(std::uint32_t index) const {
 CasterResult Shadows::measure(const CasterMesh& c, const LightCamera& light, const scene::NBufferLevels& lo,
                               const scene::NBufferLevels& hi) const {
   CasterResult r;
-  const scene::Aabb& b = scene_.scene.objects[c.object];
-  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, d0 = INFINITY, d1 = -INFINITY;
-  std::array<glm::dvec4, 8> corners;
-  for (int k = 0; k < 8; ++k)
-    corners[static_cast<std::size_t>(k)] = light.clip({k & 1 ? b.hi[0] : b.lo[0], k & 2 ? b.hi[1] : b.lo[1], k & 4 ? b.hi[2] : b.lo[2]});
-  // Bounds wholly outside one side plane of the light's frustum (a plane through the light) or
-  // beyond its far plane: every light ray through the caster stays outside the frustum, so its
-  // volume holds no lit receiver, even when the bounds reach behind the near plane.
-  const auto all = [&](auto outside) { return std::all_of(corners.begin(), corners.end(), outside); };
-  if (all([](const glm::dvec4& q) { return q.x > q.w; }) || all([](const glm::dvec4& q) { return q.x < -q.w; }) ||
-      all([](const glm::dvec4& q) { return q.y > q.w; }) || all([](const glm::dvec4& q) { return q.y < -q.w; }) ||
-      all([](const glm::dvec4& q) { return q.z > q.w; })) {
-    r.decision = CasterDecision::OutsideLight;
+  const nbsim::shadows::CasterRect rect = nbsim::shadows::caster_rect(scene_.scene.objects[c.object], light, litmap_);
+  r.caster_near = rect.caster_near, r.caster_far = rect.caster_far;
+  if (rect.decision != nbsim::shadows::Decision::Volume) {
+    r.decision = rect.decision == nbsim::shadows::Decision::CrossesNear ? CasterDecision::CrossesNear : CasterDecision::OutsideLight;
     return r;
   }
-  for (const glm::dvec4& q : corners) {
-    if (q.w < light.near_m) {  // behind the near plane: never culled or clamped
-      r.decision = CasterDecision::CrossesNear;
-      r.caster_near = 0.0f, r.caster_far = 1.0f;
-      return r;
-    }
-    const double s = litmap_;
-    x0 = std::min(x0, (q.x / q.w * 0.5 + 0.5) * s), x1 = std::max(x1, (q.x / q.w * 0.5 + 0.5) * s);
-    y0 = std::min(y0, (q.y / q.w * 0.5 + 0.5) * s), y1 = std::max(y1, (q.y / q.w * 0.5 + 0.5) * s);
-    d0 = std::min(d0, q.z / q.w * 0.5 + 0.5), d1 = std::max(d1, q.z / q.w * 0.5 + 0.5);
-  }
-  r.caster_near = static_cast<float>(d0), r.caster_far = static_cast<float>(d1);
-  // The lexels the bounds touch, grown by one lexel (llvmpipe has no conservative rasterization),
-  // clipped to the litmap.
-  const int lx = std::max(0, static_cast<int>(std::floor(x0)) - 1), hx = std::min(litmap_ - 1, static_cast<int>(std::floor(x1)) + 1);
-  const int ly = std::max(0, static_cast<int>(std::floor(y0)) - 1), hy = std::min(litmap_ - 1, static_cast<int>(std::floor(y1)) + 1);
-  if (x1 < 0.0 || y1 < 0.0 || x0 >= litmap_ || y0 >= litmap_ || lx > hx || ly > hy || d0 > 1.0) {
-    r.decision = CasterDecision::OutsideLight;
-    return r;
-  }
-  r.x = lx, r.y = ly, r.w = hx - lx + 1, r.h = hy - ly + 1;
+  r.x = rect.x, r.y = rect.y, r.w = rect.w, r.h = rect.h;
   // Up to four lookups in each N-buffer: the nearest (min) and the farthest (max) visible receiver.
   const Covering cov = cover(Rect{r.x, r.y, r.w, r.h}, covering_, lo.levels - 1);
   const std::size_t plane = static_cast<std::size_t>(cov.level) * static_cast<std::size_t>(litmap_) * static_cast<std::size_t>(litmap_);
@@ -399,29 +365,17 @@ CasterResult Shadows::measure(const CasterMesh& c, const LightCamera& light, con
 }
 
 void Shadows::decide(CasterResult& r, const LightCamera& light, double slab_min, double slab_max) const {
-  // The slab of visible receivers, widened: [near, far] in light window depth.
-  const double far = far_end(light, slab_max);
-  if (far < std::max(slab_min, static_cast<double>(r.caster_near))) {
+  nbsim::shadows::CasterRect rect;
+  rect.caster_near = r.caster_near, rect.caster_far = r.caster_far;
+  const nbsim::shadows::Planes p = nbsim::shadows::slab_planes(rect, light, slab_min, slab_max, margin_, rule_);
+  if (p.culled) {
     r.decision = CasterDecision::Culled;
     return;
   }
-  // The planes: clamped mode ends its volume there, the others cut its sides there.
-  r.clamp_far = static_cast<float>(far);
-  const double near_m = light.distance_of_depth(slab_min) * (1.0 - margin_.rel) - margin_.metres;
-  const double near = near_m > light.near_m ? light.depth_of_distance(near_m) : 0.0;
-  // The paper's rule sets the plane whenever it is in front of some of the caster (the volume is
-  // split where the caster crosses it); the other only when every receiver is behind the whole
-  // caster.
-  if (rule_ == ClampRule::Edge ? near > r.caster_near : near >= r.caster_far) r.clamp_near = static_cast<float>(near);
+  r.clamp_far = p.clamp_far, r.clamp_near = p.clamp_near;
 }
 
-VolumeEnds Shadows::ends_of(const CasterResult& r, bool clamped) const {
-  VolumeEnds e;
-  e.clamped = clamped;
-  e.far_plane = std::isfinite(r.clamp_far), e.far_depth = r.clamp_far;
-  e.near_plane = r.clamp_near > 0.0f, e.near_depth = r.clamp_near;
-  return e;
-}
+VolumeEnds Shadows::ends_of(const CasterResult& r, bool clamped) const { return nbsim::shadows::volume_ends(r.clamp_near, r.clamp_far, clamped); }
 
 void Shadows::upload(const std::vector<glm::vec4>& positions) {
   const std::size_t bytes = std::max<std::size_t>(positions.size() * sizeof(glm::vec4), 16);
