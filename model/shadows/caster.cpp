@@ -66,6 +66,13 @@ std::optional<std::uint64_t> optional_scalar(const scene::TechniqueRecord& rec, 
   return std::nullopt;
 }
 
+double real(const scene::TechniqueRecord& rec, std::string_view name, std::uint64_t frame) {
+  for (const scene::TechniqueField& f : rec.fields)
+    if (f.name == name)
+      if (const auto* v = std::get_if<double>(&f.value)) return *v;
+  throw InputError(fmt::format("frame {}: the ShadowCasters (SHDC) record has no '{}'", frame, name));
+}
+
 std::uint64_t scalar(const scene::TechniqueRecord& rec, std::string_view name, std::uint64_t frame) {
   if (const auto v = optional_scalar(rec, name)) return *v;
   throw InputError(fmt::format("frame {}: the ShadowCasters (SHDC) record has no '{}'", frame, name));
@@ -113,6 +120,9 @@ FrameCasters read_casters(const scene::Frame& f) {
   c.cls = field<std::uint32_t>(*rec, "class", frame);
   c.kept = field<std::uint32_t>(*rec, "kept", frame);
   c.fill_infinite = field<std::uint32_t>(*rec, "fill_infinite", frame);
+  const char* light_fields[9] = {"light_eye_x",    "light_eye_y",   "light_eye_z",  "light_target_x", "light_target_y",
+                                 "light_target_z", "light_fov_deg", "light_near_m", "light_far_m"};
+  for (std::size_t k = 0; k < 9; ++k) c.light[k] = real(*rec, light_fields[k], frame);
   for (const scene::TechniqueField& value : rec->fields)
     if (const auto* names = value.name == "class_names" ? std::get_if<std::string>(&value.value) : nullptr) c.class_names = split_names(*names);
   for (std::size_t n : {c.lookups.size(), c.decision.size(), c.x.size(), c.y.size(), c.w.size(), c.h.size(), c.draw.size(),

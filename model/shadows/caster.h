@@ -76,6 +76,9 @@ struct FrameCasters {
   // and the fill of its infinite volume (GL's reference pass, or its own draw in mode infinite).
   std::vector<std::string> class_names;
   std::vector<std::uint32_t> cls, kept, fill_infinite;
+  // The light camera as the capture built it: eye x, y, z, target x, y, z, field of view (degrees),
+  // near and far (metres); volume.h's light_of() makes it.
+  std::array<double, 9> light{};
   std::size_t size() const noexcept { return object.size(); }
   Rect rect(std::size_t i) const noexcept { return Rect{x[i], y[i], w[i], h[i]}; }
 };

@@ -3,7 +3,10 @@
 
 #include <fmt/format.h>
 
+#include <zlib.h>
+
 #include <algorithm>
+#include <limits>
 
 #include "model/common/error.h"
 #include "model/shadows/roles.h"
@@ -14,6 +17,10 @@ void ShadowsUnitConfig::describe(config::Schema& s, ShadowsUnitConfig& c) {
   s.add("shadows.tests_per_cycle", c.tests_per_cycle, "casters/cycle",
         "casters through the rectangle and cull-decision stage a cycle (the queries are the N-buffer units')", 0.01, 1024.0);
   s.add("shadows.latency_cycles", c.latency_cycles, "cycles", "latency of a frame's batch of caster decisions", 0, 100000);
+  s.add("shadows.volumes", c.volumes,
+        "the shadow volumes drawn: trace (GL's, as captured) or the volumes of mode infinite, culled or clamped that the model builds "
+        "from the trace's caster meshes with its own N-buffer answers (the paper's clamp rule; the trace's litmaps)",
+        {"trace", "infinite", "culled", "clamped"});
 }
 
 ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ShadowsUnitConfig& config,
@@ -70,7 +77,20 @@ ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& r
       mask_diff_(stats().counter("mask_diff", "pixels", "pixels where the model's mask differs from GL's shadow_mask (must be 0)")),
       mask_diff_infinite_(stats().counter("mask_diff_infinite", "pixels",
                                           "pixels where the model's mask differs from GL's shadow_mask_infinite (must be 0)")),
-      gl_mask_diff_(stats().counter("gl_mask_diff", "pixels", "pixels where GL's shadow_mask differs from its shadow_mask_infinite")) {
+      gl_mask_diff_(stats().counter("gl_mask_diff", "pixels", "pixels where GL's shadow_mask differs from its shadow_mask_infinite")),
+      model_volumes_(stats().counter("model_volumes", "draws", "shadow volumes the model built itself (config shadows.volumes)")),
+      rect_mismatches_(stats().counter("rect_mismatches", "casters",
+                                       "casters whose rectangle or outside/near decision, recomputed from the caster meshes, differs from SHDC's")),
+      stencil_checksum_(stats().counter("stencil_checksum", "crc",
+                                        "CRC-32 of the model's stencil buffer at each frame's end (a frame's value is its own; the run's is their sum)")) {
+  if (config_.volumes != "trace") {
+    own_mode_ = parse_mode(config_.volumes);
+    if (!setup_.edge_rule)
+      throw InputError(fmt::format("shadows.volumes={}: the model builds volumes with the paper's clamp rule (edge), and this trace was "
+                                   "captured with clamp_rule caster, whose slabs need what the observer sees per object; capture it with "
+                                   "--clamp-rule edge",
+                                   config_.volumes));
+  }
   NBSIM_CHECK(min_nb_.op() == FarOp::Min && max_nb_.op() == FarOp::Max, "the shadows program needs a min and a max N-buffer");
 }
 
@@ -91,10 +111,14 @@ void ShadowsUnit::draw_finished(const cp::Work& w, const depth::DrawResult& r) {
   ++completed_;
   const scene::DrawRecord& d = w.record();
   if (d.role == kShadowVolumeRole) {
-    if (w.draw < volume_share_.size() && volume_share_[w.draw]) {
-      FillShare& share = *volume_share_[w.draw];
-      ++share.volumes, share.fill += r.depth.fragments, share.gl_fill += d.gl.fragments;
+    FillShare* share = nullptr;
+    if (w.own) {
+      const auto it = own_share_.find(w.own.get());
+      if (it != own_share_.end()) share = it->second;
+    } else if (w.draw < volume_share_.size()) {
+      share = volume_share_[w.draw];
     }
+    if (share) ++share->volumes, share->fill += r.depth.fragments, share->gl_fill += d.gl.fragments;
     fill_ += r.depth.fragments;
     gl_fill_ += d.gl.fragments;
     stencil_tests_ += r.stencil.tests;
@@ -158,6 +182,7 @@ void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, co
   measured_ += index_.size();
   if (c.reference_fill) reference_fill_ += *c.reference_fill, ++reference_frames_;
   volume_share_.assign(f.draws.size(), nullptr);
+  model_zmin_.assign(n, 1.0f), model_zmax_.assign(n, 0.0f);
   for (std::size_t i = 0; i < n; ++i) {
     FillShare& share = breakdown_[{c.class_names[c.cls[i]], std::string(kKeptNames[c.kept[i]])}];
     ++share.casters;
@@ -168,6 +193,7 @@ void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, co
     const std::size_t i = index_[k];
     const nbuffer::QueryAnswer& lo = min_answers_[k];
     const nbuffer::QueryAnswer& hi = max_answers_[k];
+    model_zmin_[i] = lo.value, model_zmax_[i] = hi.value;
     const auto texels = static_cast<std::uint32_t>(lo.lookups + hi.lookups);
     lookups_ += texels;
     lookup_mismatches_ += texels != c.lookups[i] ? 1 : 0;
@@ -198,6 +224,7 @@ void ShadowsUnit::compare_masks(const scene::Frame& f) {
   const scene::StencilSnapshot& mask = image("shadow_mask");
   const scene::StencilSnapshot& infinite = image("shadow_mask_infinite");
   std::uint64_t set = 0;
+  stencil_checksum_ += crc32(0L, stencil_.texels.data(), static_cast<uInt>(stencil_.texels.size()));
   mask_diff_ += mask_pixels_differing(stencil_.texels, region, mask, &set);
   mask_pixels_ += set;
   mask_diff_infinite_ += mask_pixels_differing(stencil_.texels, region, infinite);
@@ -210,10 +237,69 @@ void ShadowsUnit::compare_masks(const scene::Frame& f) {
   gl_mask_diff_ += gl_diff;
 }
 
+void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>& f, const FrameCasters& c, Mode mode,
+                                      cp::CommandProcessor& cp) {
+  const std::uint64_t frame = f->begin.frame;
+  const LightFrustum light = light_of(c, frame);
+  const glm::mat4 view_proj = observer_view_proj(f->begin);
+  own_share_.clear();
+  std::vector<glm::vec4> positions;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (meshes_->meshes[i].object != c.object[i])
+      throw InputError(fmt::format("frame {}: caster {} is object {} in ShadowCasters, {} in ShadowCasterMeshes", frame, i, c.object[i],
+                                   meshes_->meshes[i].object));
+    // The caster's rectangle from its bounds and the capture's light, against the record's.
+    const CasterRect rect = caster_rect(meshes_->bounds[i], light, static_cast<int>(c.litmap_size));
+    const auto recorded = static_cast<Decision>(c.decision[i]);
+    const bool measured = recorded == Decision::Volume || recorded == Decision::Culled;
+    rect_mismatches_ += (measured ? rect.decision != Decision::Volume || rect.x != c.x[i] || rect.y != c.y[i] || rect.w != c.w[i] ||
+                                        rect.h != c.h[i]
+                                  : rect.decision != recorded)
+                            ? 1
+                            : 0;
+    // Its decision and planes from the model's own answers.
+    float clamp_near = 0.0f, clamp_far = std::numeric_limits<float>::infinity();
+    bool dropped = rect.decision == Decision::OutsideLight;
+    if (rect.decision == Decision::Volume) {
+      const Planes p = slab_planes(rect, light, model_zmin_[i], model_zmax_[i], setup_.margin, ClampRule::Edge);
+      dropped = p.culled;
+      if (!p.culled) clamp_near = p.clamp_near, clamp_far = p.clamp_far;
+    }
+    if (mode != Mode::Infinite && dropped) continue;
+    positions.clear();
+    append_volume(meshes_->vertices, meshes_->meshes[i], light, volume_ends(clamp_near, clamp_far, mode == Mode::Clamped), positions);
+    if (positions.empty()) continue;
+    auto d = std::make_shared<scene::DrawRecord>(volume_draw(c.object[i]));
+    d->index = static_cast<std::uint32_t>(f->draws.size() + own_share_.size());
+    d->clip_positions.reserve(positions.size());
+    for (const glm::vec4& p : positions) d->clip_positions.push_back(clip_position(view_proj, p));
+    // Its share of the fill: GL's reason, unless the model decided otherwise.
+    const bool gl_dropped = c.kept[i] == static_cast<std::uint32_t>(KeptBy::Dropped);
+    const std::string kept(kKeptNames[dropped ? 0 : gl_dropped ? static_cast<std::size_t>(KeptBy::Receivers) : c.kept[i]]);
+    own_share_[d.get()] = &breakdown_[{c.class_names[c.cls[i]], kept}];
+    auto w = std::make_shared<cp::Work>();
+    w->frame = f;
+    w->draw = 0;
+    w->own = std::move(d);
+    ++issued_, ++volume_draws_, ++model_volumes_;
+    cp.issue_draw(std::move(w));
+  }
+}
+
 void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) {
   ++frames_begun_;
   // Everything the frame needs is checked before anything is issued (a damaged trace: exit 2).
   const FrameCasters c = read_casters(*f);
+  if (std::optional<CasterMeshes> m = read_caster_meshes(*f)) {
+    if (m->meshes.size() != c.size())
+      throw InputError(fmt::format("frame {}: the ShadowCasterMeshes record has {} casters, the ShadowCasters record {}", f->begin.frame,
+                                   m->meshes.size(), c.size()));
+    meshes_ = std::move(m);
+  }
+  if (own_mode_ && !meshes_)
+    throw InputError(fmt::format("frame {}: shadows.volumes={} needs the casters' meshes (a ShadowCasterMeshes record in the trace's first "
+                                 "frame): capture the trace again with this nbsim",
+                                 f->begin.frame, config_.volumes));
   if (static_cast<int>(c.litmap_size) != setup_.litmap_size)
     throw InputError(fmt::format("frame {}: the ShadowCasters record's litmap_size {} is not the header's {}", f->begin.frame,
                                  c.litmap_size, setup_.litmap_size));
@@ -246,8 +332,10 @@ void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Co
   min_nb_.unit().drain();
   max_nb_.unit().drain();
   ++frames_;
-  // 5. The volumes, after the scene's depth (the draws keep their order in the pipeline).
-  issue_role(f, kShadowVolumeRole, cp);
+  // 5. The volumes, after the scene's depth (the draws keep their order in the pipeline): GL's, or
+  //    the model's own.
+  if (own_mode_) issue_model_volumes(f, c, *own_mode_, cp);
+  else issue_role(f, kShadowVolumeRole, cp);
   wait_all();
   // 6. The shadow mask from the model's stencil buffer.
   compare_masks(*f);

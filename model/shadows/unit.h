@@ -14,11 +14,14 @@
 //     (caster.h) on the model's values and on GL's; the record's outside/crossing casters are
 //     taken as recorded (the rectangle comes from the capture's double-precision light camera);
 //  5. the recorded ShadowVolume draws (clip positions from transform feedback, depth clamp,
-//     two-sided z-fail stencil) through the pipeline: the fill and the stencil tests;
+//     two-sided z-fail stencil) through the pipeline: the fill and the stencil tests; or, with
+//     config shadows.volumes = infinite, culled or clamped, the model's own volumes of that mode,
+//     built from the trace's caster meshes (SHDG) and the capture's light (SHDC) with the model's
+//     N-buffer answers and the paper's clamp rule (volume.h), transformed as llvmpipe's vertex
+//     shader does: a capture in one mode replays as any mode, bit-exact with a capture of that mode;
 //  6. at the end, the model's stencil buffer gives the shadow mask (STNC light_region AND
 //     stencil != 0), compared pixel by pixel with GL's `shadow_mask` and `shadow_mask_infinite`.
-// The volume geometry is GL's for the capture's mode: the model's decisions are checked, not
-// drawn (another mode needs the casters' meshes to regenerate volumes; the trace does not hold them).
+// The litmaps are GL's in every case: another litmap size needs the litmap passes modelled.
 #pragma once
 
 #include <map>
@@ -33,12 +36,17 @@
 #include "model/query/units.h"
 #include "model/raster/stencil_test.h"
 #include "model/shadows/caster.h"
+#include "model/shadows/volume.h"
 
 namespace nbsim::shadows {
 
 struct ShadowsUnitConfig {
   double tests_per_cycle = 1.0;  // casters through the rectangle/decision stage a cycle; tunable
   int latency_cycles = 20;       // per frame's batch of caster decisions; tunable
+  // Which shadow volumes go down the pipeline: "trace" (GL's, as the capture drew them) or the
+  // volumes of mode "infinite", "culled" or "clamped" that the model builds itself from the trace's
+  // caster meshes (SHDG) with its own decisions and planes.
+  std::string volumes = "trace";
 
   // Declares "shadows.<field>".
   static void describe(config::Schema& s, ShadowsUnitConfig& c);
@@ -50,6 +58,7 @@ struct ShadowsSetup {
   int litmap_size = 0;
   Mode mode = Mode::Clamped;
   ClampMargin margin;
+  bool edge_rule = true;  // the trace's clamp_rule is the paper's ("edge")
 };
 
 // Where the volumes' fill goes: the casters of one class ("bird") kept for one reason (KeptBy),
@@ -86,6 +95,8 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
   std::uint64_t build(query::NBufferStructure& nb, const scene::Frame& f, std::string_view name);
   void query_casters(const scene::Frame& f, const FrameCasters& c, const LightDepth& light);
   void compare_masks(const scene::Frame& f);
+  // Builds and issues the model's own volumes of mode `mode` (config volumes).
+  void issue_model_volumes(const std::shared_ptr<const scene::Frame>& f, const FrameCasters& c, Mode mode, cp::CommandProcessor& cp);
 
   ShadowsUnitConfig config_;
   ShadowsSetup setup_;
@@ -100,10 +111,14 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
       &decision_mismatches_, &zmin_mismatches_, &zmax_mismatches_, &not_conservative_, &unsafe_culls_, &culls_lost_,
       &lookups_, &lookup_mismatches_, &build_texels_, &litmap_draws_, &litmap_reprojections_, &receiver_splats_, &scene_depth_tests_,
       &volume_draws_, &fill_, &gl_fill_, &reference_fill_, &reference_frames_, &stencil_tests_, &mask_pixels_, &gl_mask_pixels_, &mask_diff_, &mask_diff_infinite_,
-      &gl_mask_diff_;
+      &gl_mask_diff_, &model_volumes_, &rect_mismatches_, &stencil_checksum_;
 
   FillBreakdown breakdown_;
   std::vector<FillShare*> volume_share_;  // this frame's draw index -> its caster's share (null: none)
+  std::map<const scene::DrawRecord*, FillShare*> own_share_;  // the model's own volume draws' shares
+  std::vector<float> model_zmin_, model_zmax_;  // this frame's answers per caster (1 and 0: not measured)
+  std::optional<Mode> own_mode_;                 // config volumes, when the model builds them
+  std::optional<CasterMeshes> meshes_;     // the trace's SHDG, from its first frame
   std::vector<Rect> rects_;
   std::vector<float> nearest_;
   std::vector<std::size_t> index_;

@@ -6,11 +6,18 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <utility>
+
+#include "model/common/error.h"
+#include "model/scene/technique_record.h"
+#include "model/shadows/roles.h"
 
 namespace nbsim::shadows {
 
@@ -272,6 +279,99 @@ VolumeEnds volume_ends(float clamp_near, float clamp_far, bool clamped) {
   e.far_plane = std::isfinite(clamp_far), e.far_depth = clamp_far;
   e.near_plane = clamp_near > 0.0f, e.near_depth = clamp_near;
   return e;
+}
+
+scene::DrawRecord volume_draw(std::uint32_t object) {
+  scene::DrawRecord d;
+  d.role = kShadowVolumeRole;
+  d.object = static_cast<std::int32_t>(object);
+  d.state.func = scene::DepthFunc::Less;
+  d.state.write = false;
+  d.state.test = true;
+  d.state.cull = scene::CullFace::None;
+  d.state.front_ccw = true;
+  d.state.clip = scene::ClipControl::NegativeOneToOne;
+  d.state.depth_clamp = true;
+  scene::StencilState& s = d.stencil;
+  s.test = true;
+  for (scene::StencilFace* f : {&s.front, &s.back}) {
+    f->func = scene::DepthFunc::Always;
+    f->ref = 0;
+    f->value_mask = 0xFFu;
+    f->write_mask = 0xFFu;
+  }
+  s.front.depth_fail = scene::StencilOp::DecrWrap;
+  s.back.depth_fail = scene::StencilOp::IncrWrap;
+  return d;
+}
+
+std::array<float, 4> clip_position(const glm::mat4& m, const glm::vec4& p) noexcept {
+  std::array<float, 4> out{};
+  for (int r = 0; r < 4; ++r) {
+    float v = m[0][r] * p.x;
+    v = v + m[1][r] * p.y;
+    v = v + m[2][r] * p.z;
+    v = v + m[3][r] * p.w;
+    out[static_cast<std::size_t>(r)] = v;
+  }
+  return out;
+}
+
+glm::mat4 observer_view_proj(const scene::FrameBegin& begin) {
+  glm::mat4 view, proj;
+  std::memcpy(&view[0][0], begin.view.data(), 64);
+  std::memcpy(&proj[0][0], begin.proj.data(), 64);
+  return proj * view;
+}
+
+LightFrustum light_of(const FrameCasters& c, std::uint64_t frame) {
+  LightFrustum l;
+  const auto& v = c.light;
+  l.eye = {v[0], v[1], v[2]};
+  l.target = {v[3], v[4], v[5]};
+  l.fov_y_deg = v[6], l.near_m = v[7], l.far_m = v[8];
+  if (!l.make())
+    throw InputError(fmt::format("frame {}: the ShadowCasters record's light camera is degenerate (at ({}, {}, {}) looking at ({}, {}, {}), "
+                                 "field of view {} degrees, near {} m, far {} m)",
+                                 frame, v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]));
+  return l;
+}
+
+std::optional<CasterMeshes> read_caster_meshes(const scene::Frame& f) {
+  const scene::TechniqueRecord* rec = nullptr;
+  for (const scene::TechniqueRecord& r : f.technique_records)
+    if (r.type == kCasterMeshesRecordType) rec = &r;
+  if (!rec) return std::nullopt;
+  const std::uint64_t frame = f.begin.frame;
+  const char* label = "ShadowCasterMeshes (SHDG)";
+  const auto& object = scene::record_field<std::uint32_t>(*rec, "object", label, frame);
+  const auto& bounds = scene::record_field<float>(*rec, "bounds", label, frame);
+  const auto& first = scene::record_field<std::uint32_t>(*rec, "first_triangle", label, frame);
+  const auto& count = scene::record_field<std::uint32_t>(*rec, "triangle_count", label, frame);
+  const auto& vertices = scene::record_field<float>(*rec, "vertices", label, frame);
+  const auto& triangles = scene::record_field<std::uint32_t>(*rec, "triangles", label, frame);
+  if (bounds.size() != 6 * object.size() || first.size() != object.size() || count.size() != object.size() || vertices.size() % 3 ||
+      triangles.size() % 3)
+    throw InputError(fmt::format("frame {}: the {} record's fields do not agree in length", frame, label));
+  CasterMeshes m;
+  for (std::size_t i = 0; i + 2 < vertices.size(); i += 3) m.vertices.emplace_back(vertices[i], vertices[i + 1], vertices[i + 2]);
+  for (std::size_t c = 0; c < object.size(); ++c) {
+    if (std::uint64_t{first[c]} + count[c] > triangles.size() / 3)
+      throw InputError(fmt::format("frame {}: caster {} (object {})'s triangles run past the {} record's", frame, c, object[c], label));
+    const std::span<const std::uint32_t> t(triangles.data() + 3 * std::size_t{first[c]}, 3 * std::size_t{count[c]});
+    for (std::uint32_t v : t)
+      if (v >= m.vertices.size())
+        throw InputError(fmt::format("frame {}: caster {} (object {}) names vertex {} of {}", frame, c, object[c], v, m.vertices.size()));
+    std::optional<CasterMesh> mesh = closed_mesh(object[c], t);
+    if (!mesh)
+      throw InputError(fmt::format("frame {}: caster {} (object {})'s mesh in the {} record is not closed: its shadow volume would leak",
+                                   frame, c, object[c], label));
+    m.meshes.push_back(std::move(*mesh));
+    scene::Aabb b;
+    for (std::size_t k = 0; k < 3; ++k) b.lo[k] = bounds[6 * c + k], b.hi[k] = bounds[6 * c + 3 + k];
+    m.bounds.push_back(b);
+  }
+  return m;
 }
 
 }  // namespace nbsim::shadows

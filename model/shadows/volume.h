@@ -114,4 +114,31 @@ double slab_far_end(const LightFrustum& light, double slab_max, const ClampMargi
 // The ends of a caster's volume from its recorded planes (clamp_far +inf: none).
 VolumeEnds volume_ends(float clamp_near, float clamp_far, bool clamped);
 
+// The draw of a shadow volume as the capture records it: z-fail, two-sided stencil (back faces
+// INCR_WRAP, front faces DECR_WRAP on depth fail, always passing, all bits), depth test LESS without
+// writes, no face culling, depth clamp on, GL's default clip control; no clip positions yet.
+scene::DrawRecord volume_draw(std::uint32_t object);
+
+// gl_Position of the volume's vertex shader: view_proj * position in float, each row summed left
+// to right with a rounding after every product and sum, as llvmpipe computes it (bit-equal with
+// GL's transform feedback on every volume vertex measured).
+std::array<float, 4> clip_position(const glm::mat4& view_proj, const glm::vec4& position) noexcept;
+// The observer's view_proj of a frame: proj * view in float, as the capture computes it.
+glm::mat4 observer_view_proj(const scene::FrameBegin& begin);
+
+// The light camera a frame's SHDC record holds (the capture's, in double precision); throws
+// InputError when it is degenerate.
+LightFrustum light_of(const FrameCasters& c, std::uint64_t frame);
+
+// The casters' meshes of a trace (SHDG), in SHDC's order.
+struct CasterMeshes {
+  std::vector<glm::vec3> vertices;
+  std::vector<CasterMesh> meshes;  // indices into vertices
+  std::vector<scene::Aabb> bounds;
+};
+inline constexpr std::uint32_t kCasterMeshesRecordType = 0x47444853u;  // fourcc "SHDG" (traces/format/shadows/shadows_chunk.h)
+// Decodes and checks a frame's SHDG record, or nullopt when the frame has none; throws InputError
+// naming the caster for a mesh that is not closed (its volume would leak) and for a damaged record.
+std::optional<CasterMeshes> read_caster_meshes(const scene::Frame& f);
+
 }  // namespace nbsim::shadows

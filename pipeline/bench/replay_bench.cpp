@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "model/common/error.h"
+#include "model/config/schema.h"
 #include "pipeline/sim/replay.h"
 #include "traces/capture/capture.h"
 #include "traces/capture/technique.h"
@@ -39,6 +40,12 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
 
   pipeline::ReplayOptions r;
   r.trace = file;
+  {
+    config::Schema schema;  // a bad key was refused before the capture (run_replay_bench's caller checks nothing: here)
+    pipeline::GpuConfig::describe(schema, r.config);
+    for (const std::string& set : o.sets) schema.set(set);
+    r.config_values = schema.values();
+  }
   pipeline::ReplaySummary s;
   try {
     s = pipeline::replay(r);
@@ -59,6 +66,7 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
   const auto mode = values.find(preset.mode_option);
   j["mode"] = mode == values.end() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(mode->second);
   j["options"] = values;
+  j["sets"] = o.sets;
   j["draws"] = s.draws;
   j["gl_ms"] = cap.gl_ms;
   j["replay_ms"] = s.host_seconds * 1e3;

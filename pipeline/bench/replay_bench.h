@@ -10,6 +10,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "traces/capture/technique.h"
 
@@ -22,6 +23,7 @@ struct ReplayBenchOptions {
   std::optional<std::string> size, scene, path;
   std::optional<std::string> mode;  // the value of the preset's mode option (its variant: a test mode, a shape, ...)
   std::map<std::string, std::string> options;  // capture options by name, over the preset's
+  std::vector<std::string> sets;               // model config keys, unit.field=value (the replay's)
 };
 
 // One JSON object: bench, technique, size, frames, scene, path, mode (the preset's mode option's

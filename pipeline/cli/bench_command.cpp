@@ -17,7 +17,9 @@
 #include "model/scene/frame.h"
 #include "model/common/error.h"
 #include "pipeline/bench/nbuffer_bench.h"
+#include "model/config/schema.h"
 #include "pipeline/bench/replay_bench.h"
+#include "pipeline/sim/gpu.h"
 #include "pipeline/cli/command.h"
 #include "traces/capture/paths.h"
 #include "traces/capture/scenes.h"
@@ -120,6 +122,7 @@ void add_bench_commands(CLI::App& app, Action& action) {
     CLI::Option* scene = rep->add_option("--scene", g->scene, "Scene (default: the technique's bench preset)");
     CLI::Option* path = rep->add_option("--path", g->path, "Camera path (default: the technique's bench preset)");
     CLI::Option* mode = rep->add_option("--mode", g->mode, "The technique's variant: the value of its bench preset's mode option");
+    rep->add_option("--set", ro->sets, "Override one model config key of the replay, unit.field=value (repeatable)");
     // Every capture option of every technique, scene and camera path, passed on to the capture
     // over the technique's preset (the capture refuses one its technique, scene and path lack).
     std::vector<const capture::PluginInfo*> plugins;
@@ -156,6 +159,12 @@ void add_bench_commands(CLI::App& app, Action& action) {
         if (option->count()) ro->options[name] = g->values[name];
       action = [ro] {
         if (ro->size) parse_size(*ro->size, "--size");
+        {  // a bad config key is refused before anything is captured
+          config::Schema schema;
+          pipeline::GpuConfig c;
+          pipeline::GpuConfig::describe(schema, c);
+          for (const std::string& set : ro->sets) schema.set(set);
+        }
         fmt::print("{}\n", bench::run_replay_bench(*ro).dump());
         return 0;
       };

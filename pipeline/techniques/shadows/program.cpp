@@ -28,6 +28,7 @@ Program build(const ProgramContext& c) {
   s.mode = *shadows::parse_mode(c.header.text("shadow_mode"));
   s.litmap_size = static_cast<int>(c.header.whole("litmap_size"));
   s.margin = *shadows::parse_clamp_margin(c.header.text("clamp_margin"));
+  s.edge_rule = c.header.text("clamp_rule") == "edge";
   Program p;
   const auto nbuffer = [&](const char* instance, FarOp op) {
     return std::make_unique<query::NBufferStructure>(instance, c.registry, c.nbuffer_config(instance), s.litmap_size,
@@ -45,7 +46,7 @@ Program build(const ProgramContext& c) {
 }
 
 // The shadows program's counters in run.json's per-frame values (differences at frame ends).
-constexpr std::array<const char*, 19> kShadowsFrameCounts = {
+constexpr std::array<const char*, 21> kShadowsFrameCounts = {"model_volumes", "stencil_checksum",
     "casters",     "culled",          "gl_culled",       "outside",    "crossing_near",       "kept_by_slab", "reference_fill",
     "lookups",     "build_texels",    "litmap_reprojections", "receiver_splats", "volume_draws", "fill", "gl_fill",
     "stencil_tests", "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches"};
@@ -79,7 +80,8 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, std::uint64_t cyc
   j["cycles"] = cycles;
   j["cycles_per_frame"] = per_frame(cycles);
   for (const char* name : {"decision_mismatches", "zmin_mismatches", "zmax_mismatches", "not_conservative", "unsafe_culls",
-                           "culls_lost", "lookup_mismatches", "mask_diff", "mask_diff_infinite", "gl_mask_diff", "gl_mask_pixels"})
+                           "culls_lost", "lookup_mismatches", "mask_diff", "mask_diff_infinite", "gl_mask_diff", "gl_mask_pixels",
+                           "model_volumes", "rect_mismatches"})
     j[name] = stat(p, name);
   return j;
 }

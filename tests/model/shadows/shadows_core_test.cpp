@@ -7,6 +7,7 @@
 
 #include "model/common/error.h"
 #include "model/shadows/caster.h"
+#include "model/shadows/volume.h"
 
 namespace {
 
@@ -130,6 +131,51 @@ TEST(ShadowsCoreTest, MaskFromStencil) {
   EXPECT_EQ(mask_pixels_differing(stencil, region, same, &set), 0u);
   EXPECT_EQ(set, 2u) << "stencil 2 outside the light region is not shadow";
   EXPECT_EQ(mask_pixels_differing(stencil, region, other), 2u);
+}
+
+// The casters' meshes (SHDG): a closed tetrahedron reads back as a caster with its bounds; a mesh
+// with a face missing (its volume would leak) or a vertex index out of range is refused naming the
+// caster and its object.
+TEST(ShadowsCoreTest, CasterMeshesReadAndOpenMeshRefused) {
+  const auto frame_with = [](std::vector<std::uint32_t> triangles, std::vector<float> vertices) {
+    nbsim::scene::Frame f;
+    f.begin.frame = 0;
+    nbsim::scene::TechniqueRecord r;
+    r.type = kCasterMeshesRecordType;
+    r.decoded = true;
+    const std::uint32_t n = static_cast<std::uint32_t>(triangles.size() / 3);
+    r.fields = {{"count", std::uint64_t{1}},
+                {"object", std::vector<std::uint32_t>{7}},
+                {"bounds", std::vector<float>{0, 0, 0, 1, 1, 1}},
+                {"first_triangle", std::vector<std::uint32_t>{0}},
+                {"triangle_count", std::vector<std::uint32_t>{n}},
+                {"vertices", std::move(vertices)},
+                {"triangles", std::move(triangles)}};
+    f.technique_records.push_back(std::move(r));
+    return f;
+  };
+  const std::vector<float> corners = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const std::vector<std::uint32_t> tetra = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+  const auto m = read_caster_meshes(frame_with(tetra, corners));
+  ASSERT_TRUE(m.has_value());
+  ASSERT_EQ(m->meshes.size(), 1u);
+  EXPECT_EQ(m->meshes[0].object, 7u);
+  EXPECT_EQ(m->meshes[0].triangles.size(), 4u);
+  EXPECT_EQ(m->bounds[0].hi[2], 1.0f);
+  EXPECT_FALSE(read_caster_meshes(nbsim::scene::Frame{}).has_value()) << "a frame without the record";
+  const auto message = [&](std::vector<std::uint32_t> t, std::vector<float> v) {
+    try {
+      read_caster_meshes(frame_with(std::move(t), std::move(v)));
+    } catch (const nbsim::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string open = message({0, 2, 1, 0, 1, 3, 0, 3, 2}, corners);
+  EXPECT_NE(open.find("caster 0 (object 7)'s mesh"), std::string::npos) << open;
+  EXPECT_NE(open.find("not closed"), std::string::npos) << open;
+  const std::string range = message({0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 9}, corners);
+  EXPECT_NE(range.find("names vertex 9 of 4"), std::string::npos) << range;
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <random>
 #include <string>
 
@@ -165,6 +166,34 @@ void check_frame_budget(const TechniqueSetup& s) {
 
 glm::dmat4 to_dmat(const glm::mat4& m) { return glm::dmat4(m); }
 
+// The SHDG record of `casters`: their bounds and triangles, each caster's vertices numbered anew in
+// the order its triangles first use them (the model's volumes index them the same way).
+trace::TechniqueRecord caster_meshes(const CaptureScene& scene, const std::vector<CasterMesh>& casters) {
+  std::vector<std::uint32_t> object, first, count, triangles;
+  std::vector<float> bounds, vertices;
+  for (const CasterMesh& c : casters) {
+    object.push_back(c.object);
+    const scene::Aabb& b = scene.scene.objects[c.object];
+    bounds.insert(bounds.end(), {b.lo[0], b.lo[1], b.lo[2], b.hi[0], b.hi[1], b.hi[2]});
+    first.push_back(static_cast<std::uint32_t>(triangles.size() / 3));
+    count.push_back(static_cast<std::uint32_t>(c.triangles.size()));
+    std::map<std::uint32_t, std::uint32_t> number;
+    for (const auto& t : c.triangles)
+      for (std::uint32_t v : t) {
+        const auto [it, added] = number.emplace(v, static_cast<std::uint32_t>(vertices.size() / 3));
+        if (added) vertices.insert(vertices.end(), {scene.vertices[v].x, scene.vertices[v].y, scene.vertices[v].z});
+        triangles.push_back(it->second);
+      }
+  }
+  trace::TechniqueRecord rec;
+  rec.type = trace::kCasterMeshesChunk;
+  rec.decoded = true;
+  rec.fields = {{"count", std::uint64_t{casters.size()}}, {"object", std::move(object)},       {"bounds", std::move(bounds)},
+                {"first_triangle", std::move(first)},    {"triangle_count", std::move(count)}, {"vertices", std::move(vertices)},
+                {"triangles", std::move(triangles)}};
+  return rec;
+}
+
 struct CasterResult {
   std::int32_t x = 0, y = 0, w = 0, h = 0;
   float caster_near = 0, caster_far = 0, z_min = 1, z_max = 0;
@@ -236,6 +265,7 @@ class Shadows final : public Technique {
   GLuint volume_vao_ = 0, volume_vbo_ = 0, reference_count_ = 0;
   std::size_t volume_capacity_ = 0, reference_capacity_ = 4;  // bytes
   std::string class_names_;  // the scene's object classes, comma-separated (SHDC class_names)
+  trace::TechniqueRecord meshes_;  // SHDG: the casters' meshes, written with the first frame
 };
 
 Shadows::Shadows(const TechniqueSetup& s)
@@ -270,6 +300,7 @@ Shadows::Shadows(const TechniqueSetup& s)
     for (std::size_t k = 0; k < 3; ++k) bounds_.lo[k] = std::min(bounds_.lo[k], b.lo[k]), bounds_.hi[k] = std::max(bounds_.hi[k], b.hi[k]);
   if (light_text_ != "auto") parse_light(light_text_);
   for (const std::string& name : scene_.class_names) class_names_ += (class_names_.empty() ? "" : ",") + name;
+  meshes_ = caster_meshes(scene_, casters_);
   light_at(0);  // a fixed light is checked here (degenerate frustum, inside a caster), before any frame
 
   litmap_prog_ = link_program({compile_shader(GL_VERTEX_SHADER, shaders::shadows_litmap_vert, "shadows/litmap.vert"),
@@ -394,21 +425,6 @@ std::vector<std::uint8_t> Shadows::read_stencil() const {
   glBindFramebuffer(GL_READ_FRAMEBUFFER, target_.framebuffer());
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadPixels(0, 0, width_, height_, GL_STENCIL_INDEX, GL_UNSIGNED_BYTE, s.data());  // bottom row first = y up
-  return s;
-}
-
-// The stencil state of every volume draw: z-fail, two-sided, wrapping.
-scene::StencilState volume_stencil() {
-  scene::StencilState s;
-  s.test = true;
-  for (scene::StencilFace* f : {&s.front, &s.back}) {
-    f->func = scene::DepthFunc::Always;
-    f->ref = 0;
-    f->value_mask = 0xFFu;
-    f->write_mask = 0xFFu;
-  }
-  s.front.depth_fail = scene::StencilOp::DecrWrap;
-  s.back.depth_fail = scene::StencilOp::IncrWrap;
   return s;
 }
 
@@ -590,13 +606,7 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
   glStencilOpSeparate(GL_BACK, GL_KEEP, GL_INCR_WRAP, GL_KEEP);
   for (std::size_t c = 0; c < casters_.size(); ++c) {
     if (ranges[c].second == 0) continue;
-    DrawRecord d;
-    d.role = nbsim::shadows::kShadowVolumeRole;
-    d.object = static_cast<std::int32_t>(casters_[c].object);
-    d.state = depth_state(false, false, true);
-    d.state.cull = scene::CullFace::None;
-    d.state.depth_clamp = true;
-    d.stencil = volume_stencil();
+    DrawRecord d = nbsim::shadows::volume_draw(casters_[c].object);
     const std::size_t slot = recorder_.begin_draw(std::move(d), ranges[c].second);
     results[c].draw = static_cast<std::int32_t>(slot);
     glUniform1ui(u_vslot, static_cast<GLuint>(slot));
@@ -732,8 +742,18 @@ CapturedFrame Shadows::render(std::uint32_t index, const CameraPose& pose) {
                 {"class_names", class_names_},
                 {"class", std::move(cls)},
                 {"kept", std::move(kept)},
-                {"fill_infinite", std::move(fill_infinite)}};
+                {"fill_infinite", std::move(fill_infinite)},
+                {"light_eye_x", light.eye.x},
+                {"light_eye_y", light.eye.y},
+                {"light_eye_z", light.eye.z},
+                {"light_target_x", light.target.x},
+                {"light_target_y", light.target.y},
+                {"light_target_z", light.target.z},
+                {"light_fov_deg", light.fov_y_deg},
+                {"light_near_m", light.near_m},
+                {"light_far_m", light.far_m}};
   f.technique_records.push_back(std::move(rec));
+  if (index == 0) f.technique_records.push_back(meshes_);
   out.counts = {{"fill", fill},
                 {"fill_infinite", reference_fill},
                 {"casters", n},

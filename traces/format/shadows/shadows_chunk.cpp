@@ -29,7 +29,11 @@ std::uint64_t scalar(const TechniqueRecord& r, const char* name) {
 // The rule of shadows_chunk_spec(): what a reader refuses beyond the field types.
 std::string shadows_rule(const TechniqueRecord& r) {
   const std::uint64_t count = scalar(r, "count"), size = scalar(r, "litmap_size");
-  if (std::string problem = vector_lengths_problem(r, count, {"count", "litmap_size", "reference_fill", "mask_diff_pixels", "class_names"}, "caster");
+  if (std::string problem = vector_lengths_problem(r, count,
+                                                   {"count", "litmap_size", "reference_fill", "mask_diff_pixels", "class_names", "light_eye_x",
+                                                    "light_eye_y", "light_eye_z", "light_target_x", "light_target_y", "light_target_z",
+                                                    "light_fov_deg", "light_near_m", "light_far_m"},
+                                                   "caster");
       !problem.empty())
     return problem;
   const auto& kept = vec<std::uint32_t>(r, "kept");
@@ -83,12 +87,46 @@ ChunkSpec shadows_chunk_spec() {
        {"class", FieldKind::VecU32, "the caster's class: an index into class_names"},
        {"kept", FieldKind::VecU32, "why a culled or clamped capture keeps its volume, in every mode: 0 dropped (decision 1 or 2), 1 a visible "
         "receiver in its slab, 2 the observer sees the caster, 3 only the slab's widening keeps it, 4 it crosses the light's near plane"},
-       {"fill_infinite", FieldKind::VecU32, "rasterized fragments of its infinite volume (its share of reference_fill)"}}};
+       {"fill_infinite", FieldKind::VecU32, "rasterized fragments of its infinite volume (its share of reference_fill)"},
+       {"light_eye_x", FieldKind::F64, "the light camera as the capture built it in double precision (the volumes' points come from it): "
+        "position x, metres"},
+       {"light_eye_y", FieldKind::F64, "position y"},
+       {"light_eye_z", FieldKind::F64, "position z"},
+       {"light_target_x", FieldKind::F64, "the point it looks at, x"},
+       {"light_target_y", FieldKind::F64, "y"},
+       {"light_target_z", FieldKind::F64, "z"},
+       {"light_fov_deg", FieldKind::F64, "field of view, degrees"},
+       {"light_near_m", FieldKind::F64, "near plane, metres"},
+       {"light_far_m", FieldKind::F64, "far plane, metres"}}};
   spec.rule = shadows_rule;
   return spec;
 }
 
 namespace {
+
+// The rule of caster_meshes_chunk_spec().
+std::string caster_meshes_rule(const TechniqueRecord& r) {
+  const std::uint64_t count = scalar(r, "count");
+  const auto& object = vec<std::uint32_t>(r, "object");
+  const auto& bounds = vec<float>(r, "bounds");
+  const auto& first = vec<std::uint32_t>(r, "first_triangle");
+  const auto& tris = vec<std::uint32_t>(r, "triangle_count");
+  const auto& vertices = vec<float>(r, "vertices");
+  const auto& indices = vec<std::uint32_t>(r, "triangles");
+  if (object.size() != count || first.size() != count || tris.size() != count)
+    return fmt::format("object, first_triangle and triangle_count have {}, {} and {} elements, but count is {}", object.size(), first.size(),
+                       tris.size(), count);
+  if (bounds.size() != 6 * count) return fmt::format("bounds has {} floats, not six for each of {} casters", bounds.size(), count);
+  if (vertices.size() % 3 != 0) return fmt::format("vertices has {} floats, not three a vertex", vertices.size());
+  if (indices.size() % 3 != 0) return fmt::format("triangles has {} indices, not three a triangle", indices.size());
+  for (std::size_t c = 0; c < count; ++c)
+    if (static_cast<std::uint64_t>(first[c]) + tris[c] > indices.size() / 3)
+      return fmt::format("caster {} (object {}): triangles {} + {} run past the {} triangles", c, object[c], first[c], tris[c], indices.size() / 3);
+  for (std::size_t i = 0; i < indices.size(); ++i)
+    if (indices[i] >= vertices.size() / 3)
+      return fmt::format("triangle index {} is vertex {}, but there are {} vertices", i, indices[i], vertices.size() / 3);
+  return {};
+}
 
 bool valid_margin(std::string_view v) { return shadows::parse_clamp_margin(v).has_value(); }
 
@@ -113,6 +151,21 @@ std::vector<HeaderKeySpec> shadows_header_keys() {
 }
 
 // This technique's part of the format (technique_chunks.h): its chunk type and header keys.
-TechniqueFormat shadows_format() { return {{shadows_chunk_spec()}, shadows_header_keys()}; }
+ChunkSpec caster_meshes_chunk_spec() {
+  ChunkSpec spec{kCasterMeshesChunk,
+                 "shadows",
+                 "ShadowCasterMeshes",
+                 {{"count", FieldKind::U32, "casters (the scene objects whose triangles form closed surfaces), in SHDC's order"},
+                  {"object", FieldKind::VecU32, "each caster's object id"},
+                  {"bounds", FieldKind::VecF32, "each caster's bounds: lo x, y, z, hi x, y, z (metres), six floats a caster"},
+                  {"first_triangle", FieldKind::VecU32, "each caster's first triangle in `triangles`"},
+                  {"triangle_count", FieldKind::VecU32, "its triangles"},
+                  {"vertices", FieldKind::VecF32, "world positions, x, y, z a vertex (metres, y up)"},
+                  {"triangles", FieldKind::VecU32, "three vertex indices a triangle, counter-clockwise seen from outside"}}};
+  spec.rule = caster_meshes_rule;
+  return spec;
+}
+
+TechniqueFormat shadows_format() { return {{shadows_chunk_spec(), caster_meshes_chunk_spec()}, shadows_header_keys()}; }
 
 }  // namespace nbsim::trace

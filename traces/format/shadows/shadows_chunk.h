@@ -13,6 +13,9 @@
 namespace nbsim::trace {
 
 inline constexpr std::uint32_t kShadowsChunk = fourcc("SHDC");
+// The casters' meshes (ShadowCasterMeshes), in the first frame of a trace only: what the model
+// builds shadow volumes from (model/shadows/volume.h).
+inline constexpr std::uint32_t kCasterMeshesChunk = fourcc("SHDG");
 
 // Decisions of the SHDC field `decision` (fixed values: they are in files).
 enum class CasterDecision : std::uint32_t {
@@ -26,6 +29,11 @@ enum class CasterDecision : std::uint32_t {
 // index c), then the frame's reference fill and mask difference. Its rule: every vector has `count` elements, decision at most 3, rectangles inside the
 // litmap (x, y >= 0, w, h >= 0, x + w and y + h at most litmap_size), draw -1 or a draw index.
 ChunkSpec shadows_chunk_spec();
+
+// The casters' meshes: count, object ids, bounds (six floats each), each caster's triangles as a
+// range of `triangles` (three vertex indices each, into `vertices`, three floats each). Its rule:
+// the vectors' lengths agree, every range and vertex index is inside its array.
+ChunkSpec caster_meshes_chunk_spec();
 
 // Its header keys (what the replay reads to build the litmaps' N-buffers and clamp the volumes).
 std::vector<HeaderKeySpec> shadows_header_keys();

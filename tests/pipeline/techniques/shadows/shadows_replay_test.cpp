@@ -12,6 +12,7 @@
 #include <map>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "tests/common/run_nbsim.h"
 #include "traces/format/reader.h"
@@ -103,6 +104,45 @@ TEST_P(ShadowsReplayTest, ReplaysExactlyInEveryMode) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, ShadowsReplayTest, ::testing::Values("boxes", "terrain", "city"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// The model's own volumes (shadows.volumes, built from the trace's caster meshes with the model's
+// N-buffer answers): a capture in one mode replays as each mode with the fill, the stencil buffer
+// (its CRC-32 every frame, the model's stencil being GL's in the trace replays above) and the mask
+// a capture of that mode gives on GL, on every scene; and the captured mode rebuilt gives GL's own
+// volumes back.
+TEST_P(ShadowsReplayTest, ModelBuiltVolumesReplayAnyMode) {
+  const std::string scene = GetParam();
+  std::map<std::string, nlohmann::json> gl;
+  for (const std::string mode : {"infinite", "culled", "clamped"}) gl[mode] = replay(capture(scene, mode));
+  const auto checksums = [](const nlohmann::json& run) {
+    std::vector<std::uint64_t> v;
+    for (const auto& f : run["frames"]) v.push_back(f["stencil_checksum"].get<std::uint64_t>());
+    return v;
+  };
+  for (const std::string from : {"infinite", "clamped"})
+    for (const std::string as : {"infinite", "culled", "clamped"}) {
+      SCOPED_TRACE(scene + ": a " + from + " capture replayed as " + as);
+      const auto run = replay(capture(scene, from), " --set shadows.volumes=" + as, "as_" + as);
+      const auto& s = run["summary"]["shadows"];
+      const auto& g = gl[as]["summary"]["shadows"];
+      EXPECT_EQ(s["model_volumes"], g["volume_draws"]) << "the volumes a capture of that mode drew";
+      EXPECT_EQ(s["fill"], g["gl_fill"]) << "GL's fill in that mode";
+      EXPECT_EQ(checksums(run), checksums(gl[as])) << "GL's stencil buffer in that mode, frame by frame";
+      EXPECT_EQ(s["mask_diff"], 0);
+      EXPECT_EQ(s["mask_diff_infinite"], 0);
+      EXPECT_EQ(s["rect_mismatches"], 0) << "rectangles from the meshes' bounds and the recorded light";
+      EXPECT_EQ(run["summary"]["draws_exact"], run["summary"]["draws"]) << "GL's own draws (scene) stay exact";
+    }
+}
+
+// Bad input for the model's own volumes: a trace of the caster rule is refused, naming why.
+TEST(ShadowsModelVolumesTest, CasterRuleTraceRefused) {
+  const fs::path t = capture("boxes", "clamped", "--clamp-rule caster");
+  const fs::path dir = t.parent_path() / "caster_rule_run";
+  const CliResult r = run_nbsim("replay " + t.string() + " --out " + dir.string() + " --set shadows.volumes=clamped");
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "clamp_rule caster") && has(r.err, "--clamp-rule edge")) << r.err;
+}
 
 // Lossy N-buffer designs (u16, divisor 2, level cap 2) stay conservative: no z_min above GL's, no
 // z_max below, no caster culled that GL's values keep; the mask (GL's volumes) is unchanged.

@@ -44,6 +44,7 @@ TEST(ShadowsChunkTest, DecodedAndDamageRefused) {
     o.counted_words(f.cls);
     o.counted_words(f.kept);
     o.counted_words(std::vector<std::uint32_t>{500, 70, 9000});  // fill_infinite
+    for (double v : {10.0, 90.0, 12.5, 50.0, 0.0, 50.0, 60.0, 0.5, 400.0}) o.f64(v);  // the light camera
     return o.take();
   };
   TechniqueRecord raw;
@@ -61,12 +62,13 @@ TEST(ShadowsChunkTest, DecodedAndDamageRefused) {
   longer.push_back(0);
   e = record_error(kShadowsChunk, longer);
   EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "decodes long")) << e;
-  // The layout before the per-caster breakdown (class_names, class, kept, fill_infinite): refused
+  // The layout before the per-caster breakdown (class_names, class, kept, fill_infinite) and the
+  // light camera: refused
   // naming the type, the missing field and where this nbsim's fields are listed.
-  const std::ptrdiff_t breakdown_bytes = (4 + 10) + 3 * (4 + 3 * 4);
+  const std::ptrdiff_t breakdown_bytes = (4 + 10) + 3 * (4 + 3 * 4) + 9 * 8;
   e = record_error(kShadowsChunk, std::vector<std::uint8_t>(raw.payload.begin(), raw.payload.end() - breakdown_bytes));
   EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, "technique chunk SHDC (ShadowCasters, technique shadows) does not have this nbsim's layout") &&
-              has(e, "'class_names'") && has(e, "18 fields of 22 read") && has(e, "`nbsim trace format SHDC`"))
+              has(e, "'class_names'") && has(e, "18 fields of 31 read") && has(e, "`nbsim trace format SHDC`"))
       << e;
   std::vector<std::uint8_t> hostile = raw.payload;
   put_le32(hostile, 8, 0xFFFFFFFFu);  // the object vector's count
@@ -92,6 +94,33 @@ TEST(ShadowsChunkTest, DecodedAndDamageRefused) {
     e = record_error(kShadowsChunk, payload(b.f));
     EXPECT_TRUE(has(e, "chunk 2 (SHDC)") && has(e, b.message)) << b.message << ": " << e;
   }
+}
+
+// SHDG, the casters' meshes: decoded, encoded back to the same bytes; ranges and vertex indices
+// outside their arrays refused naming the caster or the index.
+TEST(ShadowsChunkTest, CasterMeshesDecodedAndDamageRefused) {
+  auto payload = [](std::vector<std::uint32_t> first, std::vector<std::uint32_t> triangles) {
+    bytes::Out o;
+    o.u32(1);
+    o.counted_words(std::vector<std::uint32_t>{4});  // object
+    o.counted_words(std::vector<float>{0, 0, 0, 1, 1, 1});  // bounds
+    o.counted_words(first);
+    o.counted_words(std::vector<std::uint32_t>{4});  // triangle_count
+    o.counted_words(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1});  // vertices
+    o.counted_words(triangles);
+    return o.take();
+  };
+  const std::vector<std::uint32_t> tetra = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+  const auto raw = payload({0}, tetra);
+  const TechniqueRecord r = decode_technique(kCasterMeshesChunk, raw);
+  ASSERT_TRUE(r.decoded) << "the format library registers SHDG";
+  EXPECT_EQ(encode(r), raw);
+  std::string e = record_error(kCasterMeshesChunk, payload({1}, tetra));
+  EXPECT_TRUE(has(e, "(SHDG)") && has(e, "caster 0 (object 4): triangles 1 + 4 run past the 4 triangles")) << e;
+  std::vector<std::uint32_t> bad = tetra;
+  bad[11] = 9;
+  e = record_error(kCasterMeshesChunk, payload({0}, bad));
+  EXPECT_TRUE(has(e, "triangle index 11 is vertex 9, but there are 4 vertices")) << e;
 }
 
 }  // namespace
