@@ -24,11 +24,12 @@ void ShadowsUnitConfig::describe(config::Schema& s, ShadowsUnitConfig& c) {
 }
 
 ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ShadowsUnitConfig& config,
-                         const ShadowsSetup& setup, const raster::StencilImage& stencil, query::NBufferStructure& min_nb,
-                         query::NBufferStructure& max_nb)
+                         const ShadowsSetup& setup, const DepthImage& depth, const raster::StencilImage& stencil,
+                         query::NBufferStructure& min_nb, query::NBufferStructure& max_nb)
     : sim::Unit(name, registry),
       config_(config),
       setup_(setup),
+      depth_(depth),
       stencil_(stencil),
       min_nb_(min_nb),
       max_nb_(max_nb),
@@ -82,7 +83,10 @@ ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& r
       rect_mismatches_(stats().counter("rect_mismatches", "casters",
                                        "casters whose rectangle or outside/near decision, recomputed from the caster meshes, differs from SHDC's")),
       stencil_checksum_(stats().counter("stencil_checksum", "crc",
-                                        "CRC-32 of the model's stencil buffer at each frame's end (a frame's value is its own; the run's is their sum)")) {
+                                        "CRC-32 of the model's stencil buffer at each frame's end (a frame's value is its own; the run's is their sum)")),
+      own_mask_diff_(stats().counter("own_mask_diff", "pixels",
+                                     "with the model's own culled or clamped volumes: pixels where its mask differs from its own infinite "
+                                     "volumes' mask, cut at the same planes (must be 0)")) {
   if (config_.volumes != "trace") {
     own_mode_ = parse_mode(config_.volumes);
     if (!setup_.edge_rule)
@@ -235,6 +239,21 @@ void ShadowsUnit::compare_masks(const scene::Frame& f) {
   }
   gl_mask_pixels_ += gl_set;
   gl_mask_diff_ += gl_diff;
+  if (own_mode_ && *own_mode_ != Mode::Infinite) {
+    // The model's own reference, off the clock: its infinite volumes into a cleared stencil over
+    // this frame's depth (volumes write no depth), compared with its mode's mask.
+    DepthImage depth = depth_;
+    raster::StencilImage reference(stencil_.width, stencil_.height, 0);
+    raster::RasterPath path(setup_.reference_path, depth, reference);
+    const scene::DrawRecord d = volume_draw(0);
+    raster::DrawState state = raster::draw_state(d.state);
+    state.stencil = raster::stencil_state(d.stencil);
+    path.draw(reference_clip_, state);
+    for (std::size_t i = 0; i < reference.texels.size() && i < stencil_.texels.size(); ++i) {
+      const bool lit = region.texels[i] != 0;
+      own_mask_diff_ += (lit && reference.texels[i] != 0) != (lit && stencil_.texels[i] != 0) ? 1 : 0;
+    }
+  }
 }
 
 void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>& f, const FrameCasters& c, Mode mode,
@@ -243,6 +262,7 @@ void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>&
   const LightFrustum light = light_of(c, frame);
   const glm::mat4 view_proj = observer_view_proj(f->begin);
   own_share_.clear();
+  reference_clip_.clear();
   std::vector<glm::vec4> positions;
   for (std::size_t i = 0; i < c.size(); ++i) {
     if (meshes_->meshes[i].object != c.object[i])
@@ -264,6 +284,11 @@ void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>&
       const Planes p = slab_planes(rect, light, model_zmin_[i], model_zmax_[i], setup_.margin, ClampRule::Edge);
       dropped = p.culled;
       if (!p.culled) clamp_near = p.clamp_near, clamp_far = p.clamp_far;
+    }
+    if (mode != Mode::Infinite) {  // the reference: every caster's infinite volume at the same planes
+      positions.clear();
+      append_volume(meshes_->vertices, meshes_->meshes[i], light, volume_ends(clamp_near, clamp_far, false), positions);
+      for (const glm::vec4& p : positions) reference_clip_.push_back(clip_position(view_proj, p));
     }
     if (mode != Mode::Infinite && dropped) continue;
     positions.clear();

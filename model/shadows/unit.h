@@ -34,6 +34,7 @@
 #include "model/cp/unit.h"
 #include "model/depth/unit.h"
 #include "model/query/units.h"
+#include "model/raster/raster_path.h"
 #include "model/raster/stencil_test.h"
 #include "model/shadows/caster.h"
 #include "model/shadows/volume.h"
@@ -59,6 +60,9 @@ struct ShadowsSetup {
   Mode mode = Mode::Clamped;
   ClampMargin margin;
   bool edge_rule = true;  // the trace's clamp_rule is the paper's ("edge")
+  // The replay's raster settings (viewport, depth format, fused arithmetic), for the reference pass
+  // of the model's own volumes.
+  raster::RasterPathConfig reference_path;
 };
 
 // Where the volumes' fill goes: the casters of one class ("bird") kept for one reason (KeptBy),
@@ -76,8 +80,8 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
  public:
   // `min_nb` (op min, over litmap_min) and `max_nb` (op max, over litmap_max), litmap_size square.
   ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ShadowsUnitConfig& config,
-              const ShadowsSetup& setup, const raster::StencilImage& stencil, query::NBufferStructure& min_nb,
-              query::NBufferStructure& max_nb);
+              const ShadowsSetup& setup, const DepthImage& depth, const raster::StencilImage& stencil,
+              query::NBufferStructure& min_nb, query::NBufferStructure& max_nb);
 
   void run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
 
@@ -100,7 +104,11 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
 
   ShadowsUnitConfig config_;
   ShadowsSetup setup_;
+  const DepthImage& depth_;
   const raster::StencilImage& stencil_;
+  // The model's own infinite volumes at the planes of its own mode's (clip positions), drawn off
+  // the clock into a scratch stencil at the frame's end: the reference its mask must equal.
+  std::vector<geometry::ClipPosition> reference_clip_;
   query::NBufferStructure& min_nb_;
   query::NBufferStructure& max_nb_;
 
@@ -111,7 +119,7 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
       &decision_mismatches_, &zmin_mismatches_, &zmax_mismatches_, &not_conservative_, &unsafe_culls_, &culls_lost_,
       &lookups_, &lookup_mismatches_, &build_texels_, &litmap_draws_, &litmap_reprojections_, &receiver_splats_, &scene_depth_tests_,
       &volume_draws_, &fill_, &gl_fill_, &reference_fill_, &reference_frames_, &stencil_tests_, &mask_pixels_, &gl_mask_pixels_, &mask_diff_, &mask_diff_infinite_,
-      &gl_mask_diff_, &model_volumes_, &rect_mismatches_, &stencil_checksum_;
+      &gl_mask_diff_, &model_volumes_, &rect_mismatches_, &stencil_checksum_, &own_mask_diff_;
 
   FillBreakdown breakdown_;
   std::vector<FillShare*> volume_share_;  // this frame's draw index -> its caster's share (null: none)

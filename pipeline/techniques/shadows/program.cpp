@@ -29,6 +29,13 @@ Program build(const ProgramContext& c) {
   s.litmap_size = static_cast<int>(c.header.whole("litmap_size"));
   s.margin = *shadows::parse_clamp_margin(c.header.text("clamp_margin"));
   s.edge_rule = c.header.text("clamp_rule") == "edge";
+  s.reference_path.width_px = c.view.width_px;
+  s.reference_path.height_px = c.view.height_px;
+  s.reference_path.batch_triangles = c.config.geometry.batch_triangles;
+  s.reference_path.fused_viewport = c.config.geometry.fused_viewport;
+  s.reference_path.fused_interpolation = c.config.depth.fused_interpolation;
+  if (const std::string* f = c.header.property("depth_format"))
+    if (const auto format = raster::parse_depth_format(*f)) s.reference_path.depth_format = *format;
   Program p;
   const auto nbuffer = [&](const char* instance, FarOp op) {
     return std::make_unique<query::NBufferStructure>(instance, c.registry, c.nbuffer_config(instance), s.litmap_size,
@@ -36,7 +43,7 @@ Program build(const ProgramContext& c) {
   };
   auto min_nb = nbuffer("litmap_min", FarOp::Min);
   auto max_nb = nbuffer("litmap_max", FarOp::Max);
-  auto unit = std::make_unique<shadows::ShadowsUnit>("shadows", c.registry, c.config.group<shadows::ShadowsUnitConfig>("shadows"), s, c.stencil_buffer, *min_nb, *max_nb);
+  auto unit = std::make_unique<shadows::ShadowsUnit>("shadows", c.registry, c.config.group<shadows::ShadowsUnitConfig>("shadows"), s, c.depth_buffer, c.stencil_buffer, *min_nb, *max_nb);
   p.structures.push_back(std::move(min_nb));
   p.structures.push_back(std::move(max_nb));
   p.frames = unit.get();
@@ -81,7 +88,7 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, std::uint64_t cyc
   j["cycles_per_frame"] = per_frame(cycles);
   for (const char* name : {"decision_mismatches", "zmin_mismatches", "zmax_mismatches", "not_conservative", "unsafe_culls",
                            "culls_lost", "lookup_mismatches", "mask_diff", "mask_diff_infinite", "gl_mask_diff", "gl_mask_pixels",
-                           "model_volumes", "rect_mismatches"})
+                           "model_volumes", "rect_mismatches", "own_mask_diff"})
     j[name] = stat(p, name);
   return j;
 }

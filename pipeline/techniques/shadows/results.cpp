@@ -27,6 +27,11 @@ TechniqueResults shadows_results() {
                                      "frame; 0 (culling and clamping change no pixel)",
                                      K::Error, shd("mask_diff_infinite"));
   mask_diff_infinite.must_be_zero = true;
+  Metric own_mask_diff = metric("own_mask_diff", "pixels",
+                                "with shadows.volumes culled or clamped: shadow-mask pixels where the model's mask differs from its own "
+                                "infinite volumes' cut at the same planes, over every frame; 0",
+                                K::Error, shd("own_mask_diff"));
+  own_mask_diff.must_be_zero = true;
   Metric unsafe = metric("unsafe_culls", "casters",
                          "casters the design's N-buffers cull that the cull rule on GL's full-resolution values keeps; 0 for a "
                          "conservative design",
@@ -56,6 +61,7 @@ TechniqueResults shadows_results() {
              shd("stencil_tests_per_frame")),
       mask_diff,
       mask_diff_infinite,
+      own_mask_diff,
       unsafe,
       metric("not_conservative", "casters", "casters whose z_min is above GL's or z_max below GL's, over every frame", K::Error,
              shd("not_conservative")),

@@ -58,7 +58,7 @@ void add_shadows_commands(CLI::App& app, Action& action) {
                               "gl_fill_per_frame", "reference_fill_per_frame", "fill_ratio_to_infinite", "build_texels_per_frame", "lookups_per_frame", "stencil_tests_per_frame",
                               "litmap_reprojections_per_frame", "receiver_splats_per_frame", "cycles_per_frame", "nbuffer_memory_bytes", "mask_diff",
                               "mask_diff_infinite", "decision_mismatches", "zmin_mismatches", "zmax_mismatches",
-                              "not_conservative", "unsafe_culls", "kept_by_slab"})
+                              "not_conservative", "unsafe_culls", "kept_by_slab", "model_volumes", "own_mask_diff"})
           r[k] = (*p)[k];
         r["fill_breakdown"] = p->value("fill_breakdown", nlohmann::json::array());
         r["draws"] = (*sum)["draws"];

@@ -131,8 +131,29 @@ TEST_P(ShadowsReplayTest, ModelBuiltVolumesReplayAnyMode) {
       EXPECT_EQ(s["mask_diff"], 0);
       EXPECT_EQ(s["mask_diff_infinite"], 0);
       EXPECT_EQ(s["rect_mismatches"], 0) << "rectangles from the meshes' bounds and the recorded light";
+      EXPECT_EQ(s["own_mask_diff"], 0) << "the mask equals the model's own infinite volumes'";
       EXPECT_EQ(run["summary"]["draws_exact"], run["summary"]["draws"]) << "GL's own draws (scene) stay exact";
     }
+}
+
+// A lossy design of both N-buffers (u16, a quarter of the resolution) with the model's own clamped
+// volumes: looser slabs, so at least GL's clamped fill, and the mask equal to the model's own
+// infinite volumes' cut at the same planes (GL's infinite reference is cut at GL's planes, so a few
+// of its boundary pixels may rasterize otherwise).
+TEST(ShadowsModelVolumesTest, LossyDesignKeepsItsOwnMask) {
+  for (const std::string scene : {"terrain", "city"}) {
+    SCOPED_TRACE(scene);
+    const auto gl = replay(capture(scene, "clamped"));
+    const auto run = replay(capture(scene, "clamped"),
+                            " --set shadows.volumes=clamped --set litmap_min.format=u16 --set litmap_max.format=u16"
+                            " --set litmap_min.resolution_divisor=4 --set litmap_max.resolution_divisor=4",
+                            "lossy_own");
+    const auto& s = run["summary"]["shadows"];
+    EXPECT_EQ(s["own_mask_diff"], 0);
+    EXPECT_EQ(s["unsafe_culls"], 0);
+    EXPECT_GE(s["fill"].get<double>(), gl["summary"]["shadows"]["gl_fill"].get<double>()) << "a looser slab draws no less";
+    EXPECT_GT(s["model_volumes"].get<int>(), 0);
+  }
 }
 
 // Bad input for the model's own volumes: a trace of the caster rule is refused, naming why.
