@@ -17,8 +17,8 @@ using LightCamera = nbsim::shadows::LightFrustum;
 using nbsim::shadows::CasterMesh;
 using nbsim::shadows::VolumeEnds;
 
-// The casters of `scene`, in object order: the objects whose triangles form closed surfaces (open
-// objects, the ground plane and the terrain, are receivers only).
+// The casters of `scene`, in object order: the objects whose triangles form closed surfaces, but
+// the ground (class "ground": receivers only, like every open object).
 std::vector<CasterMesh> find_casters(const CaptureScene& scene);
 
 // Appends the volume of `caster` lit from `light` to `out` (three positions a triangle).
