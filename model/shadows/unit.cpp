@@ -281,7 +281,7 @@ void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>&
     float clamp_near = 0.0f, clamp_far = std::numeric_limits<float>::infinity();
     bool dropped = rect.decision == Decision::OutsideLight;
     if (rect.decision == Decision::Volume) {
-      const Planes p = slab_planes(rect, light, model_zmin_[i], model_zmax_[i], setup_.margin, ClampRule::Edge);
+      const Planes p = slab_planes(rect.caster_near, rect.caster_far, light, model_zmin_[i], model_zmax_[i], setup_.margin, ClampRule::Edge);
       dropped = p.culled;
       if (!p.culled) clamp_near = p.clamp_near, clamp_far = p.clamp_far;
     }

@@ -253,12 +253,12 @@ double slab_far_end(const LightFrustum& light, double slab_max, const ClampMargi
   return light.depth_of_distance(light.distance_of_depth(slab_max) * (1.0 + margin.rel) + margin.metres);
 }
 
-Planes slab_planes(const CasterRect& r, const LightFrustum& light, double slab_min, double slab_max, const ClampMargin& margin,
-                   ClampRule rule) {
+Planes slab_planes(float caster_near, float caster_far, const LightFrustum& light, double slab_min, double slab_max,
+                   const ClampMargin& margin, ClampRule rule) {
   Planes p;
   // The slab of visible receivers, widened: [near, far] in light window depth.
   const double far = slab_far_end(light, slab_max, margin);
-  if (far < std::max(slab_min, static_cast<double>(r.caster_near))) {
+  if (far < std::max(slab_min, static_cast<double>(caster_near))) {
     p.culled = true;
     return p;
   }
@@ -269,7 +269,7 @@ Planes slab_planes(const CasterRect& r, const LightFrustum& light, double slab_m
   // The paper's rule sets the plane whenever it is in front of some of the caster (the volume is
   // split where the caster crosses it); the other only when every receiver is behind the whole
   // caster.
-  if (rule == ClampRule::Edge ? near > r.caster_near : near >= r.caster_far) p.clamp_near = static_cast<float>(near);
+  if (rule == ClampRule::Edge ? near > caster_near : near >= caster_far) p.clamp_near = static_cast<float>(near);
   return p;
 }
 

@@ -97,16 +97,16 @@ CasterRect caster_rect(const scene::Aabb& bounds, const LightFrustum& light, int
 enum class ClampRule : std::uint8_t { Edge = 0, Caster = 1 };
 inline constexpr std::array<std::string_view, 2> kClampRuleNames = {"edge", "caster"};
 
-// The decision and planes of a caster with rectangle `r` from the light depths of the receivers
-// its slab holds, [slab_min, slab_max]: culled when the far end, widened by the margin, is nearer
-// than max(slab_min, caster_near); else the far plane there and the near plane at slab_min
-// narrowed by the margin, as the rule allows (0: none).
+// The decision and planes of a caster whose bounds span light depths [caster_near, caster_far],
+// from the light depths of the receivers its slab holds, [slab_min, slab_max]: culled when the far
+// end, widened by the margin, is nearer than max(slab_min, caster_near); else the far plane there
+// and the near plane at slab_min narrowed by the margin, as the rule allows (0: none).
 struct Planes {
   bool culled = false;
   float clamp_near = 0.0f, clamp_far = 0.0f;
 };
-Planes slab_planes(const CasterRect& r, const LightFrustum& light, double slab_min, double slab_max, const ClampMargin& margin,
-                   ClampRule rule);
+Planes slab_planes(float caster_near, float caster_far, const LightFrustum& light, double slab_min, double slab_max,
+                   const ClampMargin& margin, ClampRule rule);
 // The far end of a slab whose farthest receiver is at light window depth `slab_max`, pushed back by
 // the margin.
 double slab_far_end(const LightFrustum& light, double slab_max, const ClampMargin& margin);

@@ -152,6 +152,25 @@ std::map<std::string, ModeRun> run_case(const Case& c, const std::string& tag) {
   return runs;
 }
 
+// One box (the boxes scene, seed 5) lit from its -x side, 45 degrees up, so that its shadow falls
+// on +x over the box's z extent; the light's option is set in `c`.
+struct LitBox {
+  Case c;
+  glm::vec3 lo{0.0f}, hi{0.0f}, light{0.0f};
+  float cz = 0.0f;  // the box's middle z
+};
+LitBox box_lit_from_minus_x(const std::string& litmap) {
+  LitBox l;
+  l.c.options = {{"boxes", "1"}, {"seed", "5"}, {"litmap", litmap}};
+  const CaptureScene scene = find_scene("boxes").make(l.c.options);
+  const scene::Aabb& b = scene.scene.objects[1];
+  l.lo = lo_of(b), l.hi = hi_of(b);
+  l.cz = 0.5f * (l.lo.z + l.hi.z);
+  l.light = {l.lo.x - 40.0f, 40.0f + l.hi.y, l.cz};
+  l.c.options.set("light", nbsim::testing::light_text(l.light, {l.hi.x, 0.0f, l.cz}));
+  return l;
+}
+
 // Index in the SHDC vectors of the caster that is scene object `object`, or -1.
 int caster_of(const scene::TechniqueRecord& rec, std::uint32_t object) {
   const auto& objects = field<std::uint32_t>(rec, "object");
@@ -297,14 +316,10 @@ TEST(ShadowsHardCasesTest, IntermediateOccluder) {
 // its far plane before the shadow's far end; (d) it looks away from both: culled. Case (e) is
 // IntermediateOccluder.
 TEST(ShadowsHardCasesTest, Figure5Configurations) {
-  Case c;
-  c.options = {{"boxes", "1"}, {"seed", "5"}, {"litmap", "256"}};
-  const CaptureScene scene = find_scene("boxes").make(c.options);
-  const scene::Aabb& b = scene.scene.objects[1];
-  const glm::vec3 lo = lo_of(b), hi = hi_of(b);
-  const float cz = 0.5f * (lo.z + hi.z);
-  const glm::vec3 light{lo.x - 40.0f, 40.0f + hi.y, cz};
-  c.options.set("light", nbsim::testing::light_text(light, {hi.x, 0.0f, cz}));
+  LitBox box = box_lit_from_minus_x("256");
+  Case& c = box.c;
+  const glm::vec3 lo = box.lo, hi = box.hi, light = box.light;
+  const float cz = box.cz;
   // The shadow's far end: the light ray over the box's far top edge meets the ground.
   const glm::vec3 top{hi.x, hi.y, cz};
   const glm::vec3 tip = light + (top - light) * (light.y / (light.y - top.y));
@@ -356,14 +371,10 @@ TEST(ShadowsHardCasesTest, Figure5Configurations) {
 // the next pixel). The litmap pass keeps a fragment by the farthest observer depth of its 3x3
 // pixels; mask pixels next to the edge must survive.
 TEST(ShadowsHardCasesTest, ReprojectionAtDepthDiscontinuities) {
-  Case c;
-  c.options = {{"boxes", "1"}, {"seed", "5"}, {"litmap", "128"}};
-  const CaptureScene scene = find_scene("boxes").make(c.options);
-  const scene::Aabb& b = scene.scene.objects[1];
-  const glm::vec3 lo = lo_of(b), hi = hi_of(b);
-  const float cz = 0.5f * (lo.z + hi.z);
-  // The light on the -x side, 45 degrees up: the shadow falls on +x, over the box's z extent.
-  c.options.set("light", nbsim::testing::light_text({lo.x - 40.0f, 40.0f + hi.y, cz}, {hi.x, 0.0f, cz}));
+  LitBox box = box_lit_from_minus_x("128");  // the shadow falls on +x, over the box's z extent
+  Case& c = box.c;
+  const glm::vec3 lo = box.lo, hi = box.hi;
+  const float cz = box.cz;
   // The eye on the -x, -z side: the box's right silhouette is its (hi.x, lo.z) edge, the shadowed
   // ground right behind it.
   c.poses = {{{lo.x - 4.0f, 0.6f * hi.y, lo.z - 16.0f}, {hi.x + 2.0f, 0.0f, 0.5f * (lo.z + cz)}},

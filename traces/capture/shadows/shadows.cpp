@@ -396,9 +396,7 @@ CasterResult Shadows::measure(const CasterMesh& c, const LightCamera& light, con
 }
 
 void Shadows::decide(CasterResult& r, const LightCamera& light, double slab_min, double slab_max) const {
-  nbsim::shadows::CasterRect rect;
-  rect.caster_near = r.caster_near, rect.caster_far = r.caster_far;
-  const nbsim::shadows::Planes p = nbsim::shadows::slab_planes(rect, light, slab_min, slab_max, margin_, rule_);
+  const nbsim::shadows::Planes p = nbsim::shadows::slab_planes(r.caster_near, r.caster_far, light, slab_min, slab_max, margin_, rule_);
   if (p.culled) {
     r.decision = CasterDecision::Culled;
     return;

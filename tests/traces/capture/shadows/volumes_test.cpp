@@ -124,6 +124,9 @@ TEST(ShadowVolumeTest, ClosedInEveryCutAndStartingAtTheCasterOrTheMinPlane) {
         if (!clamped) continue;
         // Light rays through the caster: the volume begins at max(caster, plane) along each.
         const double plane_m = light.distance_of_depth(near);
+        std::vector<glm::vec4> caster_tris;  // the caster itself, for where a ray enters it
+        for (const auto& ct : c.triangles)
+          for (std::uint32_t i : ct) caster_tris.emplace_back(scene.vertices[i], 1.0f);
         int rays = 0;
         for (int k = 0; k < 400; ++k) {
           const auto& t = c.triangles[std::uniform_int_distribution<std::size_t>(0, c.triangles.size() - 1)(rng)];
@@ -134,9 +137,6 @@ TEST(ShadowVolumeTest, ClosedInEveryCutAndStartingAtTheCasterOrTheMinPlane) {
                                glm::dvec3(scene.vertices[t[2]]) * v;
           const glm::dvec3 dir = glm::normalize(p - light.eye);
           // Where the ray enters the caster: the nearest hit on its triangles.
-          std::vector<glm::vec4> caster_tris;
-          for (const auto& ct : c.triangles)
-            for (std::uint32_t i : ct) caster_tris.emplace_back(scene.vertices[i], 1.0f);
           const double enter = first_hit(caster_tris, light.eye, dir);
           const double axis = glm::dot(dir, glm::normalize(light.target - light.eye));  // distance along the view axis per metre
           const double expected = std::max(enter, plane_m / axis);
