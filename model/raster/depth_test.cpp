@@ -32,8 +32,9 @@ void run_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint
   k.written += written;
 }
 
-// The peel's path (DepthState::peel_layer or passed_mask set): the strict compare against the
-// previous layer, then the depth test; one pixel at a time (a peel is not the hot path).
+// The path of a fragment stage (DepthState::peel_layer, passed_mask or shader set): the strict
+// compare against the previous layer, the shader's discard, then the depth test; one pixel at a
+// time (not the hot path).
 void run_peel_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint16_t mask, const DepthState& state,
                     bool fused, DepthFormat format, DepthCounters& k) {
   for (unsigned m = mask; m != 0; m &= m - 1) {
@@ -47,6 +48,10 @@ void run_peel_block(DepthImage& img, const DepthPlane& plane, int x, int y, std:
         ++k.peel_discarded;
         continue;
       }
+    }
+    if (state.shader && state.shader->discards(px, py, plane.raw_at(px, py, fused))) {
+      ++k.shader_discarded;
+      continue;
     }
     if (!state.test) {
       ++k.passed;
@@ -91,6 +96,7 @@ DepthCounters& DepthCounters::operator+=(const DepthCounters& o) {
   blocks += o.blocks;
   peel_reads += o.peel_reads;
   peel_discarded += o.peel_discarded;
+  shader_discarded += o.shader_discarded;
   return *this;
 }
 
@@ -103,7 +109,7 @@ void EarlyDepthTest::test_block(const DepthPlane& plane, int x, int y, std::uint
   const auto n = static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(mask)));
   k.fragments += n;
   k.blocks += 1;
-  if (state.peel_layer || state.passed_mask) {
+  if (state.peel_layer || state.passed_mask || state.shader) {
     NBSIM_CHECK(!state.peel_layer || state.peel_layer->texels.size() == buffer_->texels.size(), "peel layer of another size");
     NBSIM_CHECK(!state.passed_mask || state.passed_mask->size() == buffer_->texels.size(), "passed mask of another size");
     run_peel_block(*buffer_, plane, x, y, mask, state, fused_, format_, k);

@@ -67,6 +67,15 @@ inline float stored_depth(DepthFormat format, float z) noexcept {
   return format == DepthFormat::Unorm24 ? from_unorm24(to_unorm24(z)) : z;
 }
 
+// A fragment shader's discard before the depth test (the fragment counted as rasterized, never
+// depth tested): `discards` gets the pixel and the fragment's gl_FragCoord.z, the depth plane's
+// value before the [0, 1] clamp (DepthPlane::raw_at), as llvmpipe's shader sees it.
+class FragmentShader {
+ public:
+  virtual ~FragmentShader() = default;
+  virtual bool discards(int x, int y, float frag_z) const = 0;
+};
+
 struct DepthState {
   DepthFunc func = DepthFunc::Less;
   bool test = true;   // GL_DEPTH_TEST
@@ -80,6 +89,9 @@ struct DepthState {
   // When set (a vector of buffer-size bytes), the pixels where a sample passed the depth test are
   // set to 1 (never cleared here): which texels a peel pass wrote, even at the clear value 1.0.
   std::vector<std::uint8_t>* passed_mask = nullptr;
+  // When set, every fragment runs it after the peel compare and before the depth test; a discarded
+  // fragment is counted in `fragments` and `shader_discarded`.
+  const FragmentShader* shader = nullptr;
 };
 
 // Per-draw counters of the depth test (added to, never reset, by the unit).
@@ -91,6 +103,7 @@ struct DepthCounters {
   std::uint64_t blocks = 0;       // 4x4 blocks with at least one fragment
   std::uint64_t peel_reads = 0;      // previous-layer reads of the peel compare (DepthState::peel_layer)
   std::uint64_t peel_discarded = 0;  // fragments the peel compare discarded (not strictly behind the layer)
+  std::uint64_t shader_discarded = 0;  // fragments DepthState::shader discarded
   DepthCounters& operator+=(const DepthCounters& o);
 };
 

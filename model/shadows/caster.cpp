@@ -153,7 +153,7 @@ FrameCasters read_casters(const scene::Frame& f) {
   return c;
 }
 
-DepthRange exact_range(const scene::DepthSnapshot& litmap_min, const scene::DepthSnapshot& litmap_max, const Rect& r) noexcept {
+DepthRange exact_range(const DepthImage& litmap_min, const DepthImage& litmap_max, const Rect& r) noexcept {
   DepthRange e;
   for (int y = std::max(r.y, 0); y < std::min(r.y + r.h, litmap_min.height); ++y)
     for (int x = std::max(r.x, 0); x < std::min(r.x + r.w, litmap_min.width); ++x) {

@@ -94,7 +94,7 @@ FrameCasters read_casters(const scene::Frame& f);
 struct DepthRange {
   float z_min = 1.0f, z_max = 0.0f;
 };
-DepthRange exact_range(const scene::DepthSnapshot& litmap_min, const scene::DepthSnapshot& litmap_max, const Rect& r) noexcept;
+DepthRange exact_range(const DepthImage& litmap_min, const DepthImage& litmap_max, const Rect& r) noexcept;
 
 // What the model found for one measured caster (rectangle inside the litmap), against GL's record.
 struct CasterCheck {

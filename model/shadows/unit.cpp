@@ -6,6 +6,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <bit>
 #include <limits>
 
 #include "model/common/error.h"
@@ -19,8 +20,19 @@ void ShadowsUnitConfig::describe(config::Schema& s, ShadowsUnitConfig& c) {
   s.add("shadows.latency_cycles", c.latency_cycles, "cycles", "latency of a frame's batch of caster decisions", 0, 100000);
   s.add("shadows.volumes", c.volumes,
         "the shadow volumes drawn: trace (GL's, as captured) or the volumes of mode infinite, culled or clamped that the model builds "
-        "from the trace's caster meshes with its own N-buffer answers (the paper's clamp rule; the trace's litmaps)",
-        {"trace", "infinite", "culled", "clamped"});
+        "from the trace's caster meshes with its own N-buffer answers (the paper's clamp rule), or model (the model's own in the "
+        "trace's shadow_mode)",
+        {"trace", "infinite", "culled", "clamped", "model"});
+  s.add("shadows.litmaps", c.litmaps,
+        "the litmaps the N-buffers are built over: trace (GL's images) or model (drawn by the model from the trace's object meshes: "
+        "the litmap draws with their reprojection test and the receiver splat, bit-exact with GL's at the captured size)",
+        {"trace", "model"});
+  s.add("shadows.litmap_size", c.litmap_size, "lexels",
+        "side of the model's litmaps and of both N-buffers (0: the trace's litmap_size); another size needs shadows.litmaps=model and "
+        "shadows.volumes infinite, culled or clamped",
+        0, 4096);
+  s.add("shadows.litmap_fragments_per_cycle", c.litmap_fragments_per_cycle, "fragments/cycle",
+        "the model's litmap passes (shadows.litmaps=model): litmap fragments (each reprojected) and splat points a cycle", 0.01, 1024.0);
 }
 
 ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ShadowsUnitConfig& config,
@@ -86,15 +98,37 @@ ShadowsUnit::ShadowsUnit(const sc_core::sc_module_name& name, stats::Registry& r
                                         "CRC-32 of the model's stencil buffer at each frame's end (a frame's value is its own; the run's is their sum)")),
       own_mask_diff_(stats().counter("own_mask_diff", "pixels",
                                      "with the model's own culled or clamped volumes: pixels where its mask differs from its own infinite "
-                                     "volumes' mask, cut at the same planes (must be 0)")) {
+                                     "volumes' mask, cut at the same planes (must be 0)")),
+      litmap_texel_diff_(stats().counter("litmap_texel_diff", "texels",
+                                         "with shadows.litmaps=model at the captured size: litmap texels (both litmaps) that differ from "
+                                         "GL's, bit for bit (must be 0)")),
+      litmap_fragment_diff_(stats().counter("litmap_fragment_diff", "draws",
+                                            "with shadows.litmaps=model at the captured size: litmap and splat draws whose rasterized "
+                                            "fragments differ from GL's counter (must be 0)")),
+      litmap_discarded_(stats().counter("litmap_discarded", "fragments",
+                                        "with shadows.litmaps=model: litmap fragments the reprojection test discarded (unseen by the observer)")),
+      model_litmap_frames_(stats().counter("model_litmap_frames", "frames", "frames whose litmaps the model drew")),
+      mask_errors_(stats().counter("mask_errors", "pixels",
+                                   "shadow-mask pixels unlike the reference of the volumes drawn: GL's mode and infinite masks for "
+                                   "GL's volumes (mask_diff + mask_diff_infinite), the model's own infinite volumes at the same planes "
+                                   "for its own culled or clamped ones (own_mask_diff); 0 for the model's own infinite volumes, their "
+                                   "own reference (must be 0)")) {
   if (config_.volumes != "trace") {
-    own_mode_ = parse_mode(config_.volumes);
+    own_mode_ = config_.volumes == "model" ? std::optional<Mode>(setup_.mode) : parse_mode(config_.volumes);
     if (!setup_.edge_rule)
       throw InputError(fmt::format("shadows.volumes={}: the model builds volumes with the paper's clamp rule (edge), and this trace was "
                                    "captured with clamp_rule caster, whose slabs need what the observer sees per object; capture it with "
                                    "--clamp-rule edge",
                                    config_.volumes));
   }
+  own_litmaps_ = config_.litmaps == "model";
+  if (other_size() && !own_litmaps_)
+    throw InputError(fmt::format("shadows.litmap_size={}: the trace's litmaps are {}x{}; another size needs shadows.litmaps=model",
+                                 setup_.litmap_size, setup_.trace_litmap_size, setup_.trace_litmap_size));
+  if (other_size() && !own_mode_)
+    throw InputError(fmt::format("shadows.litmap_size={}: GL's volumes belong to the captured {}x{} litmaps; another size needs the model's "
+                                 "own volumes (shadows.volumes=infinite, culled or clamped)",
+                                 setup_.litmap_size, setup_.trace_litmap_size, setup_.trace_litmap_size));
   NBSIM_CHECK(min_nb_.op() == FarOp::Min && max_nb_.op() == FarOp::Max, "the shadows program needs a min and a max N-buffer");
 }
 
@@ -146,20 +180,51 @@ void ShadowsUnit::issue_role(const std::shared_ptr<const scene::Frame>& f, scene
   }
 }
 
-std::uint64_t ShadowsUnit::build(query::NBufferStructure& nb, const scene::Frame& f, std::string_view name) {
-  const scene::DepthSnapshot* s = f.depth(name);
-  if (!s) throw InputError(fmt::format("frame {}: no '{}' depth image: the {} N-buffer has nothing to be built from", f.begin.frame,
-                                       name, name == "litmap_min" ? "min" : "max"));
-  if (s->width != setup_.litmap_size || s->height != setup_.litmap_size)
-    throw InputError(fmt::format("frame {}: the '{}' depth image is {}x{}, the trace's litmap_size {}", f.begin.frame, name,
-                                 s->width, s->height, setup_.litmap_size));
-  image_.width = s->width, image_.height = s->height;
-  image_.texels = s->texels;
+std::uint64_t ShadowsUnit::build(query::NBufferStructure& nb, const DepthImage& image) {
   // Every level of every texel from the new image (the litmaps are redrawn each frame).
   nbuffer::NBufferUnit& unit = nb.unit();
-  std::uint64_t texels = unit.depth_changed(image_, Rect{0, 0, s->width, s->height}).recomputed();
+  std::uint64_t texels = unit.depth_changed(image, Rect{0, 0, image.width, image.height}).recomputed();
   texels += unit.end_of_pass().recomputed();
   return texels;
+}
+
+const DepthImage& ShadowsUnit::litmap(const scene::Frame& f, bool max) {
+  if (own_litmaps_) return max ? own_.max : own_.min;
+  const char* name = max ? "litmap_max" : "litmap_min";
+  const scene::DepthSnapshot* s = f.depth(name);
+  if (s->width != setup_.litmap_size || s->height != setup_.litmap_size)
+    throw InputError(fmt::format("frame {}: the '{}' depth image is {}x{}, the trace's litmap_size {}", f.begin.frame, name, s->width,
+                                 s->height, setup_.litmap_size));
+  DepthImage& image = max ? gl_max_ : gl_min_;
+  image.width = s->width, image.height = s->height;
+  image.texels = s->texels;
+  return image;
+}
+
+void ShadowsUnit::draw_own_litmaps(const scene::Frame& f, const FrameCasters& c) {
+  const DepthImage sampled = sampled_depth_image(depth_, setup_.reference_path.depth_format);
+  LitmapCounters k;
+  own_ = draw_litmaps(f, *litmap_meshes_, light_of(c, f.begin.frame), setup_.litmap_size, setup_.reproject, sampled,
+                      setup_.reference_path, !other_size(), k);
+  label_with([&] { return fmt::format("litmap passes: {} fragments, {} splat points", k.fragments, k.splat_points); });
+  work(sim::batch_cycles(k.fragments + k.splat_points, config_.litmap_fragments_per_cycle, 0));
+  ++model_litmap_frames_;
+  litmap_draws_ += k.draws;
+  litmap_reprojections_ += k.fragments;
+  litmap_discarded_ += k.discarded;
+  receiver_splats_ += k.splat_fragments;
+  litmap_fragment_diff_ += k.fragment_diff;
+  if (other_size()) return;
+  for (const bool max : {false, true}) {
+    const scene::DepthSnapshot& gl = *f.depth(max ? "litmap_max" : "litmap_min");
+    const DepthImage& mine = max ? own_.max : own_.min;
+    if (gl.width != mine.width || gl.height != mine.height) {
+      litmap_texel_diff_ += mine.texels.size();
+      continue;
+    }
+    for (std::size_t i = 0; i < gl.texels.size(); ++i)
+      litmap_texel_diff_ += std::bit_cast<std::uint32_t>(gl.texels[i]) != std::bit_cast<std::uint32_t>(mine.texels[i]) ? 1 : 0;
+  }
 }
 
 void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, const LightDepth& light) {
@@ -172,6 +237,14 @@ void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, co
     outside_ += decision == Decision::OutsideLight ? 1 : 0;
     crossing_near_ += decision == Decision::CrossesNear ? 1 : 0;
     gl_culled_ += decision == Decision::Culled ? 1 : 0;
+    if (other_size()) {  // the rectangle at the model's size, from the caster's bounds
+      const CasterRect r = caster_rect(meshes_->bounds[i], light_of(c, f.begin.frame), setup_.litmap_size);
+      if (r.decision != Decision::Volume) continue;
+      index_.push_back(i);
+      rects_.push_back(Rect{r.x, r.y, r.w, r.h});
+      nearest_.push_back(0.0f);
+      continue;
+    }
     if (decision != Decision::Volume && decision != Decision::Culled) continue;
     index_.push_back(i);
     rects_.push_back(c.rect(i));
@@ -200,9 +273,18 @@ void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, co
     model_zmin_[i] = lo.value, model_zmax_[i] = hi.value;
     const auto texels = static_cast<std::uint32_t>(lo.lookups + hi.lookups);
     lookups_ += texels;
-    lookup_mismatches_ += texels != c.lookups[i] ? 1 : 0;
     build_texels_ += lo.update.recomputed() + hi.update.recomputed();  // lazy policy
-    const DepthRange exact = exact_range(*f.depth("litmap_min"), *f.depth("litmap_max"), rects_[k]);  // off the clock
+    if (other_size()) {  // GL's per-caster record belongs to its own litmap size: the design against its own litmaps' lexels
+      const DepthRange exact = exact_range(own_.min, own_.max, rects_[k]);  // off the clock
+      not_conservative_ += lo.value > exact.z_min || hi.value < exact.z_max ? 1 : 0;
+      unsafe_culls_ += litmap_rule_culls(lo.value, hi.value, c.caster_near[i], light, setup_.margin) &&
+                               !litmap_rule_culls(exact.z_min, exact.z_max, c.caster_near[i], light, setup_.margin)
+                           ? 1
+                           : 0;
+      continue;
+    }
+    lookup_mismatches_ += texels != c.lookups[i] ? 1 : 0;
+    const DepthRange exact = exact_range(litmap(f, false), litmap(f, true), rects_[k]);  // off the clock
     const CasterCheck k2 = check_caster(c, i, lo.value, hi.value, exact, light, setup_.margin);
     culled_ += k2.model_culled ? 1 : 0;
     kept_by_slab_ += k2.kept_by_slab ? 1 : 0;
@@ -229,9 +311,12 @@ void ShadowsUnit::compare_masks(const scene::Frame& f) {
   const scene::StencilSnapshot& infinite = image("shadow_mask_infinite");
   std::uint64_t set = 0;
   stencil_checksum_ += crc32(0L, stencil_.texels.data(), static_cast<uInt>(stencil_.texels.size()));
-  mask_diff_ += mask_pixels_differing(stencil_.texels, region, mask, &set);
+  const std::uint64_t diff = mask_pixels_differing(stencil_.texels, region, mask, &set);
+  const std::uint64_t diff_infinite = mask_pixels_differing(stencil_.texels, region, infinite);
+  mask_diff_ += diff;
   mask_pixels_ += set;
-  mask_diff_infinite_ += mask_pixels_differing(stencil_.texels, region, infinite);
+  mask_diff_infinite_ += diff_infinite;
+  if (!own_mode_) mask_errors_ += diff + diff_infinite;
   std::uint64_t gl_set = 0, gl_diff = 0;
   for (std::size_t i = 0; i < mask.texels.size(); ++i) {
     gl_set += mask.texels[i] != 0 ? 1 : 0;
@@ -249,10 +334,13 @@ void ShadowsUnit::compare_masks(const scene::Frame& f) {
     raster::DrawState state = raster::draw_state(d.state);
     state.stencil = raster::stencil_state(d.stencil);
     path.draw(reference_clip_, state);
+    std::uint64_t own = 0;
     for (std::size_t i = 0; i < reference.texels.size() && i < stencil_.texels.size(); ++i) {
       const bool lit = region.texels[i] != 0;
-      own_mask_diff_ += (lit && reference.texels[i] != 0) != (lit && stencil_.texels[i] != 0) ? 1 : 0;
+      own += (lit && reference.texels[i] != 0) != (lit && stencil_.texels[i] != 0) ? 1 : 0;
     }
+    own_mask_diff_ += own;
+    mask_errors_ += own;
   }
 }
 
@@ -269,20 +357,22 @@ void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>&
       throw InputError(fmt::format("frame {}: caster {} is object {} in ShadowCasters, {} in ShadowCasterMeshes", frame, i, c.object[i],
                                    meshes_->meshes[i].object));
     // The caster's rectangle from its bounds and the capture's light, against the record's.
-    const CasterRect rect = caster_rect(meshes_->bounds[i], light, static_cast<int>(c.litmap_size));
+    const CasterRect rect = caster_rect(meshes_->bounds[i], light, setup_.litmap_size);
     const auto recorded = static_cast<Decision>(c.decision[i]);
     const bool measured = recorded == Decision::Volume || recorded == Decision::Culled;
-    rect_mismatches_ += (measured ? rect.decision != Decision::Volume || rect.x != c.x[i] || rect.y != c.y[i] || rect.w != c.w[i] ||
-                                        rect.h != c.h[i]
-                                  : rect.decision != recorded)
-                            ? 1
-                            : 0;
+    if (!other_size())
+      rect_mismatches_ += (measured ? rect.decision != Decision::Volume || rect.x != c.x[i] || rect.y != c.y[i] || rect.w != c.w[i] ||
+                                          rect.h != c.h[i]
+                                    : rect.decision != recorded)
+                              ? 1
+                              : 0;
     // Its decision and planes from the model's own answers.
     float clamp_near = 0.0f, clamp_far = std::numeric_limits<float>::infinity();
     bool dropped = rect.decision == Decision::OutsideLight;
     if (rect.decision == Decision::Volume) {
       const Planes p = slab_planes(rect.caster_near, rect.caster_far, light, model_zmin_[i], model_zmax_[i], setup_.margin, ClampRule::Edge);
       dropped = p.culled;
+      if (other_size() && p.culled) ++culled_;  // (at the captured size, query_casters counts it)
       if (!p.culled) clamp_near = p.clamp_near, clamp_far = p.clamp_far;
     }
     if (mode != Mode::Infinite) {  // the reference: every caster's infinite volume at the same planes
@@ -325,9 +415,14 @@ void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Co
     throw InputError(fmt::format("frame {}: shadows.volumes={} needs the casters' meshes (a ShadowCasterMeshes record in the trace's first "
                                  "frame): capture the trace again with this nbsim",
                                  f->begin.frame, config_.volumes));
-  if (static_cast<int>(c.litmap_size) != setup_.litmap_size)
+  if (std::optional<LitmapMeshes> m = read_litmap_meshes(*f)) litmap_meshes_ = std::move(m);
+  if (own_litmaps_ && !litmap_meshes_)
+    throw InputError(fmt::format("frame {}: shadows.litmaps=model needs every object's mesh (a ShadowLitmapMeshes record in the trace's "
+                                 "first frame): capture the trace again with this nbsim",
+                                 f->begin.frame));
+  if (static_cast<int>(c.litmap_size) != setup_.trace_litmap_size)
     throw InputError(fmt::format("frame {}: the ShadowCasters record's litmap_size {} is not the header's {}", f->begin.frame,
-                                 c.litmap_size, setup_.litmap_size));
+                                 c.litmap_size, setup_.trace_litmap_size));
   if (!f->light) throw InputError(fmt::format("frame {}: no light camera (LGHT)", f->begin.frame));
   const std::optional<LightDepth> light = LightDepth::make(*f->light);
   if (!light)
@@ -343,14 +438,19 @@ void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Co
 
   // 1. The observer's depth.
   issue_role(f, scene::DrawRole::Scene, cp);
-  // 2. The litmap pass: GL's images; its reprojections are its fragments (no clip positions), and
-  //    the receiver splat's points (one observer texel read each) are its fragments.
-  for (const scene::DrawRecord& d : f->draws)
-    if (d.role == kLitmapRole) ++litmap_draws_, litmap_reprojections_ += d.gl.fragments;
-    else if (d.role == kReceiverSplatRole) receiver_splats_ += d.gl.fragments;
+  // 2. The litmap pass: the model's, once the observer's depth is done; or GL's images, whose
+  //    reprojections are GL's fragment counts, as are the receiver splat's points.
+  if (own_litmaps_) {
+    wait_all();
+    draw_own_litmaps(*f, c);
+  } else {
+    for (const scene::DrawRecord& d : f->draws)
+      if (d.role == kLitmapRole) ++litmap_draws_, litmap_reprojections_ += d.gl.fragments;
+      else if (d.role == kReceiverSplatRole) receiver_splats_ += d.gl.fragments;
+  }
   // 3. Both N-buffers from the litmaps (each unit's engine builds while the scene is drawn).
-  build_texels_ += build(min_nb_, *f, "litmap_min");
-  build_texels_ += build(max_nb_, *f, "litmap_max");
+  build_texels_ += build(min_nb_, litmap(*f, false));
+  build_texels_ += build(max_nb_, litmap(*f, true));
   // 4. The casters' queries and decisions (the query ports wait for their engines; a frame with no
   // caster to query still waits for both builds).
   query_casters(*f, c, *light);

@@ -1,11 +1,14 @@
 // ShadowsUnit: the frame program of shadow volumes with litmaps (N-buffer paper 3.3/4.4). Per frame:
 //  1. the recorded Scene draws (the observer's depth and, with DEPTH24_STENCIL8, its stencil);
-//  2. the litmaps: GL's litmap draws have no clip positions (their fragment shader discards what
-//     the observer does not see after reprojecting each fragment into the observer's view, a
-//     step the model does not replay), so the program takes the `litmap_min` and `litmap_max`
-//     depth images as GL computed them and counts the pass's reprojections as the litmap draws'
-//     rasterized fragments (GL's counter: one reprojection a fragment, reading up to 3x3 texels),
-//     and the receiver splat's points (role ReceiverSplat, one observer texel read each);
+//  2. the litmaps: with config shadows.litmaps = trace, the `litmap_min` and `litmap_max` depth
+//     images as GL computed them, the pass's reprojections counted as the litmap draws' rasterized
+//     fragments (GL's counter: one reprojection a fragment, reading up to 3x3 texels) and the
+//     receiver splat's points (role ReceiverSplat, one observer texel read each); with
+//     shadows.litmaps = model, the model draws both litmaps itself (litmap.h: the trace's object
+//     meshes, SHDM, from the light, each fragment reprojected into its own observer depth, and the
+//     splat), at the trace's litmap size (then compared texel by texel with GL's) or at
+//     shadows.litmap_size, after the observer's depth is done and timed at
+//     shadows.litmap_fragments_per_cycle;
 //  3. a min N-buffer over litmap_min and a max N-buffer over litmap_max (two instances of the
 //     N-buffer unit, "litmap_min" and "litmap_max", each with its own config), built from those
 //     images (every texel of every level, timed by each unit's update engine);
@@ -21,7 +24,8 @@
 //     shader does: a capture in one mode replays as any mode, bit-exact with a capture of that mode;
 //  6. at the end, the model's stencil buffer gives the shadow mask (STNC light_region AND
 //     stencil != 0), compared pixel by pixel with GL's `shadow_mask` and `shadow_mask_infinite`.
-// The litmaps are GL's in every case: another litmap size needs the litmap passes modelled.
+// Another litmap size needs the model's litmaps and its own volumes (GL's rectangles, decisions
+// and volumes belong to the captured size).
 #pragma once
 
 #include <map>
@@ -37,6 +41,7 @@
 #include "model/raster/raster_path.h"
 #include "model/raster/stencil_test.h"
 #include "model/shadows/caster.h"
+#include "model/shadows/litmap.h"
 #include "model/shadows/volume.h"
 
 namespace nbsim::shadows {
@@ -48,6 +53,11 @@ struct ShadowsUnitConfig {
   // volumes of mode "infinite", "culled" or "clamped" that the model builds itself from the trace's
   // caster meshes (SHDG) with its own decisions and planes.
   std::string volumes = "trace";
+  // Whose litmaps the N-buffers are built over: "trace" (GL's images) or "model" (drawn by the
+  // model from the trace's meshes, litmap.h), of side litmap_size (0: the trace's).
+  std::string litmaps = "trace";
+  int litmap_size = 0;
+  double litmap_fragments_per_cycle = 4.0;  // the model's litmap passes: fragments and points a cycle; tunable
 
   // Declares "shadows.<field>".
   static void describe(config::Schema& s, ShadowsUnitConfig& c);
@@ -56,7 +66,9 @@ struct ShadowsUnitConfig {
 // What the program needs to know about the trace (its header).
 struct ShadowsSetup {
   int width_px = 0, height_px = 0;
-  int litmap_size = 0;
+  int litmap_size = 0;        // the N-buffers' side: config litmap_size, or the trace's
+  int trace_litmap_size = 0;  // the header's litmap_size
+  ReprojectSettings reproject;  // the header's near, far and reproject_tolerance
   Mode mode = Mode::Clamped;
   ClampMargin margin;
   bool edge_rule = true;  // the trace's clamp_rule is the paper's ("edge")
@@ -89,6 +101,8 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
   void depth_written(const cp::Work&, const DepthImage&, const Rect&) override {}
   void draw_finished(const cp::Work& w, const depth::DrawResult& r) override;
 
+  // The side of the litmaps and N-buffers this replay uses (config litmap_size or the trace's).
+  int litmap_size() const noexcept { return setup_.litmap_size; }
   // The run's fill per caster class and reason kept.
   const FillBreakdown& breakdown() const noexcept { return breakdown_; }
 
@@ -96,7 +110,12 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
   void issue_role(const std::shared_ptr<const scene::Frame>& f, scene::DrawRole role, cp::CommandProcessor& cp);
   void wait_all();
   // Builds one N-buffer from the frame's depth image `name`; returns the texels recomputed.
-  std::uint64_t build(query::NBufferStructure& nb, const scene::Frame& f, std::string_view name);
+  std::uint64_t build(query::NBufferStructure& nb, const DepthImage& image);
+  // Draws the model's litmaps of the frame (config litmaps = model) and compares them with GL's.
+  void draw_own_litmaps(const scene::Frame& f, const FrameCasters& c);
+  // The litmap the frame's N-buffers are built over: the model's or GL's.
+  const DepthImage& litmap(const scene::Frame& f, bool max);
+  bool other_size() const noexcept { return setup_.litmap_size != setup_.trace_litmap_size; }
   void query_casters(const scene::Frame& f, const FrameCasters& c, const LightDepth& light);
   void compare_masks(const scene::Frame& f);
   // Builds and issues the model's own volumes of mode `mode` (config volumes).
@@ -119,7 +138,8 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
       &decision_mismatches_, &zmin_mismatches_, &zmax_mismatches_, &not_conservative_, &unsafe_culls_, &culls_lost_,
       &lookups_, &lookup_mismatches_, &build_texels_, &litmap_draws_, &litmap_reprojections_, &receiver_splats_, &scene_depth_tests_,
       &volume_draws_, &fill_, &gl_fill_, &reference_fill_, &reference_frames_, &stencil_tests_, &mask_pixels_, &gl_mask_pixels_, &mask_diff_, &mask_diff_infinite_,
-      &gl_mask_diff_, &model_volumes_, &rect_mismatches_, &stencil_checksum_, &own_mask_diff_;
+      &gl_mask_diff_, &model_volumes_, &rect_mismatches_, &stencil_checksum_, &own_mask_diff_, &litmap_texel_diff_,
+      &litmap_fragment_diff_, &litmap_discarded_, &model_litmap_frames_, &mask_errors_;
 
   FillBreakdown breakdown_;
   std::vector<FillShare*> volume_share_;  // this frame's draw index -> its caster's share (null: none)
@@ -127,6 +147,10 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
   std::vector<float> model_zmin_, model_zmax_;  // this frame's answers per caster (1 and 0: not measured)
   std::optional<Mode> own_mode_;                 // config volumes, when the model builds them
   std::optional<CasterMeshes> meshes_;     // the trace's SHDG, from its first frame
+  std::optional<LitmapMeshes> litmap_meshes_;  // its SHDM
+  bool own_litmaps_ = false;                // config litmaps = model
+  LitmapImages own_;                         // this frame's model litmaps
+  DepthImage gl_min_, gl_max_;               // this frame's GL litmaps (config litmaps = trace)
   std::vector<Rect> rects_;
   std::vector<float> nearest_;
   std::vector<std::size_t> index_;

@@ -43,6 +43,7 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
   {
     config::Schema schema;  // a bad key was refused before the capture (run_replay_bench's caller checks nothing: here)
     pipeline::GpuConfig::describe(schema, r.config);
+    for (const std::string& set : preset.replay_sets) schema.set(set);
     for (const std::string& set : o.sets) schema.set(set);
     r.config_values = schema.values();
   }
@@ -66,7 +67,9 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
   const auto mode = values.find(preset.mode_option);
   j["mode"] = mode == values.end() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(mode->second);
   j["options"] = values;
-  j["sets"] = o.sets;
+  std::vector<std::string> sets = preset.replay_sets;
+  sets.insert(sets.end(), o.sets.begin(), o.sets.end());
+  j["sets"] = sets;
   j["draws"] = s.draws;
   j["gl_ms"] = cap.gl_ms;
   j["replay_ms"] = s.host_seconds * 1e3;

@@ -67,6 +67,9 @@ struct BenchPreset {
   std::string scene = "city", path = "walk", size = "512x512";
   OptionValues options;     // capture options the preset sets (the rest keep their defaults)
   std::string mode_option;  // the capture option the bench's --mode sets ("": --mode is refused)
+  // Model config keys the bench's replay sets (unit.field=value) before the user's --set: what makes
+  // the replay model the technique's whole frame.
+  std::vector<std::string> replay_sets;
 };
 
 // Another name of a technique's capture with its scene fixed: `nbsim capture ALIAS ...` is

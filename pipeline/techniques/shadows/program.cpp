@@ -26,7 +26,14 @@ Program build(const ProgramContext& c) {
   // The header's shadows keys were checked against their declarations when the trace was opened
   // (traces/format/shadows/shadows_chunk.cpp).
   s.mode = *shadows::parse_mode(c.header.text("shadow_mode"));
-  s.litmap_size = static_cast<int>(c.header.whole("litmap_size"));
+  s.trace_litmap_size = static_cast<int>(c.header.whole("litmap_size"));
+  const auto& config = c.config.group<shadows::ShadowsUnitConfig>("shadows");
+  s.litmap_size = config.litmap_size > 0 ? config.litmap_size : s.trace_litmap_size;
+  const shadows::ClampMargin tolerance = *shadows::parse_clamp_margin(c.header.text("reproject_tolerance"));
+  s.reproject.tolerance_rel = static_cast<float>(tolerance.rel);
+  s.reproject.tolerance_m = static_cast<float>(tolerance.metres);
+  s.reproject.near_m = static_cast<float>(c.header.real("near"));
+  s.reproject.far_m = static_cast<float>(c.header.real("far"));
   s.margin = *shadows::parse_clamp_margin(c.header.text("clamp_margin"));
   s.edge_rule = c.header.text("clamp_rule") == "edge";
   s.reference_path.width_px = c.view.width_px;
@@ -43,7 +50,7 @@ Program build(const ProgramContext& c) {
   };
   auto min_nb = nbuffer("litmap_min", FarOp::Min);
   auto max_nb = nbuffer("litmap_max", FarOp::Max);
-  auto unit = std::make_unique<shadows::ShadowsUnit>("shadows", c.registry, c.config.group<shadows::ShadowsUnitConfig>("shadows"), s, c.depth_buffer, c.stencil_buffer, *min_nb, *max_nb);
+  auto unit = std::make_unique<shadows::ShadowsUnit>("shadows", c.registry, config, s, c.depth_buffer, c.stencil_buffer, *min_nb, *max_nb);
   p.structures.push_back(std::move(min_nb));
   p.structures.push_back(std::move(max_nb));
   p.frames = unit.get();
@@ -53,10 +60,10 @@ Program build(const ProgramContext& c) {
 }
 
 // The shadows program's counters in run.json's per-frame values (differences at frame ends).
-constexpr std::array<const char*, 21> kShadowsFrameCounts = {"model_volumes", "stencil_checksum",
+constexpr std::array<const char*, 24> kShadowsFrameCounts = {"model_volumes", "stencil_checksum",
     "casters",     "culled",          "gl_culled",       "outside",    "crossing_near",       "kept_by_slab", "reference_fill",
-    "lookups",     "build_texels",    "litmap_reprojections", "receiver_splats", "volume_draws", "fill", "gl_fill",
-    "stencil_tests", "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches"};
+    "lookups",     "build_texels",    "litmap_reprojections", "receiver_splats", "litmap_texel_diff", "litmap_fragment_diff", "volume_draws", "fill", "gl_fill",
+    "stencil_tests", "mask_pixels", "mask_diff",       "mask_diff_infinite", "decision_mismatches", "mask_errors"};
 
 // The per-frame values the summary keeps (the shadows table's per-frame fill and culls).
 constexpr std::array<const char*, 6> kPerFrame = {"fill", "reference_fill", "culled", "gl_culled", "mask_diff", "mask_diff_infinite"};
@@ -88,7 +95,8 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, std::uint64_t cyc
   j["cycles_per_frame"] = per_frame(cycles);
   for (const char* name : {"decision_mismatches", "zmin_mismatches", "zmax_mismatches", "not_conservative", "unsafe_culls",
                            "culls_lost", "lookup_mismatches", "mask_diff", "mask_diff_infinite", "gl_mask_diff", "gl_mask_pixels",
-                           "model_volumes", "rect_mismatches", "own_mask_diff"})
+                           "model_volumes", "rect_mismatches", "own_mask_diff", "model_litmap_frames", "litmap_texel_diff",
+                           "litmap_fragment_diff", "litmap_discarded", "mask_errors"})
     j[name] = stat(p, name);
   return j;
 }
@@ -103,6 +111,7 @@ nlohmann::ordered_json summary(const SummaryInputs& in) {
   // Where the fill goes: per caster class and reason kept, per frame, largest fill first.
   nlohmann::ordered_json rows = nlohmann::ordered_json::array();
   if (const auto* unit = dynamic_cast<const shadows::ShadowsUnit*>(in.program.unit.get())) {
+    j["replayed_litmap_size"] = unit->litmap_size();  // the header's litmap_size, or config shadows.litmap_size
     const double frames = std::max<double>(1.0, static_cast<double>(stat(in.group, "frames")));
     std::vector<std::pair<const std::pair<std::string, std::string>*, const shadows::FillShare*>> shares;
     for (const auto& [key, share] : unit->breakdown()) shares.emplace_back(&key, &share);

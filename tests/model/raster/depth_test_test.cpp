@@ -69,6 +69,31 @@ TEST(DepthTestTest, DisabledTestPassesWithoutWriting) {
   EXPECT_EQ(img.at(0, 0), 0.25f);
 }
 
+// A fragment shader's discard runs before the depth test: a discarded fragment is rasterized
+// (counted) but never tested or written, and the shader sees the depth before the [0, 1] clamp.
+TEST(DepthTestTest, FragmentShaderDiscardsBeforeTheTest) {
+  struct OddColumns final : FragmentShader {
+    mutable float last_z = 0.0f;
+    bool discards(int x, int, float z) const override {
+      last_z = z;
+      return x % 2 == 1;
+    }
+  } shader;
+  DepthImage img(8, 8, 1.0f);
+  EarlyDepthTest unit(img);
+  DepthCounters k;
+  DepthState state{DepthFunc::Less, true, true};
+  state.shader = &shader;
+  unit.test_block(DepthPlane{-0.25f, 0, 0}, 0, 0, 0x000f, state, k);  // pixels (0..3, 0)
+  EXPECT_EQ(k.fragments, 4u);
+  EXPECT_EQ(k.shader_discarded, 2u);
+  EXPECT_EQ(k.depth_tests, 2u);
+  EXPECT_EQ(k.written, 2u);
+  EXPECT_EQ(img.at(0, 0), 0.0f) << "the kept fragment's depth, clamped";
+  EXPECT_EQ(img.at(1, 0), 1.0f) << "a discarded fragment writes nothing";
+  EXPECT_EQ(shader.last_z, -0.25f) << "gl_FragCoord.z is not clamped";
+}
+
 // llvmpipe's 24-bit depth: the product rounded to float, then ties to even; ends and NaN fixed.
 TEST(DepthTestTest, Unorm24Conversion) {
   struct Row {

@@ -111,8 +111,9 @@ TEST(ShadowsCoreTest, CasterChecks) {
 
 // The exact range reads the rectangle's lexels only: the min of litmap_min, the max of litmap_max.
 TEST(ShadowsCoreTest, ExactRangeOfARectangle) {
-  const nbsim::scene::DepthSnapshot lo{"litmap_min", 3, 2, {0.5f, 0.2f, 0.9f, 0.6f, 0.7f, 0.1f}};
-  const nbsim::scene::DepthSnapshot hi{"litmap_max", 3, 2, {0.5f, 0.8f, 0.9f, 0.6f, 0.7f, 0.95f}};
+  nbsim::DepthImage lo(3, 2, 0.0f), hi(3, 2, 0.0f);
+  lo.texels = {0.5f, 0.2f, 0.9f, 0.6f, 0.7f, 0.1f};
+  hi.texels = {0.5f, 0.8f, 0.9f, 0.6f, 0.7f, 0.95f};
   const DepthRange r = exact_range(lo, hi, nbsim::Rect{0, 0, 2, 2});
   EXPECT_FLOAT_EQ(r.z_min, 0.2f);
   EXPECT_FLOAT_EQ(r.z_max, 0.8f) << "0.9 and 0.95 lie outside the rectangle";

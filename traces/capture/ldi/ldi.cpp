@@ -265,7 +265,7 @@ const std::vector<OptionSpec>& ldi_options() {
 
 BenchPreset ldi_bench_preset() {
   // The LDI work does not look at the observer: the smallest scene and viewport the capture accepts.
-  return {"boxes", "fly", "8x8", {{"boxes", "0"}, {"shape", "knot"}, {"ldi-size", "256"}}, "shape"};
+  return {"boxes", "fly", "8x8", {{"boxes", "0"}, {"shape", "knot"}, {"ldi-size", "256"}}, "shape", {}};
 }
 
 std::unique_ptr<Technique> make_ldi(const TechniqueSetup& setup) { return std::make_unique<Ldi>(setup); }

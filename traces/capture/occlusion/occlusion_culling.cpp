@@ -248,7 +248,7 @@ const std::vector<OptionSpec>& occlusion_culling_options() {
 
 BenchPreset occlusion_culling_bench_preset() {
   // The flat occlusion queries draw every candidate's box: the most raster work.
-  return {"city", "walk", "512x512", {{"mode", "oq"}, {"levels-every", "0"}}, "mode"};
+  return {"city", "walk", "512x512", {{"mode", "oq"}, {"levels-every", "0"}}, "mode", {}};
 }
 
 std::unique_ptr<Technique> make_occlusion_culling(const TechniqueSetup& setup) { return std::make_unique<OcclusionCulling>(setup); }

@@ -395,7 +395,7 @@ const std::vector<OptionSpec>& particles_options() {
 }
 
 BenchPreset particles_bench_preset() {
-  return {"city", "walk", "512x512", {{"mode", "nb"}, {"levels-every", "0"}, {"particles", "10000"}, {"sprite", "16"}}, "mode"};
+  return {"city", "walk", "512x512", {{"mode", "nb"}, {"levels-every", "0"}, {"particles", "10000"}, {"sprite", "16"}}, "mode", {}};
 }
 
 std::unique_ptr<Technique> make_particles(const TechniqueSetup& setup) { return std::make_unique<Particles>(setup); }

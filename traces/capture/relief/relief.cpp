@@ -488,7 +488,7 @@ const std::vector<OptionSpec>& relief_options() {
 
 BenchPreset relief_bench_preset() {
   // The box is seen from its own camera: the smallest scene the capture accepts; --size is the viewport.
-  return {"boxes", "fly", "512x512", {{"boxes", "0"}, {"field", "fbm"}, {"field-size", "128"}}, "field"};
+  return {"boxes", "fly", "512x512", {{"boxes", "0"}, {"field", "fbm"}, {"field-size", "128"}}, "field", {}};
 }
 
 std::unique_ptr<Technique> make_relief(const TechniqueSetup& setup) { return std::make_unique<Relief>(setup); }

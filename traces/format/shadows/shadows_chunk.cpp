@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <set>
 #include <string>
 #include <variant>
 
@@ -104,11 +105,11 @@ ChunkSpec shadows_chunk_spec() {
 
 namespace {
 
-// The rule of caster_meshes_chunk_spec().
-std::string caster_meshes_rule(const TechniqueRecord& r) {
+// What SHDG and SHDM share: per mesh an object id and a range of `triangles`, whose indices name
+// vertices of `vertices`. `what` names a mesh in messages ("caster"); "" when the rule holds.
+std::string mesh_ranges_rule(const TechniqueRecord& r, std::string_view what) {
   const std::uint64_t count = scalar(r, "count");
   const auto& object = vec<std::uint32_t>(r, "object");
-  const auto& bounds = vec<float>(r, "bounds");
   const auto& first = vec<std::uint32_t>(r, "first_triangle");
   const auto& tris = vec<std::uint32_t>(r, "triangle_count");
   const auto& vertices = vec<float>(r, "vertices");
@@ -116,15 +117,33 @@ std::string caster_meshes_rule(const TechniqueRecord& r) {
   if (object.size() != count || first.size() != count || tris.size() != count)
     return fmt::format("object, first_triangle and triangle_count have {}, {} and {} elements, but count is {}", object.size(), first.size(),
                        tris.size(), count);
-  if (bounds.size() != 6 * count) return fmt::format("bounds has {} floats, not six for each of {} casters", bounds.size(), count);
   if (vertices.size() % 3 != 0) return fmt::format("vertices has {} floats, not three a vertex", vertices.size());
   if (indices.size() % 3 != 0) return fmt::format("triangles has {} indices, not three a triangle", indices.size());
   for (std::size_t c = 0; c < count; ++c)
     if (static_cast<std::uint64_t>(first[c]) + tris[c] > indices.size() / 3)
-      return fmt::format("caster {} (object {}): triangles {} + {} run past the {} triangles", c, object[c], first[c], tris[c], indices.size() / 3);
+      return fmt::format("{} {} (object {}): triangles {} + {} run past the {} triangles", what, c, object[c], first[c], tris[c],
+                         indices.size() / 3);
   for (std::size_t i = 0; i < indices.size(); ++i)
     if (indices[i] >= vertices.size() / 3)
       return fmt::format("triangle index {} is vertex {}, but there are {} vertices", i, indices[i], vertices.size() / 3);
+  return {};
+}
+
+// The rule of caster_meshes_chunk_spec().
+std::string caster_meshes_rule(const TechniqueRecord& r) {
+  const std::uint64_t count = scalar(r, "count");
+  const auto& bounds = vec<float>(r, "bounds");
+  if (std::string e = mesh_ranges_rule(r, "caster"); !e.empty()) return e;
+  if (bounds.size() != 6 * count) return fmt::format("bounds has {} floats, not six for each of {} casters", bounds.size(), count);
+  return {};
+}
+
+// The rule of litmap_meshes_chunk_spec().
+std::string litmap_meshes_rule(const TechniqueRecord& r) {
+  if (std::string e = mesh_ranges_rule(r, "mesh"); !e.empty()) return e;
+  std::set<std::uint32_t> seen;
+  for (const std::uint32_t o : vec<std::uint32_t>(r, "object"))
+    if (!seen.insert(o).second) return fmt::format("object {} is listed twice", o);
   return {};
 }
 
@@ -166,6 +185,22 @@ ChunkSpec caster_meshes_chunk_spec() {
   return spec;
 }
 
-TechniqueFormat shadows_format() { return {{shadows_chunk_spec(), caster_meshes_chunk_spec()}, shadows_header_keys()}; }
+ChunkSpec litmap_meshes_chunk_spec() {
+  ChunkSpec spec{kLitmapMeshesChunk,
+                 "shadows",
+                 "ShadowLitmapMeshes",
+                 {{"count", FieldKind::U32, "scene objects (every object a litmap draw may draw)"},
+                  {"object", FieldKind::VecU32, "each object's id"},
+                  {"first_triangle", FieldKind::VecU32, "each object's first triangle in `triangles`"},
+                  {"triangle_count", FieldKind::VecU32, "its triangles, in the order GL draws them"},
+                  {"vertices", FieldKind::VecF32, "world positions, x, y, z a vertex (metres, y up)"},
+                  {"triangles", FieldKind::VecU32, "three vertex indices a triangle"}}};
+  spec.rule = litmap_meshes_rule;
+  return spec;
+}
+
+TechniqueFormat shadows_format() {
+  return {{shadows_chunk_spec(), caster_meshes_chunk_spec(), litmap_meshes_chunk_spec()}, shadows_header_keys()};
+}
 
 }  // namespace nbsim::trace

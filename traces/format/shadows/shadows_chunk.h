@@ -16,6 +16,9 @@ inline constexpr std::uint32_t kShadowsChunk = fourcc("SHDC");
 // The casters' meshes (ShadowCasterMeshes), in the first frame of a trace only: what the model
 // builds shadow volumes from (model/shadows/volume.h).
 inline constexpr std::uint32_t kCasterMeshesChunk = fourcc("SHDG");
+// Every scene object's mesh (ShadowLitmapMeshes), in the first frame of a trace only: what the
+// model draws its own litmaps from (model/shadows/litmap.h).
+inline constexpr std::uint32_t kLitmapMeshesChunk = fourcc("SHDM");
 
 // Decisions of the SHDC field `decision` (fixed values: they are in files).
 enum class CasterDecision : std::uint32_t {
@@ -34,6 +37,11 @@ ChunkSpec shadows_chunk_spec();
 // range of `triangles` (three vertex indices each, into `vertices`, three floats each). Its rule:
 // the vectors' lengths agree, every range and vertex index is inside its array.
 ChunkSpec caster_meshes_chunk_spec();
+
+// The litmap meshes: count, object ids, each object's triangles as a range of `triangles` (three
+// vertex indices each, into `vertices`, three floats each). Its rule: the vectors' lengths agree,
+// every range and vertex index is inside its array, no object twice.
+ChunkSpec litmap_meshes_chunk_spec();
 
 // Its header keys (what the replay reads to build the litmaps' N-buffers and clamp the volumes).
 std::vector<HeaderKeySpec> shadows_header_keys();

@@ -2,13 +2,16 @@
 // and city in every shadow mode, replayed by the shadows program: every draw's fragments and passed
 // samples equal GL's, the stencil buffer and both shadow masks equal GL's, the model's z_min/z_max
 // and lookups equal the capture's and no decision unlike the capture's rule; the fill falls from
-// infinite to culled to clamped. A u16, divisor-2 or level-capped N-buffer stays conservative; a
+// infinite to culled to clamped. The model's own volumes replay any mode, and its own litmaps equal
+// GL's at the captured size and give GL's clamped result at 32 and 128 lexels. A u16, divisor-2 or level-capped N-buffer stays conservative; a
 // damaged SHDC record, a missing litmap or a truncated trace is refused with exit 2; `nbsim shadows --json` rows.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
 #include <map>
 #include <string>
 #include <variant>
@@ -36,9 +39,12 @@ const std::map<std::string, std::string> kSceneArgs = {
 
 // Captures `scene` in `mode` once per test binary run (cached by name).
 fs::path capture(const std::string& scene, const std::string& mode, const std::string& extra = "") {
-  const fs::path t = scratch(scene + "_" + mode + (extra.empty() ? "" : "_x") + ".nbt");
+  std::string tag;
+  for (const char ch : extra) tag += std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
+  const fs::path t = scratch(scene + "_" + mode + (extra.empty() ? "" : "_" + tag) + ".nbt");
   if (fs::exists(t)) return t;
-  const CliResult c = run_nbsim("capture shadows " + kSceneArgs.at(scene) + " --path fly --size 128x96 --frames 2 --litmap 64 "
+  const std::string litmap = extra.find("--litmap ") == std::string::npos ? "--litmap 64 " : "";
+  const CliResult c = run_nbsim("capture shadows " + kSceneArgs.at(scene) + " --path fly --size 128x96 --frames 2 " + litmap +
                                 "--shadow-mode " + mode + " " + extra + " -o " + t.string());
   EXPECT_EQ(c.status, 0) << scene << " " << mode << ": " << c.out << c.err;
   return t;
@@ -50,6 +56,28 @@ nlohmann::json replay(const fs::path& t, const std::string& sets = "", const std
   EXPECT_EQ(r.status, 0) << r.out << r.err;
   std::ifstream in(dir / "run.json");
   return nlohmann::json::parse(in);
+}
+
+// Rewrites `good` into `bad`, frame 1 changed by `edit` (and frame 0 by `first`).
+template <class Edit, class First = void (*)(nbsim::scene::Frame&)>
+void rewrite(const fs::path& good, const fs::path& bad, Edit edit, First first = [](nbsim::scene::Frame&) {}) {
+  nbsim::trace::FrameReader in(good);
+  nbsim::trace::TraceWriter w(bad, in.trace().properties());
+  if (in.trace().scene()) w.write(*in.trace().scene());
+  while (auto f = in.next()) {
+    if (f->ordinal == 1) edit(*f);
+    if (f->ordinal == 0) first(*f);
+    w.begin_frame(f->begin);
+    for (const auto& d : f->draws) w.write(d);
+    for (const auto& d : f->depths) w.write(d);
+    for (const auto& l : f->levels) w.write(l);
+    for (const auto& s : f->stencils) w.write(s);
+    if (f->light) w.write_light(*f->light);
+    for (const auto& r : f->technique_records) w.write(r);
+    if (f->truth) w.write(*f->truth);
+    w.end_frame(f->end);
+  }
+  w.close();
 }
 
 class ShadowsReplayTest : public ::testing::TestWithParam<std::string> {};
@@ -136,6 +164,76 @@ TEST_P(ShadowsReplayTest, ModelBuiltVolumesReplayAnyMode) {
     }
 }
 
+// The model's own litmaps (shadows.litmaps=model, drawn from the trace's object meshes): at the
+// captured size every litmap texel and every litmap and splat draw's fragment count equal GL's; at
+// another size (half and twice the captured side), an infinite capture replayed as clamped gives
+// the fill, the stencil buffer frame by frame and the mask of a clamped capture at that size on GL.
+TEST_P(ShadowsReplayTest, ModelLitmapsAtAnySize) {
+  const std::string scene = GetParam();
+  const auto checksums = [](const nlohmann::json& run) {
+    std::vector<std::uint64_t> v;
+    for (const auto& f : run["frames"]) v.push_back(f["stencil_checksum"].get<std::uint64_t>());
+    return v;
+  };
+  {
+    SCOPED_TRACE(scene + ": the captured size");
+    const auto run = replay(capture(scene, "clamped"), " --set shadows.litmaps=model", "own_litmaps");
+    const auto& s = run["summary"]["shadows"];
+    EXPECT_EQ(s["model_litmap_frames"], 2);
+    EXPECT_EQ(s["litmap_texel_diff"], 0) << "both litmaps equal GL's, bit for bit";
+    EXPECT_EQ(s["litmap_fragment_diff"], 0) << "every litmap and splat draw rasterizes GL's fragments";
+    EXPECT_GT(s["litmap_discarded"].get<int>(), 0) << "the reprojection test drops what the observer cannot see";
+    EXPECT_EQ(s["zmin_mismatches"], 0);
+    EXPECT_EQ(s["zmax_mismatches"], 0);
+    EXPECT_EQ(s["fill"], s["gl_fill"]);
+    EXPECT_EQ(s["mask_diff"], 0);
+  }
+  for (const int size : {32, 128}) {
+    SCOPED_TRACE(scene + ": litmaps of " + std::to_string(size));
+    const std::string litmap = "--litmap " + std::to_string(size);
+    const auto gl = replay(capture(scene, "clamped", litmap));
+    const auto run = replay(capture(scene, "infinite"),
+                            " --set shadows.litmaps=model --set shadows.volumes=clamped --set shadows.litmap_size=" + std::to_string(size),
+                            "as_clamped_" + std::to_string(size));
+    const auto& s = run["summary"]["shadows"];
+    const auto& g = gl["summary"]["shadows"];
+    EXPECT_EQ(s["model_volumes"], g["volume_draws"]) << "the volumes a clamped capture at that size drew";
+    EXPECT_EQ(s["fill"], g["gl_fill"]) << "GL's clamped fill at that size";
+    EXPECT_EQ(checksums(run), checksums(gl)) << "GL's stencil buffer at that size, frame by frame";
+    EXPECT_EQ(s["mask_pixels"], g["gl_mask_pixels"]);
+    EXPECT_EQ(s["own_mask_diff"], 0);
+    EXPECT_EQ(s["culled"], g["gl_culled"]) << "the casters GL culled at that size";
+  }
+}
+
+// Another litmap size without the model's litmaps and volumes, or a trace without SHDM, is refused.
+TEST(ShadowsModelLitmapsTest, BadSettingsRefused) {
+  const fs::path t = capture("boxes", "clamped");
+  const auto refused = [&](const std::string& sets, const std::string& message, const fs::path& trace) {
+    const CliResult r = run_nbsim("replay " + trace.string() + " --out " + (t.parent_path() / "bad_litmaps_run").string() + sets);
+    EXPECT_EQ(r.status, 2) << sets << ": " << r.out << r.err;
+    EXPECT_TRUE(has(r.err, message)) << r.err;
+  };
+  refused(" --set shadows.litmap_size=32", "another size needs shadows.litmaps=model", t);
+  refused(" --set shadows.litmap_size=32 --set shadows.litmaps=model", "needs the model's own volumes", t);
+  const fs::path bare = scratch("no_litmap_meshes.nbt");
+  rewrite(t, bare, [](nbsim::scene::Frame&) {}, [](nbsim::scene::Frame& f) {
+    std::erase_if(f.technique_records, [](const auto& r) { return r.type == nbsim::trace::fourcc("SHDM"); });
+  });
+  refused(" --set shadows.litmaps=model", "needs every object's mesh (a ShadowLitmapMeshes record", bare);
+}
+
+// The litmap comparison sees a single changed texel of GL's litmap.
+TEST(ShadowsModelLitmapsTest, OneChangedTexelCounted) {
+  const fs::path bad = scratch("one_texel.nbt");
+  rewrite(capture("boxes", "clamped"), bad, [](nbsim::scene::Frame& f) {
+    for (auto& d : f.depths)
+      if (d.name == "litmap_min") d.texels[d.texels.size() / 2] = std::nextafter(d.texels[d.texels.size() / 2], 0.0f);
+  });
+  const auto run = replay(bad, " --set shadows.litmaps=model", "own");
+  EXPECT_EQ(run["summary"]["shadows"]["litmap_texel_diff"], 1);
+}
+
 // A lossy design of both N-buffers (u16, a quarter of the resolution) with the model's own clamped
 // volumes: looser slabs, so at least GL's clamped fill, and the mask equal to the model's own
 // infinite volumes' cut at the same planes (GL's infinite reference is cut at GL's planes, so a few
@@ -188,27 +286,6 @@ TEST(ShadowsDesignTest, ReducedNBuffersStayConservative) {
   const auto u16 = replay(t, designs[0].sets, "u16b")["summary"]["shadows"];
   const auto full = replay(t)["summary"]["shadows"];
   EXPECT_LE(u16["culled"].get<int>(), full["culled"].get<int>()) << "a looser design culls no more";
-}
-
-// Rewrites `good` into `bad`, frame 1 changed by `edit`.
-template <class Edit>
-void rewrite(const fs::path& good, const fs::path& bad, Edit edit) {
-  nbsim::trace::FrameReader in(good);
-  nbsim::trace::TraceWriter w(bad, in.trace().properties());
-  if (in.trace().scene()) w.write(*in.trace().scene());
-  while (auto f = in.next()) {
-    if (f->ordinal == 1) edit(*f);
-    w.begin_frame(f->begin);
-    for (const auto& d : f->draws) w.write(d);
-    for (const auto& d : f->depths) w.write(d);
-    for (const auto& l : f->levels) w.write(l);
-    for (const auto& s : f->stencils) w.write(s);
-    if (f->light) w.write_light(*f->light);
-    for (const auto& r : f->technique_records) w.write(r);
-    if (f->truth) w.write(*f->truth);
-    w.end_frame(f->end);
-  }
-  w.close();
 }
 
 void expect_refused(const fs::path& bad, const std::string& message) {

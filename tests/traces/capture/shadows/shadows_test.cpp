@@ -74,8 +74,8 @@ std::vector<FrameResult> check_trace(const fs::path& file, const std::string& mo
     r.mask = f->stencil("shadow_mask")->texels;
     r.reference = f->stencil("shadow_mask_infinite")->texels;
     EXPECT_EQ(r.mask, r.reference) << "frame " << f->begin.frame << ": the " << mode << " mask differs from the infinite one";
-    const std::size_t records = f->begin.frame == 0 ? 2 : 1;
-    EXPECT_EQ(f->technique_records.size(), records) << "one SHDC record a frame, and the casters' meshes (SHDG) in the first";
+    const std::size_t records = f->begin.frame == 0 ? 3 : 1;
+    EXPECT_EQ(f->technique_records.size(), records) << "one SHDC record a frame, and the casters' (SHDG) and every object's (SHDM) meshes in the first";
     if (f->technique_records.size() != records) return out;
     const auto& rec = f->technique_records[0];
     EXPECT_EQ(rec.type, trace::kShadowsChunk);
@@ -197,7 +197,7 @@ TEST(ShadowsTest, GroundFacingTheLightKeepsItsShadow) {
   const auto counts = render_once("boxes", o, {{b.hi[0] + 5.0f, 3.0f, bz}, {b.hi[0] + 5.5f, 0.0f, bz}}, &f);
   EXPECT_GT(counts.at("mask_pixels"), 0u) << "the box's shadow is seen";
   EXPECT_EQ(counts.at("mask_diff_pixels"), 0u) << "clamped to a zero-thickness slab, the mask is the infinite one";
-  ASSERT_EQ(f.technique_records.size(), 2u) << "SHDC and, in the first frame, SHDG";
+  ASSERT_EQ(f.technique_records.size(), 3u) << "SHDC and, in the first frame, SHDG and SHDM";
   const auto& rec = f.technique_records[0];
   const auto& object = field<std::uint32_t>(rec, "object");
   ASSERT_EQ(object.size(), 1u) << "one caster: the box (the plane is open)";

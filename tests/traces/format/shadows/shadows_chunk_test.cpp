@@ -123,4 +123,27 @@ TEST(ShadowsChunkTest, CasterMeshesDecodedAndDamageRefused) {
   EXPECT_TRUE(has(e, "triangle index 11 is vertex 9, but there are 4 vertices")) << e;
 }
 
+// SHDM, every object's mesh: decoded, encoded back to the same bytes; an object listed twice and a
+// range outside the triangles refused, naming them.
+TEST(ShadowsChunkTest, LitmapMeshesDecodedAndDamageRefused) {
+  auto payload = [](std::vector<std::uint32_t> object, std::vector<std::uint32_t> first) {
+    bytes::Out o;
+    o.u32(static_cast<std::uint32_t>(object.size()));
+    o.counted_words(object);
+    o.counted_words(first);
+    o.counted_words(std::vector<std::uint32_t>(object.size(), 1));  // triangle_count
+    o.counted_words(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0});  // vertices
+    o.counted_words(std::vector<std::uint32_t>{0, 1, 2, 2, 1, 0});  // triangles
+    return o.take();
+  };
+  const auto raw = payload({3, 7}, {0, 1});
+  const TechniqueRecord r = decode_technique(kLitmapMeshesChunk, raw);
+  ASSERT_TRUE(r.decoded) << "the format library registers SHDM";
+  EXPECT_EQ(encode(r), raw);
+  std::string e = record_error(kLitmapMeshesChunk, payload({3, 3}, {0, 1}));
+  EXPECT_TRUE(has(e, "(SHDM)") && has(e, "object 3 is listed twice")) << e;
+  e = record_error(kLitmapMeshesChunk, payload({3, 7}, {0, 2}));
+  EXPECT_TRUE(has(e, "mesh 1 (object 7): triangles 2 + 1 run past the 2 triangles")) << e;
+}
+
 }  // namespace
