@@ -31,6 +31,10 @@ void ShadowsUnitConfig::describe(config::Schema& s, ShadowsUnitConfig& c) {
         "side of the model's litmaps and of both N-buffers (0: the trace's litmap_size); another size needs shadows.litmaps=model and "
         "shadows.volumes infinite, culled or clamped",
         0, 4096);
+  s.add("shadows.own_reference", c.own_reference,
+        "with the model's own culled or clamped volumes: draw its own infinite volumes at the same planes off the clock each frame "
+        "and count the mask pixels unlike them (own_mask_diff, mask_errors); false skips the check (as the capture's timing leaves "
+        "out GL's reference pass)");
   s.add("shadows.litmap_fragments_per_cycle", c.litmap_fragments_per_cycle, "fragments/cycle",
         "the model's litmap passes (shadows.litmaps=model): litmap fragments (each reprojected) and splat points a cycle", 0.01, 1024.0);
 }
@@ -188,17 +192,17 @@ std::uint64_t ShadowsUnit::build(query::NBufferStructure& nb, const DepthImage& 
   return texels;
 }
 
-const DepthImage& ShadowsUnit::litmap(const scene::Frame& f, bool max) {
-  if (own_litmaps_) return max ? own_.max : own_.min;
-  const char* name = max ? "litmap_max" : "litmap_min";
-  const scene::DepthSnapshot* s = f.depth(name);
-  if (s->width != setup_.litmap_size || s->height != setup_.litmap_size)
-    throw InputError(fmt::format("frame {}: the '{}' depth image is {}x{}, the trace's litmap_size {}", f.begin.frame, name, s->width,
-                                 s->height, setup_.litmap_size));
-  DepthImage& image = max ? gl_max_ : gl_min_;
-  image.width = s->width, image.height = s->height;
-  image.texels = s->texels;
-  return image;
+void ShadowsUnit::take_gl_litmaps(const scene::Frame& f) {
+  for (const bool max : {false, true}) {
+    const char* name = max ? "litmap_max" : "litmap_min";
+    const scene::DepthSnapshot* s = f.depth(name);
+    if (s->width != setup_.litmap_size || s->height != setup_.litmap_size)
+      throw InputError(fmt::format("frame {}: the '{}' depth image is {}x{}, the trace's litmap_size {}", f.begin.frame, name, s->width,
+                                   s->height, setup_.litmap_size));
+    DepthImage& image = max ? gl_max_ : gl_min_;
+    image.width = s->width, image.height = s->height;
+    image.texels = s->texels;
+  }
 }
 
 void ShadowsUnit::draw_own_litmaps(const scene::Frame& f, const FrameCasters& c) {
@@ -284,7 +288,7 @@ void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, co
       continue;
     }
     lookup_mismatches_ += texels != c.lookups[i] ? 1 : 0;
-    const DepthRange exact = exact_range(litmap(f, false), litmap(f, true), rects_[k]);  // off the clock
+    const DepthRange exact = exact_range(litmap(false), litmap(true), rects_[k]);  // off the clock
     const CasterCheck k2 = check_caster(c, i, lo.value, hi.value, exact, light, setup_.margin);
     culled_ += k2.model_culled ? 1 : 0;
     kept_by_slab_ += k2.kept_by_slab ? 1 : 0;
@@ -324,7 +328,7 @@ void ShadowsUnit::compare_masks(const scene::Frame& f) {
   }
   gl_mask_pixels_ += gl_set;
   gl_mask_diff_ += gl_diff;
-  if (own_mode_ && *own_mode_ != Mode::Infinite) {
+  if (own_mode_ && *own_mode_ != Mode::Infinite && config_.own_reference) {
     // The model's own reference, off the clock: its infinite volumes into a cleared stencil over
     // this frame's depth (volumes write no depth), compared with its mode's mask.
     DepthImage depth = depth_;
@@ -375,7 +379,7 @@ void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>&
       if (other_size() && p.culled) ++culled_;  // (at the captured size, query_casters counts it)
       if (!p.culled) clamp_near = p.clamp_near, clamp_far = p.clamp_far;
     }
-    if (mode != Mode::Infinite) {  // the reference: every caster's infinite volume at the same planes
+    if (mode != Mode::Infinite && config_.own_reference) {  // the reference: every caster's infinite volume at the same planes
       positions.clear();
       append_volume(meshes_->vertices, meshes_->meshes[i], light, volume_ends(clamp_near, clamp_far, false), positions);
       for (const glm::vec4& p : positions) reference_clip_.push_back(clip_position(view_proj, p));
@@ -444,13 +448,14 @@ void ShadowsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Co
     wait_all();
     draw_own_litmaps(*f, c);
   } else {
+    take_gl_litmaps(*f);
     for (const scene::DrawRecord& d : f->draws)
       if (d.role == kLitmapRole) ++litmap_draws_, litmap_reprojections_ += d.gl.fragments;
       else if (d.role == kReceiverSplatRole) receiver_splats_ += d.gl.fragments;
   }
   // 3. Both N-buffers from the litmaps (each unit's engine builds while the scene is drawn).
-  build_texels_ += build(min_nb_, litmap(*f, false));
-  build_texels_ += build(max_nb_, litmap(*f, true));
+  build_texels_ += build(min_nb_, litmap(false));
+  build_texels_ += build(max_nb_, litmap(true));
   // 4. The casters' queries and decisions (the query ports wait for their engines; a frame with no
   // caster to query still waits for both builds).
   query_casters(*f, c, *light);

@@ -58,6 +58,10 @@ struct ShadowsUnitConfig {
   std::string litmaps = "trace";
   int litmap_size = 0;
   double litmap_fragments_per_cycle = 4.0;  // the model's litmap passes: fragments and points a cycle; tunable
+  // With the model's own culled or clamped volumes, also draw its own infinite volumes at the same
+  // planes off the clock as their reference (own_mask_diff, mask_errors). Off skips the check (the
+  // replay bench: GL's time leaves out its reference pass too).
+  bool own_reference = true;
 
   // Declares "shadows.<field>".
   static void describe(config::Schema& s, ShadowsUnitConfig& c);
@@ -113,8 +117,10 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
   std::uint64_t build(query::NBufferStructure& nb, const DepthImage& image);
   // Draws the model's litmaps of the frame (config litmaps = model) and compares them with GL's.
   void draw_own_litmaps(const scene::Frame& f, const FrameCasters& c);
+  // Copies the frame's GL litmaps (config litmaps = trace), checking their size.
+  void take_gl_litmaps(const scene::Frame& f);
   // The litmap the frame's N-buffers are built over: the model's or GL's.
-  const DepthImage& litmap(const scene::Frame& f, bool max);
+  const DepthImage& litmap(bool max) const noexcept { return own_litmaps_ ? (max ? own_.max : own_.min) : (max ? gl_max_ : gl_min_); }
   bool other_size() const noexcept { return setup_.litmap_size != setup_.trace_litmap_size; }
   void query_casters(const scene::Frame& f, const FrameCasters& c, const LightDepth& light);
   void compare_masks(const scene::Frame& f);

@@ -118,15 +118,24 @@ TEST(DepthTestTest, Unorm24Conversion) {
 // integer ones) and converts back to the same value.
 TEST(DepthTestTest, Unorm24FloatsAreOneToOne) {
   float last = -1.0f;
-  std::uint32_t bad_order = 0, bad_back = 0;
+  std::uint32_t bad_order = 0, bad_back = 0, bad_quotient = 0, bad_round = 0;
   for (std::uint32_t q = 0; q <= 16777215u; ++q) {
     const float f = from_unorm24(q);
     bad_order += f > last ? 0 : 1;
     bad_back += to_unorm24(f) == q ? 0 : 1;
+    bad_quotient += f == static_cast<float>(static_cast<double>(q) / 16777215.0) ? 0 : 1;
+    // to_unorm24's rounding against the library's nearbyint, at q and halfway to q + 1.
+    for (const float z : {static_cast<float>(q) / 16777215.0f, (static_cast<float>(q) + 0.5f) / 16777215.0f}) {
+      const float p = z * 16777215.0f;
+      const std::uint32_t want = p >= 16777215.0f ? 16777215u : static_cast<std::uint32_t>(std::nearbyint(p));
+      bad_round += to_unorm24(z) == want ? 0 : 1;
+    }
     last = f;
   }
   EXPECT_EQ(bad_order, 0u) << "from_unorm24 must be strictly increasing";
   EXPECT_EQ(bad_back, 0u) << "to_unorm24(from_unorm24(q)) must be q";
+  EXPECT_EQ(bad_quotient, 0u) << "the reciprocal product rounds to the quotient's float";
+  EXPECT_EQ(bad_round, 0u) << "to_unorm24 rounds as std::nearbyint";
   EXPECT_EQ(from_unorm24(16777215u), 1.0f);
   EXPECT_EQ(stored_depth(DepthFormat::Float32, 0.3f), 0.3f) << "Float32 stores the fragment depth";
 }
