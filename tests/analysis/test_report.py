@@ -283,7 +283,22 @@ class FixtureReport(unittest.TestCase):
         block = text.split("Shadows (")[1].split("Layered depth images (")[0]
         lines = [line for line in block.splitlines() if line.startswith("| ") and not line.startswith("| scene")]
         self.assertEqual(len(lines), 9, block)
-        self.assertIn("| city | clamped | 64 |", block)
+        self.assertIn("| city | - | clamped | 64 |", block)
+
+    def test_shadows_reading_per_camera_path(self):
+        # Rows of one scene on two camera paths (the flyover and the paper's observer on the ground):
+        # sorted fly first, and the reading names the path of each clamped ratio.
+        sys.path.insert(0, str(ROOT / "analysis" / "techniques" / "shadows"))
+        import section as shadows_section  # noqa: E402
+        base = json.loads((FIXTURE / "shadows" / "shadows.json").read_text())
+        city = [r for r in base if r["scene"] == "city"]
+        ground = [dict(r, path="ground", fill_per_frame=r["fill_per_frame"] / 2,
+                       ratio_to_infinite=r.get("ratio_to_infinite") and r["ratio_to_infinite"] / 2) for r in city]
+        rows = shadows_section.shadows_rows([dict(r, path="fly") for r in city] + ground)
+        self.assertEqual([r["path"] for r in rows], ["fly"] * len(city) + ["ground"] * len(city))
+        reading = " ".join(shadows_section.shadows_reading(rows))
+        self.assertIn("city (fly path): clamping cuts the fill", reading)
+        self.assertIn("city (ground path): clamping cuts the fill", reading)
 
 
 class Pareto(unittest.TestCase):

@@ -23,6 +23,10 @@ SHADOW_SCENES = ["boxes", "terrain", "city"]
 SHADOW_MODES = ["infinite", "culled", "clamped"]
 
 
+# The camera paths: the flyover first, then the paper's observer on the ground.
+SHADOW_PATHS = ["fly", "ground", "walk"]
+
+
 # What a row of shadows.json (nbsim shadows --out) must hold for the report's table and reading.
 SHADOW_NEED = ["scene", "shadow_mode", "frames", "casters_per_frame", "gl_culled_per_frame", "outside_per_frame",
                "fill_per_frame", "build_texels_per_frame", "lookups_per_frame", "cycles_per_frame", "mask_diff",
@@ -54,7 +58,7 @@ def shadows_rows(rows):
     infinite fill of the same frames: the row's ratio_to_infinite, else fill / reference_fill) and the paper's
     ratio for clamped rows."""
     out = []
-    for r in sorted(rows, key=lambda r: (_order(SHADOW_SCENES, r["scene"]), r["scene"],
+    for r in sorted(rows, key=lambda r: (_order(SHADOW_SCENES, r["scene"]), r["scene"], _order(SHADOW_PATHS, r.get("path", "")),
                                          _order(SHADOW_MODES, r["shadow_mode"]), str(r.get("litmap_size", "")))):
         rr = dict(r)
         rr["casters_culled_per_frame"] = r["gl_culled_per_frame"] + r["outside_per_frame"]
@@ -66,6 +70,7 @@ def shadows_rows(rows):
         rr["paper_ratio"] = paper[0] if paper else None
         rr["paper_text"] = paper[1] if paper else ""
         rr["mask_pixels_differing"] = r["mask_diff"] + r["mask_diff_infinite"]
+        rr["path"] = r.get("path") or ""
         out.append(rr)
     return out
 
@@ -82,8 +87,11 @@ def shadows_reading(rows):
     else:
         out.append(f"Culling and clamping changed no shadow-mask pixel: 0 differing from GL's mask and from its infinite "
                    f"reference in every row ({len(rows)} traces, {total_frames} frames).")
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        g = [r for r in rows if r["scene"] == scene]
+    several_paths = {sc for sc in (r["scene"] for r in rows) if len({r["path"] for r in rows if r["scene"] == sc}) > 1}
+    for scene, path in dict.fromkeys((r["scene"], r["path"]) for r in rows):
+        g = [r for r in rows if r["scene"] == scene and r["path"] == path]
+        if scene in several_paths:
+            scene = f"{scene} ({path} path)"
         for r in (r for r in g if r["shadow_mode"] == "clamped" and r["ratio"] is not None):
             lit = f" (litmap {r['litmap_size']})" if r.get("litmap_size") and \
                 sum(1 for x in g if x["shadow_mode"] == "clamped") > 1 else ""
@@ -123,10 +131,10 @@ def headline_shadows(label, rows, reading):
     lines = [f"Shadows ({label}): fill per frame beside the paper's clamped / infinite ratio (640x480: city 20 M -> "
              "512 K px, 2.5%; simpler scenes about 20%)",
              "",
-             "| scene | mode | litmap | fill | ratio | paper | casters culled | build | lookups | cycles | mask px differing |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "| scene | path | mode | litmap | fill | ratio | paper | casters culled | build | lookups | cycles | mask px differing |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        lines.append(f"| {r['scene']} | {r['shadow_mode']} | {r.get('litmap_size') or '-'} | {r['fill_per_frame']:,.0f} | "
+        lines.append(f"| {r['scene']} | {r['path'] or '-'} | {r['shadow_mode']} | {r.get('litmap_size') or '-'} | {r['fill_per_frame']:,.0f} | "
                      f"{pct(r['ratio'])} | {r['paper_text'] or '-'} | "
                      f"{r['casters_culled_per_frame']:,.1f} of {r['casters_per_frame']:,.0f} | "
                      f"{r['build_texels_per_frame']:,.0f} | {r['lookups_per_frame']:,.0f} | {r['cycles_per_frame']:,.0f} | "
@@ -143,7 +151,7 @@ def section(rep):
     for r in rows:
         r["trace_name"] = trace_name(str(r.get("trace", "?")))
     ratio = lambda v: "-" if v is None else f"{100 * v:.1f}%"  # noqa: E731
-    cols = [("scene", "scene", None), ("mode", "shadow_mode", None), ("litmap (lexels)", "litmap_size", None),
+    cols = [("scene", "scene", None), ("path", "path", None), ("mode", "shadow_mode", None), ("litmap (lexels)", "litmap_size", None),
             ("trace", "trace_name", None), ("frames", "frames", None),
             ("fill/frame", "fill_per_frame", None), ("ratio to infinite", "ratio", ratio),
             ("paper", "paper_text", lambda v: v or "-"),
@@ -163,11 +171,12 @@ def section(rep):
     # clamped bars as the fill it would give (paper ratio x the trace's infinite reference fill)
     fig, ax = plt.subplots(figsize=FIGSIZE, constrained_layout=True)
     colours = {"infinite": "#999999", "culled": "#6fa8dc", "clamped": "#b2182b"}
-    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    groups = list(dict.fromkeys((r["scene"], r["path"]) for r in rows))
+    several = len({p for _, p in groups}) > 1
     x, ticks, labels = 0.0, [], []
     marked = False
-    for scene in scenes:
-        g = [r for r in rows if r["scene"] == scene]
+    for scene, camera in groups:
+        g = [r for r in rows if r["scene"] == scene and r["path"] == camera]
         start = x
         for r in g:
             v = max(float(r["fill_per_frame"]), 1.0)  # log scale: an empty fill sits on the floor
@@ -182,12 +191,12 @@ def section(rep):
                 marked = True
             x += 1
         ticks.append((start + x - 1) / 2)
-        labels.append(scene)
+        labels.append(f"{scene}\n{camera}" if several else scene)
         x += 0.8
     ax.set_yscale("log")
     ax.set_ylim(top=ax.get_ylim()[1] * 4)  # headroom for the labels and the legend
     ax.set_xticks(ticks, labels)
-    ax.set_xlabel("scene")
+    ax.set_xlabel("scene (and camera path)" if several else "scene")
     ax.set_ylabel("shadow-volume fill per frame (fragments, log scale)")
     ax.set_title(f"Shadows: fill per frame by mode, beside the paper's ratio ({len(rows)} traces)", fontsize=10)
     ax.grid(axis="y", alpha=0.3, which="both")
@@ -199,7 +208,8 @@ def section(rep):
     return (f"<p>From <code>{rep.rel(path)}</code> (<code>nbsim shadows TRACE... --out</code>: one replay per trace, "
             f"traces {html.escape(traces)}, each in the shadow mode it was captured in on Mesa; {setting_text}). Fill: rasterized fragments of "
             "the shadow-volume draws; ratio: the fill over GL's infinite volumes of the same frames (every capture "
-            "also draws them as a reference). The paper (Décoret 2005, 4.4, 640x480) gives clamped / infinite: "
+            "also draws them as a reference). Path: fly, the camera about 130 m up, above the birds; ground, the paper's "
+            "set-up, an observer at eye height with the birds above the view and their shadows in it. The paper (Décoret 2005, 4.4, 640x480) gives clamped / infinite: "
             "2.5% in its city (20 M -> 512 K pixels) and on its terrain, about 20% on simpler scenes. Casters "
             "culled: by GL, outside the light's frustum included. N-buffer build and lookups: texels of both "
             "litmap N-buffers (min and max) built and read per frame. Mask pixels differing: the model's shadow "

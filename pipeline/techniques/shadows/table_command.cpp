@@ -96,13 +96,14 @@ void add_shadows_commands(CLI::App& app, Action& action) {
         return differing == 0 ? 0 : 1;
       }
       fmt::print("Shadows: fill per frame (paper, 640x480: city 20 M -> 512 K px, 2.5%; simpler scenes about 20%)\n");
-      fmt::print("{:<8} {:<9} {:>12} {:>8} {:>7} {:>14} {:>10} {:>8} {:>11} {:>8} {:>8} {:>10}\n", "scene", "mode", "fill/frame",
-                 "ratio", "paper", "culled/casters", "build", "lookups", "cycles", "mask", "mask_inf", "mismatches");
+      fmt::print("{:<8} {:<7} {:<9} {:>12} {:>8} {:>7} {:>14} {:>10} {:>8} {:>11} {:>8} {:>8} {:>10}\n", "scene", "path", "mode",
+                 "fill/frame", "ratio", "paper", "culled/casters", "build", "lookups", "cycles", "mask", "mask_inf", "mismatches");
       for (const auto& r : list) {
         const auto num = [&](const char* k) { return r[k].is_number() ? r[k].get<double>() : 0.0; };
         const std::string scene = r["scene"].get<std::string>();
         const std::string paper = r["shadow_mode"] == "clamped" ? (scene == "boxes" ? "~20%" : "2.5%") : "-";
-        fmt::print("{:<8} {:<9} {:>12.0f} {:>8} {:>7} {:>14} {:>10.0f} {:>8.0f} {:>11.0f} {:>8} {:>8} {:>10}\n", scene,
+        const std::string path = r["path"].is_string() && !r["path"].get<std::string>().empty() ? r["path"].get<std::string>() : "-";
+        fmt::print("{:<8} {:<7} {:<9} {:>12.0f} {:>8} {:>7} {:>14} {:>10.0f} {:>8.0f} {:>11.0f} {:>8} {:>8} {:>10}\n", scene, path,
                    r["shadow_mode"].get<std::string>(), num("fill_per_frame"),
                    r["ratio_to_infinite"].is_number() ? fmt::format("{:.1f}%", 100.0 * num("ratio_to_infinite")) : std::string("-"),
                    paper, fmt::format("{:.1f}/{:.0f}", num("gl_culled_per_frame") + num("outside_per_frame"), num("casters_per_frame")),
@@ -123,7 +124,7 @@ void add_shadows_commands(CLI::App& app, Action& action) {
                        b["casters_per_frame"].get<double>(), b["fill_per_frame"].get<double>(), b["fill_infinite_per_frame"].get<double>(),
                        total > 0.0 ? 100.0 * b["fill_per_frame"].get<double>() / total : 0.0);
         }
-      if (differing) fmt::print("mask pixels differing from GL's: {}\n", differing);
+      if (differing) fmt::print("mask pixels differing from the reference of the volumes drawn: {}\n", differing);
       return differing == 0 ? 0 : 1;
     };
   });
