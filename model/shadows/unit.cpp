@@ -264,7 +264,7 @@ void ShadowsUnit::query_casters(const scene::Frame& f, const FrameCasters& c, co
   if (c.reference_fill) reference_fill_ += *c.reference_fill, ++reference_frames_;
   volume_share_.assign(f.draws.size(), nullptr);
   model_zmin_.assign(n, 1.0f), model_zmax_.assign(n, 0.0f);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n && !own_mode_; ++i) {  // the model's own volumes count their casters by its own decisions
     FillShare& share = breakdown_[{c.class_names[c.cls[i]], std::string(kKeptNames[c.kept[i]])}];
     ++share.casters;
     share.fill_infinite += c.fill_infinite[i];
@@ -379,6 +379,13 @@ void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>&
       if (other_size() && p.culled) ++culled_;  // (at the captured size, query_casters counts it)
       if (!p.culled) clamp_near = p.clamp_near, clamp_far = p.clamp_far;
     }
+    // Its share of the fill: GL's reason, unless the model decided otherwise (it drops a caster GL
+    // kept, or keeps one GL dropped: then for a receiver in its slab).
+    const bool gl_dropped = c.kept[i] == static_cast<std::uint32_t>(KeptBy::Dropped);
+    FillShare& share = breakdown_[{c.class_names[c.cls[i]],
+                                   std::string(kKeptNames[dropped ? 0 : gl_dropped ? static_cast<std::size_t>(KeptBy::Receivers) : c.kept[i]])}];
+    ++share.casters;
+    share.fill_infinite += c.fill_infinite[i];
     if (mode != Mode::Infinite && config_.own_reference) {  // the reference: every caster's infinite volume at the same planes
       positions.clear();
       append_volume(meshes_->vertices, meshes_->meshes[i], light, volume_ends(clamp_near, clamp_far, false), positions);
@@ -392,10 +399,7 @@ void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>&
     d->index = static_cast<std::uint32_t>(f->draws.size() + own_share_.size());
     d->clip_positions.reserve(positions.size());
     for (const glm::vec4& p : positions) d->clip_positions.push_back(clip_position(view_proj, p));
-    // Its share of the fill: GL's reason, unless the model decided otherwise.
-    const bool gl_dropped = c.kept[i] == static_cast<std::uint32_t>(KeptBy::Dropped);
-    const std::string kept(kKeptNames[dropped ? 0 : gl_dropped ? static_cast<std::size_t>(KeptBy::Receivers) : c.kept[i]]);
-    own_share_[d.get()] = &breakdown_[{c.class_names[c.cls[i]], kept}];
+    own_share_[d.get()] = &share;
     auto w = std::make_shared<cp::Work>();
     w->frame = f;
     w->draw = 0;

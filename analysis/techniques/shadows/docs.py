@@ -261,6 +261,10 @@ LITMAP_SCENES = {"boxes": ["--scene", "boxes", "--seed", "9"],
                  "terrain": ["--scene", "terrain", "--seed", "3", "--towers", "20", "--birds", "500"],
                  "city": ["--scene", "city", "--seed", "4", "--objects", "1800"]}
 LITMAP_SIDES = (200, 96, 384)  # captured, then the two others
+# The other designs beside the sides: (label, capture arguments, replay settings).
+LITMAP_DESIGNS = [(str(side), ["--litmap", str(side)], ["--set", f"shadows.litmap_size={side}"]) for side in LITMAP_SIDES[1:]] + \
+    [(f"{LITMAP_SIDES[0]}, corners covering", ["--litmap", str(LITMAP_SIDES[0]), "--covering", "corners"],
+      ["--set", "litmap_min.covering=corners", "--set", "litmap_max.covering=corners"])]
 
 
 def model_litmaps_commands():
@@ -268,14 +272,14 @@ def model_litmaps_commands():
     for s, args in LITMAP_SCENES.items():
         common = ["capture", "shadows", *args, "--path", "fly", "--size", "400x300", "--frames", "3"]
         cmds.append([*common, "--litmap", str(LITMAP_SIDES[0]), "--shadow-mode", "infinite", "-o", f"lm_{s}_inf.nbt"])
-        for side in LITMAP_SIDES[1:]:
-            cmds.append([*common, "--litmap", str(side), "--shadow-mode", "clamped", "-o", f"lm_{s}_c{side}.nbt"])
+        for k, (_, capture, _) in enumerate(LITMAP_DESIGNS):
+            cmds.append([*common, *capture, "--shadow-mode", "clamped", "-o", f"lm_{s}_c{k}.nbt"])
     for s in LITMAP_SCENES:
         cmds.append(["replay", f"lm_{s}_inf.nbt", "--out", f"lm_{s}_same", "--set", "shadows.litmaps=model"])
-        for side in LITMAP_SIDES[1:]:
-            cmds.append(["replay", f"lm_{s}_c{side}.nbt", "--out", f"lm_{s}_gl{side}"])
-            cmds.append(["replay", f"lm_{s}_inf.nbt", "--out", f"lm_{s}_m{side}", "--set", "shadows.litmaps=model",
-                         "--set", "shadows.volumes=clamped", "--set", f"shadows.litmap_size={side}"])
+        for k, (_, _, sets) in enumerate(LITMAP_DESIGNS):
+            cmds.append(["replay", f"lm_{s}_c{k}.nbt", "--out", f"lm_{s}_gl{k}"])
+            cmds.append(["replay", f"lm_{s}_inf.nbt", "--out", f"lm_{s}_m{k}", "--set", "shadows.litmaps=model",
+                         "--set", "shadows.volumes=clamped", *sets])
     return cmds
 
 
@@ -283,8 +287,8 @@ def model_litmaps_files():
     files = []
     for s in LITMAP_SCENES:
         files.append(f"lm_{s}_same/run.json")
-        for side in LITMAP_SIDES[1:]:
-            files += [f"lm_{s}_gl{side}/run.json", f"lm_{s}_m{side}/run.json"]
+        for k in range(len(LITMAP_DESIGNS)):
+            files += [f"lm_{s}_gl{k}/run.json", f"lm_{s}_m{k}/run.json"]
     return tuple(files)
 
 
@@ -292,7 +296,7 @@ def render_model_litmaps(outputs):
     import json
     files = [json.loads(t) for t in outputs[-len(model_litmaps_files()):]]
     lines = [f"| scene | litmaps of {LITMAP_SIDES[0]} (captured): texels unlike GL's, draws with other fragment counts | fragments "
-             "reprojected / frame (discarded) | side | GL: clamped capture, fill / frame | model: infinite capture as clamped, fill / "
+             "reprojected / frame (discarded) | litmap side (design) | GL: clamped capture, fill / frame | model: infinite capture as clamped, fill / "
              "frame | stencil buffer equal to GL's, frames | mask pixels (GL, model) |",
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
     k = 0
@@ -300,7 +304,7 @@ def render_model_litmaps(outputs):
         same = files[k]["summary"]["shadows"]
         k += 1
         frames = max(1, same["frames"])
-        for j, side in enumerate(LITMAP_SIDES[1:]):
+        for j, (side, _, _) in enumerate(LITMAP_DESIGNS):
             g, m = files[k], files[k + 1]
             k += 2
             gs, ms = g["summary"]["shadows"], m["summary"]["shadows"]

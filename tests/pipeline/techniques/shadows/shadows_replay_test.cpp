@@ -161,13 +161,18 @@ TEST_P(ShadowsReplayTest, ModelBuiltVolumesReplayAnyMode) {
       EXPECT_EQ(s["rect_mismatches"], 0) << "rectangles from the meshes' bounds and the recorded light";
       EXPECT_EQ(s["own_mask_diff"], 0) << "the mask equals the model's own infinite volumes'";
       EXPECT_EQ(run["summary"]["draws_exact"], run["summary"]["draws"]) << "GL's own draws (scene) stay exact";
+      double casters = 0.0, fill = 0.0;
+      for (const auto& b : s["fill_breakdown"]) casters += b["casters_per_frame"].get<double>(), fill += b["fill_per_frame"].get<double>();
+      EXPECT_DOUBLE_EQ(casters, s["casters_per_frame"].get<double>()) << "the breakdown counts every caster once, by the model's decision";
+      EXPECT_DOUBLE_EQ(fill, s["fill_per_frame"].get<double>()) << "and all of the model's fill";
     }
 }
 
 // The model's own litmaps (shadows.litmaps=model, drawn from the trace's object meshes): at the
 // captured size every litmap texel and every litmap and splat draw's fragment count equal GL's; at
-// another size (half and twice the captured side), an infinite capture replayed as clamped gives
-// the fill, the stencil buffer frame by frame and the mask of a clamped capture at that size on GL.
+// another size (half and twice the captured side) or with the N-buffers' other covering, an
+// infinite capture replayed as clamped gives the fill, the stencil buffer frame by frame and the
+// mask of a clamped capture of that design on GL.
 TEST_P(ShadowsReplayTest, ModelLitmapsAtAnySize) {
   const std::string scene = GetParam();
   const auto checksums = [](const nlohmann::json& run) {
@@ -188,21 +193,24 @@ TEST_P(ShadowsReplayTest, ModelLitmapsAtAnySize) {
     EXPECT_EQ(s["fill"], s["gl_fill"]);
     EXPECT_EQ(s["mask_diff"], 0);
   }
-  for (const int size : {32, 128}) {
-    SCOPED_TRACE(scene + ": litmaps of " + std::to_string(size));
-    const std::string litmap = "--litmap " + std::to_string(size);
-    const auto gl = replay(capture(scene, "clamped", litmap));
-    const auto run = replay(capture(scene, "infinite"),
-                            " --set shadows.litmaps=model --set shadows.volumes=clamped --set shadows.litmap_size=" + std::to_string(size),
-                            "as_clamped_" + std::to_string(size));
+  const struct {
+    std::string tag, capture, sets;
+  } designs[] = {{"32", "--litmap 32", " --set shadows.litmap_size=32"},
+                 {"128", "--litmap 128", " --set shadows.litmap_size=128"},
+                 {"corners", "--covering corners", " --set litmap_min.covering=corners --set litmap_max.covering=corners"}};
+  for (const auto& design : designs) {
+    SCOPED_TRACE(scene + ": " + design.capture);
+    const auto gl = replay(capture(scene, "clamped", design.capture));
+    const auto run = replay(capture(scene, "infinite"), " --set shadows.litmaps=model --set shadows.volumes=clamped" + design.sets,
+                            "as_clamped_" + design.tag);
     const auto& s = run["summary"]["shadows"];
     const auto& g = gl["summary"]["shadows"];
-    EXPECT_EQ(s["model_volumes"], g["volume_draws"]) << "the volumes a clamped capture at that size drew";
-    EXPECT_EQ(s["fill"], g["gl_fill"]) << "GL's clamped fill at that size";
-    EXPECT_EQ(checksums(run), checksums(gl)) << "GL's stencil buffer at that size, frame by frame";
+    EXPECT_EQ(s["model_volumes"], g["volume_draws"]) << "the volumes a clamped capture of that design drew";
+    EXPECT_EQ(s["fill"], g["gl_fill"]) << "GL's clamped fill of that design";
+    EXPECT_EQ(checksums(run), checksums(gl)) << "GL's stencil buffer of that design, frame by frame";
     EXPECT_EQ(s["mask_pixels"], g["gl_mask_pixels"]);
     EXPECT_EQ(s["own_mask_diff"], 0);
-    EXPECT_EQ(s["culled"], g["gl_culled"]) << "the casters GL culled at that size";
+    EXPECT_EQ(s["culled"], g["gl_culled"]) << "the casters GL culled of that design";
   }
 }
 
@@ -393,7 +401,9 @@ TEST(ShadowsTableTest, JsonRowsWithRatioToInfinite) {
       EXPECT_EQ(b["class"], "box");
       fill += b["fill_per_frame"].get<double>(), infinite += b["fill_infinite_per_frame"].get<double>();
       casters += b["casters_per_frame"].get<double>();
-      if (b["kept"] == "dropped") EXPECT_EQ(b["fill_per_frame"].get<double>(), row["shadow_mode"] == "infinite" ? b["fill_infinite_per_frame"].get<double>() : 0.0);
+      if (b["kept"] == "dropped") {
+        EXPECT_EQ(b["fill_per_frame"].get<double>(), row["shadow_mode"] == "infinite" ? b["fill_infinite_per_frame"].get<double>() : 0.0);
+      }
     }
     EXPECT_NEAR(fill, row["fill_per_frame"].get<double>(), 1e-6 * fill) << row["shadow_mode"];
     EXPECT_NEAR(infinite, row["reference_fill_per_frame"].get<double>(), 1e-6 * infinite) << row["shadow_mode"];
