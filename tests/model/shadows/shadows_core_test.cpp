@@ -6,7 +6,9 @@
 #include <cmath>
 
 #include "model/common/error.h"
+#include "model/raster/depth_test.h"
 #include "model/shadows/caster.h"
+#include "model/shadows/litmap.h"
 #include "model/shadows/volume.h"
 
 namespace {
@@ -177,6 +179,21 @@ TEST(ShadowsCoreTest, CasterMeshesReadAndOpenMeshRefused) {
   EXPECT_NE(open.find("not closed"), std::string::npos) << open;
   const std::string range = message({0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 9}, corners);
   EXPECT_NE(range.find("names vertex 9 of 4"), std::string::npos) << range;
+}
+
+// The observer depth as the litmap shaders read it: a float buffer as stored; a 24-bit one as
+// llvmpipe's texelFetch converts the stored value q (float(q) times the float of 1 / (2^24 - 1)),
+// which for half of the values is not the quotient's float the model stores.
+TEST(ShadowsCoreTest, ObserverDepthAsTheShaderSamplesIt) {
+  nbsim::DepthImage stored(2, 1, 0.0f);
+  const std::uint32_t q = 3;  // 3 / (2^24 - 1): the product and the quotient round apart
+  stored.texels = {nbsim::raster::from_unorm24(q), 1.0f};
+  const float product = 3.0f * static_cast<float>(1.0 / 16777215.0);
+  ASSERT_NE(product, stored.texels[0]) << "a value where the two conversions differ";
+  const nbsim::DepthImage s = sampled_depth_image(stored, nbsim::raster::DepthFormat::Unorm24);
+  EXPECT_EQ(s.texels[0], product);
+  EXPECT_EQ(s.texels[1], 1.0f);
+  EXPECT_EQ(sampled_depth_image(stored, nbsim::raster::DepthFormat::Float32).texels, stored.texels);
 }
 
 }  // namespace
