@@ -73,6 +73,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
 
     BoxDrawCounts c;
     c.method = r.method;
+    c.storage_bytes = storage_bytes(r.method, gl.field.size, gl.levels);
     c.triangles = k.geometry.prims_out;
     c.blocks = k.depth.blocks;
     c.depth_tests = k.depth.depth_tests;

@@ -42,6 +42,9 @@ struct BoxDrawCounts {
   std::uint64_t reference_hits = 0, wrong_hit = 0, wrong_miss = 0, far_hit = 0;
   std::uint64_t errors() const noexcept { return wrong_hit + wrong_miss + far_hit; }
   double distance_sum = 0.0;  // texels between the hit and the reference's, summed over fragments where both hit
+  // The textures the method reads, bytes (4 a texel, as GL's R32F textures): the heights; the safety
+  // radii (robust, robust_clamp); every N-buffer level (nbuffer).
+  std::uint64_t storage_bytes = 0;
 };
 
 struct ReliefFrameCounts {

@@ -131,6 +131,8 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
                                      "distance from the reference's hit summed over fragments where both hit");
     c.cycles = counter("cycles", "cycles", "cycles of the box draws");
     c.cache_misses = counter("cache_misses", "lookups", "texel cache misses");
+    c.storage_bytes = counter("storage_bytes", "bytes",
+                              "bytes of the textures the method reads (heights; radii or N-buffer levels), 4 a texel; the largest field's");
   }
 }
 
@@ -184,6 +186,7 @@ void ReliefUnit::account(const BoxDrawCounts& d) {
   *c.distance_microtexels += static_cast<std::uint64_t>(std::llround(d.distance_sum * 1e6));
   *c.cycles += spent;
   *c.cache_misses += draw_misses_;
+  c.storage_bytes->raise_to(d.storage_bytes);
   draw_misses_ = draw_hits_ = 0;
 }
 

@@ -61,7 +61,7 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   struct PerMethod {
     stats::Counter *draws, *rasterized, *fragments, *gl_fragments, *samples, *gl_samples, *pixel_mismatches, *walk_mismatches, *lookups,
         *gl_lookups, *steps, *bisections, *hits, *capped, *reference_hits, *wrong_hit, *wrong_miss, *far_hit, *errors,
-        *distance_microtexels, *cycles, *cache_misses;
+        *distance_microtexels, *cycles, *cache_misses, *storage_bytes;
   };
 
   ReliefUnitConfig config_;

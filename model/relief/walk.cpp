@@ -304,6 +304,16 @@ void walk_nbuffer(Reader& r, const WalkParams& p, const FragmentRay& ray, WalkRe
 
 }  // namespace
 
+std::uint64_t storage_bytes(Method m, int size, int levels) noexcept {
+  const std::uint64_t plane = 4 * static_cast<std::uint64_t>(std::max(size, 0)) * static_cast<std::uint64_t>(std::max(size, 0));
+  switch (m) {
+    case Method::Robust:
+    case Method::RobustClamp: return 2 * plane;
+    case Method::NBuffer: return plane * (1 + static_cast<std::uint64_t>(std::max(levels, 0)));
+    default: return plane;
+  }
+}
+
 std::string_view to_string(Method m) noexcept {
   const auto i = static_cast<std::size_t>(m);
   return i < kMethodNames.size() ? kMethodNames[i] : "?";

@@ -50,6 +50,12 @@ namespace nbsim::relief {
 enum class Method : std::uint8_t { Binary = 0, Exact = 1, Robust = 2, RobustClamp = 3, NBuffer = 4 };
 inline constexpr int kMethods = 5;
 std::string_view to_string(Method m) noexcept;
+
+// The bytes of the textures method `m` reads for an N x N heightfield with an N-buffer of `levels`
+// levels, 4 a texel (R32F, as the capture's textures): heights for every method, plus the safety
+// radii (robust, robust_clamp) or every N-buffer level (nbuffer). (The paper also stores a normal a
+// texel for shading, which no walk reads: 5 floats with the radius.)
+std::uint64_t storage_bytes(Method m, int size, int levels) noexcept;
 std::optional<Method> parse_method(std::string_view s) noexcept;
 inline constexpr std::array<Method, kMethods> kAllMethods = {Method::Binary, Method::Exact, Method::Robust, Method::RobustClamp,
                                                              Method::NBuffer};

@@ -118,6 +118,7 @@ def relief_ranking(doc):
         rr["walk_mismatches"] = sum(x["walk_mismatches"] for x in mine)
         rr["pixel_mismatches"] = sum(x["pixel_mismatches"] for x in mine)
         rr["fragments_unlike_gl"] = sum(abs(x["fragments"] - x["gl_fragments"]) for x in mine)
+        rr.setdefault("storage_bytes_per_texel", None)  # nbsim relief before it reported storage
         out.append(rr)
     return out
 
@@ -287,6 +288,7 @@ def section(rep):
          ("lookups/fragment", "lookups_per_fragment", num(2)), ("steps/fragment", "steps_per_fragment", num(2)),
          ("fragments", "fragments", None), ("hit errors", "errors", None),
          ("hit error", "error_rate", lambda v: pct(v, 3)), ("Pareto", "pareto_mark", None),
+         ("storage (bytes/texel)", "storage_bytes_per_texel", lambda v: "-" if v is None else f"{v:g}"),
          ("walks differing from GL's", "walk_mismatches", None),
          ("pixels differing from GL's", "pixel_mismatches", None),
          ("fragments unlike GL's count", "fragments_unlike_gl", None)],

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <string>
 
 #include "model/relief/unit.h"
@@ -41,6 +42,7 @@ void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_jso
     if (stat(now, (prefix + "draws").c_str()) == stat(last, (prefix + "draws").c_str())) continue;
     nlohmann::ordered_json v;
     for (const char* name : kReliefFrameCounts) v[name] = stat(now, (prefix + name).c_str()) - stat(last, (prefix + name).c_str());
+    v["storage_bytes"] = stat(now, (prefix + "storage_bytes").c_str());  // the largest field's so far, not a difference
     methods[std::string(relief::to_string(m))] = v;
   }
   pf["relief"] = methods;
@@ -63,7 +65,7 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
     nlohmann::ordered_json e;
     for (const char* name : {"draws", "rasterized", "fragments", "gl_fragments", "samples", "gl_samples", "pixel_mismatches", "walk_mismatches", "lookups",
                              "gl_lookups", "steps", "bisections", "hits", "capped", "reference_hits", "wrong_hit", "wrong_miss",
-                             "far_hit", "errors", "cycles", "cache_misses"})
+                             "far_hit", "errors", "cycles", "cache_misses", "storage_bytes"})
       e[name] = v(name);
     const double fragments = static_cast<double>(v("fragments"));
     const auto per = [fragments](std::uint64_t x) {
@@ -100,6 +102,11 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
 nlohmann::ordered_json summary(const SummaryInputs& in) {
   nlohmann::ordered_json j = totals(in.group, in.stats.contains("gpu.memory") ? in.stats["gpu.memory"] : nlohmann::ordered_json::object(), in.cycles);
   for (const char* key : {"relief_field", "relief_field_size", "relief_box_height", "relief_angles"}) copy_property(in.header, key, j);
+  // Storage a texel of the heightfield: what each method's textures cost (4 bytes a value).
+  const std::string* size = in.header.property("relief_field_size");
+  const double n = size ? std::strtod(size->c_str(), nullptr) : 0.0;
+  for (auto& [name, e] : j["methods"].items())
+    e["storage_bytes_per_texel"] = n > 0 ? nlohmann::ordered_json(e["storage_bytes"].get<double>() / (n * n)) : nlohmann::ordered_json(nullptr);
   return j;
 }
 

@@ -57,6 +57,9 @@ nlohmann::ordered_json relief_rows(const std::vector<nlohmann::json>& runs, cons
         r["lookups_per_fragment"] = ratio(static_cast<double>(u(v, "lookups")), n);
         r["steps_per_fragment"] = ratio(static_cast<double>(u(v, "steps")), n);
         r["error_rate"] = ratio(static_cast<double>(u(v, "errors")), n);
+        const double texels = static_cast<double>(r["field_size"].get<int>()) * static_cast<double>(r["field_size"].get<int>());
+        r["storage_bytes"] = v.contains("storage_bytes") ? u(v, "storage_bytes") : 0;
+        r["storage_bytes_per_texel"] = ratio(static_cast<double>(r["storage_bytes"].get<std::uint64_t>()), texels);
         rows.push_back(std::move(r));
       }
     }
@@ -66,7 +69,7 @@ nlohmann::ordered_json relief_rows(const std::vector<nlohmann::json>& runs, cons
 
 nlohmann::ordered_json relief_ranking(const nlohmann::ordered_json& rows) {
   struct Sum {
-    double fragments = 0, lookups = 0, steps = 0, errors = 0, cycles = 0, rows = 0;
+    double fragments = 0, lookups = 0, steps = 0, errors = 0, cycles = 0, rows = 0, storage_per_texel = 0;
   };
   std::map<std::string, Sum> sums;
   for (const auto& r : rows) {
@@ -77,6 +80,7 @@ nlohmann::ordered_json relief_ranking(const nlohmann::ordered_json& rows) {
     s.errors += static_cast<double>(u(r, "errors"));
     s.cycles += static_cast<double>(u(r, "cycles"));
     s.rows += 1;
+    if (r["storage_bytes_per_texel"].is_number()) s.storage_per_texel = std::max(s.storage_per_texel, r["storage_bytes_per_texel"].get<double>());
   }
   struct Entry {
     std::string method;
@@ -100,6 +104,7 @@ nlohmann::ordered_json relief_ranking(const nlohmann::ordered_json& rows) {
     j["errors"] = static_cast<std::uint64_t>(e.s.errors);
     j["error_rate"] = e.error;
     j["pareto"] = !dominated;
+    j["storage_bytes_per_texel"] = e.s.storage_per_texel;  // the largest over the rows' fields
     out.push_back(std::move(j));
   }
   return out;

@@ -75,11 +75,11 @@ void add_relief_commands(CLI::App& app, Action& action) {
                    num(r, "steps_per_fragment"), r["cycles"].get<std::uint64_t>(), r["errors"].get<std::uint64_t>(),
                    100.0 * num(r, "error_rate"));
       fmt::print("\nRanking (cost: mean cycles per box draw; * on the Pareto front of cost against error)\n");
-      fmt::print("{:<13} {:>12} {:>10} {:>9} {:>9}\n", "method", "cycles/frame", "lookups/f", "errors", "error");
+      fmt::print("{:<13} {:>12} {:>10} {:>9} {:>9} {:>13}\n", "method", "cycles/frame", "lookups/f", "errors", "error", "bytes/texel");
       for (const auto& r : doc["ranking"])
-        fmt::print("{:<13} {:>12.0f} {:>10.2f} {:>9} {:>8.3f}%{}\n", r["method"].get<std::string>(), num(r, "cycles_per_frame"),
+        fmt::print("{:<13} {:>12.0f} {:>10.2f} {:>9} {:>8.3f}% {:>13.1f}{}\n", r["method"].get<std::string>(), num(r, "cycles_per_frame"),
                    num(r, "lookups_per_fragment"), r["errors"].get<std::uint64_t>(), 100.0 * num(r, "error_rate"),
-                   r["pareto"].get<bool>() ? " *" : "");
+                   num(r, "storage_bytes_per_texel"), r["pareto"].get<bool>() ? " *" : "");
       if (!doc["nbuffer_vs_exact"].empty()) {
         fmt::print("\nN-buffer walk against the exact walk\n");
         fmt::print("{:<22} {:>5} {:>12} {:>12} {:>7} {:>12} {:>14}\n", "field", "size", "exact look/f", "nbuf look/f", "ratio",

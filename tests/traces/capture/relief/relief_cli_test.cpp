@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "tests/common/refused.h"
+#include "model/nbuffer/covering.h"
 #include "tests/common/run_nbsim.h"
 
 namespace nbsim {
@@ -62,6 +63,11 @@ void expect_exact_replay(const nlohmann::json& relief, const std::string& what) 
     if (name == "nbuffer" || name == "robust") {
       EXPECT_EQ(m["errors"], 0) << "the robust and N-buffer walks are exact";
     }
+    // Storage a texel, 4 bytes a value: heights; radii too (robust); every N-buffer level too (nbuffer).
+    const int n = std::stoi(relief["relief_field_size"].get<std::string>());
+    const double per_texel = m["storage_bytes_per_texel"].get<double>();
+    const double values = name == "nbuffer" ? 1 + nbsim::nbuffer_level_count(n, n) : name.rfind("robust", 0) == 0 ? 2 : 1;
+    EXPECT_EQ(per_texel, 4.0 * values);
   }
 }
 
