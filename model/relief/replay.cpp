@@ -47,6 +47,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   referenced_.assign(pixels, 0);
   ReliefFrameCounts out;
   out.size = gl.field.size;
+  for (const float r : gl.radius.radius) out.radius_sum += static_cast<std::uint64_t>(r), out.radius_zero += r == 0.0f ? 1 : 0;
   out.view_angle = gl.view_angle;
 
   std::size_t next_record = 0;

@@ -49,6 +49,8 @@ struct BoxDrawCounts {
 
 struct ReliefFrameCounts {
   int size = 0;  // the heightfield's N
+  // The frame's safety radii (RLFH): their sum and the texels at 0, over its N * N texels.
+  std::uint64_t radius_sum = 0, radius_zero = 0;
   std::uint64_t scene_draws = 0, scene_depth_tests = 0;  // a scene drawn before the boxes (placement city)
   double view_angle = 0.0;
   std::vector<BoxDrawCounts> draws;  // relief_box draws in order

@@ -96,7 +96,10 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
       cache_misses_(stats().counter("cache_misses", "lookups", "lookups that missed the texel cache (a line read each)")),
       memory_bytes_(stats().counter("memory_bytes", "bytes", "texel cache line reads on the channel (client relief)")),
       memory_stall_cycles_(stats().counter("memory_stall_cycles", "cycles", "cycles waiting for the channel after the work was done")),
-      cycles_(stats().counter("cycles", "cycles", "cycles of every box draw (memory stalls included)")) {
+      cycles_(stats().counter("cycles", "cycles", "cycles of every box draw (memory stalls included)")),
+      radius_texels_(stats().counter("radius_texels", "texels", "safety-radius texels of the frames' heightfields (N * N a frame)")),
+      radius_sum_(stats().counter("radius_sum", "texels", "their radii summed (whole texels)")),
+      radius_zero_(stats().counter("radius_zero", "texels", "of those, texels with radius 0")) {
   while ((1 << line_shift_) < config_.cache_line_bytes) ++line_shift_;
   if (!(box_height > 0.0 && std::isfinite(box_height)))
     throw InputError(fmt::format("the relief trace's box height is {}; it must be a positive number", box_height));
@@ -197,6 +200,9 @@ void ReliefUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Com
   const ReliefFrameCounts k =
       replay_.run_frame(*f, config_.hit_tolerance_texels, box_height_, &ReliefUnit::on_lookup, this, &ReliefUnit::on_draw);
   ++frames_;
+  radius_texels_ += static_cast<std::uint64_t>(k.size) * static_cast<std::uint64_t>(k.size);
+  radius_sum_ += k.radius_sum;
+  radius_zero_ += k.radius_zero;
   // The scene's depth (placement city): its depth tests through the same test lanes, charged after
   // the frame's box draws (the frame's total is what a sweep reads).
   if (k.scene_draws) {

@@ -73,7 +73,8 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   std::uint64_t draw_misses_ = 0, draw_hits_ = 0;
   std::uint64_t last_line_ = ~std::uint64_t{0};  // the cache line of the last lookup
   int line_shift_ = 0;                            // log2 of relief.cache_line_bytes (a power of two)  // the current box draw's cache outcomes
-  stats::Counter &frames_, &scene_draws_, &scene_depth_tests_, &box_draws_, &cache_hits_, &cache_misses_, &memory_bytes_, &memory_stall_cycles_, &cycles_;
+  stats::Counter &frames_, &scene_draws_, &scene_depth_tests_, &box_draws_, &cache_hits_, &cache_misses_, &memory_bytes_, &memory_stall_cycles_, &cycles_,
+      &radius_texels_, &radius_sum_, &radius_zero_;
   std::array<PerMethod, kMethods> per_method_{};
 };
 

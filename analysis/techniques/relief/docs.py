@@ -145,3 +145,49 @@ BLOCKS = [
                     "8", "--seed", "4", "--placement", "city", "--field", "walls", "--field-size", "64", "-o", "c.nbt"],
                    ["compare", "c.nbt", "--json"]], render_city),
 ]
+
+
+# The paper's Figure 12: the allowed error epsilon against the safety radius (mean, share at 0), the
+# robust searches' cost and their hit error, on a terrain and on a heightfield baked from a mesh, with
+# the strict radius and the paper's (the maximum over directions, as its text says, and the
+# minimum, which bounds every ray).
+FIG12_FIELDS = {"terrain": ["--field", "fbm", "--field-size", "64", "--seed", "21"],
+                "knot": ["--field-mesh", "shape:knot", "--field-size", "64"]}
+FIG12_EPSILONS = ("0", "0.005", "0.01", "0.02", "0.05", "0.1")
+FIG12_RADII = [("strict", [])] + [(f"paper {c}, {e}", ["--radius", "paper", "--radius-combine", c, "--radius-epsilon", e])
+                                  for c in ("min", "max") for e in FIG12_EPSILONS]
+
+
+def fig12_commands():
+    caps, runs = [], []
+    for f, args in FIG12_FIELDS.items():
+        for k, (_, radius) in enumerate(FIG12_RADII):
+            caps.append(["capture", "relief", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "256x256", "--frames", "4",
+                         *args, "--methods", "exact,robust,robust_clamp", *radius, "-o", f"f12_{f}_{k}.nbt"])
+            runs.append(["replay", f"f12_{f}_{k}.nbt", "--out", f"f12_{f}_{k}"])
+    return caps + runs
+
+
+def fig12_files():
+    return tuple(f"f12_{f}_{k}/run.json" for f in FIG12_FIELDS for k in range(len(FIG12_RADII)))
+
+
+def render_fig12(outputs):
+    import json
+    files = [json.loads(t) for t in outputs[-len(fig12_files()):]]
+    lines = ["| heightfield | radius | mean radius (texels) | radius 0 | robust: cycles / frame | lookups / fragment | hit errors | "
+             "robust_clamp: cycles / frame | hit errors | walks unlike GL's |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    k = 0
+    for f in FIG12_FIELDS:
+        for label, _ in FIG12_RADII:
+            s = files[k]["summary"]["relief"]
+            k += 1
+            r, c = s["methods"]["robust"], s["methods"]["robust_clamp"]
+            mism = sum(m["walk_mismatches"] + m["pixel_mismatches"] for m in s["methods"].values())
+            lines.append(f"| {f} | {label} | {s['radius_mean']:.2f} | {100 * s['radius_zero_fraction']:.1f} % | {n(r['cycles_per_frame'])} | "
+                         f"{r['lookups_per_fragment']:.1f} | {r['errors']:,} ({100 * r['error_rate']:.2f} %) | {n(c['cycles_per_frame'])} | "
+                         f"{c['errors']:,} ({100 * c['error_rate']:.2f} %) | {mism} |")
+    return "\n".join(lines)
+
+
+BLOCKS.append(Block("figure12", fig12_commands(), render_fig12, files=fig12_files()))

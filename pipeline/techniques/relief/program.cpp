@@ -56,6 +56,11 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
                            "memory_stall_cycles", "cycles"})
     j[name] = stat(p, name);
   j["cycles_total"] = cycles;
+  // The safety radii the robust searches read (the trace's: strict, or the paper's with its epsilon).
+  const double radius_texels = static_cast<double>(stat(p, "radius_texels"));
+  j["radius_mean"] = radius_texels > 0 ? nlohmann::ordered_json(static_cast<double>(stat(p, "radius_sum")) / radius_texels) : nlohmann::ordered_json(nullptr);
+  j["radius_zero_fraction"] =
+      radius_texels > 0 ? nlohmann::ordered_json(static_cast<double>(stat(p, "radius_zero")) / radius_texels) : nlohmann::ordered_json(nullptr);
   j["channel_bytes"] = stat(memory, "bytes_relief");
   nlohmann::ordered_json methods = nlohmann::ordered_json::object();
   for (relief::Method m : relief::kAllMethods) {
@@ -101,7 +106,9 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
 
 nlohmann::ordered_json summary(const SummaryInputs& in) {
   nlohmann::ordered_json j = totals(in.group, in.stats.contains("gpu.memory") ? in.stats["gpu.memory"] : nlohmann::ordered_json::object(), in.cycles);
-  for (const char* key : {"relief_field", "relief_field_size", "relief_box_height", "relief_angles"}) copy_property(in.header, key, j);
+  for (const char* key : {"relief_field", "relief_field_size", "relief_box_height", "relief_angles", "relief_radius", "relief_radius_epsilon",
+                          "relief_radius_combine"})
+    copy_property(in.header, key, j);
   // Storage a texel of the heightfield: what each method's textures cost (4 bytes a value).
   const std::string* size = in.header.property("relief_field_size");
   const double n = size ? std::strtod(size->c_str(), nullptr) : 0.0;

@@ -17,6 +17,7 @@
 #include "model/common/error.h"
 #include "model/mesh/shapes.h"
 #include "model/relief/heightfield.h"
+#include "model/relief/paper_radius.h"
 #include "model/relief/radius.h"
 #include "model/relief/score.h"
 #include "model/relief/walk.h"
@@ -66,6 +67,27 @@ const OptionSpec& field_mesh_option() {
 const OptionSpec& radius_file_option() {
   static const OptionSpec spec = text_option(
       "radius-file", "A single-channel image of safety radii in texels for the field, checked against it ('none': computed)", "none");
+  return spec;
+}
+const OptionSpec& radius_option() {
+  static const OptionSpec spec = choice_option(
+      "radius", "The safety radius: strict (every ray from anywhere in the texel, blocked ones too) or paper (Baboud & Decoret 3.5: "
+                "unblocked rays only, with --radius-epsilon and --radius-combine)",
+      "strict", {"strict", "paper"});
+  return spec;
+}
+const OptionSpec& radius_epsilon_option() {
+  static const OptionSpec spec = text_option(
+      "radius-epsilon", "Paper radius: how far (box heights, 0 to 1) a ray may pass under the surface without counting as a second "
+                        "crossing; larger gives larger radii and misses silhouettes up to that tall",
+      "0");
+  return spec;
+}
+const OptionSpec& radius_combine_option() {
+  static const OptionSpec spec = choice_option(
+      "radius-combine", "Paper radius: a texel's radius is the maximum over directions (the paper's wording) or the minimum (a bound "
+                        "for every ray)",
+      "max", {"max", "min"});
   return spec;
 }
 const OptionSpec& max_radius_option() {
@@ -244,12 +266,21 @@ class Relief final : public Technique {
       description_ = fmt::format("{}:{} seed {}", o.text(field_option()), param, seed_);
     }
     for (float& h : field_.heights) h += 0.0f;  // -0.0 becomes +0.0: one zero, so GL's max and the model's agree bit for bit
+    paper_radius_ = o.text(radius_option()) == "paper";
+    paper_.epsilon = parse_number(o.text(radius_epsilon_option()), "radius-epsilon", 0.0, 1.0);
+    paper_.combine = o.text(radius_combine_option()) == "min" ? relief::RadiusCombine::Min : relief::RadiusCombine::Max;
+    if (!paper_radius_ && (paper_.epsilon != 0.0 || paper_.combine != relief::RadiusCombine::Max))
+      throw InputError("--radius-epsilon and --radius-combine set the paper's radius: add --radius paper");
     const std::string radius_file = o.text(radius_file_option());
+    if (radius_file != "none" && paper_radius_)
+      throw InputError("--radius-file gives the radii: it takes no --radius paper (the file is checked against the strict guarantee)");
     if (radius_file != "none") {
       const relief::Heightfield r = read_square(radius_file, "--radius-file");
       radius_ = {r.size, r.heights};
       if (const std::string problem = relief::radius_problem(field_, radius_, max_radius_); !problem.empty())
         throw InputError(fmt::format("--radius-file '{}' does not match the heightfield: {}", radius_file, problem));
+    } else if (paper_radius_) {
+      radius_ = relief::paper_safety_radius(field_, max_radius_, paper_);
     } else {
       radius_ = relief::safety_radius(field_, max_radius_);
     }
@@ -282,6 +313,9 @@ class Relief final : public Technique {
             {"relief_frustum_apex", fmt::format("{}", apex_)},
             {"relief_angles", join(angles_)},
             {"relief_max_radius", std::to_string(max_radius_)},
+            {"relief_radius", paper_radius_ ? "paper" : "strict"},
+            {"relief_radius_epsilon", fmt::format("{}", paper_.epsilon)},
+            {"relief_radius_combine", std::string(relief::kRadiusCombineNames[static_cast<std::size_t>(paper_.combine)])},
             {"relief_linear_steps", std::to_string(params_.linear_steps)},
             {"relief_binary_steps", std::to_string(params_.binary_steps)},
             {"relief_root_steps", std::to_string(params_.root_steps)},
@@ -459,6 +493,8 @@ class Relief final : public Technique {
   int max_radius_ = 16;
   relief::Heightfield field_;
   relief::SafetyRadius radius_;
+  bool paper_radius_ = false;         // --radius paper
+  relief::PaperRadiusOptions paper_;  // its epsilon and combination
   std::string description_;
   std::vector<relief::Method> methods_;
   std::vector<double> angles_;
@@ -479,7 +515,7 @@ class Relief final : public Technique {
 
 const std::vector<OptionSpec>& relief_options() {
   static const std::vector<OptionSpec> options = {field_option(),        field_param_option(), field_size_option(),   field_file_option(),  field_mesh_option(),
-                                                  radius_file_option(),  max_radius_option(),  methods_option(),      angles_option(),
+                                                  radius_file_option(),  radius_option(), radius_epsilon_option(), radius_combine_option(), max_radius_option(),  methods_option(),      angles_option(),
                                                   box_height_option(),   frustum_option(),     linear_steps_option(), binary_steps_option(), root_steps_option(),
                                                   tolerance_option(),    placement_option(),   box_at_option(),       relief_covering_option(),
                                                   align_option(),        seed_option()};

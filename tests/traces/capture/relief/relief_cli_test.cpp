@@ -134,6 +134,31 @@ TEST(ReliefCliTest, HeightfieldFileAndTable) {
   fs::remove_all(dir);
 }
 
+// The paper's radius (--radius paper): fresh captures replay exactly for every method; with the
+// minimum over directions and epsilon 0 the robust search stays exact, and a larger epsilon (the
+// paper's maximum) makes it cheaper than with the strict radius, at some hit error.
+TEST(ReliefCliTest, PaperRadiusReplaysExactly) {
+  const fs::path dir = testing::scratch_path("nbsim_relief_cli_paper", "x").parent_path();
+  const auto exact = [](const nlohmann::json& r, const std::string& what) {
+    ASSERT_TRUE(r.is_object()) << what;
+    for (const auto& [name, m] : r["methods"].items()) {
+      EXPECT_EQ(m["walk_mismatches"], 0) << what << " " << name;
+      EXPECT_EQ(m["pixel_mismatches"], 0) << what << " " << name;
+      EXPECT_EQ(m["fragments"], m["gl_fragments"]) << what << " " << name;
+    }
+  };
+  const std::string field = "--field fbm --field-size 40 --field-param 5 --seed 17 --angles 55 ";
+  const nlohmann::json bound = capture_and_compare(dir / "min.nbt", field + "--radius paper --radius-combine min");
+  exact(bound, "min");
+  EXPECT_EQ(bound["methods"]["robust"]["errors"], 0) << "the minimum at epsilon 0 bounds the walk's rays";
+  const nlohmann::json strict = capture_and_compare(dir / "strict.nbt", field);
+  const nlohmann::json loose = capture_and_compare(dir / "loose.nbt", field + "--radius paper --radius-epsilon 0.05");
+  exact(loose, "epsilon 0.05");
+  EXPECT_LT(loose["methods"]["robust"]["lookups"].get<double>(), strict["methods"]["robust"]["lookups"].get<double>())
+      << "larger radii, fewer lookups";
+  fs::remove_all(dir);
+}
+
 TEST(ReliefCliTest, BadInputExitsTwoAndWritesNothing) {
   const fs::path out = testing::scratch_path("nbsim_relief_cli_bad", "never.nbt");
   const fs::path dir = out.parent_path() / "files";
@@ -168,7 +193,12 @@ TEST(ReliefCliTest, BadInputExitsTwoAndWritesNothing) {
                            {"--box-at 1,2,3", "--box-at needs --placement city"},
                            {"--placement city --angles 10", "--angles is for --placement own"},
                            {"--placement city --frustum 1", "takes the box, not a --frustum"},
-                           {"--placement city --box-at 1,2", "is not X,Z,SIZE"}},
+                           {"--placement city --box-at 1,2", "is not X,Z,SIZE"},
+                           {"--radius paper --radius-epsilon 2", "--radius-epsilon '2'"},
+                           {"--radius paper --radius-epsilon nan", "--radius-epsilon 'nan'"},
+                           {"--radius-epsilon 0.1", "add --radius paper"},
+                           {"--radius exact", "exact"},
+                           {("--radius paper --radius-file " + radius_big.string()).c_str(), "takes no --radius paper"}},
                           o, out);
   fs::remove_all(out.parent_path());
 }
