@@ -23,6 +23,15 @@ import report  # noqa: E402
 import report_data  # noqa: E402
 import table1  # noqa: E402
 
+
+def load_technique_module(technique, name):
+    """analysis/techniques/TECHNIQUE/NAME.py under a name of its own (every technique has a section.py)."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(f"{technique}_{name}", ROOT / "analysis" / "techniques" / technique / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
 # Each technique's report section (analysis/techniques/NAME/section.py), by name.
 SECTIONS = {s.NAME: s for s in report.technique_sections()}
 
@@ -285,11 +294,27 @@ class FixtureReport(unittest.TestCase):
         self.assertEqual(len(lines), 9, block)
         self.assertIn("| city | - | clamped | 64 |", block)
 
+    def test_relief_figure12_points(self):
+        # The Figure 12 series: per radius (strict first, then paper by combination and epsilon) the robust
+        # searches' mean cycles and hit error over their rows.
+        relief_section = load_technique_module("relief", "section")
+
+        def row(radius, combine, eps, method, cycles, errors, fragments=100):
+            return {"radius": radius, "radius_combine": combine, "radius_epsilon": eps, "radius_mean": 1.5, "method": method,
+                    "cycles": cycles, "errors": errors, "fragments": fragments}
+        doc = {"rows": [row("paper", "min", 0.05, "robust", 10, 2), row("paper", "min", 0.05, "robust", 20, 0),
+                        row("strict", None, 0.0, "robust", 40, 0), row("paper", "min", 0.0, "robust", 30, 0),
+                        row("paper", "min", 0.0, "exact", 99, 9)]}
+        pts = relief_section.figure12_points(doc)
+        self.assertEqual([(p["radius"], p["epsilon"]) for p in pts], [("strict", 0.0), ("paper", 0.0), ("paper", 0.05)])
+        self.assertEqual(pts[2]["robust_cycles"], 15)
+        self.assertAlmostEqual(pts[2]["robust_error"], 0.01)
+        self.assertIsNone(pts[0]["robust_clamp_cycles"])
+
     def test_shadows_reading_per_camera_path(self):
         # Rows of one scene on two camera paths (the flyover and the paper's observer on the ground):
         # sorted fly first, and the reading names the path of each clamped ratio.
-        sys.path.insert(0, str(ROOT / "analysis" / "techniques" / "shadows"))
-        import section as shadows_section  # noqa: E402
+        shadows_section = load_technique_module("shadows", "section")
         base = json.loads((FIXTURE / "shadows" / "shadows.json").read_text())
         city = [r for r in base if r["scene"] == "city"]
         ground = [dict(r, path="ground", fill_per_frame=r["fill_per_frame"] / 2,

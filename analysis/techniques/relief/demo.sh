@@ -18,3 +18,19 @@ for f in fbm walls spikes saddle step; do
 done
 "$nbsim" relief "${rtraces[@]}" --out "$out/relief" | tail -32 || echo "relief: a walk differs from GL's or a replay failed (see above)"
 "$nbsim" compare traces/samples/relief_fbm_64.nbt | tail -7 || echo "relief: the model's replay of the sample differs from GL's (see above)"
+# The paper's Figure 12: the safety radius's allowed error against the robust searches' cost and hit
+# error, on an fbm terrain (64², 128 x 128, the four view angles): the strict radius, then the
+# paper's with the minimum and with the maximum over directions at each epsilon (about 10 s).
+mkdir -p "$out/relief_figure12/traces"
+ftraces=()
+for spec in "strict" "paper min 0" "paper min 0.01" "paper min 0.02" "paper min 0.05" "paper min 0.1" \
+            "paper max 0" "paper max 0.01" "paper max 0.02" "paper max 0.05" "paper max 0.1"; do
+  read -r kind combine epsilon <<< "$spec"
+  t="$out/relief_figure12/traces/fbm_64_${kind}_${combine:-all}_${epsilon:-0}.nbt"
+  radius=()
+  [[ $kind == paper ]] && radius=(--radius paper --radius-combine "$combine" --radius-epsilon "$epsilon")
+  [[ -f "$t" ]] || "$nbsim" capture relief --scene boxes --boxes 0 --path fly --size 128x128 --frames 4 --seed 5 --field fbm \
+    --field-size 64 --methods exact,robust,robust_clamp "${radius[@]}" -o "$t" > /dev/null
+  ftraces+=("$t")
+done
+"$nbsim" relief "${ftraces[@]}" --out "$out/relief_figure12" > /dev/null || echo "relief: a Figure 12 walk differs from GL's or a replay failed"

@@ -2,6 +2,7 @@
 #include "pipeline/techniques/relief/relief_table.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <array>
 #include <map>
 #include <sstream>
@@ -39,6 +40,17 @@ nlohmann::ordered_json relief_rows(const std::vector<nlohmann::json>& runs, cons
     } catch (const std::exception&) {
       angles.clear();
     }
+    // The trace's safety radius (relief_radius and its settings; strict before the header had them)
+    // and the replay's statistics of it.
+    const std::string radius = props.value("relief_radius", "strict");
+    const double epsilon = std::strtod(props.value("relief_radius_epsilon", "0").c_str(), nullptr);
+    const std::string combine = props.value("relief_radius_combine", "max");
+    nlohmann::ordered_json radius_mean = nullptr, radius_zero = nullptr;
+    if (run.contains("summary") && run["summary"].contains("relief")) {
+      const auto& sr = run["summary"]["relief"];
+      if (sr.contains("radius_mean")) radius_mean = sr["radius_mean"];
+      if (sr.contains("radius_zero_fraction")) radius_zero = sr["radius_zero_fraction"];
+    }
     for (const nlohmann::json& f : run["frames"]) {
       if (!f.contains("relief")) continue;
       const std::uint64_t frame = u(f, "frame");
@@ -50,6 +62,11 @@ nlohmann::ordered_json relief_rows(const std::vector<nlohmann::json>& runs, cons
         r["frame"] = frame;
         r["angle"] = angles.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(angles[frame % angles.size()]);
         r["method"] = method;
+        r["radius"] = radius;
+        r["radius_epsilon"] = epsilon;
+        r["radius_combine"] = radius == "paper" ? nlohmann::ordered_json(combine) : nlohmann::ordered_json(nullptr);
+        r["radius_mean"] = radius_mean;
+        r["radius_zero_fraction"] = radius_zero;
         for (const char* k : {"fragments", "gl_fragments", "lookups", "steps", "errors", "reference_hits", "cycles", "pixel_mismatches",
                               "walk_mismatches"})
           r[k] = u(v, k);
