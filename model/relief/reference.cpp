@@ -15,7 +15,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <vector>
 
 #include <fmt/format.h>
 
@@ -78,6 +77,47 @@ double first_root(const Quadratic& q, double length) noexcept {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+// One axis's cell-boundary crossings t = (k + 0.5 - o) / d strictly inside (t_enter, t_exit), k in
+// [-1, N], in increasing t: k runs up for d > 0 and down for d < 0, and the rounded quotient is
+// monotone in k, so the ones at or before t_enter lead and the ones at or after t_exit trail.
+class AxisCuts {
+ public:
+  AxisCuts(double o, double d, double t_enter, double t_exit, int n) : o_(o), d_(d), t_enter_(t_enter), t_exit_(t_exit) {
+    if (d == 0.0) return;
+    const double a = o + t_enter * d - 0.5, b = o + t_exit * d - 0.5;
+    const double first = std::max(std::ceil(std::min(a, b)), -1.0), last = std::min(std::floor(std::max(a, b)), static_cast<double>(n));
+    if (first > last) return;
+    k_ = d > 0.0 ? first : last;
+    end_ = d > 0.0 ? last : first;
+    step_ = d > 0.0 ? 1.0 : -1.0;
+    live_ = true;
+    advance();
+  }
+  // The next crossing, +inf when there is none.
+  double peek() const noexcept { return live_ ? t_ : std::numeric_limits<double>::infinity(); }
+  double take() noexcept {
+    const double t = t_;
+    k_ += step_;
+    advance();
+    return t;
+  }
+
+ private:
+  // Moves to the first k from k_ whose crossing lies inside the interval, or ends.
+  void advance() noexcept {
+    for (; live_; k_ += step_) {
+      if (step_ > 0.0 ? k_ > end_ : k_ < end_) break;
+      t_ = (k_ + 0.5 - o_) / d_;
+      if (t_ >= t_exit_) break;
+      if (t_ > t_enter_) return;
+    }
+    live_ = false;
+  }
+  double o_, d_, t_enter_, t_exit_;
+  double k_ = 0.0, end_ = 0.0, step_ = 1.0, t_ = 0.0;
+  bool live_ = false;
+};
+
 }  // namespace
 
 ReferenceHit reference_hit(const Heightfield& field, const std::array<double, 3>& origin, const std::array<double, 3>& direction,
@@ -89,36 +129,30 @@ ReferenceHit reference_hit(const Heightfield& field, const std::array<double, 3>
   if (oz + t_enter * dz - surface_height(field, ox + t_enter * dx, oy + t_enter * dy) <= 0.0) return {true, t_enter};
 
   // The cuts: every t in (t_enter, t_exit) where x or y crosses a cell boundary k + 0.5, k in
-  // [-1, N] (beyond the outermost boundaries every texel is virtual and the surface is 0).
-  std::vector<double> cuts{t_enter};
+  // [-1, N] (beyond the outermost boundaries every texel is virtual and the surface is 0), in
+  // increasing order: each axis's crossings come in order, so the two are merged as the walk goes
+  // (the same sequence a sort of all of them gives), and the walk stops at the first hit.
   const int n = field.size;
-  auto add_crossings = [&](double o, double d) {
-    if (d == 0.0) return;
-    const double a = o + t_enter * d - 0.5, b = o + t_exit * d - 0.5;
-    const double first = std::max(std::ceil(std::min(a, b)), -1.0), last = std::min(std::floor(std::max(a, b)), static_cast<double>(n));
-    for (double k = first; k <= last; k += 1.0) {
-      const double t = (k + 0.5 - o) / d;
-      if (t > t_enter && t < t_exit) cuts.push_back(t);
+  AxisCuts xs(ox, dx, t_enter, t_exit, n), ys(oy, dy, t_enter, t_exit, n);
+  double ta = t_enter;
+  for (;;) {
+    const double tx = xs.peek(), ty = ys.peek();
+    const bool last = !(tx < t_exit) && !(ty < t_exit);
+    const double tb = last ? t_exit : tx <= ty ? xs.take() : ys.take();
+    if (tb > ta) {  // else a corner (its neighbours cover it), or t_enter == t_exit (checked above)
+      const double tm = 0.5 * (ta + tb);
+      const double cx = std::clamp(ox + tm * dx - 0.5, -2.0, n + 1.0), cy = std::clamp(oy + tm * dy - 0.5, -2.0, n + 1.0);
+      const int ci = static_cast<int>(std::floor(cx)), cj = static_cast<int>(std::floor(cy));
+      const double h00 = field.at(ci, cj), h10 = field.at(ci + 1, cj), h01 = field.at(ci, cj + 1), h11 = field.at(ci + 1, cj + 1);
+      const double A = h10 - h00, B = h01 - h00, C = h00 - h10 - h01 + h11;
+      // The patch h(u, v) = h00 + A u + B v + C u v along u = ua + s dx, v = va + s dy.
+      const double ua = ox + ta * dx - (ci + 0.5), va = oy + ta * dy - (cj + 0.5);
+      const Quadratic f{-C * dx * dy, dz - (A * dx + B * dy + C * (ua * dy + va * dx)), oz + ta * dz - (h00 + A * ua + B * va + C * ua * va)};
+      if (f.c <= 0.0) return {true, ta};  // only by rounding: the previous piece ended a hair above
+      if (const double s = first_root(f, tb - ta); !std::isnan(s)) return {true, std::min(ta + s, tb)};
     }
-  };
-  add_crossings(ox, dx);
-  add_crossings(oy, dy);
-  std::sort(cuts.begin() + 1, cuts.end());
-  cuts.push_back(t_exit);
-
-  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
-    const double ta = cuts[k], tb = cuts[k + 1];
-    if (!(tb > ta)) continue;  // a corner (its neighbours cover it), or t_enter == t_exit (checked above)
-    const double tm = 0.5 * (ta + tb);
-    const double cx = std::clamp(ox + tm * dx - 0.5, -2.0, n + 1.0), cy = std::clamp(oy + tm * dy - 0.5, -2.0, n + 1.0);
-    const int ci = static_cast<int>(std::floor(cx)), cj = static_cast<int>(std::floor(cy));
-    const double h00 = field.at(ci, cj), h10 = field.at(ci + 1, cj), h01 = field.at(ci, cj + 1), h11 = field.at(ci + 1, cj + 1);
-    const double A = h10 - h00, B = h01 - h00, C = h00 - h10 - h01 + h11;
-    // The patch h(u, v) = h00 + A u + B v + C u v along u = ua + s dx, v = va + s dy.
-    const double ua = ox + ta * dx - (ci + 0.5), va = oy + ta * dy - (cj + 0.5);
-    const Quadratic f{-C * dx * dy, dz - (A * dx + B * dy + C * (ua * dy + va * dx)), oz + ta * dz - (h00 + A * ua + B * va + C * ua * va)};
-    if (f.c <= 0.0) return {true, ta};  // only by rounding: the previous piece ended a hair above
-    if (const double s = first_root(f, tb - ta); !std::isnan(s)) return {true, std::min(ta + s, tb)};
+    if (last) break;
+    ta = tb;
   }
   return {};
 }
