@@ -100,15 +100,20 @@ SafetyRadius paper_safety_radius(const Heightfield& field, int max_radius, const
   const double limit = static_cast<double>(max_radius) + 1.0;
   // Per start point of the (N (m - 1) + 1)^2 lattice (shared by neighbouring texels) and direction.
   const int side = n * (m - 1) + 1;
+  std::vector<std::array<double, 2>> dirs(static_cast<std::size_t>(d));
+  for (int k = 0; k < d; ++k) {
+    const double angle = 2.0 * std::numbers::pi * (k + 0.5) / d;
+    dirs[static_cast<std::size_t>(k)] = {std::cos(angle), std::sin(angle)};
+  }
   std::vector<float> point(static_cast<std::size_t>(side) * static_cast<std::size_t>(side) * static_cast<std::size_t>(d));
   for (int b = 0; b < side; ++b)
-    for (int a = 0; a < side; ++a)
+    for (int a = 0; a < side; ++a) {
+      const double px = static_cast<double>(a) / (m - 1), py = static_cast<double>(b) / (m - 1);
       for (int k = 0; k < d; ++k) {
-        const double angle = 2.0 * std::numbers::pi * (k + 0.5) / d;
-        const double px = static_cast<double>(a) / (m - 1), py = static_cast<double>(b) / (m - 1);
-        point[(static_cast<std::size_t>(b) * side + a) * d + k] =
-            static_cast<float>(paper_point_radius(field, px, py, std::cos(angle), std::sin(angle), limit, o));
+        const auto [dx, dy] = dirs[static_cast<std::size_t>(k)];
+        point[(static_cast<std::size_t>(b) * side + a) * d + k] = static_cast<float>(paper_point_radius(field, px, py, dx, dy, limit, o));
       }
+    }
   SafetyRadius out{n, std::vector<float>(static_cast<std::size_t>(n) * static_cast<std::size_t>(n), 0.0f)};
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {

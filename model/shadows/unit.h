@@ -161,7 +161,6 @@ class ShadowsUnit : public sim::Unit, public cp::FrameProgram, public depth::Dep
   std::vector<float> nearest_;
   std::vector<std::size_t> index_;
   std::vector<nbuffer::QueryAnswer> min_answers_, max_answers_;
-  DepthImage image_;
 };
 
 }  // namespace nbsim::shadows

@@ -219,16 +219,16 @@ def render_table1(outputs):
              "lookups / fragment | binary: cycles | lookups / fragment | paper, Hz (binary, exact, robust) |",
              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
     robust = {}
-    for (label, kind, n, radius, _), f in zip(T1_CASES, files):
+    for (label, kind, size, radius, _), f in zip(T1_CASES, files):
         s = f["summary"]["relief"]
         m = s["methods"]
-        paper = ", ".join(str(T1_PAPER_HZ[x][T1_SIZES.index(n)]) for x in ("binary", "exact", "robust")) if kind == "terrain" else "-"
-        lines.append(f"| {label} | {radius} | {s['radius_mean']:.2f} | {n_(m['robust']['cycles_per_frame'])} | "
-                     f"{m['robust']['lookups_per_fragment']:.1f} | {m['robust']['errors']:,} | {n_(m['exact']['cycles_per_frame'])} | "
-                     f"{m['exact']['lookups_per_fragment']:.1f} | {n_(m['binary']['cycles_per_frame'])} | "
+        paper = ", ".join(str(T1_PAPER_HZ[x][T1_SIZES.index(size)]) for x in ("binary", "exact", "robust")) if kind == "terrain" else "-"
+        lines.append(f"| {label} | {radius} | {s['radius_mean']:.2f} | {n(m['robust']['cycles_per_frame'])} | "
+                     f"{m['robust']['lookups_per_fragment']:.1f} | {m['robust']['errors']:,} | {n(m['exact']['cycles_per_frame'])} | "
+                     f"{m['exact']['lookups_per_fragment']:.1f} | {n(m['binary']['cycles_per_frame'])} | "
                      f"{m['binary']['lookups_per_fragment']:.1f} | {paper} |")
         if kind == "terrain":
-            robust[(radius, n)] = m["robust"]
+            robust[(radius, size)] = m["robust"]
     def growth(radius, key):
         a, b = robust[(radius, T1_SIZES[0])][key], robust[(radius, T1_SIZES[-1])][key]
         return b / a
@@ -237,10 +237,6 @@ def render_table1(outputs):
               f"{growth('paper', 'cycles_per_frame'):.2f}; with the strict radius: lookups x "
               f"{growth('strict', 'lookups_per_fragment'):.2f}, cycles x {growth('strict', 'cycles_per_frame'):.2f}."]
     return "\n".join(lines)
-
-
-def n_(v):
-    return n(v)
 
 
 BLOCKS.append(Block("table1_setup", table1_commands(), render_table1, files=tuple(f"t1_{k}/run.json" for k in range(len(T1_CASES)))))
