@@ -1,6 +1,7 @@
 // Early depth test on 4x4 blocks against a float DepthImage; see depth_test.h.
 #include "model/raster/depth_test.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 
@@ -41,7 +42,7 @@ void run_peel_block(DepthImage& img, const DepthPlane& plane, int x, int y, std:
     const int i = std::countr_zero(m);
     const int px = x + (i & 3), py = y + (i >> 2);
     const std::size_t at = static_cast<std::size_t>(py) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(px);
-    const float interpolated = plane.at(px, py, fused);
+    float interpolated = plane.at(px, py, fused);
     if (state.peel_layer) {
       ++k.peel_reads;
       if (!(interpolated > state.peel_layer->texels[at])) {  // strict; NaN and +inf layers drop the fragment
@@ -53,6 +54,8 @@ void run_peel_block(DepthImage& img, const DepthPlane& plane, int x, int y, std:
       ++k.shader_discarded;
       continue;
     }
+    if (state.shader)
+      if (const std::optional<float> written = state.shader->frag_depth(px, py)) interpolated = std::clamp(*written, 0.0f, 1.0f);
     if (!state.test) {
       ++k.passed;
       if (state.passed_mask) (*state.passed_mask)[at] = 1;

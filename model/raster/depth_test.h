@@ -70,10 +70,14 @@ inline float stored_depth(DepthFormat format, float z) noexcept {
 // A fragment shader's discard before the depth test (the fragment counted as rasterized, never
 // depth tested): `discards` gets the pixel and the fragment's gl_FragCoord.z, the depth plane's
 // value before the [0, 1] clamp (DepthPlane::raw_at), as llvmpipe's shader sees it.
+// A shader that writes gl_FragDepth (frag_depth returns it) has it clamped to [0, 1], then tested and
+// stored instead of the interpolated depth (llvmpipe clamps a written depth even in a float buffer
+// without depth clamp: ReliefGlWalkTest.FragDepthOutsideTheUnitRange).
 class FragmentShader {
  public:
   virtual ~FragmentShader() = default;
   virtual bool discards(int x, int y, float frag_z) const = 0;
+  virtual std::optional<float> frag_depth(int /*x*/, int /*y*/) const { return std::nullopt; }
 };
 
 struct DepthState {

@@ -23,6 +23,7 @@ namespace {
 
 constexpr const char* kFieldLabel = "ReliefField (RLFH)";
 constexpr const char* kFragmentsLabel = "ReliefFragments (RLFF)";
+constexpr const char* kDepthLabel = "ReliefDepth (RLFD)";
 // Limits fixed by the design (traces/format/relief/relief_chunk.h, radius.h, walk.h WalkParams).
 constexpr std::uint64_t kMaxRadiusLimit = 255, kMaxLinearSteps = 1024, kMaxBisections = 32;
 
@@ -200,6 +201,37 @@ std::vector<GlReliefFragments> read_relief_fragments(const scene::Frame& f, std:
     if (f.draws[d].role == kReliefBoxRole && record_of_draw[d] == f.technique_records.size())
       throw InputError(fmt::format("frame {}: relief_box draw {} has no {} record", frame, f.draws[d].index, kFragmentsLabel));
   return out;
+}
+
+std::optional<GlReliefDepth> read_relief_depth(const scene::Frame& f, bool required) {
+  const std::uint64_t frame = f.begin.frame;
+  bool present = false;
+  for (const scene::TechniqueRecord& r : f.technique_records) present = present || r.type == kReliefDepthRecordType;
+  if (!present && !required) return std::nullopt;
+  const scene::TechniqueRecord& rec = scene::single_record(
+      f, kReliefDepthRecordType, kDepthLabel, "the trace's boxes write depth (relief_box_depth), and nothing says what GL's depth became");
+  GlReliefDepth g;
+  const std::vector<float>& m = scene::record_field<float>(rec, "texel_to_clip", kDepthLabel, frame);
+  if (m.size() != 16) throw InputError(fmt::format("frame {}: the {} record's texel_to_clip has {} values, not 16", frame, kDepthLabel, m.size()));
+  for (std::size_t k = 0; k < 16; ++k) {
+    if (!std::isfinite(m[k])) throw InputError(fmt::format("frame {}: the {} record's texel_to_clip[{}] is {}", frame, kDepthLabel, k, m[k]));
+    g.texel_to_clip[k] = m[k];
+  }
+  g.draws = scene::record_field<std::uint32_t>(rec, "draws", kDepthLabel, frame);
+  g.depth_crc = scene::record_field<std::uint32_t>(rec, "depth_crc", kDepthLabel, frame);
+  if (g.depth_crc.size() != g.draws.size())
+    throw InputError(fmt::format("frame {}: the {} record has {} draws but {} CRCs", frame, kDepthLabel, g.draws.size(), g.depth_crc.size()));
+  std::size_t next = 0;
+  for (const scene::DrawRecord& d : f.draws) {
+    if (d.role != kReliefBoxRole) continue;
+    if (next >= g.draws.size() || g.draws[next] != d.index)
+      throw InputError(fmt::format("frame {}: relief_box draw {} has no depth CRC in the {} record (in draw order)", frame, d.index, kDepthLabel));
+    ++next;
+  }
+  if (next != g.draws.size())
+    throw InputError(fmt::format("frame {}: the {} record lists {} draws, but the frame has {} relief_box draws", frame, kDepthLabel,
+                                 g.draws.size(), next));
+  return g;
 }
 
 }  // namespace nbsim::relief

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@ namespace nbsim::relief {
 
 inline constexpr std::uint32_t kReliefFieldRecordType = 0x48464C52u;      // fourcc "RLFH" (traces/format/relief/relief_chunk.h)
 inline constexpr std::uint32_t kReliefFragmentsRecordType = 0x46464C52u;  // fourcc "RLFF"
+inline constexpr std::uint32_t kReliefDepthRecordType = 0x44464C52u;      // fourcc "RLFD"
 
 // RLFH, checked.
 struct GlReliefField {
@@ -49,5 +51,16 @@ struct GlReliefFragments {
 };
 // Every RLFF of the frame, in record order; `viewport_pixels` bounds `pixel`.
 std::vector<GlReliefFragments> read_relief_fragments(const scene::Frame& f, std::uint64_t viewport_pixels);
+
+// RLFD, checked: what the box draws left in GL's depth buffer (box_depth.h).
+struct GlReliefDepth {
+  std::array<float, 16> texel_to_clip{};  // column-major
+  std::vector<std::uint32_t> draws;       // the frame's relief_box draws, in order
+  std::vector<std::uint32_t> depth_crc;   // per draw: CRC-32 of the depth buffer right after it
+};
+// The frame's RLFD. `required` (the header's relief_box_depth is box or exact): its absence is an
+// InputError; otherwise absent gives an empty optional. Every relief_box draw of the frame must have
+// its CRC, in order.
+std::optional<GlReliefDepth> read_relief_depth(const scene::Frame& f, bool required);
 
 }  // namespace nbsim::relief

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
+
+#include <zlib.h>
 
 #include "model/common/error.h"
 #include "model/relief/roles.h"
@@ -23,16 +26,41 @@ raster::RasterPathConfig path_config(int width, int height, bool fused) {
   return c;
 }
 
+// The second pass of a box draw that writes depth: the walk's misses discarded, the hits tested
+// and written at the box's interpolated depth, or at their own (exact).
+class KeepHits final : public raster::FragmentShader {
+ public:
+  KeepHits(const std::vector<std::uint8_t>& hit, const std::vector<float>* depth, int width) : hit_(hit), depth_(depth), width_(width) {}
+  bool discards(int x, int y, float) const override { return hit_[at(x, y)] == 0; }
+  std::optional<float> frag_depth(int x, int y) const override {
+    if (!depth_) return std::nullopt;
+    return (*depth_)[at(x, y)];
+  }
+
+ private:
+  std::size_t at(int x, int y) const noexcept { return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x); }
+  const std::vector<std::uint8_t>& hit_;
+  const std::vector<float>* depth_;
+  int width_;
+};
+
 }  // namespace
 
-ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, CoveringSpec covering)
+ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, CoveringSpec covering, BoxDepth box_depth)
     : width_(width),
       height_(height),
       covering_(covering),
+      box_depth_(box_depth),
       depth_(path_config(width, height, fused_interpolation).width_px, height, 1.0f),
+      without_box_(width, height, 1.0f),
       passed_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0),
-      path_(path_config(width, height, fused_interpolation), depth_) {
+      path_(path_config(width, height, fused_interpolation), depth_),
+      without_box_path_(path_config(width, height, fused_interpolation), without_box_) {
   path_.set_reuse_rasterization(true);  // every method draws the same box
+  if (box_depth_ != BoxDepth::None) {
+    hit_.assign(passed_.size(), 0);
+    if (box_depth_ == BoxDepth::Exact) hit_depth_.assign(passed_.size(), 0.0f);
+  }
 }
 
 ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double tolerance, double box_height, LookupObserver observer,
@@ -50,14 +78,32 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   for (const float r : gl.radius.radius) out.radius_sum += static_cast<std::uint64_t>(r), out.radius_zero += r == 0.0f ? 1 : 0;
   out.view_angle = gl.view_angle;
 
-  std::size_t next_record = 0;
+  const bool writes = box_depth_ != BoxDepth::None;
+  const std::optional<GlReliefDepth> gl_depth = read_relief_depth(f, writes);
+  std::size_t next_record = 0, box_draw = 0;
   std::fill(depth_.texels.begin(), depth_.texels.end(), 1.0f);  // the frame's depth buffer: the scene's, then tested by the boxes
+  // A box draw's counts are handed on once the scene draws after it are counted too.
+  std::optional<BoxDrawCounts> open;
+  const auto close = [&] {
+    if (!open) return;
+    if (draw_done) draw_done(context, *open);
+    out.draws.push_back(*open);
+    open.reset();
+  };
   for (const scene::DrawRecord& d : f.draws) {
-    if (d.role == scene::DrawRole::Scene) {  // boxes in a scene: its depth, drawn first
+    if (d.role == scene::DrawRole::Scene) {  // boxes in a scene: its depth, drawn before and after the boxes
       if (d.topology != scene::Topology::Triangles || d.clip_positions.size() % 3 != 0)
         throw InputError(fmt::format("frame {}: scene draw {} is not a list of triangles", f.begin.frame, d.index));
-      out.scene_depth_tests += path_.draw(d.clip_positions, raster::draw_state(d.state)).depth.depth_tests;
+      const raster::DrawState s = raster::draw_state(d.state);
+      const raster::DrawCounters k = path_.draw(d.clip_positions, s);
+      out.scene_depth_tests += k.depth.depth_tests;
       ++out.scene_draws;
+      out.scene_mismatches += k.depth.passed != d.gl.samples_passed ? 1 : 0;
+      if (open) {
+        ++open->scene_after_draws;
+        open->scene_after_samples += k.depth.passed;
+        if (writes) open->scene_hidden += without_box_path_.draw(d.clip_positions, s).depth.passed - k.depth.passed;
+      }
       continue;
     }
     if (d.role != kReliefBoxRole) continue;
@@ -66,10 +112,19 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     if (next_record >= records.size() || records[next_record].draw != d.index)
       throw InputError(fmt::format("frame {}: relief_box draw {} has no ReliefFragments (RLFF) record in draw order", f.begin.frame, d.index));
     const GlReliefFragments& r = records[next_record++];
+    close();
+    // Every box draw starts from the depth before the frame's first (box_depth.h).
+    if (box_draw++ == 0) before_boxes_ = depth_.texels;
+    else std::copy(before_boxes_.begin(), before_boxes_.end(), depth_.texels.begin());
+    if (writes) std::copy(before_boxes_.begin(), before_boxes_.end(), without_box_.texels.begin());
 
+    // The walk's fragments: after the early test (none, box), or every rasterized one (exact: the
+    // test waits for the shader's depth). No write here: a box draw writes after its walks.
     std::fill(passed_.begin(), passed_.end(), std::uint8_t{0});
     raster::DrawState s = raster::draw_state(d.state);
     s.depth.passed_mask = &passed_;
+    s.depth.write = false;
+    if (box_depth_ == BoxDepth::Exact) s.depth.test = false;
     const raster::DrawCounters k = path_.draw(d.clip_positions, s);
 
     BoxDrawCounts c;
@@ -98,6 +153,10 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       WalkResult w;
       if (ray) w = walk(r.method, view, params, *ray, observer, context);
       const std::uint32_t code = w.capped ? 2u : w.hit ? 1u : 0u;
+      if (writes) {
+        hit_[px] = code == 1u ? 1 : 0;
+        if (box_depth_ == BoxDepth::Exact && code == 1u) hit_depth_[px] = hit_depth(gl_depth->texel_to_clip, *ray, w.t);
+      }
       c.lookups += w.lookups, c.steps += w.steps, c.bisections += w.bisections;
       c.longest_walk = std::max<std::uint64_t>(c.longest_walk, w.lookups);
       c.hits += code == 1u, c.capped += code == 2u, c.samples += code == 1u;
@@ -121,9 +180,22 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       ++g;
     }
     c.pixel_mismatches += r.pixel.size() - g;
-    if (draw_done) draw_done(context, c);
-    out.draws.push_back(c);
+    if (writes) {  // the write: the hits at the box's depth (early test, late write) or at their own
+      raster::DrawState keep = raster::draw_state(d.state);
+      const KeepHits shader(hit_, box_depth_ == BoxDepth::Exact ? &hit_depth_ : nullptr, width_);
+      keep.depth.shader = &shader;
+      const raster::DrawCounters w = path_.draw(d.clip_positions, keep);
+      c.samples = w.depth.passed;
+      c.depth_written = w.depth.written;
+      if (box_depth_ == BoxDepth::Exact) c.depth_tests = w.depth.depth_tests;
+      std::fill(hit_.begin(), hit_.end(), std::uint8_t{0});
+      const std::uint32_t crc = static_cast<std::uint32_t>(
+          crc32(0L, reinterpret_cast<const Bytef*>(depth_.texels.data()), static_cast<uInt>(depth_.texels.size() * sizeof(float))));
+      c.depth_mismatches = crc != gl_depth->depth_crc[box_draw - 1] ? 1 : 0;
+    }
+    open = c;
   }
+  close();
   if (next_record != records.size())
     throw InputError(fmt::format("frame {}: {} ReliefFragments (RLFF) records, but {} relief_box draws", f.begin.frame, records.size(),
                                  next_record));

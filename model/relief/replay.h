@@ -9,7 +9,15 @@
 //     is convex and back faces are culled);
 //  2. every such fragment's walk (walk.h) with the draw's method, compared with GL's fragment by
 //     fragment: the same pixels, and the same hit, t (bits), lookups, steps and bisections;
-//  3. every walk scored against the exact reference (score.h): the method's hit error.
+//  3. every walk scored against the exact reference (score.h): the method's hit error;
+//  4. what the draw leaves in the depth buffer (box_depth.h, the header's relief_box_depth): with
+//     box, the hits' interpolated box depth (early test, late write); with exact, the hits' own
+//     depth (the test after the walk: step 1 then tests nothing and every rasterized fragment
+//     walks), the buffer then compared with GL's by its CRC (RLFD). Every box draw starts from the
+//     depth as it was before the frame's first box draw; scene draws after a box draw are that
+//     draw's "scene after": their samples, and the fragments the box's depth hid (the same draws
+//     replayed against the depth without the box).
+// Every scene draw's samples passed are compared with GL's.
 // GL's counters of the draw: fragments (relief.frag counts after the early test) and samples passed
 // (fragments that were not discarded: the hits).
 #pragma once
@@ -20,6 +28,7 @@
 
 #include "model/common/depth.h"
 #include "model/raster/raster_path.h"
+#include "model/relief/box_depth.h"
 #include "model/relief/records.h"
 #include "model/relief/score.h"
 #include "model/relief/walk.h"
@@ -45,13 +54,19 @@ struct BoxDrawCounts {
   // The textures the method reads, bytes (4 a texel, as GL's R32F textures): the heights; the safety
   // radii (robust, robust_clamp); every N-buffer level (nbuffer).
   std::uint64_t storage_bytes = 0;
+  // The box's depth (box_depth.h): depth values the draw wrote; 1 when the depth buffer after it
+  // differs from GL's (its RLFD CRC), else 0; the scene draws after it (placement city), the samples
+  // they passed and the fragments of theirs the box's depth hid.
+  std::uint64_t depth_written = 0, depth_mismatches = 0;
+  std::uint64_t scene_after_draws = 0, scene_after_samples = 0, scene_hidden = 0;
 };
 
 struct ReliefFrameCounts {
   int size = 0;  // the heightfield's N
   // The frame's safety radii (RLFH): their sum and the texels at 0, over its N * N texels.
   std::uint64_t radius_sum = 0, radius_zero = 0;
-  std::uint64_t scene_draws = 0, scene_depth_tests = 0;  // a scene drawn before the boxes (placement city)
+  std::uint64_t scene_draws = 0, scene_depth_tests = 0;  // the scene's draws (placement city), before and after the boxes
+  std::uint64_t scene_mismatches = 0;                    // scene draws whose samples passed differ from GL's (expected 0)
   double view_angle = 0.0;
   std::vector<BoxDrawCounts> draws;  // relief_box draws in order
 };
@@ -60,7 +75,8 @@ class ReliefReplay {
  public:
   // The viewport (1 .. 16384 a side; InputError otherwise). `covering`: the N-buffer walk's, the
   // capture's (the trace header's nbuffer_covering).
-  ReliefReplay(int width, int height, bool fused_interpolation = true, CoveringSpec covering = {});
+  // `box_depth`: the header's relief_box_depth (none for a trace without it).
+  ReliefReplay(int width, int height, bool fused_interpolation = true, CoveringSpec covering = {}, BoxDepth box_depth = BoxDepth::None);
   ReliefReplay(const ReliefReplay&) = delete;
   ReliefReplay& operator=(const ReliefReplay&) = delete;
 
@@ -75,13 +91,19 @@ class ReliefReplay {
  private:
   int width_, height_;
   CoveringSpec covering_;
+  BoxDepth box_depth_;
   DepthImage depth_;
+  std::vector<float> before_boxes_;  // the depth before the frame's first box draw
+  DepthImage without_box_;           // the scene after a box drawn without it (box_depth_ not none)
+  std::vector<std::uint8_t> hit_;     // per pixel: the current box draw's walk hit there
+  std::vector<float> hit_depth_;      // and its exact depth (box_depth_ exact)
   std::vector<std::uint8_t> passed_;
   // The frame's references by pixel (the methods' draws share the frame's rays): computed at the
   // first draw that walks the pixel.
   std::vector<ReferenceHit> reference_;
   std::vector<std::uint8_t> referenced_;
   raster::RasterPath path_;
+  raster::RasterPath without_box_path_;
 };
 
 }  // namespace nbsim::relief

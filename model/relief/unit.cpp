@@ -80,17 +80,18 @@ void ReliefUnitConfig::validate() const {
 
 ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ReliefUnitConfig& config,
                        memory::Channel& memory, int width, int height, double box_height, bool fused_interpolation,
-                       CoveringSpec covering)
+                       CoveringSpec covering, BoxDepth box_depth)
     : sim::Unit(name, registry),
       config_((config.validate(), config)),
       memory_(memory),
       client_(memory.add_client("relief")),
       box_height_(box_height),
-      replay_(width, height, fused_interpolation, covering),
+      replay_(width, height, fused_interpolation, covering, box_depth),
       cache_(cache_config(config)),
       frames_(stats().counter("frames", "frames", "frames replayed")),
-      scene_draws_(stats().counter("scene_draws", "draws", "scene draws before the boxes (placement city)")),
+      scene_draws_(stats().counter("scene_draws", "draws", "scene draws before and after the boxes (placement city)")),
       scene_depth_tests_(stats().counter("scene_depth_tests", "tests", "depth tests of the scene draws (charged at relief.tests_per_cycle)")),
+      scene_mismatches_(stats().counter("scene_mismatches", "draws", "scene draws whose samples passed differ from GL's (expected 0)")),
       box_draws_(stats().counter("box_draws", "draws", "relief_box draws replayed")),
       cache_hits_(stats().counter("cache_hits", "lookups", "lookups the texel cache served")),
       cache_misses_(stats().counter("cache_misses", "lookups", "lookups that missed the texel cache (a line read each)")),
@@ -136,6 +137,11 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
     c.cache_misses = counter("cache_misses", "lookups", "texel cache misses");
     c.storage_bytes = counter("storage_bytes", "bytes",
                               "bytes of the textures the method reads (heights; radii or N-buffer levels), 4 a texel; the largest field's");
+    c.depth_written = counter("depth_written", "texels", "depth values the box draws wrote (relief_box_depth box or exact)");
+    c.depth_mismatches = counter("depth_mismatches", "draws", "box draws after which the depth buffer differs from GL's (expected 0)");
+    c.scene_after_draws = counter("scene_after_draws", "draws", "scene draws after the box draws (placement city)");
+    c.scene_after_samples = counter("scene_after_samples", "samples", "samples those scene draws passed");
+    c.scene_hidden = counter("scene_hidden", "fragments", "fragments of those scene draws the box's depth hid");
   }
 }
 
@@ -190,6 +196,8 @@ void ReliefUnit::account(const BoxDrawCounts& d) {
   *c.cycles += spent;
   *c.cache_misses += draw_misses_;
   c.storage_bytes->raise_to(d.storage_bytes);
+  *c.depth_written += d.depth_written, *c.depth_mismatches += d.depth_mismatches;
+  *c.scene_after_draws += d.scene_after_draws, *c.scene_after_samples += d.scene_after_samples, *c.scene_hidden += d.scene_hidden;
   draw_misses_ = draw_hits_ = 0;
 }
 
@@ -207,6 +215,7 @@ void ReliefUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Com
   // the frame's box draws (the frame's total is what a sweep reads).
   if (k.scene_draws) {
     scene_draws_ += k.scene_draws;
+    scene_mismatches_ += k.scene_mismatches;
     scene_depth_tests_ += k.scene_depth_tests;
     const std::uint64_t spent = ceil_div(static_cast<double>(k.scene_depth_tests), config_.tests_per_cycle);
     work(spent);

@@ -46,7 +46,8 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   // `box_height`: the trace header's relief_box_height. `memory`: the shared channel; the unit
   // registers as its client "relief".
   ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const ReliefUnitConfig& config, memory::Channel& memory,
-             int width, int height, double box_height, bool fused_interpolation, CoveringSpec covering = {});
+             int width, int height, double box_height, bool fused_interpolation, CoveringSpec covering = {},
+             BoxDepth box_depth = BoxDepth::None);
 
   void run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor& cp) override;
 
@@ -61,7 +62,8 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   struct PerMethod {
     stats::Counter *draws, *rasterized, *fragments, *gl_fragments, *samples, *gl_samples, *pixel_mismatches, *walk_mismatches, *lookups,
         *gl_lookups, *steps, *bisections, *hits, *capped, *reference_hits, *wrong_hit, *wrong_miss, *far_hit, *errors,
-        *distance_microtexels, *cycles, *cache_misses, *storage_bytes;
+        *distance_microtexels, *cycles, *cache_misses, *storage_bytes, *depth_written, *depth_mismatches, *scene_after_draws,
+        *scene_after_samples, *scene_hidden;
   };
 
   ReliefUnitConfig config_;
@@ -73,7 +75,7 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   std::uint64_t draw_misses_ = 0, draw_hits_ = 0;
   std::uint64_t last_line_ = ~std::uint64_t{0};  // the cache line of the last lookup
   int line_shift_ = 0;                            // log2 of relief.cache_line_bytes (a power of two)  // the current box draw's cache outcomes
-  stats::Counter &frames_, &scene_draws_, &scene_depth_tests_, &box_draws_, &cache_hits_, &cache_misses_, &memory_bytes_, &memory_stall_cycles_, &cycles_,
+  stats::Counter &frames_, &scene_draws_, &scene_depth_tests_, &scene_mismatches_, &box_draws_, &cache_hits_, &cache_misses_, &memory_bytes_, &memory_stall_cycles_, &cycles_,
       &radius_texels_, &radius_sum_, &radius_zero_;
   std::array<PerMethod, kMethods> per_method_{};
 };

@@ -1,13 +1,25 @@
 // One relief ray per box fragment, with the draw's method: the twin of model/relief/walk.cpp,
 // expression for expression (every float is `precise`, so no product and sum are fused and the
-// order is the written one); change one, change the other. Early fragment tests: the walk runs only
-// for fragments that pass the depth test against the box's own (conservative) depth, and the
-// fragment counter counts those. Depth writes are off for the box draws: the box face's depth is
-// not the relief surface's, and with early tests a discarded fragment would still write it.
+// order is the written one); change one, change the other. BOX_DEPTH (model/relief/box_depth.h)
+// says what the draw leaves in the depth buffer:
+//  0 none, 1 box: early fragment tests, depth writes off here: the walk runs only for fragments that
+//    pass the depth test against the box face's depth, and the fragment counter counts those. (Box:
+//    the paper's conservative depth is written by relief_keep.frag right after, for the hits: GL
+//    cannot record a discarded fragment's walk without a memory write, and a memory write turns
+//    llvmpipe's early test off; with early_fragment_tests a discarded fragment would still write.)
+//  2 exact: gl_FragDepth is the hit's depth (hit_depth, box_depth.cpp's twin), so the test runs after
+//    the shader: every rasterized fragment walks and is counted, and the draw writes depth.
 // Per fragment: a record of six words at results[6 * pixel]: 1 (the shader ran), hit (0 miss,
 // 1 hit, 2 capped), the hit's t (bits), lookups, steps, bisections. A miss discards.
 #version 450 core
+#ifndef BOX_DEPTH
+#define BOX_DEPTH 0
+#endif
+#if BOX_DEPTH != 2
 layout(early_fragment_tests) in;
+#else
+uniform mat4 texel_to_clip;  // the vertex shader's: the hit point's clip position
+#endif
 layout(std430, binding = 0) buffer Fragments { uint fragments[]; };
 layout(std430, binding = 1) buffer Results { uint results[]; };
 uniform uint draw_slot;
@@ -298,6 +310,18 @@ bool fragment_ray(float px, float py) {
   return true;
 }
 
+#if BOX_DEPTH == 2
+float hit_depth(float t) {
+  precise float x = along(o.x, t, d.x);
+  precise float y = along(o.y, t, d.y);
+  precise float z = along(o.z, t, d.z);
+  precise float cz = ((texel_to_clip[0][2] * x + texel_to_clip[1][2] * y) + texel_to_clip[2][2] * z) + texel_to_clip[3][2];
+  precise float cw = ((texel_to_clip[0][3] * x + texel_to_clip[1][3] * y) + texel_to_clip[2][3] * z) + texel_to_clip[3][3];
+  precise float r = (cz / cw) * 0.5 + 0.5;
+  return r;
+}
+#endif
+
 void main() {
   atomicAdd(fragments[draw_slot], 1u);
   uint pixel = uint(gl_FragCoord.y) * uint(viewport_width) + uint(gl_FragCoord.x);
@@ -321,5 +345,8 @@ void main() {
   results[6u * pixel + 4u] = steps;
   results[6u * pixel + 5u] = bisections;
   if (code != 1u) discard;
+#if BOX_DEPTH == 2
+  gl_FragDepth = hit_depth(hit_t);
+#endif
   hit_mask = 1u;
 }

@@ -22,10 +22,13 @@ namespace {
 Program build(const ProgramContext& c) {
   c.require_no_cull_mode("a relief trace walks its own rays");
   const double box_height = c.header.real("relief_box_height");  // above 0: checked when the trace was opened
+  // What the boxes write (a trace from before the key: its default, nothing); a valid choice: checked when opened.
+  const std::string* depth_key = c.header.property("relief_box_depth");
+  const relief::BoxDepth box_depth = depth_key ? relief::parse_box_depth(*depth_key).value_or(relief::BoxDepth::None) : relief::BoxDepth::None;
   Program p;
   // The N-buffer walk covers as the capture did (its GL walks are compared one by one).
   auto unit = std::make_unique<relief::ReliefUnit>("relief", c.registry, c.config.group<relief::ReliefUnitConfig>("relief"), c.memory, c.view.width_px, c.view.height_px,
-                                                   box_height, c.config.depth.fused_interpolation, c.capture_covering());
+                                                   box_height, c.config.depth.fused_interpolation, c.capture_covering(), box_depth);
   p.frames = unit.get();
   p.unit = std::move(unit);
   return p;
@@ -52,7 +55,7 @@ void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_jso
 // lookups and steps per fragment, cycles, and hit error against the exact reference.
 nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::ordered_json& memory, std::uint64_t cycles) {
   nlohmann::ordered_json j;
-  for (const char* name : {"frames", "scene_draws", "scene_depth_tests", "box_draws", "cache_hits", "cache_misses", "memory_bytes",
+  for (const char* name : {"frames", "scene_draws", "scene_depth_tests", "scene_mismatches", "box_draws", "cache_hits", "cache_misses", "memory_bytes",
                            "memory_stall_cycles", "cycles"})
     j[name] = stat(p, name);
   j["cycles_total"] = cycles;
@@ -70,7 +73,8 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
     nlohmann::ordered_json e;
     for (const char* name : {"draws", "rasterized", "fragments", "gl_fragments", "samples", "gl_samples", "pixel_mismatches", "walk_mismatches", "lookups",
                              "gl_lookups", "steps", "bisections", "hits", "capped", "reference_hits", "wrong_hit", "wrong_miss",
-                             "far_hit", "errors", "cycles", "cache_misses", "storage_bytes"})
+                             "far_hit", "errors", "cycles", "cache_misses", "storage_bytes", "depth_written", "depth_mismatches",
+                             "scene_after_draws", "scene_after_samples", "scene_hidden"})
       e[name] = v(name);
     const double fragments = static_cast<double>(v("fragments"));
     const auto per = [fragments](std::uint64_t x) {
@@ -107,7 +111,7 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
 nlohmann::ordered_json summary(const SummaryInputs& in) {
   nlohmann::ordered_json j = totals(in.group, in.stats.contains("gpu.memory") ? in.stats["gpu.memory"] : nlohmann::ordered_json::object(), in.cycles);
   for (const char* key : {"relief_field", "relief_field_size", "relief_box_height", "relief_angles", "relief_radius", "relief_radius_epsilon",
-                          "relief_radius_combine"})
+                          "relief_radius_combine", "relief_box_depth", "relief_placement"})
     copy_property(in.header, key, j);
   // Storage a texel of the heightfield: what each method's textures cost (4 bytes a value).
   const std::string* size = in.header.property("relief_field_size");
@@ -117,11 +121,12 @@ nlohmann::ordered_json summary(const SummaryInputs& in) {
   return j;
 }
 
-// Every method's fragments, samples and walks equal GL's.
+// Every method's fragments, samples, walks and depth equal GL's, and every scene draw's samples.
 bool exact(const nlohmann::ordered_json& s) {
+  if (s.value("scene_mismatches", 0) != 0) return false;
   for (const auto& [name, m] : s["methods"].items())
     if (m.value("pixel_mismatches", 0) != 0 || m.value("walk_mismatches", 0) != 0 || m.value("fragments", 0) != m.value("gl_fragments", 0) ||
-        m.value("samples", 0) != m.value("gl_samples", 0))
+        m.value("samples", 0) != m.value("gl_samples", 0) || m.value("depth_mismatches", 0) != 0)
       return false;
   return true;
 }

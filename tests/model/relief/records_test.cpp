@@ -283,5 +283,52 @@ TEST(ReliefRecordsTest, NoBoxDrawNoFragments) {
   EXPECT_TRUE(read_relief_fragments(f, kViewportPixels).empty());
 }
 
+// RLFD (the depth the boxes left): read back, optional unless the boxes write depth, and every
+// damage an InputError naming the frame.
+TEST(ReliefRecordsTest, DepthRecord) {
+  scene::Frame f = sample_frame();
+  EXPECT_FALSE(read_relief_depth(f, false).has_value()) << "no RLFD and none needed";
+  try {
+    read_relief_depth(f, true);
+    ADD_FAILURE() << "a missing RLFD was accepted where the boxes write depth";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no ReliefDepth (RLFD) record"), std::string::npos) << e.what();
+  }
+  scene::TechniqueRecord depth;
+  depth.type = kReliefDepthRecordType;
+  depth.decoded = true;
+  std::vector<float> m(16, 0.0f);
+  m[0] = m[5] = m[10] = m[15] = 1.0f;
+  depth.fields = {field("texel_to_clip", m), field("draws", std::vector<std::uint32_t>{1, 2}),
+                  field("depth_crc", std::vector<std::uint32_t>{7, 8})};
+  f.technique_records.push_back(depth);
+  const std::optional<GlReliefDepth> g = read_relief_depth(f, true);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_EQ(g->texel_to_clip[10], 1.0f);
+  EXPECT_EQ(g->depth_crc, (std::vector<std::uint32_t>{7, 8}));
+  using F = scene::Frame;
+  constexpr std::uint32_t D = kReliefDepthRecordType;
+  const std::pair<std::function<void(F&)>, const char*> damages[] = {
+      {[](F& f) { vec<float>(f, D, "texel_to_clip").pop_back(); }, "texel_to_clip has 15 values, not 16"},
+      {[](F& f) { vec<float>(f, D, "texel_to_clip")[3] = INFINITY; }, "texel_to_clip[3] is inf"},
+      {[](F& f) { vec<std::uint32_t>(f, D, "depth_crc").pop_back(); }, "has 2 draws but 1 CRCs"},
+      {[](F& f) { vec<std::uint32_t>(f, D, "draws") = {0, 2}; }, "relief_box draw 1 has no depth CRC"},
+      {[](F& f) { vec<std::uint32_t>(f, D, "draws") = {1, 2, 3}, vec<std::uint32_t>(f, D, "depth_crc") = {1, 2, 3}; },
+       "lists 3 draws, but the frame has 2 relief_box draws"},
+      {[](F& f) { field_of(f, D, "draws").name = "draw"; }, "has no field 'draws'"},
+  };
+  for (const auto& [damage, message] : damages) {
+    F bad = f;
+    damage(bad);
+    try {
+      read_relief_depth(bad, false);
+      ADD_FAILURE() << message << ": accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("frame 9"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace nbsim::relief

@@ -1,6 +1,9 @@
 // The relief walks on GL; see gl_walk.h.
 #include "traces/capture/relief/gl_walk.h"
 
+#include <zlib.h>
+
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 
@@ -17,11 +20,12 @@ constexpr int kWords = 6;  // relief.frag's record: ran, hit, t, lookups, steps,
 }
 
 struct GlReliefWalker::Objects {
-  GLuint program = 0, vao = 0, vbo = 0, ebo = 0, results = 0, fbo = 0, depth = 0, colour = 0;
+  GLuint program = 0, keep = 0, vao = 0, vbo = 0, ebo = 0, results = 0, fbo = 0, depth = 0, colour = 0;
   GLuint heights = 0, radii = 0;
   std::unique_ptr<GlslNBuffer> nbuffer;
   ~Objects() {
     glDeleteProgram(program);
+    glDeleteProgram(keep);
     glDeleteVertexArrays(1, &vao);
     GLuint buffers[] = {vbo, ebo, results};
     glDeleteBuffers(3, buffers);
@@ -31,14 +35,18 @@ struct GlReliefWalker::Objects {
   }
 };
 
-GlReliefWalker::GlReliefWalker(int width, int height, CoveringSpec covering)
-    : gl_(std::make_unique<Objects>()), width_(width), height_(height), covering_(covering) {
+GlReliefWalker::GlReliefWalker(int width, int height, CoveringSpec covering, relief::BoxDepth box_depth)
+    : gl_(std::make_unique<Objects>()), width_(width), height_(height), covering_(covering), box_depth_(box_depth) {
   NBSIM_CHECK(width > 0 && height > 0, "relief viewport");
   Objects& o = *gl_;
+  const std::string defines = covering_glsl(covering) + "#define BOX_DEPTH " + std::to_string(static_cast<int>(box_depth)) + "\n";
   o.program = link_program({compile_shader(GL_VERTEX_SHADER, shaders::relief_relief_vert, "relief/relief.vert"),
-                            compile_shader(GL_FRAGMENT_SHADER, with_defines(shaders::relief_relief_frag, covering_glsl(covering)),
-                                           "relief/relief.frag")},
+                            compile_shader(GL_FRAGMENT_SHADER, with_defines(shaders::relief_relief_frag, defines), "relief/relief.frag")},
                            "relief", true);
+  if (box_depth == relief::BoxDepth::Box)
+    o.keep = link_program({compile_shader(GL_VERTEX_SHADER, shaders::relief_relief_vert, "relief/relief.vert"),
+                           compile_shader(GL_FRAGMENT_SHADER, shaders::relief_relief_keep_frag, "relief/relief_keep.frag")},
+                          "relief keep");
   glCreateVertexArrays(1, &o.vao);
   glCreateBuffers(1, &o.vbo);
   glCreateBuffers(1, &o.ebo);
@@ -125,7 +133,7 @@ GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, 
   glDisable(GL_STENCIL_TEST);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
-  glDepthMask(GL_FALSE);
+  glDepthMask(box_depth_ == relief::BoxDepth::Exact ? GL_TRUE : GL_FALSE);
   glEnable(GL_CULL_FACE);
   glCullFace(GL_BACK);
   glFrontFace(GL_CCW);
@@ -168,15 +176,25 @@ GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, 
   d.role = nbsim::relief::kReliefBoxRole;
   d.state.func = scene::DepthFunc::Less;
   d.state.test = true;
-  d.state.write = false;
+  d.state.write = box_depth_ != relief::BoxDepth::None;  // the paper's draw (box: the keep pass below writes)
   d.state.cull = scene::CullFace::Back;
   d.state.front_ccw = true;
   d.discards = true;
+  d.writes_depth = box_depth_ == relief::BoxDepth::Exact;
   const std::size_t slot = recorder.begin_draw(std::move(d), 36);
   glUniform1ui(glGetUniformLocation(p, "draw_slot"), static_cast<GLuint>(slot));
   glDrawElements(GL_TRIANGLES, 36, GL_UNSIGNED_INT, nullptr);
   recorder.end_draw();
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  if (box_depth_ == relief::BoxDepth::Box) {  // the hits' box depth, late (relief_keep.frag)
+    glUseProgram(o.keep);
+    glUniformMatrix4fv(glGetUniformLocation(o.keep, "texel_to_clip"), 1, GL_FALSE, view.texel_to_clip.data());
+    glUniform1i(glGetUniformLocation(o.keep, "viewport_width"), width_);
+    glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glDepthMask(GL_TRUE);
+    glDrawElements(GL_TRIANGLES, 36, GL_UNSIGNED_INT, nullptr);
+    glDepthMask(GL_FALSE);
+  }
 
   std::vector<std::uint32_t> words(std::size_t{kWords} * width_ * height_);
   glGetNamedBufferSubData(o.results, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
@@ -195,6 +213,16 @@ GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, 
     out.bisections.push_back(w[5]);
   }
   glUseProgram(0);
+  if (box_depth_ != relief::BoxDepth::None) {  // the depth the draw left, as a checksum (its read-back timed apart)
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<float> depth(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer ? framebuffer : o.fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width_, height_, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());  // bottom row first = y up
+    out.depth_crc = static_cast<std::uint32_t>(
+        crc32(0L, reinterpret_cast<const Bytef*>(depth.data()), static_cast<uInt>(depth.size() * sizeof(float))));
+    out.readback_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
   return out;
 }
 

@@ -9,8 +9,10 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
+#include "model/relief/box_depth.h"
 #include "model/relief/heightfield.h"
 #include "model/relief/radius.h"
 #include "model/relief/walk.h"
@@ -23,6 +25,11 @@ namespace nbsim::capture {
 struct GlFragments {
   std::vector<std::uint32_t> pixel, hit, lookups, steps, bisections;
   std::vector<float> t;
+  // With a box depth other than none: the CRC-32 (zlib) of the depth buffer right after the draw,
+  // window depths as floats, y up, row-major; and the milliseconds its read-back took (capture
+  // work, not the technique's: the caller takes it off the frame's GL time).
+  std::optional<std::uint32_t> depth_crc;
+  double readback_ms = 0.0;
 };
 
 // A camera on the box: texel space to clip (column-major, float, as GL takes it) and the ray frame.
@@ -35,7 +42,10 @@ class GlReliefWalker {
  public:
   // A width x height viewport; the N-buffer walk covers its spans as `covering` says (draw()'s
   // params must carry the same).
-  GlReliefWalker(int width, int height, CoveringSpec covering = {});
+  // `box_depth`: what each box draw leaves in the depth buffer (model/relief/box_depth.h); box adds
+  // a depth pass after each walk (relief_keep.frag), exact compiles relief.frag to write
+  // gl_FragDepth (no early tests).
+  GlReliefWalker(int width, int height, CoveringSpec covering = {}, relief::BoxDepth box_depth = relief::BoxDepth::None);
   ~GlReliefWalker();
   GlReliefWalker(const GlReliefWalker&) = delete;
   GlReliefWalker& operator=(const GlReliefWalker&) = delete;
@@ -60,6 +70,7 @@ class GlReliefWalker {
   std::unique_ptr<Objects> gl_;
   int width_, height_;
   CoveringSpec covering_;
+  relief::BoxDepth box_depth_;
   int size_ = 0;
 };
 

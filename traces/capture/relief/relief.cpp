@@ -16,6 +16,7 @@
 
 #include "model/common/error.h"
 #include "model/mesh/shapes.h"
+#include "model/relief/box_depth.h"
 #include "model/relief/heightfield.h"
 #include "model/relief/paper_radius.h"
 #include "model/relief/radius.h"
@@ -136,6 +137,14 @@ const OptionSpec& placement_option() {
       "own", {"own", "city"});
   return spec;
 }
+const OptionSpec& box_depth_option() {
+  static const OptionSpec spec = choice_option(
+      "box-depth", "what a box draw leaves in the depth buffer (the relief paper's section 4.4; model/relief/box_depth.h): box: "
+                   "the box face's depth where the ray hit, a miss discarded (the paper's; early depth test, late write); exact: "
+                   "the hit's depth (gl_FragDepth: every fragment walks, tested after); none: nothing (depth writes off)",
+      "box", {"box", "exact", "none"});
+  return spec;
+}
 const OptionSpec& box_at_option() {
   static const OptionSpec spec = text_option(
       "box-at", "placement city: X,Z,SIZE in metres (the box's corner on the ground at y = 0 and its side; its height is "
@@ -232,6 +241,7 @@ class Relief final : public Technique {
     if (city_ && o.text(angles_option()) != angles_option().default_value)
       throw InputError("--angles is for --placement own (in the city the observer's path views the box)");
     box_at_ = o.text(box_at_option());
+    box_depth_ = *relief::parse_box_depth(o.text(box_depth_option()));
     seed_ = static_cast<std::uint64_t>(o.integer(seed_option()));
     max_radius_ = static_cast<int>(o.integer(max_radius_option()));
     apex_ = parse_number(o.text(frustum_option()), "frustum", 0.0, 1e6);
@@ -292,12 +302,18 @@ class Relief final : public Technique {
     params_.covering = read_covering(o, relief_covering_option());
     tolerance_ = parse_number(o.text(tolerance_option()), "tolerance", 0.0, 1e6);
     if (city_ && apex_ > 0.0) throw InputError("--placement city takes the box, not a --frustum");
-    walker_ = std::make_unique<GlReliefWalker>(width_, height_, params_.covering);
+    walker_ = std::make_unique<GlReliefWalker>(width_, height_, params_.covering, box_depth_);
     if (city_) {
       pass_ = std::make_unique<ScenePass>(scene_, false);
       target_ = std::make_unique<RenderTarget>(width_, height_);
+      glCreateTextures(GL_TEXTURE_2D, 1, &saved_depth_);
+      glTextureStorage2D(saved_depth_, 1, GL_DEPTH_COMPONENT32F, width_, height_);
     }
   }
+
+  ~Relief() override { glDeleteTextures(1, &saved_depth_); }
+  Relief(const Relief&) = delete;
+  Relief& operator=(const Relief&) = delete;
 
   trace::Properties variant_properties() const override {
     std::string methods;
@@ -314,6 +330,7 @@ class Relief final : public Technique {
             {"relief_angles", join(angles_)},
             {"relief_max_radius", std::to_string(max_radius_)},
             {"relief_radius", paper_radius_ ? "paper" : "strict"},
+            {"relief_box_depth", std::string(relief::kBoxDepthNames[static_cast<std::size_t>(box_depth_)])},
             {"relief_radius_epsilon", fmt::format("{}", paper_.epsilon)},
             {"relief_radius_combine", std::string(relief::kRadiusCombineNames[static_cast<std::size_t>(paper_.combine)])},
             {"relief_linear_steps", std::to_string(params_.linear_steps)},
@@ -355,37 +372,56 @@ class Relief final : public Technique {
     for (std::size_t k = 0; k < 3; ++k) f.begin.eye[k] = static_cast<float>(cam.eye_world[k]);
 
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<std::uint32_t> in_frustum;
+    // Placement city: the objects in the frustum, front to back as an engine sorts its opaque draws,
+    // split at the box: those whose bounds come nearer the eye than the box's are drawn before it
+    // (they may hide box fragments: walks saved by the early test), the others after each box draw
+    // (the box's depth may hide them).
+    std::vector<std::uint32_t> before, after;
     if (city_) {
       const scene::FrameView fv = scene::FrameView::make(f.begin, width_, height_, projection_.near_m, 0.0, false, false);
-      in_frustum = scene::frustum_objects(scene_.scene, fv);
+      const glm::dvec3 eye(pose.eye);
+      const double box_distance = distance_to(box_bounds_, eye);
+      for (std::uint32_t o : scene::frustum_objects(scene_.scene, fv))
+        (distance_to(scene_.scene.objects[o], eye) < box_distance ? before : after).push_back(o);
     }
-    recorder_.begin_frame(16 + methods_.size() + in_frustum.size());
-    if (city_) {  // the scene's depth first: the box draws test against it
-      glBindFramebuffer(GL_FRAMEBUFFER, target_->framebuffer());
-      target_->clear_depth(false);
-      const glm::mat4 view = view_matrix(pose), proj = projection_matrix(projection_, static_cast<double>(width_) / height_);
-      pass_->begin(*target_, proj * view, false, recorder_);
-      for (std::uint32_t o : in_frustum) {
+    recorder_.begin_frame(16 + before.size() + methods_.size() * (1 + after.size()));
+    const glm::mat4 city_view_proj =
+        projection_matrix(projection_, static_cast<double>(width_) / height_) * view_matrix(pose);
+    const auto draw_scene = [&](const std::vector<std::uint32_t>& objects) {
+      pass_->begin(*target_, city_view_proj, false, recorder_);
+      for (std::uint32_t o : objects) {
         scene::DrawRecord d;
         d.role = scene::DrawRole::Scene;
         d.object = static_cast<std::int32_t>(o);
         d.state = depth_state(false, true, true);
         pass_->draw_object(recorder_, std::move(d), o);
       }
+    };
+    if (city_) {  // the scene's depth first: the box draws test against it
+      glBindFramebuffer(GL_FRAMEBUFFER, target_->framebuffer());
+      target_->clear_depth(false);
+      draw_scene(before);
+      glCopyImageSubData(target_->depth_texture(), GL_TEXTURE_2D, 0, 0, 0, 0, saved_depth_, GL_TEXTURE_2D, 0, 0, 0, 0, width_, height_, 1);
     }
     walker_->set_field(field_, radius_, recorder_);
     const std::vector<float> levels = walker_->levels();
     std::vector<GlFragments> gl;
-    if (!city_) walker_->clear_depth();
-    for (relief::Method m : methods_) gl.push_back(walker_->draw(m, cam.view, params_, recorder_, city_ ? target_->framebuffer() : 0));
+    double readback_ms = 0.0;
+    for (relief::Method m : methods_) {
+      // Every method's box starts from the same depth (box_depth.h): the scene's before it, or clear.
+      if (city_) glCopyImageSubData(saved_depth_, GL_TEXTURE_2D, 0, 0, 0, 0, target_->depth_texture(), GL_TEXTURE_2D, 0, 0, 0, 0, width_, height_, 1);
+      else walker_->clear_depth();
+      gl.push_back(walker_->draw(m, cam.view, params_, recorder_, city_ ? target_->framebuffer() : 0));
+      readback_ms += gl.back().readback_ms;
+      if (city_) draw_scene(after);
+    }
     f.draws = recorder_.collect();
     if (city_) {
       std::memcpy(f.begin.view.data(), glm::value_ptr(view_matrix(pose)), 64);
       std::memcpy(f.begin.proj.data(), glm::value_ptr(projection_matrix(projection_, static_cast<double>(width_) / height_)), 64);
       f.begin.eye = {pose.eye.x, pose.eye.y, pose.eye.z};
     }
-    f.end.gl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    f.end.gl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() - readback_ms;
 
     trace::TechniqueRecord field;
     field.type = trace::kReliefFieldChunk;
@@ -416,6 +452,7 @@ class Relief final : public Technique {
     // the frame's rays: each pixel's reference is computed once).
     std::map<std::uint32_t, relief::ReferenceHit> references;
     std::size_t box = 0;
+    std::vector<std::uint32_t> depth_draws, depth_crcs;  // RLFD: the depth each box draw left
     for (const scene::DrawRecord& d : f.draws) {
       if (d.role != nbsim::relief::kReliefBoxRole) continue;
       const relief::Method m = methods_[box];
@@ -451,6 +488,16 @@ class Relief final : public Technique {
                   {"steps", g.steps},
                   {"bisections", g.bisections}};
       f.technique_records.push_back(std::move(r));
+      if (g.depth_crc) depth_draws.push_back(d.index), depth_crcs.push_back(*g.depth_crc);
+    }
+    if (box_depth_ != relief::BoxDepth::None) {
+      trace::TechniqueRecord depth;
+      depth.type = trace::kReliefDepthChunk;
+      depth.decoded = true;
+      depth.fields = {{"texel_to_clip", std::vector<float>(cam.view.texel_to_clip.begin(), cam.view.texel_to_clip.end())},
+                      {"draws", depth_draws},
+                      {"depth_crc", depth_crcs}};
+      f.technique_records.push_back(std::move(depth));
     }
     f.end.frame = index;
     f.end.draws = static_cast<std::uint32_t>(f.draws.size());
@@ -481,9 +528,21 @@ class Relief final : public Technique {
     to_world[2][1] = h;
     to_world[1][2] = -side / n;
     to_world[3] = glm::dvec4(x0, 0.0, z0, 1.0);
+    box_bounds_.lo = {static_cast<float>(x0), 0.0f, static_cast<float>(z0 - side)};
+    box_bounds_.hi = {static_cast<float>(x0 + side), static_cast<float>(h), static_cast<float>(z0)};
     const glm::dmat4 f = glm::inverse(to_world);
     for (std::size_t k = 0; k < 16; ++k) world_to_texel_[k] = glm::value_ptr(f)[k];
     box_at_ = fmt::format("{},{},{}", x0, z0, side);
+  }
+
+  // The distance from `eye` to the nearest point of `b` (0 inside).
+  static double distance_to(const scene::Aabb& b, const glm::dvec3& eye) {
+    double sum = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double out = std::max({0.0, static_cast<double>(b.lo[k]) - eye[k], eye[k] - static_cast<double>(b.hi[k])});
+      sum += out * out;
+    }
+    return std::sqrt(sum);
   }
 
   static void counts_add(CapturedFrame& out, const std::string& name, std::uint64_t v) { out.counts.emplace_back(name, v); }
@@ -504,6 +563,9 @@ class Relief final : public Technique {
   Projection projection_;
   bool city_ = false;
   std::string box_at_;
+  relief::BoxDepth box_depth_ = relief::BoxDepth::Box;
+  scene::Aabb box_bounds_;      // the box in world space (placement city)
+  GLuint saved_depth_ = 0;      // the scene's depth before the box draws (placement city), restored before each
   std::array<double, 16> world_to_texel_{};
   std::unique_ptr<ScenePass> pass_;
   std::unique_ptr<RenderTarget> target_;
@@ -517,7 +579,7 @@ const std::vector<OptionSpec>& relief_options() {
   static const std::vector<OptionSpec> options = {field_option(),        field_param_option(), field_size_option(),   field_file_option(),  field_mesh_option(),
                                                   radius_file_option(),  radius_option(), radius_epsilon_option(), radius_combine_option(), max_radius_option(),  methods_option(),      angles_option(),
                                                   box_height_option(),   frustum_option(),     linear_steps_option(), binary_steps_option(), root_steps_option(),
-                                                  tolerance_option(),    placement_option(),   box_at_option(),       relief_covering_option(),
+                                                  tolerance_option(),    placement_option(),   box_at_option(),       box_depth_option(),       relief_covering_option(),
                                                   align_option(),        seed_option()};
   return options;
 }

@@ -104,7 +104,32 @@ std::string fragments_rule(const TechniqueRecord& r) {
   return {};
 }
 
+std::string depth_rule(const TechniqueRecord& r) {
+  if (std::string p = float_vector_problem(r, "texel_to_clip", 16, "a 4x4 matrix"); !p.empty()) return p;
+  const TechniqueField* draws = find_field(r, "draws");
+  const TechniqueField* crcs = find_field(r, "depth_crc");
+  const auto& d = std::get<std::vector<std::uint32_t>>(draws->value);
+  const auto& c = std::get<std::vector<std::uint32_t>>(crcs->value);
+  if (c.size() != d.size()) return fmt::format("field 'depth_crc' has {} values, but there are {} draws", c.size(), d.size());
+  for (std::size_t k = 1; k < d.size(); ++k)
+    if (d[k] <= d[k - 1]) return fmt::format("field 'draws' is not strictly increasing: {} after {}", d[k], d[k - 1]);
+  return {};
+}
+
 }  // namespace
+
+ChunkSpec relief_depth_chunk_spec() {
+  ChunkSpec spec{kReliefDepthChunk,
+                 "relief",
+                 "ReliefDepth",
+                 {{"texel_to_clip", FieldKind::VecF32,
+                   "the box's vertex transform, texel space to clip, 16 values column-major (the exact depth's hit point goes through it)"},
+                  {"draws", FieldKind::VecU32, "the frame's relief_box draws, by index, in order"},
+                  {"depth_crc", FieldKind::VecU32,
+                   "per draw: CRC-32 (zlib) of GL's depth buffer right after it, window depths as floats, y up, row-major"}}};
+  spec.rule = depth_rule;
+  return spec;
+}
 
 ChunkSpec relief_field_chunk_spec() {
   ChunkSpec spec{
@@ -203,6 +228,8 @@ std::vector<HeaderKeySpec> relief_header_keys() {
           whole_key(t, "relief_max_radius", 1, 255, "16", "cap of the safety radius, texels"),
           choice_key(t, "relief_radius", {"strict", "paper"}, "strict",
                      "the safety radius: strict (every ray from the texel, blocked ones too) or paper (unblocked rays, an allowed error)"),
+          choice_key(t, "relief_box_depth", {"none", "box", "exact"}, "none",
+                     "what a box draw leaves in the depth buffer: nothing, the box face's depth where the ray hit, or the hit's depth"),
           real_key(t, "relief_radius_epsilon", 0.0, 1.0, false, "0",
                    "paper radius: how far (box heights) a ray may pass under the surface without counting as a second crossing"),
           choice_key(t, "relief_radius_combine", {"max", "min"}, "max",
@@ -216,6 +243,8 @@ std::vector<HeaderKeySpec> relief_header_keys() {
 }
 
 // This technique's part of the format (technique_chunks.h): the field and fragment chunks and the header keys.
-TechniqueFormat relief_format() { return {{relief_field_chunk_spec(), relief_fragments_chunk_spec()}, relief_header_keys()}; }
+TechniqueFormat relief_format() {
+  return {{relief_field_chunk_spec(), relief_fragments_chunk_spec(), relief_depth_chunk_spec()}, relief_header_keys()};
+}
 
 }  // namespace nbsim::trace

@@ -18,6 +18,7 @@ namespace nbsim::trace {
 
 inline constexpr std::uint32_t kReliefFieldChunk = fourcc("RLFH");
 inline constexpr std::uint32_t kReliefFragmentsChunk = fourcc("RLFF");
+inline constexpr std::uint32_t kReliefDepthChunk = fourcc("RLFD");
 
 // RLFF `hit` values (fixed: they are in files).
 inline constexpr std::uint32_t kReliefMiss = 0;
@@ -44,6 +45,13 @@ ChunkSpec relief_field_chunk_spec();
 // Rule: vector lengths, method below 5, hit at most 2, no NaN t, pixels strictly increasing.
 ChunkSpec relief_fragments_chunk_spec();
 
+// ReliefDepth's fields (one per frame, when the boxes write depth: header relief_box_depth box or
+// exact; model/relief/box_depth.h):
+//   texel_to_clip VecF32 (16, column-major: the box's vertex transform, which the exact depth uses),
+//   draws VecU32 (the frame's relief_box draws, in order), depth_crc VecU32 (per draw: the CRC-32 of
+//   GL's depth buffer right after it, window depths as floats, y up, row-major).
+// Rule: 16 matrix values, no NaN; one CRC per draw; draws strictly increasing.
+ChunkSpec relief_depth_chunk_spec();
 // Its header keys (the heightfield, the box and the walks' parameters; the replay reads
 // relief_box_height, the relief table the field, its size and the angles).
 std::vector<HeaderKeySpec> relief_header_keys();

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -52,6 +53,7 @@ nlohmann::json capture_and_compare(const fs::path& trace, const std::string& opt
 void expect_exact_replay(const nlohmann::json& relief, const std::string& what) {
   ASSERT_TRUE(relief.is_object()) << what;
   ASSERT_EQ(relief["methods"].size(), 5u) << what;
+  EXPECT_EQ(relief["scene_mismatches"], 0) << what << ": every scene draw's samples equal GL's";
   for (const auto& [name, m] : relief["methods"].items()) {
     SCOPED_TRACE(what + " " + name);
     EXPECT_GT(m["fragments"].get<std::uint64_t>(), 100u);
@@ -59,6 +61,7 @@ void expect_exact_replay(const nlohmann::json& relief, const std::string& what) 
     EXPECT_EQ(m["samples"], m["gl_samples"]);
     EXPECT_EQ(m["walk_mismatches"], 0);
     EXPECT_EQ(m["pixel_mismatches"], 0);
+    EXPECT_EQ(m["depth_mismatches"], 0) << "the depth buffer after each box draw equals GL's";
     EXPECT_EQ(m["capped"], 0);
     if (name == "nbuffer" || name == "robust") {
       EXPECT_EQ(m["errors"], 0) << "the robust and N-buffer walks are exact";
@@ -97,21 +100,52 @@ TEST(ReliefCliTest, HardCasesReplayExactly) {
   fs::remove_all(dir);
 }
 
-// A box standing in the city, seen along the walk: the scene's depth is drawn first and the early
-// depth test culls the box's hidden fragments, in GL and in the model alike.
+// A box standing in the city, seen along the walk, with each of the box's depth outputs (the relief
+// paper's section 4.4): the objects nearer than the box are drawn first, so the early depth test
+// culls the box's hidden fragments before their walks (box, none), or cannot (exact: the shader
+// writes the depth); the box's depth then hides part of the objects drawn after it (box, exact).
+// In GL and in the model alike: every fragment, walk and scene draw, and the depth after each box.
 TEST(ReliefCliTest, BoxInTheCity) {
   const fs::path dir = testing::scratch_path("nbsim_relief_cli_city", "x").parent_path();
-  const fs::path trace = dir / "city.nbt";
-  const CliResult c = run_nbsim("capture relief --scene city --objects 800 --path walk --size 160x120 --frames 4 --placement city "
-                                "--field fbm --field-size 32 -o " + trace.string());
-  ASSERT_EQ(c.status, 0) << c.out << c.err;
-  const CliResult r = run_nbsim("compare --json " + trace.string());
-  EXPECT_EQ(r.status, 0) << r.out << r.err;
-  const nlohmann::json relief = nlohmann::json::parse(r.out)["relief"];
-  expect_exact_replay(relief, "city");
-  EXPECT_GT(relief["scene_draws"].get<std::uint64_t>(), 100u);
-  const nlohmann::json& m = relief["methods"]["nbuffer"];
-  EXPECT_LT(m["fragments"].get<std::uint64_t>(), m["rasterized"].get<std::uint64_t>()) << "buildings hide part of the box";
+  std::map<std::string, nlohmann::json> by_mode;
+  for (const std::string mode : {"box", "exact", "none"}) {
+    SCOPED_TRACE(mode);
+    const fs::path trace = dir / ("city_" + mode + ".nbt");
+    const CliResult c = run_nbsim("capture relief --scene city --objects 800 --path walk --size 160x120 --frames 4 --placement city "
+                                  "--field fbm --field-size 32 --box-depth " + mode + " -o " + trace.string());
+    ASSERT_EQ(c.status, 0) << c.out << c.err;
+    const CliResult r = run_nbsim("compare --json " + trace.string());
+    EXPECT_EQ(r.status, 0) << r.out << r.err;
+    const nlohmann::json relief = nlohmann::json::parse(r.out)["relief"];
+    expect_exact_replay(relief, "city " + mode);
+    EXPECT_EQ(relief["relief_box_depth"], mode);
+    EXPECT_GT(relief["scene_draws"].get<std::uint64_t>(), 100u);
+    by_mode[mode] = relief["methods"]["nbuffer"];
+  }
+  const auto n = [&](const char* mode, const char* key) { return by_mode[mode][key].get<std::uint64_t>(); };
+  EXPECT_LT(n("box", "fragments"), n("box", "rasterized")) << "buildings hide part of the box: walks saved";
+  EXPECT_EQ(n("box", "fragments"), n("none", "fragments"));
+  EXPECT_EQ(n("exact", "fragments"), n("exact", "rasterized")) << "a shader that writes depth walks every fragment";
+  EXPECT_EQ(n("box", "depth_written"), n("box", "samples")) << "the box writes where its rays hit";
+  EXPECT_EQ(n("none", "depth_written"), 0u);
+  EXPECT_GT(n("box", "scene_after_draws"), 0u);
+  EXPECT_GT(n("box", "scene_hidden"), 0u) << "the box's depth hides objects behind it";
+  EXPECT_EQ(n("none", "scene_hidden"), 0u);
+  EXPECT_EQ(n("box", "scene_after_samples") + n("box", "scene_hidden"), n("none", "scene_after_samples"));
+  fs::remove_all(dir);
+}
+
+// The box's own camera with the exact depth: a frustum's hit depths through its projective map, and
+// a box seen at a grazing angle; the depth GL kept equals the model's after every draw.
+TEST(ReliefCliTest, ExactDepthOfItsOwnBox) {
+  const fs::path dir = testing::scratch_path("nbsim_relief_cli_depth", "x").parent_path();
+  for (const char* options : {"--field walls --field-size 32 --frustum 2 --angles 50 --box-depth exact",
+                              "--field fbm --field-size 32 --angles 85 --box-depth exact"}) {
+    const nlohmann::json r = capture_and_compare(dir / "exact.nbt", options);
+    expect_exact_replay(r, options);
+    if (r.is_object())
+      for (const auto& [name, m] : r["methods"].items()) EXPECT_EQ(m["depth_written"], m["samples"]) << options << " " << name;
+  }
   fs::remove_all(dir);
 }
 

@@ -11,7 +11,9 @@
 
 #include "model/relief/walk.h"
 #include "tests/common/gl_context_suite.h"
+#include "traces/capture/gl_program.h"
 #include "traces/capture/relief/gl_walk.h"
+#include "traces/capture/render_target.h"
 #include "traces/capture/relief/view.h"
 
 namespace nbsim {
@@ -184,6 +186,40 @@ TEST_F(ReliefGlWalkTest, EyeOnTheFrustumsApexPlane) {
   const double cross = std::abs(double(r0->d[0]) * r1->d[1] - double(r0->d[1]) * r1->d[0]) /
                        (std::hypot(r0->d[0], r0->d[1]) * std::hypot(r1->d[0], r1->d[1]));
   EXPECT_LT(cross, 1e-3) << "the rays' horizontal directions are parallel";
+}
+
+// What llvmpipe stores for a gl_FragDepth outside [0, 1] in a DEPTH_COMPONENT32F buffer without
+// depth clamp (the exact-depth box writes its hit's depth, which lies before the near plane when the
+// box crosses it): the model's raster path (model/raster/depth_test.h, FragmentShader::frag_depth)
+// stores what this finds.
+TEST_F(ReliefGlWalkTest, FragDepthOutsideTheUnitRange) {
+  static const char* kVert = "#version 450 core\nvoid main() { vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);"
+                             " gl_Position = vec4(p, 0.5, 1.0); }\n";
+  static const char* kFrag = "#version 450 core\nuniform float depth;\nvoid main() { gl_FragDepth = depth; }\n";
+  const GLuint p = capture::link_program({capture::compile_shader(GL_VERTEX_SHADER, kVert, "fullscreen"),
+                                          capture::compile_shader(GL_FRAGMENT_SHADER, kFrag, "frag depth")},
+                                         "frag depth");
+  capture::RenderTarget target(4, 4);
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  glBindVertexArray(vao);
+  glUseProgram(p);
+  for (const float written : {-0.25f, 1.5f, 0.375f}) {
+    target.bind();
+    target.clear_depth(false);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_DEPTH_CLAMP);
+    glUniform1f(glGetUniformLocation(p, "depth"), written);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    float stored = -9.0f;
+    glReadPixels(1, 1, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &stored);
+    EXPECT_EQ(stored, written < 0.0f ? 0.0f : written > 1.0f ? 1.0f : written) << "gl_FragDepth " << written;
+  }
+  glUseProgram(0);
+  glDeleteVertexArrays(1, &vao);
+  glDeleteProgram(p);
 }
 
 }  // namespace
