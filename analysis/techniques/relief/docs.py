@@ -134,6 +134,33 @@ def render_city(outputs):
             f"{'within' if compare['within_thresholds'] else 'OUTSIDE'} `nbsim compare`'s thresholds.")
 
 
+# The relief paper's section 4.4 in the city: the same walk with each of the box's depth outputs.
+ZBUFFER_MODES = ("none", "box", "exact")
+
+
+def zbuffer_commands():
+    caps = [["capture", "relief", "--scene", "city", "--objects", "2000", "--path", "walk", "--size", "320x240", "--frames", "8",
+             "--seed", "4", "--placement", "city", "--field", "walls", "--field-size", "64", "--box-depth", mode, "-o", f"z_{mode}.nbt"]
+            for mode in ZBUFFER_MODES]
+    return caps + [["compare", f"z_{mode}.nbt", "--json"] for mode in ZBUFFER_MODES]
+
+
+def render_zbuffer(outputs):
+    lines = ["| box depth | box fragments | walks run | walks saved by the early test | depth written | scene fragments after the box | "
+             "hidden by the box | robust cycles / frame | nbuffer cycles / frame | unlike GL (walks, pixels, depth, scene draws) |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for mode, out in zip(ZBUFFER_MODES, outputs[-len(ZBUFFER_MODES):]):
+        r = out["relief"]
+        m = r["methods"]
+        nb = m["nbuffer"]
+        unlike = sum(x["walk_mismatches"] + x["pixel_mismatches"] + x["depth_mismatches"] for x in m.values()) + r["scene_mismatches"]
+        saved = nb["rasterized"] - nb["fragments"]
+        lines.append(f"| {mode} | {nb['rasterized']:,} | {nb['fragments']:,} | {saved:,} ({100 * saved / nb['rasterized']:.1f} %) | "
+                     f"{nb['depth_written']:,} | {nb['scene_after_samples']:,} | {nb['scene_hidden']:,} | "
+                     f"{n(m['robust']['cycles_per_frame'])} | {n(nb['cycles_per_frame'])} | {unlike} |")
+    return "\n".join(lines)
+
+
 BLOCKS = [
     Block("fresh", [["oiiotool", "--pattern", "checker:width=9:height=9:color1=0.15:color2=0.85", "72x72", "1", "-d", "float",
                      "-o", "checker.exr"]] + [fresh_capture(i, a) for i, (a, _) in enumerate(FRESH)] +
@@ -144,6 +171,7 @@ BLOCKS = [
     Block("city", [["capture", "relief", "--scene", "city", "--objects", "2000", "--path", "walk", "--size", "320x240", "--frames",
                     "8", "--seed", "4", "--placement", "city", "--field", "walls", "--field-size", "64", "-o", "c.nbt"],
                    ["compare", "c.nbt", "--json"]], render_city),
+    Block("zbuffer", zbuffer_commands(), render_zbuffer),
 ]
 
 
