@@ -27,7 +27,7 @@ for spec in "strict" "paper min 0" "paper min 0.01" "paper min 0.02" "paper min 
             "paper max 0" "paper max 0.01" "paper max 0.02" "paper max 0.05" "paper max 0.1"; do
   read -r kind combine epsilon <<< "$spec"
   t="$out/relief_figure12/traces/fbm_64_${kind}_${combine:-all}_${epsilon:-0}.nbt"
-  radius=()
+  radius=(--radius strict)
   [[ $kind == paper ]] && radius=(--radius paper --radius-combine "$combine" --radius-epsilon "$epsilon")
   [[ -f "$t" ]] || "$nbsim" capture relief --scene boxes --boxes 0 --path fly --size 128x128 --frames 4 --seed 5 --field fbm \
     --field-size 64 --methods exact,robust,robust_clamp "${radius[@]}" -o "$t" > /dev/null

@@ -182,7 +182,7 @@ BLOCKS = [
 FIG12_FIELDS = {"terrain": ["--field", "fbm", "--field-size", "64", "--seed", "21"],
                 "knot": ["--field-mesh", "shape:knot", "--field-size", "64"]}
 FIG12_EPSILONS = ("0", "0.005", "0.01", "0.02", "0.05", "0.1")
-FIG12_RADII = [("strict", [])] + [(f"paper {c}, {e}", ["--radius", "paper", "--radius-combine", c, "--radius-epsilon", e])
+FIG12_RADII = [("strict", ["--radius", "strict"])] + [(f"paper {c}, {e}", ["--radius", "paper", "--radius-combine", c, "--radius-epsilon", e])
                                   for c in ("min", "max") for e in FIG12_EPSILONS]
 
 
@@ -229,7 +229,7 @@ T1_SIZES = (32, 64, 128, 256)
 T1_COMMON = ["capture", "relief", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "1600x1200", "--frames", "1",
              "--angles", "45", "--methods", "binary,exact,robust"]
 T1_CASES = [(f"terrain {n}²", "terrain", n, r, ["--field", "fbm", "--field-size", str(n), "--seed", "3", *a])
-            for n in T1_SIZES for r, a in (("strict", []), ("paper", ["--radius", "paper"]))] + \
+            for n in T1_SIZES for r, a in (("strict", ["--radius", "strict"]), ("paper", ["--radius", "paper"]))] + \
            [("walls (grid) 128²", "walls", 128, "paper", ["--field", "walls", "--field-size", "128", "--radius", "paper"]),
             ("knot (object) 128²", "knot", 128, "paper", ["--field-mesh", "shape:knot", "--field-size", "128", "--radius", "paper"])]
 T1_PAPER_HZ = {"binary": (109, 109, 110, 108), "exact": (115, 87, 58, 36), "robust": (116, 105, 97, 96)}  # Table 1, terrain

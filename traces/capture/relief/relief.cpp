@@ -67,14 +67,16 @@ const OptionSpec& field_mesh_option() {
 }
 const OptionSpec& radius_file_option() {
   static const OptionSpec spec = text_option(
-      "radius-file", "A single-channel image of safety radii in texels for the field, checked against it ('none': computed)", "none");
+      "radius-file", "A single-channel image of safety radii in texels for the field, checked against the strict guarantee; it replaces "
+                     "--radius ('none': computed)", "none");
   return spec;
 }
 const OptionSpec& radius_option() {
   static const OptionSpec spec = choice_option(
-      "radius", "The safety radius: strict (every ray from anywhere in the texel, blocked ones too) or paper (Baboud & Decoret 3.5: "
-                "unblocked rays only, with --radius-epsilon and --radius-combine)",
-      "strict", {"strict", "paper"});
+      "radius", "The safety radius: paper (Baboud & Decoret 3.5, the default: unblocked rays only, the maximum over directions, "
+                "with --radius-epsilon and --radius-combine) or strict (nbsim's: every ray from anywhere in the texel, blocked ones "
+                "too, so the robust search never steps over a crossing)",
+      "paper", {"paper", "strict"});
   return spec;
 }
 const OptionSpec& radius_epsilon_option() {
@@ -282,8 +284,13 @@ class Relief final : public Technique {
     if (!paper_radius_ && (paper_.epsilon != 0.0 || paper_.combine != relief::RadiusCombine::Max))
       throw InputError("--radius-epsilon and --radius-combine set the paper's radius: add --radius paper");
     const std::string radius_file = o.text(radius_file_option());
-    if (radius_file != "none" && paper_radius_)
-      throw InputError("--radius-file gives the radii: it takes no --radius paper (the file is checked against the strict guarantee)");
+    if (radius_file != "none") {
+      // The file's radii replace the computed ones and are held to the strict guarantee.
+      if (paper_.epsilon != 0.0 || paper_.combine != relief::RadiusCombine::Max)
+        throw InputError("--radius-file gives the radii: it takes no --radius-epsilon or --radius-combine (the file is checked "
+                         "against the strict guarantee)");
+      paper_radius_ = false;
+    }
     if (radius_file != "none") {
       const relief::Heightfield r = read_square(radius_file, "--radius-file");
       radius_ = {r.size, r.heights};

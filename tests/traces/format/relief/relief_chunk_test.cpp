@@ -194,4 +194,39 @@ TEST(ReliefChunkTest, DecodedAndDamageRefused) {
   }
 }
 
+// RLFD (the depth the boxes left) decodes, encodes back to its bytes, and its rule refuses a matrix
+// of other than 16 values or with NaN, a CRC count unlike the draw count and unsorted draws.
+TEST(ReliefChunkTest, DepthRecordRule) {
+  const auto payload = [](std::vector<float> m, std::vector<std::uint32_t> draws, std::vector<std::uint32_t> crcs) {
+    bytes::Out o;
+    o.counted_words(m);
+    o.counted_words(draws);
+    o.counted_words(crcs);
+    return o.take();
+  };
+  const std::vector<float> identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  const std::vector<std::uint8_t> good = payload(identity, {3, 5}, {0xDEADBEEFu, 7});
+  const TechniqueRecord r = decode_technique(kReliefDepthChunk, good);
+  ASSERT_TRUE(r.decoded);
+  EXPECT_EQ(encode(r), good);
+  EXPECT_EQ(kReliefDepthChunk, nbsim::relief::kReliefDepthRecordType) << "model/relief/records.h names RLFD by its fourcc";
+  std::vector<float> with_nan = identity;
+  with_nan[5] = std::nanf("");
+  const std::pair<std::vector<std::uint8_t>, const char*> bad[] = {
+      {payload(std::vector<float>(15, 0.0f), {3}, {1}), "field 'texel_to_clip' has 15 values"},
+      {payload(with_nan, {3}, {1}), "field 'texel_to_clip' has NaN at index 5"},
+      {payload(identity, {3, 5}, {1}), "field 'depth_crc' has 1 values, but there are 2 draws"},
+      {payload(identity, {5, 3}, {1, 2}), "field 'draws' is not strictly increasing: 3 after 5"},
+  };
+  for (const auto& [bytes_in, message] : bad) {
+    try {
+      decode_technique(kReliefDepthChunk, bytes_in);
+      ADD_FAILURE() << message << ": accepted";
+    } catch (const nbsim::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("ReliefDepth"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
