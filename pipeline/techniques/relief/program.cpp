@@ -35,8 +35,9 @@ Program build(const ProgramContext& c) {
 }
 
 // The relief program's counters in run.json's per-frame values, per method (differences at frame ends).
-constexpr std::array<const char*, 9> kReliefFrameCounts = {"fragments", "gl_fragments", "pixel_mismatches", "walk_mismatches",
-                                                            "lookups", "steps", "errors", "reference_hits", "cycles"};
+constexpr std::array<const char*, 13> kReliefFrameCounts = {"fragments", "gl_fragments", "pixel_mismatches", "walk_mismatches",
+                                                             "lookups", "steps", "errors", "reference_hits", "cycles", "rasterized",
+                                                             "depth_written", "depth_mismatches", "scene_hidden"};
 
 void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) {
   nlohmann::ordered_json methods = nlohmann::ordered_json::object();
@@ -92,11 +93,11 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
   }
   j["methods"] = methods;
   // Totals over the methods (the results row's metrics).
-  std::uint64_t fragments = 0, lookups = 0, errors = 0, walk_mismatches = 0, pixel_mismatches = 0;
+  std::uint64_t fragments = 0, lookups = 0, errors = 0, walk_mismatches = 0, pixel_mismatches = 0, depth_mismatches = 0;
   for (const auto& [name, e] : methods.items()) {
     fragments += e["fragments"].get<std::uint64_t>(), lookups += e["lookups"].get<std::uint64_t>();
     errors += e["errors"].get<std::uint64_t>(), walk_mismatches += e["walk_mismatches"].get<std::uint64_t>();
-    pixel_mismatches += e["pixel_mismatches"].get<std::uint64_t>();
+    pixel_mismatches += e["pixel_mismatches"].get<std::uint64_t>(), depth_mismatches += e["depth_mismatches"].get<std::uint64_t>();
   }
   j["fragments"] = fragments;
   j["lookups"] = lookups;
@@ -105,6 +106,7 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
   j["error_rate"] = fragments ? nlohmann::ordered_json(static_cast<double>(errors) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
   j["walk_mismatches"] = walk_mismatches;
   j["pixel_mismatches"] = pixel_mismatches;
+  j["depth_mismatches"] = depth_mismatches;
   return j;
 }
 

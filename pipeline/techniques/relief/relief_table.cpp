@@ -45,6 +45,7 @@ nlohmann::ordered_json relief_rows(const std::vector<nlohmann::json>& runs, cons
     const std::string radius = props.value("relief_radius", "strict");
     const double epsilon = std::strtod(props.value("relief_radius_epsilon", "0").c_str(), nullptr);
     const std::string combine = props.value("relief_radius_combine", "max");
+    const std::string box_depth = props.value("relief_box_depth", "none");
     nlohmann::ordered_json radius_mean = nullptr, radius_zero = nullptr;
     if (run.contains("summary") && run["summary"].contains("relief")) {
       const auto& sr = run["summary"]["relief"];
@@ -70,6 +71,11 @@ nlohmann::ordered_json relief_rows(const std::vector<nlohmann::json>& runs, cons
         for (const char* k : {"fragments", "gl_fragments", "lookups", "steps", "errors", "reference_hits", "cycles", "pixel_mismatches",
                               "walk_mismatches"})
           r[k] = u(v, k);
+        // What the box left in the depth buffer (relief_box_depth; none before the header had it):
+        // the fragments rasterized (those not walked were culled by the early test), the depth
+        // written, box draws whose depth differs from GL's, and later scene fragments it hid.
+        r["box_depth"] = box_depth;
+        for (const char* k : {"rasterized", "depth_written", "depth_mismatches", "scene_hidden"}) r[k] = v.contains(k) ? u(v, k) : 0;
         const double n = static_cast<double>(u(v, "fragments"));
         r["lookups_per_fragment"] = ratio(static_cast<double>(u(v, "lookups")), n);
         r["steps_per_fragment"] = ratio(static_cast<double>(u(v, "steps")), n);

@@ -42,7 +42,8 @@ void add_relief_commands(CLI::App& app, Action& action) {
       doc["nbuffer_vs_exact"] = techniques::relief_nbuffer_vs_exact(rows);
       doc["paper"] = techniques::relief_paper_table(rows);
       std::uint64_t differing = 0;
-      for (const auto& r : rows) differing += r["pixel_mismatches"].get<std::uint64_t>() + r["walk_mismatches"].get<std::uint64_t>();
+      for (const auto& r : rows)
+        differing += r["pixel_mismatches"].get<std::uint64_t>() + r["walk_mismatches"].get<std::uint64_t>() + r["depth_mismatches"].get<std::uint64_t>();
       if (!a->out.empty()) {
         const std::filesystem::path dir = a->out;
         std::ofstream f(dir / "relief.json");
@@ -50,13 +51,14 @@ void add_relief_commands(CLI::App& app, Action& action) {
         if (!f) throw InputError(fmt::format("cannot write '{}'", (dir / "relief.json").string()));
         std::ofstream c(dir / "relief.csv");
         c << "trace,field,field_size,frame,angle,method,fragments,lookups,steps,errors,reference_hits,cycles,lookups_per_fragment,"
-             "steps_per_fragment,error_rate,pixel_mismatches,walk_mismatches\n";
+             "steps_per_fragment,error_rate,pixel_mismatches,walk_mismatches,box_depth,rasterized,depth_written,depth_mismatches,scene_hidden\n";
         for (const auto& r : rows) {
           const auto num = [&](const char* k) { return r[k].is_null() ? std::string() : r[k].dump(); };
-          c << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", r["trace"].get<std::string>(), r["field"].get<std::string>(),
+          c << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", r["trace"].get<std::string>(), r["field"].get<std::string>(),
                            num("field_size"), num("frame"), num("angle"), r["method"].get<std::string>(), num("fragments"), num("lookups"),
                            num("steps"), num("errors"), num("reference_hits"), num("cycles"), num("lookups_per_fragment"),
-                           num("steps_per_fragment"), num("error_rate"), num("pixel_mismatches"), num("walk_mismatches"));
+                           num("steps_per_fragment"), num("error_rate"), num("pixel_mismatches"), num("walk_mismatches"),
+                           r["box_depth"].get<std::string>(), num("rasterized"), num("depth_written"), num("depth_mismatches"), num("scene_hidden"));
         }
         if (!c) throw InputError(fmt::format("cannot write '{}'", (dir / "relief.csv").string()));
       }
@@ -95,7 +97,7 @@ void add_relief_commands(CLI::App& app, Action& action) {
                    r["cycles_per_frame"].is_number() ? fmt::format("{:.0f} cycles, {:.2f} lookups/fragment", num(r, "cycles_per_frame"),
                                                                    num(r, "lookups_per_fragment"))
                                                      : std::string("-"));
-      if (differing) fmt::print("fragments whose walk differs from GL's: {}\n", differing);
+      if (differing) fmt::print("fragments whose walk differs from GL's, and box draws whose depth does: {}\n", differing);
       return differing == 0 ? 0 : 1;
     };
   });
