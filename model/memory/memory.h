@@ -75,4 +75,50 @@ class Cache {
   std::uint64_t hits_ = 0, misses_ = 0, writebacks_ = 0;
 };
 
+// The same LRU set-associative cache for a client that only reads and knows its lines: the same
+// hits and misses as Cache given the same sequence (line = address / line_bytes; reads only, so no
+// dirty lines or write-backs), faster. An LRU set holds the `ways` most recently used distinct lines
+// mapped to it, whatever way each sits in; here each set keeps them in recency order (most recent
+// first), so a hit on the most recent line costs one compare and nothing needs an LRU stamp.
+class LineCache {
+ public:
+  explicit LineCache(CacheConfig c);
+  // Reads `line`; true on a hit.
+  bool read(std::uint64_t line) noexcept {
+    if (sets_ == 0) {  // no cache: every access goes to memory
+      ++misses_;
+      return false;
+    }
+    std::uint64_t* ways = &tags_[(pow2_ ? line & set_mask_ : line % sets_) * ways_];
+    if (ways[0] == line) {
+      ++hits_;
+      return true;
+    }
+    // Find it (or take the least recently used, the last), then move the ones before it back.
+    int k = 1;
+    while (k < ways_ && ways[k] != line) ++k;
+    const bool hit = k < ways_;
+    if (!hit) k = ways_ - 1;
+    for (; k > 0; --k) ways[k] = ways[k - 1];
+    ways[0] = line;
+    ++(hit ? hits_ : misses_);
+    return hit;
+  }
+  void invalidate();
+  std::uint64_t hits() const noexcept { return hits_; }
+  std::uint64_t misses() const noexcept { return misses_; }
+  const CacheConfig& config() const noexcept { return c_; }
+
+ private:
+  // No address has this line (line_bytes >= 2): it marks an invalid way, which sorts last.
+  static constexpr std::uint64_t kInvalid = ~std::uint64_t{0};
+  CacheConfig c_;
+  std::uint64_t sets_ = 0;
+  int ways_ = 0;
+  bool pow2_ = false;
+  std::uint64_t set_mask_ = 0;
+  std::vector<std::uint64_t> tags_;  // sets * ways, each set most recently used first
+  std::uint64_t hits_ = 0, misses_ = 0;
+};
+
 }  // namespace nbsim::memory

@@ -23,6 +23,7 @@
 #include "model/relief/records.h"
 #include "model/relief/score.h"
 #include "model/relief/walk.h"
+#include "model/relief/workers.h"
 #include "model/scene/frame.h"
 
 namespace nbsim::relief {
@@ -47,6 +48,20 @@ struct BoxDrawCounts {
   std::uint64_t storage_bytes = 0;
 };
 
+// Where a replay's lookups go (the unit's texel cache), in the walks' order: the fragments of a draw
+// walk in parallel (workers.h), in runs of consecutive fragments in pixel order, and the runs come
+// here one after another on the calling thread, each run's lookups as LookupLines (walk.h) recorded
+// with this sink's line_shift and merge_repeats.
+class LookupSink {
+ public:
+  virtual int line_shift() const = 0;
+  virtual bool merge_repeats() const = 0;
+  virtual void take(const LookupLines& run) = 0;
+
+ protected:
+  ~LookupSink() = default;
+};
+
 struct ReliefFrameCounts {
   int size = 0;  // the heightfield's N
   // The frame's safety radii (RLFH): their sum and the texels at 0, over its N * N texels.
@@ -60,16 +75,17 @@ class ReliefReplay {
  public:
   // The viewport (1 .. 16384 a side; InputError otherwise). `covering`: the N-buffer walk's, the
   // capture's (the trace header's nbuffer_covering).
-  ReliefReplay(int width, int height, bool fused_interpolation = true, CoveringSpec covering = {});
+  // `threads`: the walks' (workers.h; every count is the same for any number).
+  ReliefReplay(int width, int height, bool fused_interpolation = true, CoveringSpec covering = {}, int threads = relief_threads());
   ReliefReplay(const ReliefReplay&) = delete;
   ReliefReplay& operator=(const ReliefReplay&) = delete;
 
   // Runs the frame. `tolerance`: score.h's, texels; `box_height`: the box's height over its width
-  // (the trace header's relief_box_height). `observer` (may be null) sees every lookup of every walk;
+  // (the trace header's relief_box_height). `lookups` (may be null) sees every lookup of every walk;
   // `draw_done` (may be null) is called after each box draw's walks with its counts.
   // InputError naming the frame for a damaged record, a box draw without its RLFF or the reverse, or
   // a box draw that is not triangles.
-  ReliefFrameCounts run_frame(const scene::Frame& f, double tolerance, double box_height, LookupObserver observer = nullptr,
+  ReliefFrameCounts run_frame(const scene::Frame& f, double tolerance, double box_height, LookupSink* lookups = nullptr,
                               void* context = nullptr, void (*draw_done)(void* context, const BoxDrawCounts& draw) = nullptr);
 
  private:
@@ -82,6 +98,18 @@ class ReliefReplay {
   std::vector<ReferenceHit> reference_;
   std::vector<std::uint8_t> referenced_;
   raster::RasterPath path_;
+  // A draw's fragments (pixels in order), their walks and scores, and their lookups by run of
+  // kRunFragments fragments: filled by the workers, read in order by the calling thread.
+  struct FragmentWalk {
+    bool ray = false;  // the pixel's ray meets the box (else no walk)
+    WalkResult walk;
+    HitScore score;
+  };
+  static constexpr std::size_t kRunFragments = 256;
+  std::vector<std::uint32_t> fragment_pixels_;
+  std::vector<FragmentWalk> walks_;
+  std::vector<LookupLines> runs_;
+  WorkerPool pool_;
 };
 
 }  // namespace nbsim::relief

@@ -54,8 +54,25 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   static std::uint64_t draw_cycles(const BoxDrawCounts& d, const ReliefUnitConfig& c);
 
  private:
-  static void on_lookup(void* self, Texture texture, std::int64_t index);
   static void on_draw(void* self, const BoxDrawCounts& d);
+
+  // The heightfield texel cache, fed the walks' lookups by the replay (replay.h) in their order,
+  // counting the current box draw's hits and misses.
+  class TexelCache final : public LookupSink {
+   public:
+    explicit TexelCache(const ReliefUnitConfig& c);
+    int line_shift() const override { return line_shift_; }
+    bool merge_repeats() const override { return merge_repeats_; }
+    void take(const LookupLines& run) override;
+    void invalidate();  // a new frame: empty, and no lookup before
+    std::uint64_t draw_hits = 0, draw_misses = 0;
+
+   private:
+    memory::LineCache cache_;
+    int line_shift_ = 0;  // log2 of relief.cache_line_bytes (a power of two)
+    bool merge_repeats_ = false;
+    std::uint64_t last_line_ = ~std::uint64_t{0};  // the cache line of the last lookup
+  };
   void account(const BoxDrawCounts& d);
 
   struct PerMethod {
@@ -69,10 +86,7 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   int client_;
   double box_height_;
   ReliefReplay replay_;
-  memory::Cache cache_;
-  std::uint64_t draw_misses_ = 0, draw_hits_ = 0;
-  std::uint64_t last_line_ = ~std::uint64_t{0};  // the cache line of the last lookup
-  int line_shift_ = 0;                            // log2 of relief.cache_line_bytes (a power of two)  // the current box draw's cache outcomes
+  TexelCache cache_;
   stats::Counter &frames_, &scene_draws_, &scene_depth_tests_, &box_draws_, &cache_hits_, &cache_misses_, &memory_bytes_, &memory_stall_cycles_, &cycles_,
       &radius_texels_, &radius_sum_, &radius_zero_;
   std::array<PerMethod, kMethods> per_method_{};

@@ -107,6 +107,39 @@ enum class Texture : std::uint8_t { Height = 0, Radius = 1, NBuffer = 2 };
 // are reads too: index -1, served without memory).
 using LookupObserver = void (*)(void* context, Texture texture, std::int64_t index);
 
+// The texel cache's address space (model/relief/unit.h): the heights, the radii and the N-buffer
+// levels 2^34 bytes apart, 4 bytes a texel.
+constexpr std::uint64_t texel_address(Texture texture, std::int64_t index) noexcept {
+  return (static_cast<std::uint64_t>(texture) << 34) + 4 * static_cast<std::uint64_t>(index);
+}
+
+// The lookups of walks run one after another, recorded as the texel cache will see them, so that
+// walks can run apart from the cache (on other threads) and the cache be fed later in the same
+// order: each read of a texel in memory as its cache line, texel_address >> line_shift (virtual
+// border texels need no memory and are left out). With merge_repeats, a line equal to the line
+// recorded just before is not recorded but counted in `repeats`: in an LRU cache that access is a
+// hit that changes nothing (the line is its set's most recently used), so the cache need not see
+// it. The first line recorded is kept whatever came before (the caller knows the line before it).
+struct LookupLines {
+  int line_shift = 6;
+  bool merge_repeats = true;
+  std::vector<std::uint64_t> lines;
+  std::uint64_t repeats = 0;
+
+  void clear() noexcept {
+    lines.clear();
+    repeats = 0;
+  }
+  void add(std::uint64_t address) {
+    const std::uint64_t line = address >> line_shift;
+    if (merge_repeats && !lines.empty() && lines.back() == line) {
+      ++repeats;
+      return;
+    }
+    lines.push_back(line);
+  }
+};
+
 // The ray of pixel centre (px, py) clipped to the box: false when it misses the box.
 struct FragmentRay {
   std::array<float, 3> o{}, d{};
@@ -121,6 +154,8 @@ std::optional<FragmentRay> fragment_ray(const RayFrame& frame, int size, float p
 // One fragment's walk with `method`. `observer` (may be null) sees every lookup.
 WalkResult walk(Method method, const FieldView& field, const WalkParams& params, const FragmentRay& ray,
                 LookupObserver observer = nullptr, void* context = nullptr);
+// The same walk (the same result, bit for bit), its lookups appended to `lines`.
+WalkResult walk(Method method, const FieldView& field, const WalkParams& params, const FragmentRay& ray, LookupLines& lines);
 
 // The iteration cap of every walk's main loop (a walk that reaches it is a capped miss).
 int walk_iteration_cap(int size) noexcept;
