@@ -89,18 +89,15 @@ class LineCache {
       ++misses_;
       return false;
     }
-    std::uint64_t* ways = &tags_[(pow2_ ? line & set_mask_ : line % sets_) * ways_];
-    if (ways[0] == line) {
-      ++hits_;
-      return true;
+    std::uint64_t* ways = &tags_[(pow2_ ? line & set_mask_ : line % sets_) * static_cast<std::uint64_t>(ways_)];
+    bool hit = false;
+    switch (ways_) {  // the usual associativities unrolled (the same branch every time)
+      case 1: hit = read_set<1>(ways, line); break;
+      case 2: hit = read_set<2>(ways, line); break;
+      case 4: hit = read_set<4>(ways, line); break;
+      case 8: hit = read_set<8>(ways, line); break;
+      default: hit = read_set_any(ways, line); break;
     }
-    // Find it (or take the least recently used, the last), then move the ones before it back.
-    int k = 1;
-    while (k < ways_ && ways[k] != line) ++k;
-    const bool hit = k < ways_;
-    if (!hit) k = ways_ - 1;
-    for (; k > 0; --k) ways[k] = ways[k - 1];
-    ways[0] = line;
     ++(hit ? hits_ : misses_);
     return hit;
   }
@@ -110,6 +107,29 @@ class LineCache {
   const CacheConfig& config() const noexcept { return c_; }
 
  private:
+  // One set of W ways, most recently used first: `line` goes first and the lines before its place
+  // (or all but the last, evicted, on a miss) move back one, without a branch on where it was.
+  template <int W>
+  static bool read_set(std::uint64_t* ways, std::uint64_t line) noexcept {
+    std::uint64_t old[W];
+    for (int k = 0; k < W; ++k) old[k] = ways[k];
+    bool seen = false;  // `line` is among the ways before k
+    ways[0] = line;
+    for (int k = 1; k < W; ++k) {
+      seen = seen || old[k - 1] == line;
+      ways[k] = seen ? old[k] : old[k - 1];
+    }
+    return seen || old[W - 1] == line;
+  }
+  bool read_set_any(std::uint64_t* ways, std::uint64_t line) const noexcept {
+    int k = 0;
+    while (k < ways_ && ways[k] != line) ++k;
+    const bool hit = k < ways_;
+    for (k = hit ? k : ways_ - 1; k > 0; --k) ways[k] = ways[k - 1];
+    ways[0] = line;
+    return hit;
+  }
+
   // No address has this line (line_bytes >= 2): it marks an invalid way, which sorts last.
   static constexpr std::uint64_t kInvalid = ~std::uint64_t{0};
   CacheConfig c_;

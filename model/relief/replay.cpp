@@ -91,10 +91,10 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     walks_.resize(fragment_pixels_.size());
     const std::size_t run_count = (fragment_pixels_.size() + kRunFragments - 1) / kRunFragments;
     if (runs_.size() < run_count) runs_.resize(run_count);
+    const LineGeometry geometry = lookups ? lookups->geometry() : LineGeometry{};
     const auto walk_run = [&](std::size_t run) {
       LookupLines& lines = runs_[run];
-      lines.clear();
-      if (lookups) lines.line_shift = lookups->line_shift(), lines.merge_repeats = lookups->merge_repeats();
+      if (lookups) lines.reset(geometry);
       const std::size_t end = std::min(fragment_pixels_.size(), (run + 1) * kRunFragments);
       for (std::size_t at = run * kRunFragments; at < end; ++at) {
         const std::uint32_t px = fragment_pixels_[at];

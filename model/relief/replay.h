@@ -51,11 +51,10 @@ struct BoxDrawCounts {
 // Where a replay's lookups go (the unit's texel cache), in the walks' order: the fragments of a draw
 // walk in parallel (workers.h), in runs of consecutive fragments in pixel order, and the runs come
 // here one after another on the calling thread, each run's lookups as LookupLines (walk.h) recorded
-// with this sink's line_shift and merge_repeats.
+// with this sink's geometry.
 class LookupSink {
  public:
-  virtual int line_shift() const = 0;
-  virtual bool merge_repeats() const = 0;
+  virtual LineGeometry geometry() const = 0;
   virtual void take(const LookupLines& run) = 0;
 
  protected:

@@ -146,10 +146,16 @@ std::uint64_t ReliefUnit::draw_cycles(const BoxDrawCounts& d, const ReliefUnitCo
 
 ReliefUnit::TexelCache::TexelCache(const ReliefUnitConfig& c) : cache_(cache_config(c)) {
   while ((1 << line_shift_) < c.cache_line_bytes) ++line_shift_;
-  // The line of the previous lookup is its set's most recently used: a hit that changes nothing in
-  // the LRU order, so the walks count it without the cache (the same hits and misses). (With no
-  // cache at all, relief.cache_bytes 0, every lookup misses.)
-  merge_repeats_ = c.cache_bytes > 0;
+  // A lookup of its set's most recently used line is a hit that changes nothing in the LRU order,
+  // so the walks count it without the cache (the same hits and misses). With no cache at all,
+  // relief.cache_bytes 0, every lookup misses; with fewer bytes than a set, a lookup of the line
+  // just before hits and every other misses (as the cache's former per-lookup model counted).
+  merge_ = c.cache_bytes > 0;
+}
+
+LineGeometry ReliefUnit::TexelCache::geometry() const {
+  const memory::CacheConfig& c = cache_.config();
+  return {line_shift_, static_cast<std::uint64_t>(c.size_bytes) / static_cast<std::uint64_t>(c.line_bytes * c.ways), merge_};
 }
 
 void ReliefUnit::TexelCache::invalidate() {
@@ -160,15 +166,16 @@ void ReliefUnit::TexelCache::invalidate() {
 // A run's lookups: virtual border texels were left out (a constant, no memory), and repeats of the
 // line before merged; the run's first line may repeat the last line of the run before.
 void ReliefUnit::TexelCache::take(const LookupLines& run) {
-  draw_hits += run.repeats;
-  if (run.lines.empty()) return;
-  std::span<const std::uint64_t> lines = run.lines;
-  if (merge_repeats_ && lines.front() == last_line_) ++draw_hits, lines = lines.subspan(1);
+  draw_hits += run.repeats();
+  std::span<const std::uint64_t> lines = run.lines();
+  if (lines.empty()) return;
+  const std::uint64_t last = lines.back();
+  if (merge_ && lines.front() == last_line_) ++draw_hits, lines = lines.subspan(1);
   std::uint64_t hits = 0;
   for (const std::uint64_t line : lines) hits += cache_.read(line) ? 1 : 0;
   draw_hits += hits;
   draw_misses += lines.size() - hits;
-  last_line_ = run.lines.back();
+  last_line_ = last;
 }
 
 void ReliefUnit::on_draw(void* self, const BoxDrawCounts& d) { static_cast<ReliefUnit*>(self)->account(d); }

@@ -61,8 +61,7 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   class TexelCache final : public LookupSink {
    public:
     explicit TexelCache(const ReliefUnitConfig& c);
-    int line_shift() const override { return line_shift_; }
-    bool merge_repeats() const override { return merge_repeats_; }
+    LineGeometry geometry() const override;
     void take(const LookupLines& run) override;
     void invalidate();  // a new frame: empty, and no lookup before
     std::uint64_t draw_hits = 0, draw_misses = 0;
@@ -70,7 +69,7 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
    private:
     memory::LineCache cache_;
     int line_shift_ = 0;  // log2 of relief.cache_line_bytes (a power of two)
-    bool merge_repeats_ = false;
+    bool merge_ = false;
     std::uint64_t last_line_ = ~std::uint64_t{0};  // the cache line of the last lookup
   };
   void account(const BoxDrawCounts& d);

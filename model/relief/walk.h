@@ -35,6 +35,7 @@
 // (the covering's distinct texels).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -113,31 +114,66 @@ constexpr std::uint64_t texel_address(Texture texture, std::int64_t index) noexc
   return (static_cast<std::uint64_t>(texture) << 34) + 4 * static_cast<std::uint64_t>(index);
 }
 
+// The texel cache as a record of lookups needs to know it (model/memory LineCache's sets).
+struct LineGeometry {
+  int line_shift = 6;      // line = texel_address >> line_shift
+  std::uint64_t sets = 0;  // set = line % sets (0: no sets, every lookup misses)
+  bool merge = true;       // merge the lookups known to hit (false: a cache of 0 bytes, where none hits)
+};
+
 // The lookups of walks run one after another, recorded as the texel cache will see them, so that
 // walks can run apart from the cache (on other threads) and the cache be fed later in the same
-// order: each read of a texel in memory as its cache line, texel_address >> line_shift (virtual
-// border texels need no memory and are left out). With merge_repeats, a line equal to the line
-// recorded just before is not recorded but counted in `repeats`: in an LRU cache that access is a
-// hit that changes nothing (the line is its set's most recently used), so the cache need not see
-// it. The first line recorded is kept whatever came before (the caller knows the line before it).
-struct LookupLines {
-  int line_shift = 6;
-  bool merge_repeats = true;
-  std::vector<std::uint64_t> lines;
-  std::uint64_t repeats = 0;
-
-  void clear() noexcept {
-    lines.clear();
-    repeats = 0;
+// order: each read of a texel in memory as its cache line (virtual border texels need no memory and
+// are left out). With `merge`, a lookup of the line its set saw last in this record is not recorded
+// but counted in `repeats`: in an LRU cache that access is a hit that changes nothing (the line is
+// its set's most recently used), whatever came before the record, so the cache need not see it.
+// Most of a walk's lookups are such (the four corners of a cell are two lines, read again by the
+// next cell), so the cache, which must see the rest in order on one thread, has little left to do.
+// (With no sets, only a repeat of the line just before is merged, as it always hit.)
+class LookupLines {
+ public:
+  // Empties the record and sets how the lines are taken.
+  void reset(const LineGeometry& g) {
+    line_shift_ = g.line_shift;
+    merge_ = g.merge;
+    // A huge cache's table would cost more to clear for every record than it saves: one entry then
+    // (the line just before).
+    const std::uint64_t table = g.sets > 0 && g.sets <= kMaxTable ? g.sets : 1;
+    pow2_ = (table & (table - 1)) == 0;
+    set_mask_ = table - 1;
+    set_count_ = table;
+    last_.assign(table, kNone);
+    size_ = 0;
+    repeats_ = 0;
   }
   void add(std::uint64_t address) {
-    const std::uint64_t line = address >> line_shift;
-    if (merge_repeats && !lines.empty() && lines.back() == line) {
-      ++repeats;
-      return;
+    const std::uint64_t line = address >> line_shift_;
+    if (merge_) {
+      std::uint64_t& last = last_[pow2_ ? line & set_mask_ : line % set_count_];
+      if (line == last) {
+        ++repeats_;
+        return;
+      }
+      last = line;
     }
-    lines.push_back(line);
+    // The storage is kept at its full size (size_ counts what is used), so a record reused for the
+    // next run neither frees nor clears it.
+    if (size_ == storage_.size()) storage_.resize(std::max<std::size_t>(4096, 2 * storage_.size()));
+    storage_[size_++] = line;
   }
+  std::span<const std::uint64_t> lines() const noexcept { return {storage_.data(), size_}; }
+  std::uint64_t repeats() const noexcept { return repeats_; }
+
+ private:
+  static constexpr std::uint64_t kNone = ~std::uint64_t{0};  // no line (addresses are multiples of 4)
+  static constexpr std::uint64_t kMaxTable = 4096;
+  int line_shift_ = 6;
+  bool merge_ = true, pow2_ = true;
+  std::uint64_t set_mask_ = 0, set_count_ = 1;
+  std::vector<std::uint64_t> last_ = {kNone};  // per set, the line it saw last
+  std::vector<std::uint64_t> storage_;
+  std::size_t size_ = 0;
+  std::uint64_t repeats_ = 0;
 };
 
 // The ray of pixel centre (px, py) clipped to the box: false when it misses the box.
