@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <span>
 
 #include "model/common/error.h"
 #include "model/relief/roles.h"
@@ -24,6 +25,40 @@ raster::RasterPathConfig path_config(int width, int height, bool fused) {
 }
 
 }  // namespace
+
+TexelCache::TexelCache(const memory::CacheConfig& c) : cache_(c) {
+  while ((1 << line_shift_) < c.line_bytes) ++line_shift_;
+  // A lookup of its set's most recently used line is a hit that changes nothing in the LRU order,
+  // so the walks count it without the cache (the same hits and misses). With no cache at all (0
+  // bytes) every lookup misses; with fewer bytes than a set, a lookup of the line just before hits
+  // and every other misses.
+  merge_ = c.size_bytes > 0;
+}
+
+LineGeometry TexelCache::geometry() const {
+  const memory::CacheConfig& c = cache_.config();
+  return {line_shift_, static_cast<std::uint64_t>(c.size_bytes) / static_cast<std::uint64_t>(c.line_bytes * c.ways), merge_};
+}
+
+void TexelCache::invalidate() {
+  cache_.invalidate();
+  last_line_ = ~std::uint64_t{0};
+}
+
+// A run's lookups: virtual border texels were left out (a constant, no memory), and the lookups known
+// to hit merged; the run's first line may repeat the last line of the run before.
+void TexelCache::take(const LookupLines& run) {
+  draw_hits += run.repeats();
+  std::span<const std::uint64_t> lines = run.lines();
+  if (lines.empty()) return;
+  const std::uint64_t last = lines.back();
+  if (merge_ && lines.front() == last_line_) ++draw_hits, lines = lines.subspan(1);
+  std::uint64_t hits = 0;
+  for (const std::uint64_t line : lines) hits += cache_.read(line) ? 1 : 0;
+  draw_hits += hits;
+  draw_misses += lines.size() - hits;
+  last_line_ = last;
+}
 
 ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, CoveringSpec covering, int threads)
     : width_(width),

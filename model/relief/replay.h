@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "model/common/depth.h"
+#include "model/memory/memory.h"
 #include "model/raster/raster_path.h"
 #include "model/relief/records.h"
 #include "model/relief/score.h"
@@ -59,6 +60,27 @@ class LookupSink {
 
  protected:
   ~LookupSink() = default;
+};
+
+// The relief unit's heightfield texel cache (unit.h) as a LookupSink: fed the walks' lookups in
+// their order, it counts the current box draw's hits and misses (the caller resets them). The same
+// hits and misses as a memory::Cache that sees every lookup of a texel in memory, at address
+// texel_address, except that with a cache of more than 0 bytes a lookup of the line just before
+// always counts as a hit (what a cache with sets does anyway, and the unit has counted so since
+// before its sets could be fewer than one).
+class TexelCache final : public LookupSink {
+ public:
+  explicit TexelCache(const memory::CacheConfig& c);  // c.line_bytes a power of two
+  LineGeometry geometry() const override;
+  void take(const LookupLines& run) override;
+  void invalidate();  // a new frame: empty, and no lookup before
+  std::uint64_t draw_hits = 0, draw_misses = 0;
+
+ private:
+  memory::LineCache cache_;
+  int line_shift_ = 0;  // log2 of the line's bytes
+  bool merge_ = false;
+  std::uint64_t last_line_ = ~std::uint64_t{0};  // the cache line of the last lookup
 };
 
 struct ReliefFrameCounts {

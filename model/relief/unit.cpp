@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <span>
 #include <string>
 
 #include "model/common/error.h"
@@ -83,7 +82,7 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
       client_(memory.add_client("relief")),
       box_height_(box_height),
       replay_(width, height, fused_interpolation, covering),
-      cache_(config_),
+      cache_(cache_config(config_)),
       frames_(stats().counter("frames", "frames", "frames replayed")),
       scene_draws_(stats().counter("scene_draws", "draws", "scene draws before the boxes (placement city)")),
       scene_depth_tests_(stats().counter("scene_depth_tests", "tests", "depth tests of the scene draws (charged at relief.tests_per_cycle)")),
@@ -142,40 +141,6 @@ std::uint64_t ReliefUnit::draw_cycles(const BoxDrawCounts& d, const ReliefUnitCo
                       static_cast<double>(d.bisections) * c.cycles_per_bisection;
   const std::uint64_t rays = std::max(ceil_div(work, c.lanes), ceil_div(static_cast<double>(d.longest_walk) * c.cycles_per_lookup, 1.0));
   return std::max({setup, walk, tests, rays}) + static_cast<std::uint64_t>(c.draw_latency_cycles);
-}
-
-ReliefUnit::TexelCache::TexelCache(const ReliefUnitConfig& c) : cache_(cache_config(c)) {
-  while ((1 << line_shift_) < c.cache_line_bytes) ++line_shift_;
-  // A lookup of its set's most recently used line is a hit that changes nothing in the LRU order,
-  // so the walks count it without the cache (the same hits and misses). With no cache at all,
-  // relief.cache_bytes 0, every lookup misses; with fewer bytes than a set, a lookup of the line
-  // just before hits and every other misses (as the cache's former per-lookup model counted).
-  merge_ = c.cache_bytes > 0;
-}
-
-LineGeometry ReliefUnit::TexelCache::geometry() const {
-  const memory::CacheConfig& c = cache_.config();
-  return {line_shift_, static_cast<std::uint64_t>(c.size_bytes) / static_cast<std::uint64_t>(c.line_bytes * c.ways), merge_};
-}
-
-void ReliefUnit::TexelCache::invalidate() {
-  cache_.invalidate();
-  last_line_ = ~std::uint64_t{0};
-}
-
-// A run's lookups: virtual border texels were left out (a constant, no memory), and repeats of the
-// line before merged; the run's first line may repeat the last line of the run before.
-void ReliefUnit::TexelCache::take(const LookupLines& run) {
-  draw_hits += run.repeats();
-  std::span<const std::uint64_t> lines = run.lines();
-  if (lines.empty()) return;
-  const std::uint64_t last = lines.back();
-  if (merge_ && lines.front() == last_line_) ++draw_hits, lines = lines.subspan(1);
-  std::uint64_t hits = 0;
-  for (const std::uint64_t line : lines) hits += cache_.read(line) ? 1 : 0;
-  draw_hits += hits;
-  draw_misses += lines.size() - hits;
-  last_line_ = last;
 }
 
 void ReliefUnit::on_draw(void* self, const BoxDrawCounts& d) { static_cast<ReliefUnit*>(self)->account(d); }

@@ -55,23 +55,6 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
 
  private:
   static void on_draw(void* self, const BoxDrawCounts& d);
-
-  // The heightfield texel cache, fed the walks' lookups by the replay (replay.h) in their order,
-  // counting the current box draw's hits and misses.
-  class TexelCache final : public LookupSink {
-   public:
-    explicit TexelCache(const ReliefUnitConfig& c);
-    LineGeometry geometry() const override;
-    void take(const LookupLines& run) override;
-    void invalidate();  // a new frame: empty, and no lookup before
-    std::uint64_t draw_hits = 0, draw_misses = 0;
-
-   private:
-    memory::LineCache cache_;
-    int line_shift_ = 0;  // log2 of relief.cache_line_bytes (a power of two)
-    bool merge_ = false;
-    std::uint64_t last_line_ = ~std::uint64_t{0};  // the cache line of the last lookup
-  };
   void account(const BoxDrawCounts& d);
 
   struct PerMethod {
