@@ -129,8 +129,10 @@ struct LineGeometry {
 // its set's most recently used), whatever came before the record, so the cache need not see it.
 // Most of a walk's lookups are such (the four corners of a cell are two lines, read again by the
 // next cell), so the cache, which must see the rest in order on one thread, has little left to do.
-// (With no sets, only a repeat of the line just before is merged, as it always hit.)
-class LookupLines {
+// (With no sets, only a repeat of the line just before is merged, as it always hit.) Aligned to a
+// cache line of the host: the records of runs walked at once on different threads sit side by side
+// in the replay's vector, and sharing a line would bounce it between the cores at every lookup.
+class alignas(64) LookupLines {
  public:
   // Empties the record and sets how the lines are taken.
   void reset(const LineGeometry& g) {
