@@ -34,6 +34,23 @@ struct Reader {
     sink.border(Texture::Height);
     return 0.0f;
   }
+  // The four corners of cell (i, j) in the shader's order (h00, h10, h01, h11): one bounds check
+  // and one index for a cell inside the field, the usual case.
+  void corners(int i, int j, float& h00, float& h10, float& h01, float& h11) {
+    const int n = f.size;
+    if (i >= 0 && j >= 0 && i + 1 < n && j + 1 < n) {
+      lookups += 4;
+      const std::int64_t index = static_cast<std::int64_t>(j) * n + i;
+      sink(Texture::Height, index);
+      sink(Texture::Height, index + 1);
+      sink(Texture::Height, index + n);
+      sink(Texture::Height, index + n + 1);
+      const float* p = f.heights.data() + index;
+      h00 = p[0], h10 = p[1], h01 = p[n], h11 = p[n + 1];
+      return;
+    }
+    h00 = height(i, j), h10 = height(i + 1, j), h01 = height(i, j + 1), h11 = height(i + 1, j + 1);
+  }
   float radius(int i, int j) {
     ++lookups;
     const std::int64_t index = static_cast<std::int64_t>(j) * f.size + i;
@@ -85,7 +102,8 @@ float above(Reader<Sink>& r, const FragmentRay& ray, float t) {
   const float u = along(ray.o[0], t, ray.d[0]) - 0.5f, v = along(ray.o[1], t, ray.d[1]) - 0.5f;
   const int i = floor_int(u), j = floor_int(v);
   const float fx = u - static_cast<float>(i), fy = v - static_cast<float>(j);
-  const float h00 = r.height(i, j), h10 = r.height(i + 1, j), h01 = r.height(i, j + 1), h11 = r.height(i + 1, j + 1);
+  float h00, h10, h01, h11;
+  r.corners(i, j, h00, h10, h01, h11);
   return along(ray.o[2], t, ray.d[2]) - bilerp(h00, h10, h01, h11, fx, fy);
 }
 
@@ -110,10 +128,7 @@ struct Cell {
 
   template <class Sink>
   void read(Reader<Sink>& r) {
-    h00 = r.height(ci, cj);
-    h10 = r.height(ci + 1, cj);
-    h01 = r.height(ci, cj + 1);
-    h11 = r.height(ci + 1, cj + 1);
+    r.corners(ci, cj, h00, h10, h01, h11);
   }
   // Height above the cell's patch at t (no lookups).
   float above(const FragmentRay& ray, float t) const noexcept {

@@ -129,7 +129,8 @@ struct LineGeometry {
 // its set's most recently used), whatever came before the record, so the cache need not see it.
 // Most of a walk's lookups are such (the four corners of a cell are two lines, read again by the
 // next cell), so the cache, which must see the rest in order on one thread, has little left to do.
-// (With no sets, only a repeat of the line just before is merged, as it always hit.) Aligned to a
+// (With no sets, a set count that is not a power of two or a huge cache, only a repeat of the line
+// just before is merged, as it always hits.) Aligned to a
 // cache line of the host: the records of runs walked at once on different threads sit side by side
 // in the replay's vector, and sharing a line would bounce it between the cores at every lookup.
 class alignas(64) LookupLines {
@@ -138,20 +139,19 @@ class alignas(64) LookupLines {
   void reset(const LineGeometry& g) {
     line_shift_ = g.line_shift;
     merge_ = g.merge;
-    // A huge cache's table would cost more to clear for every record than it saves: one entry then
-    // (the line just before).
-    const std::uint64_t table = g.sets > 0 && g.sets <= kMaxTable ? g.sets : 1;
-    pow2_ = (table & (table - 1)) == 0;
-    set_mask_ = table - 1;
-    set_count_ = table;
-    last_.assign(table, kNone);
+    // A huge cache's table would cost more to clear for every record than it saves, and a set count
+    // that is not a power of two would cost a division a lookup: one entry then (the line just
+    // before, always its set's most recently used).
+    const bool table = g.sets > 0 && g.sets <= kMaxTable && (g.sets & (g.sets - 1)) == 0;
+    set_mask_ = table ? g.sets - 1 : 0;
+    last_.assign(set_mask_ + 1, kNone);
     size_ = 0;
     repeats_ = 0;
   }
   void add(std::uint64_t address) {
     const std::uint64_t line = address >> line_shift_;
     if (merge_) {
-      std::uint64_t& last = last_[pow2_ ? line & set_mask_ : line % set_count_];
+      std::uint64_t& last = last_[line & set_mask_];
       if (line == last) {
         ++repeats_;
         return;
@@ -170,8 +170,8 @@ class alignas(64) LookupLines {
   static constexpr std::uint64_t kNone = ~std::uint64_t{0};  // no line (addresses are multiples of 4)
   static constexpr std::uint64_t kMaxTable = 4096;
   int line_shift_ = 6;
-  bool merge_ = true, pow2_ = true;
-  std::uint64_t set_mask_ = 0, set_count_ = 1;
+  bool merge_ = true;
+  std::uint64_t set_mask_ = 0;
   std::vector<std::uint64_t> last_ = {kNone};  // per set, the line it saw last
   std::vector<std::uint64_t> storage_;
   std::size_t size_ = 0;
