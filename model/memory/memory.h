@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -101,12 +102,39 @@ class LineCache {
     ++(hit ? hits_ : misses_);
     return hit;
   }
+  // Reads every line of `lines` in order (as read() one by one); returns how many hit.
+  std::uint64_t read_all(std::span<const std::uint64_t> lines) noexcept {
+    switch (ways_) {  // chosen once for the whole sequence
+      case 1: return read_all_ways<1>(lines);
+      case 2: return read_all_ways<2>(lines);
+      case 4: return read_all_ways<4>(lines);
+      case 8: return read_all_ways<8>(lines);
+      default: {
+        std::uint64_t hits = 0;
+        for (const std::uint64_t line : lines) hits += read(line) ? 1 : 0;
+        return hits;
+      }
+    }
+  }
   void invalidate();
   std::uint64_t hits() const noexcept { return hits_; }
   std::uint64_t misses() const noexcept { return misses_; }
   const CacheConfig& config() const noexcept { return c_; }
 
  private:
+  template <int W>
+  std::uint64_t read_all_ways(std::span<const std::uint64_t> lines) noexcept {
+    if (sets_ == 0) {
+      misses_ += lines.size();
+      return 0;
+    }
+    std::uint64_t hits = 0;
+    for (const std::uint64_t line : lines)
+      hits += read_set<W>(&tags_[(pow2_ ? line & set_mask_ : line % sets_) * W], line) ? 1 : 0;
+    hits_ += hits;
+    misses_ += lines.size() - hits;
+    return hits;
+  }
   // One set of W ways, most recently used first: `line` goes first and the lines before its place
   // (or all but the last, evicted, on a miss) move back one, without a branch on where it was.
   template <int W>

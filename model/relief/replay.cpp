@@ -53,8 +53,7 @@ void TexelCache::take(const LookupLines& run) {
   if (lines.empty()) return;
   const std::uint64_t last = lines.back();
   if (merge_ && lines.front() == last_line_) ++draw_hits, lines = lines.subspan(1);
-  std::uint64_t hits = 0;
-  for (const std::uint64_t line : lines) hits += cache_.read(line) ? 1 : 0;
+  const std::uint64_t hits = cache_.read_all(lines);
   draw_hits += hits;
   draw_misses += lines.size() - hits;
   last_line_ = last;

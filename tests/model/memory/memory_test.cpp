@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <vector>
 
 namespace nbsim::memory {
 namespace {
@@ -67,6 +68,14 @@ TEST(LineCacheTest, SameHitsAndMissesAsCache) {
           << "read " << k << " of address " << address << ", cache of " << config.size_bytes << " bytes, " << config.ways << " ways";
       hits += want;
     }
+    // read_all of a sequence is read() of each.
+    LineCache all(config), each(config);
+    std::vector<std::uint64_t> sequence(5000);
+    for (std::uint64_t& line : sequence) line = random() % (4 * static_cast<std::uint64_t>(config.size_bytes / config.line_bytes) + 8);
+    std::uint64_t each_hits = 0;
+    for (const std::uint64_t line : sequence) each_hits += each.read(line) ? 1 : 0;
+    EXPECT_EQ(all.read_all(sequence), each_hits);
+    EXPECT_EQ(all.misses(), each.misses());
     EXPECT_EQ(lines.hits(), reference.hits());
     EXPECT_EQ(lines.misses(), reference.misses());
     if (config.size_bytes >= config.line_bytes * config.ways) {
