@@ -20,7 +20,7 @@ constexpr float kFar = 3.0e38f;  // the shader's "no boundary" (a finite constan
 // so that a recording sink (LookupLines) costs no indirect call per lookup.
 template <class Sink>
 struct Reader {
-  const FieldView& f;
+  const FieldView f;  // a copy: its size and spans one load away, not two
   Sink& sink;
   std::uint32_t lookups = 0;
 
