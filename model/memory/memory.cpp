@@ -83,4 +83,17 @@ std::uint64_t Cache::flush() {
 
 void Cache::invalidate() { std::fill(lines_.begin(), lines_.end(), Line{}); }
 
+LineCache::LineCache(CacheConfig c) : c_(c) {
+  NBSIM_CHECK(c.size_bytes >= 0 && c.line_bytes > 1 && c.ways > 0, "line cache config not validated");
+  sets_ = static_cast<std::uint64_t>(c.size_bytes) / static_cast<std::uint64_t>(c.line_bytes * c.ways);
+  ways_ = c.ways;
+  tags_.assign(sets_ * static_cast<std::uint64_t>(c.ways), kInvalid);
+  if (sets_ > 0 && (sets_ & (sets_ - 1)) == 0) {
+    set_mask_ = sets_ - 1;
+    pow2_ = true;
+  }
+}
+
+void LineCache::invalidate() { std::fill(tags_.begin(), tags_.end(), kInvalid); }
+
 }  // namespace nbsim::memory

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,99 @@ class Cache {
   std::vector<Line> lines_;
   std::uint64_t clock_ = 0;
   std::uint64_t hits_ = 0, misses_ = 0, writebacks_ = 0;
+};
+
+// The same LRU set-associative cache for a client that only reads and knows its lines: the same
+// hits and misses as Cache given the same sequence (line = address / line_bytes; reads only, so no
+// dirty lines or write-backs), faster. An LRU set holds the `ways` most recently used distinct lines
+// mapped to it, whatever way each sits in; here each set keeps them in recency order (most recent
+// first), so a hit on the most recent line costs one compare and nothing needs an LRU stamp.
+class LineCache {
+ public:
+  explicit LineCache(CacheConfig c);
+  // Reads `line`; true on a hit.
+  bool read(std::uint64_t line) noexcept {
+    if (sets_ == 0) {  // no cache: every access goes to memory
+      ++misses_;
+      return false;
+    }
+    std::uint64_t* ways = &tags_[(pow2_ ? line & set_mask_ : line % sets_) * static_cast<std::uint64_t>(ways_)];
+    bool hit = false;
+    switch (ways_) {  // the usual associativities unrolled (the same branch every time)
+      case 1: hit = read_set<1>(ways, line); break;
+      case 2: hit = read_set<2>(ways, line); break;
+      case 4: hit = read_set<4>(ways, line); break;
+      case 8: hit = read_set<8>(ways, line); break;
+      default: hit = read_set_any(ways, line); break;
+    }
+    ++(hit ? hits_ : misses_);
+    return hit;
+  }
+  // Reads every line of `lines` in order (as read() one by one); returns how many hit.
+  std::uint64_t read_all(std::span<const std::uint64_t> lines) noexcept {
+    switch (ways_) {  // chosen once for the whole sequence
+      case 1: return read_all_ways<1>(lines);
+      case 2: return read_all_ways<2>(lines);
+      case 4: return read_all_ways<4>(lines);
+      case 8: return read_all_ways<8>(lines);
+      default: {
+        std::uint64_t hits = 0;
+        for (const std::uint64_t line : lines) hits += read(line) ? 1 : 0;
+        return hits;
+      }
+    }
+  }
+  void invalidate();
+  std::uint64_t hits() const noexcept { return hits_; }
+  std::uint64_t misses() const noexcept { return misses_; }
+  const CacheConfig& config() const noexcept { return c_; }
+
+ private:
+  template <int W>
+  std::uint64_t read_all_ways(std::span<const std::uint64_t> lines) noexcept {
+    if (sets_ == 0) {
+      misses_ += lines.size();
+      return 0;
+    }
+    std::uint64_t hits = 0;
+    for (const std::uint64_t line : lines)
+      hits += read_set<W>(&tags_[(pow2_ ? line & set_mask_ : line % sets_) * W], line) ? 1 : 0;
+    hits_ += hits;
+    misses_ += lines.size() - hits;
+    return hits;
+  }
+  // One set of W ways, most recently used first: `line` goes first and the lines before its place
+  // (or all but the last, evicted, on a miss) move back one, without a branch on where it was.
+  template <int W>
+  static bool read_set(std::uint64_t* ways, std::uint64_t line) noexcept {
+    std::uint64_t old[W];
+    for (int k = 0; k < W; ++k) old[k] = ways[k];
+    bool seen = false;  // `line` is among the ways before k
+    ways[0] = line;
+    for (int k = 1; k < W; ++k) {
+      seen = seen || old[k - 1] == line;
+      ways[k] = seen ? old[k] : old[k - 1];
+    }
+    return seen || old[W - 1] == line;
+  }
+  bool read_set_any(std::uint64_t* ways, std::uint64_t line) const noexcept {
+    int k = 0;
+    while (k < ways_ && ways[k] != line) ++k;
+    const bool hit = k < ways_;
+    for (k = hit ? k : ways_ - 1; k > 0; --k) ways[k] = ways[k - 1];
+    ways[0] = line;
+    return hit;
+  }
+
+  // No address has this line (line_bytes >= 2): it marks an invalid way, which sorts last.
+  static constexpr std::uint64_t kInvalid = ~std::uint64_t{0};
+  CacheConfig c_;
+  std::uint64_t sets_ = 0;
+  int ways_ = 0;
+  bool pow2_ = false;
+  std::uint64_t set_mask_ = 0;
+  std::vector<std::uint64_t> tags_;  // sets * ways, each set most recently used first
+  std::uint64_t hits_ = 0, misses_ = 0;
 };
 
 }  // namespace nbsim::memory

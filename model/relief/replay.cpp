@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstring>
 #include <optional>
+#include <span>
 
 #include <zlib.h>
 
@@ -46,7 +47,40 @@ class KeepHits final : public raster::FragmentShader {
 
 }  // namespace
 
-ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, CoveringSpec covering, BoxDepth box_depth)
+TexelCache::TexelCache(const memory::CacheConfig& c) : cache_(c) {
+  while ((1 << line_shift_) < c.line_bytes) ++line_shift_;
+  // A lookup of its set's most recently used line is a hit that changes nothing in the LRU order,
+  // so the walks count it without the cache (the same hits and misses). With no cache at all (0
+  // bytes) every lookup misses; with fewer bytes than a set, a lookup of the line just before hits
+  // and every other misses.
+  merge_ = c.size_bytes > 0;
+}
+
+LineGeometry TexelCache::geometry() const {
+  const memory::CacheConfig& c = cache_.config();
+  return {line_shift_, static_cast<std::uint64_t>(c.size_bytes) / static_cast<std::uint64_t>(c.line_bytes * c.ways), merge_};
+}
+
+void TexelCache::invalidate() {
+  cache_.invalidate();
+  last_line_ = ~std::uint64_t{0};
+}
+
+// A run's lookups: virtual border texels were left out (a constant, no memory), and the lookups known
+// to hit merged; the run's first line may repeat the last line of the run before.
+void TexelCache::take(const LookupLines& run) {
+  draw_hits += run.repeats();
+  std::span<const std::uint64_t> lines = run.lines();
+  if (lines.empty()) return;
+  const std::uint64_t last = lines.back();
+  if (merge_ && lines.front() == last_line_) ++draw_hits, lines = lines.subspan(1);
+  const std::uint64_t hits = cache_.read_all(lines);
+  draw_hits += hits;
+  draw_misses += lines.size() - hits;
+  last_line_ = last;
+}
+
+ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, CoveringSpec covering, BoxDepth box_depth, int threads)
     : width_(width),
       height_(height),
       covering_(covering),
@@ -55,7 +89,8 @@ ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, Cove
       without_box_(width, height, 1.0f),
       passed_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0),
       path_(path_config(width, height, fused_interpolation), depth_),
-      without_box_path_(path_config(width, height, fused_interpolation), without_box_) {
+      without_box_path_(path_config(width, height, fused_interpolation), without_box_),
+      pool_(threads) {
   path_.set_reuse_rasterization(true);  // every method draws the same box
   if (box_depth_ != BoxDepth::None) {
     hit_.assign(passed_.size(), 0);
@@ -63,7 +98,7 @@ ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, Cove
   }
 }
 
-ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double tolerance, double box_height, LookupObserver observer,
+ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double tolerance, double box_height, LookupSink* lookups,
                                           void* context, void (*draw_done)(void* context, const BoxDrawCounts& draw)) {
   const GlReliefField gl = read_relief_field(f);
   const std::uint64_t pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
@@ -137,8 +172,39 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     c.rasterized = k.depth.fragments;
     c.gl_fragments = d.gl.fragments;
     c.gl_samples = d.gl.samples_passed;
+    // The fragments' walks and scores (every pixel's reference computed at most once a frame), in
+    // parallel runs of consecutive fragments; each run's lookups go to `lookups` in pixel order.
+    fragment_pixels_.clear();
+    for (std::uint32_t px = 0; px < pixels; ++px)
+      if (passed_[px] != 0) fragment_pixels_.push_back(px);
+    walks_.resize(fragment_pixels_.size());
+    const std::size_t run_count = (fragment_pixels_.size() + kRunFragments - 1) / kRunFragments;
+    if (runs_.size() < run_count) runs_.resize(run_count);
+    const LineGeometry geometry = lookups ? lookups->geometry() : LineGeometry{};
+    const auto walk_run = [&](std::size_t run) {
+      LookupLines& lines = runs_[run];
+      if (lookups) lines.reset(geometry);
+      const std::size_t end = std::min(fragment_pixels_.size(), (run + 1) * kRunFragments);
+      for (std::size_t at = run * kRunFragments; at < end; ++at) {
+        const std::uint32_t px = fragment_pixels_[at];
+        const float fx = static_cast<float>(px % static_cast<std::uint32_t>(width_)) + 0.5f;
+        const float fy = static_cast<float>(px / static_cast<std::uint32_t>(width_)) + 0.5f;
+        const std::optional<FragmentRay> ray = fragment_ray(gl.ray, gl.field.size, fx, fy);
+        FragmentWalk& fw = walks_[at];
+        fw = FragmentWalk{};
+        if (!ray) continue;
+        fw.ray = true;
+        fw.walk = lookups ? walk(r.method, view, params, *ray, lines) : walk(r.method, view, params, *ray);
+        if (!referenced_[px]) reference_[px] = reference_of(gl.field, *ray), referenced_[px] = 1;
+        fw.score = score_against(reference_[px], *ray, gl.field.size, fw.walk.hit && !fw.walk.capped, fw.walk.t, box_height, tolerance);
+      }
+    };
+    pool_.run(run_count, walk_run, [&](std::size_t run) {
+      if (lookups) lookups->take(runs_[run]);
+    });
+
     // The model's fragments (pixel order) against GL's, merged.
-    std::size_t g = 0;
+    std::size_t g = 0, fragment = 0;
     for (std::uint32_t px = 0; px < pixels; ++px) {
       const bool model = passed_[px] != 0;
       while (g < r.pixel.size() && r.pixel[g] < px) ++c.pixel_mismatches, ++g;
@@ -147,22 +213,22 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
         if (in_gl) ++c.pixel_mismatches, ++g;
         continue;
       }
-      const float fx = static_cast<float>(px % static_cast<std::uint32_t>(width_)) + 0.5f;
-      const float fy = static_cast<float>(px / static_cast<std::uint32_t>(width_)) + 0.5f;
-      const std::optional<FragmentRay> ray = fragment_ray(gl.ray, gl.field.size, fx, fy);
-      WalkResult w;
-      if (ray) w = walk(r.method, view, params, *ray, observer, context);
+      const FragmentWalk& fw = walks_[fragment++];
+      const WalkResult& w = fw.walk;
       const std::uint32_t code = w.capped ? 2u : w.hit ? 1u : 0u;
       if (writes) {
         hit_[px] = code == 1u ? 1 : 0;
-        if (box_depth_ == BoxDepth::Exact && code == 1u) hit_depth_[px] = hit_depth(gl_depth->texel_to_clip, *ray, w.t);
+        if (box_depth_ == BoxDepth::Exact && code == 1u) {  // a hit has a ray: the pixel's, again
+          const float fx = static_cast<float>(px % static_cast<std::uint32_t>(width_)) + 0.5f;
+          const float fy = static_cast<float>(px / static_cast<std::uint32_t>(width_)) + 0.5f;
+          hit_depth_[px] = hit_depth(gl_depth->texel_to_clip, *fragment_ray(gl.ray, gl.field.size, fx, fy), w.t);
+        }
       }
       c.lookups += w.lookups, c.steps += w.steps, c.bisections += w.bisections;
       c.longest_walk = std::max<std::uint64_t>(c.longest_walk, w.lookups);
       c.hits += code == 1u, c.capped += code == 2u, c.samples += code == 1u;
-      if (ray) {
-        if (!referenced_[px]) reference_[px] = reference_of(gl.field, *ray), referenced_[px] = 1;
-        const HitScore score = score_against(reference_[px], *ray, gl.field.size, code == 1u, w.t, box_height, tolerance);
+      if (fw.ray) {
+        const HitScore& score = fw.score;
         c.reference_hits += score.reference_hit;
         c.wrong_hit += score.error == HitError::WrongHit;
         c.wrong_miss += score.error == HitError::WrongMiss;

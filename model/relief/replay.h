@@ -27,11 +27,13 @@
 #include <vector>
 
 #include "model/common/depth.h"
+#include "model/memory/memory.h"
 #include "model/raster/raster_path.h"
 #include "model/relief/box_depth.h"
 #include "model/relief/records.h"
 #include "model/relief/score.h"
 #include "model/relief/walk.h"
+#include "model/relief/workers.h"
 #include "model/scene/frame.h"
 
 namespace nbsim::relief {
@@ -61,6 +63,40 @@ struct BoxDrawCounts {
   std::uint64_t scene_after_draws = 0, scene_after_samples = 0, scene_hidden = 0;
 };
 
+// Where a replay's lookups go (the unit's texel cache), in the walks' order: the fragments of a draw
+// walk in parallel (workers.h), in runs of consecutive fragments in pixel order, and the runs come
+// here one after another on the calling thread, each run's lookups as LookupLines (walk.h) recorded
+// with this sink's geometry.
+class LookupSink {
+ public:
+  virtual LineGeometry geometry() const = 0;
+  virtual void take(const LookupLines& run) = 0;
+
+ protected:
+  ~LookupSink() = default;
+};
+
+// The relief unit's heightfield texel cache (unit.h) as a LookupSink: fed the walks' lookups in
+// their order, it counts the current box draw's hits and misses (the caller resets them). The same
+// hits and misses as a memory::Cache that sees every lookup of a texel in memory, at address
+// texel_address, except that with a cache of more than 0 bytes a lookup of the line just before
+// always counts as a hit (what a cache with sets does anyway, and the unit has counted so since
+// before its sets could be fewer than one).
+class TexelCache final : public LookupSink {
+ public:
+  explicit TexelCache(const memory::CacheConfig& c);  // c.line_bytes a power of two
+  LineGeometry geometry() const override;
+  void take(const LookupLines& run) override;
+  void invalidate();  // a new frame: empty, and no lookup before
+  std::uint64_t draw_hits = 0, draw_misses = 0;
+
+ private:
+  memory::LineCache cache_;
+  int line_shift_ = 0;  // log2 of the line's bytes
+  bool merge_ = false;
+  std::uint64_t last_line_ = ~std::uint64_t{0};  // the cache line of the last lookup
+};
+
 struct ReliefFrameCounts {
   int size = 0;  // the heightfield's N
   // The frame's safety radii (RLFH): their sum and the texels at 0, over its N * N texels.
@@ -75,17 +111,19 @@ class ReliefReplay {
  public:
   // The viewport (1 .. 16384 a side; InputError otherwise). `covering`: the N-buffer walk's, the
   // capture's (the trace header's nbuffer_covering).
-  // `box_depth`: the header's relief_box_depth (none for a trace without it).
-  ReliefReplay(int width, int height, bool fused_interpolation = true, CoveringSpec covering = {}, BoxDepth box_depth = BoxDepth::None);
+  // `box_depth`: the header's relief_box_depth (none for a trace without it). `threads`: the walks'
+  // (workers.h; every count is the same for any number).
+  ReliefReplay(int width, int height, bool fused_interpolation = true, CoveringSpec covering = {}, BoxDepth box_depth = BoxDepth::None,
+               int threads = relief_threads());
   ReliefReplay(const ReliefReplay&) = delete;
   ReliefReplay& operator=(const ReliefReplay&) = delete;
 
   // Runs the frame. `tolerance`: score.h's, texels; `box_height`: the box's height over its width
-  // (the trace header's relief_box_height). `observer` (may be null) sees every lookup of every walk;
+  // (the trace header's relief_box_height). `lookups` (may be null) sees every lookup of every walk;
   // `draw_done` (may be null) is called after each box draw's walks with its counts.
   // InputError naming the frame for a damaged record, a box draw without its RLFF or the reverse, or
   // a box draw that is not triangles.
-  ReliefFrameCounts run_frame(const scene::Frame& f, double tolerance, double box_height, LookupObserver observer = nullptr,
+  ReliefFrameCounts run_frame(const scene::Frame& f, double tolerance, double box_height, LookupSink* lookups = nullptr,
                               void* context = nullptr, void (*draw_done)(void* context, const BoxDrawCounts& draw) = nullptr);
 
  private:
@@ -104,6 +142,18 @@ class ReliefReplay {
   std::vector<std::uint8_t> referenced_;
   raster::RasterPath path_;
   raster::RasterPath without_box_path_;
+  // A draw's fragments (pixels in order), their walks and scores, and their lookups by run of
+  // kRunFragments fragments: filled by the workers, read in order by the calling thread.
+  struct FragmentWalk {
+    bool ray = false;  // the pixel's ray meets the box (else no walk)
+    WalkResult walk;
+    HitScore score;
+  };
+  static constexpr std::size_t kRunFragments = 256;
+  std::vector<std::uint32_t> fragment_pixels_;
+  std::vector<FragmentWalk> walks_;
+  std::vector<LookupLines> runs_;
+  WorkerPool pool_;
 };
 
 }  // namespace nbsim::relief

@@ -30,11 +30,6 @@ memory::CacheConfig cache_config(const ReliefUnitConfig& c) {
   return m;
 }
 
-// The texel cache's address space: heights, radii and levels 2^34 bytes apart (4 bytes a texel).
-std::uint64_t address(Texture t, std::int64_t index) {
-  return (static_cast<std::uint64_t>(t) << 34) + 4 * static_cast<std::uint64_t>(index);
-}
-
 }  // namespace
 
 void ReliefUnitConfig::describe(config::Schema& s, ReliefUnitConfig& c) {
@@ -87,7 +82,7 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
       client_(memory.add_client("relief")),
       box_height_(box_height),
       replay_(width, height, fused_interpolation, covering, box_depth),
-      cache_(cache_config(config)),
+      cache_(cache_config(config_)),
       frames_(stats().counter("frames", "frames", "frames replayed")),
       scene_draws_(stats().counter("scene_draws", "draws", "scene draws before and after the boxes (placement city)")),
       scene_depth_tests_(stats().counter("scene_depth_tests", "tests", "depth tests of the scene draws (charged at relief.tests_per_cycle)")),
@@ -101,7 +96,6 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
       radius_texels_(stats().counter("radius_texels", "texels", "safety-radius texels of the frames' heightfields (N * N a frame)")),
       radius_sum_(stats().counter("radius_sum", "texels", "their radii summed (whole texels)")),
       radius_zero_(stats().counter("radius_zero", "texels", "of those, texels with radius 0")) {
-  while ((1 << line_shift_) < config_.cache_line_bytes) ++line_shift_;
   if (!(box_height > 0.0 && std::isfinite(box_height)))
     throw InputError(fmt::format("the relief trace's box height is {}; it must be a positive number", box_height));
   for (Method m : kAllMethods) {
@@ -155,27 +149,12 @@ std::uint64_t ReliefUnit::draw_cycles(const BoxDrawCounts& d, const ReliefUnitCo
   return std::max({setup, walk, tests, rays}) + static_cast<std::uint64_t>(c.draw_latency_cycles);
 }
 
-void ReliefUnit::on_lookup(void* self, Texture texture, std::int64_t index) {
-  auto* u = static_cast<ReliefUnit*>(self);
-  if (index < 0) return;  // a virtual border texel: a constant, no memory
-  // The line of the previous lookup is its set's most recently used: a hit that changes nothing in
-  // the LRU order, so it is counted without the cache's tag search (the same hits and misses).
-  const std::uint64_t a = address(texture, index), line = a >> u->line_shift_;
-  if (line == u->last_line_ && u->config_.cache_bytes > 0) {
-    ++u->draw_hits_;
-    return;
-  }
-  u->last_line_ = line;
-  if (u->cache_.access(a, false).hit) ++u->draw_hits_;
-  else ++u->draw_misses_;
-}
-
 void ReliefUnit::on_draw(void* self, const BoxDrawCounts& d) { static_cast<ReliefUnit*>(self)->account(d); }
 
 // One box draw's timing and counters, right after its walks (its cache outcomes are draw_*_).
 void ReliefUnit::account(const BoxDrawCounts& d) {
   PerMethod& c = per_method_[static_cast<std::size_t>(d.method)];
-  const std::uint64_t bytes = draw_misses_ * static_cast<std::uint64_t>(config_.cache_line_bytes);
+  const std::uint64_t bytes = cache_.draw_misses * static_cast<std::uint64_t>(config_.cache_line_bytes);
   label_with([&] { return fmt::format("relief box, {}, {} fragments", to_string(d.method), d.fragments); });
   const std::uint64_t start = sim::local_cycles();
   const std::uint64_t mem_done = bytes ? memory_.transfer(start, bytes, client_) : start;
@@ -184,8 +163,8 @@ void ReliefUnit::account(const BoxDrawCounts& d) {
   const std::uint64_t spent = sim::local_cycles() - start;
   memory_bytes_ += bytes;
   cycles_ += spent;
-  cache_hits_ += draw_hits_;
-  cache_misses_ += draw_misses_;
+  cache_hits_ += cache_.draw_hits;
+  cache_misses_ += cache_.draw_misses;
   ++box_draws_;
   *c.draws += 1, *c.rasterized += d.rasterized, *c.fragments += d.fragments, *c.gl_fragments += d.gl_fragments, *c.samples += d.samples, *c.gl_samples += d.gl_samples;
   *c.pixel_mismatches += d.pixel_mismatches, *c.walk_mismatches += d.walk_mismatches;
@@ -194,19 +173,17 @@ void ReliefUnit::account(const BoxDrawCounts& d) {
   *c.wrong_hit += d.wrong_hit, *c.wrong_miss += d.wrong_miss, *c.far_hit += d.far_hit, *c.errors += d.errors();
   *c.distance_microtexels += static_cast<std::uint64_t>(std::llround(d.distance_sum * 1e6));
   *c.cycles += spent;
-  *c.cache_misses += draw_misses_;
+  *c.cache_misses += cache_.draw_misses;
   c.storage_bytes->raise_to(d.storage_bytes);
   *c.depth_written += d.depth_written, *c.depth_mismatches += d.depth_mismatches;
   *c.scene_after_draws += d.scene_after_draws, *c.scene_after_samples += d.scene_after_samples, *c.scene_hidden += d.scene_hidden;
-  draw_misses_ = draw_hits_ = 0;
+  cache_.draw_misses = cache_.draw_hits = 0;
 }
 
 void ReliefUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor&) {
   cache_.invalidate();  // a frame's textures are its own
-  last_line_ = ~std::uint64_t{0};
-  draw_misses_ = draw_hits_ = 0;
-  const ReliefFrameCounts k =
-      replay_.run_frame(*f, config_.hit_tolerance_texels, box_height_, &ReliefUnit::on_lookup, this, &ReliefUnit::on_draw);
+  cache_.draw_misses = cache_.draw_hits = 0;
+  const ReliefFrameCounts k = replay_.run_frame(*f, config_.hit_tolerance_texels, box_height_, &cache_, this, &ReliefUnit::on_draw);
   ++frames_;
   radius_texels_ += static_cast<std::uint64_t>(k.size) * static_cast<std::uint64_t>(k.size);
   radius_sum_ += k.radius_sum;

@@ -55,7 +55,6 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   static std::uint64_t draw_cycles(const BoxDrawCounts& d, const ReliefUnitConfig& c);
 
  private:
-  static void on_lookup(void* self, Texture texture, std::int64_t index);
   static void on_draw(void* self, const BoxDrawCounts& d);
   void account(const BoxDrawCounts& d);
 
@@ -71,10 +70,7 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   int client_;
   double box_height_;
   ReliefReplay replay_;
-  memory::Cache cache_;
-  std::uint64_t draw_misses_ = 0, draw_hits_ = 0;
-  std::uint64_t last_line_ = ~std::uint64_t{0};  // the cache line of the last lookup
-  int line_shift_ = 0;                            // log2 of relief.cache_line_bytes (a power of two)  // the current box draw's cache outcomes
+  TexelCache cache_;
   stats::Counter &frames_, &scene_draws_, &scene_depth_tests_, &scene_mismatches_, &box_draws_, &cache_hits_, &cache_misses_, &memory_bytes_, &memory_stall_cycles_, &cycles_,
       &radius_texels_, &radius_sum_, &radius_zero_;
   std::array<PerMethod, kMethods> per_method_{};

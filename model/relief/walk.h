@@ -35,6 +35,7 @@
 // (the covering's distinct texels).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -107,6 +108,76 @@ enum class Texture : std::uint8_t { Height = 0, Radius = 1, NBuffer = 2 };
 // are reads too: index -1, served without memory).
 using LookupObserver = void (*)(void* context, Texture texture, std::int64_t index);
 
+// The texel cache's address space (model/relief/unit.h): the heights, the radii and the N-buffer
+// levels 2^34 bytes apart, 4 bytes a texel.
+constexpr std::uint64_t texel_address(Texture texture, std::int64_t index) noexcept {
+  return (static_cast<std::uint64_t>(texture) << 34) + 4 * static_cast<std::uint64_t>(index);
+}
+
+// The texel cache as a record of lookups needs to know it (model/memory LineCache's sets).
+struct LineGeometry {
+  int line_shift = 6;      // line = texel_address >> line_shift
+  std::uint64_t sets = 0;  // set = line % sets (0: no sets, every lookup misses)
+  bool merge = true;       // merge the lookups known to hit (false: a cache of 0 bytes, where none hits)
+};
+
+// The lookups of walks run one after another, recorded as the texel cache will see them, so that
+// walks can run apart from the cache (on other threads) and the cache be fed later in the same
+// order: each read of a texel in memory as its cache line (virtual border texels need no memory and
+// are left out). With `merge`, a lookup of the line its set saw last in this record is not recorded
+// but counted in `repeats`: in an LRU cache that access is a hit that changes nothing (the line is
+// its set's most recently used), whatever came before the record, so the cache need not see it.
+// Most of a walk's lookups are such (the four corners of a cell are two lines, read again by the
+// next cell), so the cache, which must see the rest in order on one thread, has little left to do.
+// (With no sets, a set count that is not a power of two or a huge cache, only a repeat of the line
+// just before is merged, as it always hits.) Aligned to a
+// cache line of the host: the records of runs walked at once on different threads sit side by side
+// in the replay's vector, and sharing a line would bounce it between the cores at every lookup.
+class alignas(64) LookupLines {
+ public:
+  // Empties the record and sets how the lines are taken.
+  void reset(const LineGeometry& g) {
+    line_shift_ = g.line_shift;
+    merge_ = g.merge;
+    // A huge cache's table would cost more to clear for every record than it saves, and a set count
+    // that is not a power of two would cost a division a lookup: one entry then (the line just
+    // before, always its set's most recently used).
+    const bool table = g.sets > 0 && g.sets <= kMaxTable && (g.sets & (g.sets - 1)) == 0;
+    set_mask_ = table ? g.sets - 1 : 0;
+    last_.assign(set_mask_ + 1, kNone);
+    size_ = 0;
+    repeats_ = 0;
+  }
+  void add(std::uint64_t address) {
+    const std::uint64_t line = address >> line_shift_;
+    if (merge_) {
+      std::uint64_t& last = last_[line & set_mask_];
+      if (line == last) {
+        ++repeats_;
+        return;
+      }
+      last = line;
+    }
+    // The storage is kept at its full size (size_ counts what is used), so a record reused for the
+    // next run neither frees nor clears it.
+    if (size_ == storage_.size()) storage_.resize(std::max<std::size_t>(4096, 2 * storage_.size()));
+    storage_[size_++] = line;
+  }
+  std::span<const std::uint64_t> lines() const noexcept { return {storage_.data(), size_}; }
+  std::uint64_t repeats() const noexcept { return repeats_; }
+
+ private:
+  static constexpr std::uint64_t kNone = ~std::uint64_t{0};  // no line (addresses are multiples of 4)
+  static constexpr std::uint64_t kMaxTable = 4096;
+  int line_shift_ = 6;
+  bool merge_ = true;
+  std::uint64_t set_mask_ = 0;
+  std::vector<std::uint64_t> last_ = {kNone};  // per set, the line it saw last
+  std::vector<std::uint64_t> storage_;
+  std::size_t size_ = 0;
+  std::uint64_t repeats_ = 0;
+};
+
 // The ray of pixel centre (px, py) clipped to the box: false when it misses the box.
 struct FragmentRay {
   std::array<float, 3> o{}, d{};
@@ -121,6 +192,8 @@ std::optional<FragmentRay> fragment_ray(const RayFrame& frame, int size, float p
 // One fragment's walk with `method`. `observer` (may be null) sees every lookup.
 WalkResult walk(Method method, const FieldView& field, const WalkParams& params, const FragmentRay& ray,
                 LookupObserver observer = nullptr, void* context = nullptr);
+// The same walk (the same result, bit for bit), its lookups appended to `lines`.
+WalkResult walk(Method method, const FieldView& field, const WalkParams& params, const FragmentRay& ray, LookupLines& lines);
 
 // The iteration cap of every walk's main loop (a walk that reaches it is a capped miss).
 int walk_iteration_cap(int size) noexcept;
