@@ -31,6 +31,8 @@ raster::RasterPathConfig path_config(int width, int height, bool fused) {
 
 constexpr const char* kImageLabel = "LdiImage (LDIL)";
 constexpr const char* kTestsLabel = "LdiTests (LDIT)";
+constexpr const char* kAllLabel = "LdiAllLayers (LDIA)";
+constexpr std::uint32_t kLdiAllLayersRecordType = 0x4149444Cu;  // fourcc "LDIA" (traces/format/ldi/ldi_chunk.h)
 
 const scene::TechniqueField* find(const scene::TechniqueRecord& rec, std::string_view name) {
   for (const scene::TechniqueField& f : rec.fields)
@@ -184,6 +186,26 @@ GlLdiTests read_ldi_tests(const scene::Frame& f) {
     if (t.reference[p] < kNearSurfaceReference) throw bad("reference", t.reference[p]);
     if (std::isnan(t.z[p])) throw bad("depth z", "NaN");
   }
+  bool has_all = false;
+  for (const scene::TechniqueRecord& r : f.technique_records) has_all = has_all || r.type == kLdiAllLayersRecordType;
+  if (has_all) {
+    const scene::TechniqueRecord& all = scene::single_record(f, kLdiAllLayersRecordType, kAllLabel, "");
+    const std::uint64_t count = scalar<std::uint64_t>(all, "count", kAllLabel, frame);
+    if (count != t.count)
+      throw InputError(fmt::format("frame {}: the {} record has {} test points, but the {} record {}", frame, kAllLabel, count, kTestsLabel,
+                                   t.count));
+    const auto all_vec = [&](std::vector<std::uint32_t>& out, const char* name) {
+      out = scene::record_field<std::uint32_t>(all, name, kAllLabel, frame);
+      if (out.size() != t.count)
+        throw InputError(fmt::format("frame {}: the {} record's field '{}' has {} values, but count is {}", frame, kAllLabel, name,
+                                     out.size(), t.count));
+    };
+    all_vec(t.gl_inside_all, "gl_inside_all"), all_vec(t.gl_fetches_all, "gl_fetches_all");
+    for (std::size_t p = 0; p < t.count; ++p)
+      if (t.gl_inside_all[p] > 1)
+        throw InputError(fmt::format("frame {}: the {} record's test point {} has gl_inside_all {}", frame, kAllLabel, p, t.gl_inside_all[p]));
+    t.has_all = true;
+  }
   return t;
 }
 
@@ -264,6 +286,15 @@ LdiFrameCounts run_frame(const scene::Frame& f, PeelReplay& peel) {
     k.parity_mismatches_ranges += b.inside != (tests.gl_inside_ranges[p] == 1) ? 1 : 0;
     k.fetch_mismatches_layers += static_cast<std::uint32_t>(a.fetches) != tests.gl_fetches_layers[p] ? 1 : 0;
     k.fetch_mismatches_ranges += static_cast<std::uint32_t>(b.fetches) != tests.gl_fetches_ranges[p] ? 1 : 0;
+    VptResult c;
+    if (tests.has_all) {
+      c = vpt_all_layers(cropped, tests.x[p], tests.y[p], tests.z[p]);
+      ++k.all_points;
+      k.fetches_all += static_cast<std::uint64_t>(c.fetches);
+      k.gl_fetches_all += tests.gl_fetches_all[p];
+      k.parity_mismatches_all += c.inside != (tests.gl_inside_all[p] == 1) ? 1 : 0;
+      k.fetch_mismatches_all += static_cast<std::uint32_t>(c.fetches) != tests.gl_fetches_all[p] ? 1 : 0;
+    }
     const std::uint32_t kind = tests.kind[p];
     ++k.kind_points[kind];
     if (tests.reference[p] == kNearSurfaceReference) {
@@ -274,6 +305,7 @@ LdiFrameCounts run_frame(const scene::Frame& f, PeelReplay& peel) {
     ++k.classified_points, ++k.kind_classified[kind];
     if (a.inside != inside) ++k.misclassified_layers, ++k.kind_misclassified_layers[kind];
     if (b.inside != inside) ++k.misclassified_ranges, ++k.kind_misclassified_ranges[kind];
+    if (tests.has_all && c.inside != inside) ++k.misclassified_all;
   }
   return k;
 }

@@ -102,6 +102,10 @@ struct GlLdiTests {
   std::vector<float> z;
   std::vector<std::uint32_t> gl_inside_layers, gl_fetches_layers, gl_inside_ranges, gl_fetches_ranges;
   std::vector<std::int32_t> reference;
+  // The paper's reader (every layer read) at the same points, from the frame's LDIA record when it
+  // has one (captures before the paper's reader have none: has_all false, the vectors empty).
+  bool has_all = false;
+  std::vector<std::uint32_t> gl_inside_all, gl_fetches_all;
 };
 GlLdiTests read_ldi_tests(const scene::Frame& f);
 
@@ -123,6 +127,9 @@ struct LdiFrameCounts {
   std::uint64_t fetch_mismatches_layers = 0, fetch_mismatches_ranges = 0;
   std::uint64_t fetches_layers = 0, fetches_ranges = 0, gl_fetches_layers = 0, gl_fetches_ranges = 0;
   std::uint64_t misclassified_layers = 0, misclassified_ranges = 0, classified_points = 0, near_surface_points = 0;
+  // The paper's reader (vpt_all_layers), at the points of a frame with LDIA (else all 0).
+  std::uint64_t all_points = 0, parity_mismatches_all = 0, fetch_mismatches_all = 0, fetches_all = 0, gl_fetches_all = 0,
+                misclassified_all = 0;
   std::array<std::uint64_t, kPointKinds> kind_points{}, kind_classified{}, kind_misclassified_layers{},
       kind_misclassified_ranges{};
 };

@@ -100,6 +100,13 @@ LdiUnit::LdiUnit(const sc_core::sc_module_name& name, stats::Registry& registry,
                                             "classified points whose model uncompressed answer differs from the exact reference")),
       misclassified_ranges_(stats().counter("misclassified_ranges", "points",
                                             "classified points whose model compressed answer differs from the exact reference")),
+      all_points_(stats().counter("all_points", "points", "test points the paper's reader (every layer read) answered (frames with LDIA)")),
+      parity_mismatches_all_(stats().counter("parity_mismatches_all", "points", "points whose paper's-reader answer differs from GL's")),
+      fetch_mismatches_all_(stats().counter("fetch_mismatches_all", "points", "points whose paper's-reader fetch count differs from GL's")),
+      fetches_all_(stats().counter("fetches_all", "texels", "layer texels the model's paper's reader read (not charged: one reader runs)")),
+      gl_fetches_all_(stats().counter("gl_fetches_all", "texels", "layer texels GL's paper's reader read")),
+      misclassified_all_(stats().counter("misclassified_all", "points",
+                                         "classified points whose paper's-reader answer differs from the exact reference")),
       classified_points_(stats().counter("classified_points", "points", "points with a reference count (not within epsilon of a surface)")),
       near_surface_points_(stats().counter("near_surface_points", "points",
                                            "points within epsilon of a surface (reference -1): counted apart, not classified")),
@@ -171,6 +178,8 @@ void LdiUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Comman
   fetches_layers_ += k.fetches_layers, fetches_ranges_ += k.fetches_ranges;
   gl_fetches_layers_ += k.gl_fetches_layers, gl_fetches_ranges_ += k.gl_fetches_ranges;
   misclassified_layers_ += k.misclassified_layers, misclassified_ranges_ += k.misclassified_ranges;
+  all_points_ += k.all_points, parity_mismatches_all_ += k.parity_mismatches_all, fetch_mismatches_all_ += k.fetch_mismatches_all;
+  fetches_all_ += k.fetches_all, gl_fetches_all_ += k.gl_fetches_all, misclassified_all_ += k.misclassified_all;
   classified_points_ += k.classified_points, near_surface_points_ += k.near_surface_points;
   for (std::size_t i = 0; i < kPointKinds; ++i) {
     *kind_points_[i] += k.kind_points[i];

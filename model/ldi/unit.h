@@ -70,7 +70,8 @@ class LdiUnit : public sim::Unit, public cp::FrameProgram {
       &layer_count_mismatches_, &layer_texel_mismatches_, &crop_mismatch_, &compressed_mismatches_, &m_crop_, &m_comp_,
       &test_points_, &parity_mismatches_layers_, &parity_mismatches_ranges_, &fetch_mismatches_layers_, &fetch_mismatches_ranges_,
       &fetches_layers_, &fetches_ranges_, &gl_fetches_layers_, &gl_fetches_ranges_, &misclassified_layers_,
-      &misclassified_ranges_, &classified_points_, &near_surface_points_, &peel_cycles_, &vpt_cycles_, &peel_bytes_, &vpt_bytes_,
+      &misclassified_ranges_, &all_points_, &parity_mismatches_all_, &fetch_mismatches_all_, &fetches_all_, &gl_fetches_all_,
+      &misclassified_all_, &classified_points_, &near_surface_points_, &peel_cycles_, &vpt_cycles_, &peel_bytes_, &vpt_bytes_,
       &memory_stall_cycles_;
   std::array<stats::Counter*, kPointKinds> kind_points_{}, kind_classified_{}, kind_misclassified_layers_{},
       kind_misclassified_ranges_{};

@@ -49,6 +49,21 @@ VptResult vpt_layers(const CroppedLdi& c, int x, int y, float z) {
   return res;
 }
 
+VptResult vpt_all_layers(const CroppedLdi& c, int x, int y, float z) {
+  check_depth(z);
+  const Rect& r = c.crop.rect;
+  if (!r.contains(x, y)) return {};
+  VptResult res;
+  int in_front = 0;
+  for (int k = 0; k < c.crop.depth_complexity; ++k) {
+    ++res.fetches;
+    in_front += c.depth(x, y, k) < z ? 1 : 0;
+  }
+  res.inside = (in_front & 1) != 0;
+  res.texel = static_cast<std::uint64_t>(y - r.y) * static_cast<std::uint64_t>(r.w) + static_cast<std::uint64_t>(x - r.x);
+  return res;
+}
+
 VptResult vpt_ranges(const CompressedLdi& c, int x, int y, float z) {
   check_depth(z);
   const Rect& r = c.crop.rect;

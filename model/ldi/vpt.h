@@ -41,6 +41,12 @@ struct VptResult {
 VptResult vpt_layers(const Ldi& ldi, int x, int y, float z);
 // Uncompressed, on the cropped layered texture (up to d fetches).
 VptResult vpt_layers(const CroppedLdi& c, int x, int y, float z);
+// The paper's reader, on the cropped layered texture: every one of the d layers of the texel is
+// read and the layers in front of z counted (d fetches inside the crop, however near the point).
+// The same answer as the early-exit reader above (the layers are sorted, so no layer behind the
+// first one that is not in front is in front); Trapp & Doellner's O(d) against the compressed
+// reader's O(d/2).
+VptResult vpt_all_layers(const CroppedLdi& c, int x, int y, float z);
 // Compressed. Throws InputError when the texture is damaged where the test reads it (an offset or
 // a range count pointing past the texture).
 VptResult vpt_ranges(const CompressedLdi& c, int x, int y, float z);

@@ -21,14 +21,15 @@ def equal_or_both(model, gl):
 
 def render_fresh(outputs):
     lines = ["| capture | peel passes | fragments, model = GL | samples passed, model = GL | layer texels, crops, compressed "
-             "values differing | parity answers differing (layers / ranges) | misclassified against the exact reference |",
+             "values differing | parity answers differing (layers / ranges / every layer) | misclassified against the exact reference |",
              "|---|---:|---:|---:|---:|---:|---:|"]
     for (label, _), c in zip(FRESH, outputs[len(FRESH):]):
         s = c["ldi"]
         lines.append(f"| {label} | {s['peel_passes']} | {equal_or_both(s['peel_fragments'], s['gl_peel_fragments'])} | "
                      f"{equal_or_both(s['peel_samples'], s['gl_peel_samples'])} | {s['layer_texel_mismatches']}, "
                      f"{s['crop_mismatch']}, {s['compressed_mismatches']} | {s['parity_mismatches_layers']} / "
-                     f"{s['parity_mismatches_ranges']} | {s['misclassified_layers']} of {n(s['classified_points'])} |")
+                     f"{s['parity_mismatches_ranges']} / {s['parity_mismatches_all']} | {s['misclassified_layers']} of "
+                     f"{n(s['classified_points'])} |")
     within = sum(1 for c in outputs[len(FRESH):] if c["within_thresholds"])
     return "\n".join(lines) + f"\n\n{within} of the {len(FRESH)} captures replay within `nbsim compare`'s thresholds."
 
@@ -76,10 +77,30 @@ def render_sizes(outputs):
     fl = [r["fetches_anywhere_layers"] for r in rows]
     fr = [r["fetches_anywhere_ranges"] for r in rows]
     agree = "on every point" if disagree == 0 else f"on every point but {disagree}"
-    lines += ["", f"Both readers, and the model's parity test on GL's LDI, give GL's answers {agree}. "
+    lines += ["", f"All three readers, and the model's parity test on GL's LDI, give GL's answers {agree}. "
               f"A test reads {min(fl):.2f} to {max(fl):.2f} layer texels uncompressed against {min(fr):.2f} to {max(fr):.2f} "
               "compressed texels (RG32UI, 8 bytes each) for uniform points."]
     return "\n".join(lines)
+
+
+# The paper's reader (every layer) beside the early-exit and compressed ones, on shells of growing
+# depth complexity: Trapp & Doellner's O(d) against O(d/2).
+READER_SHELLS = (1, 2, 4, 8, 16)
+
+
+def render_readers(outputs):
+    (rows,) = outputs
+    lines = ["| shape | d | every layer (the paper's) | early exit | compressed | compressed at most (1 + d/2) | answers differing |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        d = r["layers"]
+        lines.append(f"| {r['shape']} | {d} | {r['fetches_anywhere_all']:.2f} | {r['fetches_anywhere_layers']:.2f} | "
+                     f"{r['fetches_anywhere_ranges']:.2f} | {1 + (d + 1) // 2} | {r['readers_differ'] + r['gl_parity_mismatches']} |")
+    first, last = rows[0], rows[-1]
+    grow = lambda k: last[k] / first[k]
+    return ("\n".join(lines) + f"\n\nFrom d = {first['layers']} to d = {last['layers']} the paper's reader's fetches grow "
+            f"{grow('fetches_anywhere_all'):.1f}x (O(d)), the compressed reader's {grow('fetches_anywhere_ranges'):.1f}x and the "
+            f"early exit's {grow('fetches_anywhere_layers'):.1f}x.")
 
 
 BLOCKS = [
@@ -88,4 +109,6 @@ BLOCKS = [
     Block("sample", [["compare", "traces/samples/ldi_nested_128.nbt", "--json"]], render_sample),
     Block("table1", [["ldi", "table1", "--mesh", f"{MODELS}/Collada/duck.dae", "--json"]], render_table1),
     Block("sizes", [["ldi", "table1", "--sizes", "64,128,256,512,1024", "--json"]], render_sizes),
+    Block("readers", [["ldi", "table1", "--shapes", ",".join(f"nested:{k}" for k in READER_SHELLS), "--sizes", "256", "--json"]],
+          render_readers),
 ]

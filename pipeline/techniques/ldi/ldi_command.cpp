@@ -131,29 +131,35 @@ nlohmann::ordered_json measure(const Shape& shape, int size, const Table1Args& a
     where[p] = q;
   }
   const capture::GlVptAnswers uniform = capture::gl_vpt(b, ux, uy, uz);
-  std::uint64_t near_anywhere = 0, wrong_anywhere = 0, inside_anywhere = 0, fetch_anywhere_layers = 0, fetch_anywhere_ranges = 0;
+  std::uint64_t near_anywhere = 0, wrong_anywhere = 0, inside_anywhere = 0, fetch_anywhere_layers = 0, fetch_anywhere_ranges = 0,
+                fetch_anywhere_all = 0;
   for (std::size_t p = 0; p < ux.size(); ++p) {
     fetch_anywhere_layers += uniform.fetches_layers[p];
     fetch_anywhere_ranges += uniform.fetches_ranges[p];
+    fetch_anywhere_all += uniform.fetches_all[p];
     const mesh::CrossingCount c = ref.count(where[p]);
     if (c.nearest_distance <= a.epsilon) {
       ++near_anywhere;
       continue;
     }
     inside_anywhere += c.beyond & 1u;
-    wrong_anywhere += uniform.inside_layers[p] != (c.beyond & 1u) || uniform.inside_ranges[p] != (c.beyond & 1u);
+    wrong_anywhere += uniform.inside_layers[p] != (c.beyond & 1u) || uniform.inside_ranges[p] != (c.beyond & 1u) ||
+                      uniform.inside_all[p] != (c.beyond & 1u);
   }
 
   // The model's parity test (model/ldi/vpt.h) on GL's LDI and GL's compressed texture, against GL's answers
   // and fetch counts, on every point of both sets.
   const ldi::CroppedLdi cropped = ldi::crop(b.peel.ldi);
-  std::uint64_t model_mismatches = 0;
+  std::uint64_t model_mismatches = 0, readers_differ = 0;
   const auto check = [&](const std::vector<std::int32_t>& x, const std::vector<std::int32_t>& y, const std::vector<float>& z,
                          const capture::GlVptAnswers& g) {
     for (std::size_t p = 0; p < x.size(); ++p) {
-      const ldi::VptResult l = ldi::vpt_layers(cropped, x[p], y[p], z[p]), c = ldi::vpt_ranges(b.compressed, x[p], y[p], z[p]);
+      const ldi::VptResult l = ldi::vpt_layers(cropped, x[p], y[p], z[p]), c = ldi::vpt_ranges(b.compressed, x[p], y[p], z[p]),
+                           all = ldi::vpt_all_layers(cropped, x[p], y[p], z[p]);
       model_mismatches += (l.inside ? 1u : 0u) != g.inside_layers[p] || static_cast<std::uint32_t>(l.fetches) != g.fetches_layers[p] ||
-                          (c.inside ? 1u : 0u) != g.inside_ranges[p] || static_cast<std::uint32_t>(c.fetches) != g.fetches_ranges[p];
+                          (c.inside ? 1u : 0u) != g.inside_ranges[p] || static_cast<std::uint32_t>(c.fetches) != g.fetches_ranges[p] ||
+                          (all.inside ? 1u : 0u) != g.inside_all[p] || static_cast<std::uint32_t>(all.fetches) != g.fetches_all[p];
+      readers_differ += l.inside != c.inside || l.inside != all.inside ? 1 : 0;
     }
   };
   check(pts.x, pts.y, pts.z, gl);
@@ -207,8 +213,15 @@ nlohmann::ordered_json measure(const Shape& shape, int size, const Table1Args& a
   const double un = ux.empty() ? 1.0 : static_cast<double>(ux.size());
   r["fetches_anywhere_layers"] = static_cast<double>(fetch_anywhere_layers) / un;
   r["fetches_anywhere_ranges"] = static_cast<double>(fetch_anywhere_ranges) / un;
+  r["fetches_anywhere_all"] = static_cast<double>(fetch_anywhere_all) / un;
+  // The three readers' answers on every point of both sets (the model's, which equal GL's when
+  // gl_parity_mismatches is 0): the same rule read three ways, so 0.
+  r["readers_differ"] = readers_differ;
   r["fetches_per_test_layers"] = n ? static_cast<double>(fetch_layers) / static_cast<double>(n) : 0.0;
   r["fetches_per_test_ranges"] = n ? static_cast<double>(fetch_ranges) / static_cast<double>(n) : 0.0;
+  std::uint64_t fetch_all = 0;
+  for (const std::uint32_t f : gl.fetches_all) fetch_all += f;
+  r["fetches_per_test_all"] = n ? static_cast<double>(fetch_all) / static_cast<double>(n) : 0.0;
   return r;
 }
 
@@ -258,15 +271,16 @@ int run_table1(const Table1Args& a) {
   } else {
     fmt::print("Table 1 (Trapp & Doellner 2008) on Mesa {}, grid {}: memory in 32-bit values (M_comp = 2 w_c^2), times in ms "
                "on llvmpipe (a warm-up build first); misclass.: of the points not within {} of a surface (texel-centre reference; anywhere: the point anywhere in its texel); fetch L / R: "
-               "texels a parity test read, layers / compressed\n",
+               "texels a parity test read, layers (early exit) / compressed / every layer (the paper's reader)\n",
                context.info().renderer, a.grid, a.epsilon);
-    fmt::print("{:<12} {:>5} {:>8} {:>9} {:>6} {:>11} {:>11} {:>7} {:>6} {:>9} {:>8} {:>7} {:>9} {:>9} {:>9} {:>9} {:>11}\n", "shape", "side",
-               "vertices", "d_min/max", "d", "M_crop", "M_comp", "C_ratio", "paper", "viewpoint", "peel", "crop", "compress",
-               "misclass.", "anywhere", "fetch L", "fetch R");
+    fmt::print("{:<12} {:>5} {:>8} {:>9} {:>6} {:>11} {:>11} {:>7} {:>6} {:>9} {:>8} {:>7} {:>9} {:>9} {:>9} {:>9} {:>11} {:>9}\n", "shape",
+               "side", "vertices", "d_min/max", "d", "M_crop", "M_comp", "C_ratio", "paper", "viewpoint", "peel", "crop", "compress",
+               "misclass.", "anywhere", "fetch L", "fetch R", "fetch P");
     // misclass.: the uncompressed reader's (the compressed one's is the same, or the command fails below);
     // fetch L / R: texels a test read, uncompressed layers / compressed texture
     for (const auto& r : rows)
-      fmt::print("{:<12} {:>5} {:>8} {:>9} {:>6} {:>11} {:>11} {:>7} {:>6} {:>9.1f} {:>8.1f} {:>7.2f} {:>9.2f} {:>8.3f}% {:>8.3f}% {:>9.2f} {:>11.2f}\n",
+      fmt::print("{:<12} {:>5} {:>8} {:>9} {:>6} {:>11} {:>11} {:>7} {:>6} {:>9.1f} {:>8.1f} {:>7.2f} {:>9.2f} {:>8.3f}% {:>8.3f}% {:>9.2f} {:>11.2f} "
+                 "{:>9.2f}\n",
                  r["shape"].get<std::string>(), r["ldi_size"].get<int>(), r["vertices"].get<std::size_t>(),
                  fmt::format("{}/{}", r["d_min"].get<unsigned>(), r["d_max"].get<unsigned>()), r["layers"].get<int>(),
                  r["m_crop"].get<std::uint64_t>(), r["m_comp"].get<std::uint64_t>(), cell(r["c_ratio"], 3), cell(r["paper_c_ratio"], 2),
@@ -275,7 +289,8 @@ int run_table1(const Table1Args& a) {
                  r["classified_anywhere"].get<std::uint64_t>()
                      ? 100.0 * r["misclassified_anywhere"].get<double>() / r["classified_anywhere"].get<double>()
                      : 0.0,
-                 r["fetches_per_test_layers"].get<double>(), r["fetches_per_test_ranges"].get<double>());
+                 r["fetches_per_test_layers"].get<double>(), r["fetches_per_test_ranges"].get<double>(),
+                 r["fetches_per_test_all"].get<double>());
   }
   if (!dir.empty()) {
     const std::filesystem::path json = dir / "ldi.json", csv = dir / "ldi.csv";

@@ -26,10 +26,10 @@ Program build(const ProgramContext& c) {
 }
 
 // The ldi program's counters in run.json's per-frame values (differences at frame ends).
-constexpr std::array<const char*, 16> kLdiFrameCounts = {
+constexpr std::array<const char*, 18> kLdiFrameCounts = {
     "peel_passes", "peel_fragments", "gl_peel_fragments", "peel_samples", "gl_peel_samples", "peel_pass_mismatches", "layers",
     "gl_layers", "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "test_points", "parity_mismatches_layers",
-    "parity_mismatches_ranges", "misclassified_layers", "misclassified_ranges"};
+    "parity_mismatches_ranges", "misclassified_layers", "misclassified_ranges", "parity_mismatches_all", "fetches_all"};
 
 void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) {
   for (const char* name : kLdiFrameCounts) pf[name] = stat(now, name) - stat(last, name);
@@ -45,8 +45,16 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
                            "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "m_crop", "m_comp", "test_points",
                            "parity_mismatches_layers", "parity_mismatches_ranges", "fetch_mismatches_layers",
                            "fetch_mismatches_ranges", "fetches_layers", "fetches_ranges", "gl_fetches_layers", "gl_fetches_ranges",
-                           "misclassified_layers", "misclassified_ranges", "classified_points", "near_surface_points"})
+                           "misclassified_layers", "misclassified_ranges", "classified_points", "near_surface_points", "all_points",
+                           "parity_mismatches_all", "fetch_mismatches_all", "fetches_all", "gl_fetches_all", "misclassified_all"})
     j[name] = stat(p, name);
+  // Fetches a test point of each reader: the early exit's, the compressed one's and the paper's (every layer).
+  const auto per_point = [](std::uint64_t fetches, std::uint64_t points) {
+    return points ? nlohmann::ordered_json(static_cast<double>(fetches) / static_cast<double>(points)) : nlohmann::ordered_json(nullptr);
+  };
+  j["fetches_per_point_layers"] = per_point(stat(p, "fetches_layers"), stat(p, "test_points"));
+  j["fetches_per_point_ranges"] = per_point(stat(p, "fetches_ranges"), stat(p, "test_points"));
+  j["fetches_per_point_all"] = per_point(stat(p, "fetches_all"), stat(p, "all_points"));
   const std::uint64_t classified = stat(p, "classified_points");
   const auto rate = [classified](std::uint64_t v) {
     return classified ? nlohmann::ordered_json(static_cast<double>(v) / static_cast<double>(classified)) : nlohmann::ordered_json(nullptr);
@@ -102,6 +110,10 @@ std::string describe(const nlohmann::ordered_json& l) {
                    l["test_points"].get<std::uint64_t>(), l["parity_mismatches_layers"].get<std::uint64_t>(),
                    l["parity_mismatches_ranges"].get<std::uint64_t>(), l["misclassified_layers"].get<std::uint64_t>(),
                    l["misclassified_ranges"].get<std::uint64_t>(), l["classified_points"].get<std::uint64_t>());
+  if (l.value("all_points", std::uint64_t{0}) > 0)
+    s += fmt::format("  ldi paper's reader {} points (every layer read): answers differ {}, fetch counts differ {}, misclassified {}\n",
+                     l["all_points"].get<std::uint64_t>(), l["parity_mismatches_all"].get<std::uint64_t>(),
+                     l["fetch_mismatches_all"].get<std::uint64_t>(), l["misclassified_all"].get<std::uint64_t>());
   return s;
 }
 

@@ -107,10 +107,13 @@ TEST(LdiVptTest, ReadersAgreeWithBruteForceExhaustively) {
           const bool in_crop = r.contains(x, y);
           const int front = in_ldi ? layers_in_front(l, x, y, z) : 0;
           const bool inside = (front & 1) != 0;
-          const VptResult full = vpt_layers(l, x, y, z), cropped = vpt_layers(cl, x, y, z), comp = vpt_ranges(cc, x, y, z);
+          const VptResult full = vpt_layers(l, x, y, z), cropped = vpt_layers(cl, x, y, z), comp = vpt_ranges(cc, x, y, z),
+                          every = vpt_all_layers(cl, x, y, z);
           ASSERT_EQ(full.inside, inside) << "LDI " << i << " texel (" << x << ", " << y << ") z " << z << ": full reader";
           ASSERT_EQ(cropped.inside, inside) << "LDI " << i << " texel (" << x << ", " << y << ") z " << z << ": cropped reader";
           ASSERT_EQ(comp.inside, inside) << "LDI " << i << " texel (" << x << ", " << y << ") z " << z << ": compressed reader";
+          ASSERT_EQ(every.inside, inside) << "LDI " << i << " texel (" << x << ", " << y << ") z " << z << ": the paper's reader";
+          ASSERT_EQ(every.fetches, in_crop ? d : 0) << "LDI " << i << ": the paper's reader reads every layer";
           ASSERT_EQ(full.fetches, in_ldi ? std::min(l.layer_count(), front + 1) : 0) << "LDI " << i << " full fetches";
           ASSERT_EQ(cropped.fetches, in_crop ? std::min(d, front + 1) : 0) << "LDI " << i << " cropped fetches";
           const int k = in_crop ? (l.count(x, y) + 1) / 2 : 0;
@@ -122,6 +125,7 @@ TEST(LdiVptTest, ReadersAgreeWithBruteForceExhaustively) {
           if (in_crop) {
             const auto ct = static_cast<std::size_t>((y - r.y) * r.w + (x - r.x));
             ASSERT_EQ(cropped.texel, ct) << "cropped reader's texel";
+            ASSERT_EQ(every.texel, ct) << "the paper's reader's texel";
             ASSERT_EQ(comp.texel, ct) << "compressed reader's index texel";
             ASSERT_EQ(comp.first_range, first_range[ct]) << "compressed reader's first range texel";
           }
@@ -193,21 +197,27 @@ TEST(LdiVptTest, CompressedHalvesTheFetchesOnADeepLdi) {
   const CroppedLdi cl = crop(l);
   const CompressedLdi c = compress(l);
   ASSERT_EQ(cl.crop.depth_complexity, 18);
-  long long layered = 0, compressed = 0, tests = 0;
+  long long layered = 0, compressed = 0, every = 0, tests = 0;
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x)
       for (int s = 0; s <= 32; ++s) {
         const float z = static_cast<float>(s) / 32.0f;
-        const VptResult a = vpt_layers(cl, x, y, z), b = vpt_ranges(c, x, y, z);
+        const VptResult a = vpt_layers(cl, x, y, z), b = vpt_ranges(c, x, y, z), p = vpt_all_layers(cl, x, y, z);
         ASSERT_EQ(a.inside, b.inside);
+        ASSERT_EQ(p.inside, b.inside);
+        ASSERT_EQ(p.fetches, 18) << "the paper's reader: d fetches, O(d)";
+        every += p.fetches;
         ASSERT_LE(b.fetches, 1 + 9);
         ASSERT_LE(2 * b.fetches, 3 + a.fetches) << "texel (" << x << ", " << y << ") z " << z;
         layered += a.fetches, compressed += b.fetches, ++tests;
       }
   const double mean_layered = static_cast<double>(layered) / static_cast<double>(tests),
-               mean_compressed = static_cast<double>(compressed) / static_cast<double>(tests);
-  std::cout << tests << " tests: mean fetches " << mean_layered << " layered, " << mean_compressed << " compressed\n";
+               mean_compressed = static_cast<double>(compressed) / static_cast<double>(tests),
+               mean_every = static_cast<double>(every) / static_cast<double>(tests);
+  std::cout << tests << " tests: mean fetches " << mean_every << " every layer (the paper's), " << mean_layered << " layered, "
+            << mean_compressed << " compressed\n";
   EXPECT_LT(mean_compressed, mean_layered);
+  EXPECT_LE(2 * mean_compressed, mean_every + 2) << "compressed: at most 1 + d/2 against the paper's d";
 }
 
 // A NaN test depth is bad input, refused with a message (it would otherwise read every layer).

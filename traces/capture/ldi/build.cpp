@@ -296,6 +296,8 @@ GlVptAnswers gl_vpt(const LdiBuild& b, const std::vector<std::int32_t>& x, const
   a.fetches_layers.resize(count);
   a.inside_ranges.resize(count);
   a.fetches_ranges.resize(count);
+  a.inside_all.resize(count);
+  a.fetches_all.resize(count);
   if (count == 0) return a;
   const Rect& r = b.crop.rect;
   const int d = b.crop.depth_complexity;
@@ -337,9 +339,10 @@ GlVptAnswers gl_vpt(const LdiBuild& b, const std::vector<std::int32_t>& x, const
   const GLuint prog = compute_program(shaders::ldi_vpt_comp, "ldi/vpt.comp");
   progs.programs.push_back(prog);
   Buffers bufs;
-  const GLuint in = bufs.make(), out = bufs.make();
+  const GLuint in = bufs.make(), out = bufs.make(), out_all = bufs.make();
   glNamedBufferStorage(in, static_cast<GLsizeiptr>(points.size() * 4), points.data(), 0);
   glNamedBufferStorage(out, static_cast<GLsizeiptr>(count * 16), nullptr, 0);
+  glNamedBufferStorage(out_all, static_cast<GLsizeiptr>(count * 8), nullptr, 0);
   glUseProgram(prog);
   glBindTextureUnit(0, cropped);
   glBindTextureUnit(1, compressed);
@@ -351,16 +354,21 @@ GlVptAnswers gl_vpt(const LdiBuild& b, const std::vector<std::int32_t>& x, const
   glUniform1ui(glGetUniformLocation(prog, "count"), static_cast<GLuint>(count));
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, out_all);
   glDispatchCompute(groups(static_cast<int>(count), 64), 1, 1);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   std::vector<std::uint32_t> res(4 * count);
   glGetNamedBufferSubData(out, 0, static_cast<GLsizeiptr>(res.size() * 4), res.data());
+  std::vector<std::uint32_t> all(2 * count);
+  glGetNamedBufferSubData(out_all, 0, static_cast<GLsizeiptr>(all.size() * 4), all.data());
   check_gl("parity test");
   for (std::size_t p = 0; p < count; ++p) {
     a.inside_layers[p] = res[4 * p];
     a.fetches_layers[p] = res[4 * p + 1];
     a.inside_ranges[p] = res[4 * p + 2];
     a.fetches_ranges[p] = res[4 * p + 3];
+    a.inside_all[p] = all[2 * p];
+    a.fetches_all[p] = all[2 * p + 1];
   }
   return a;
 }

@@ -73,6 +73,7 @@ LdiBuild build_ldi_along(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, 
 // crop, and b's compressed texture, uploaded as GL produced them.
 struct GlVptAnswers {
   std::vector<std::uint32_t> inside_layers, fetches_layers, inside_ranges, fetches_ranges;
+  std::vector<std::uint32_t> inside_all, fetches_all;  // the paper's reader: every layer read
 };
 GlVptAnswers gl_vpt(const LdiBuild& b, const std::vector<std::int32_t>& x, const std::vector<std::int32_t>& y,
                     const std::vector<float>& z);

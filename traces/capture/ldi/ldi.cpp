@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <numeric>
 #include <cstdio>
 #include <filesystem>
 #include <cmath>
@@ -226,6 +227,11 @@ class Ldi final : public Technique {
                     {"gl_fetches_ranges", gl.fetches_ranges},
                     {"reference", std::move(reference)}};
     f.technique_records.push_back(std::move(tests));
+    trace::TechniqueRecord all;
+    all.type = trace::kLdiAllLayersChunk;
+    all.decoded = true;
+    all.fields = {{"count", static_cast<std::uint64_t>(pts.x.size())}, {"gl_inside_all", gl.inside_all}, {"gl_fetches_all", gl.fetches_all}};
+    f.technique_records.push_back(std::move(all));
     out.counts = {{"ldi_layers", static_cast<std::uint64_t>(b.peel.ldi.layer_count())},
                   {"peel_passes", b.peel.passes.size()},
                   {"peel_fragments", fragments},
@@ -237,7 +243,8 @@ class Ldi final : public Technique {
                   {"misclassified_ranges", wrong_ranges},
                   {"readers_disagree", disagree},
                   {"fetches_layers", fetch_layers},
-                  {"fetches_ranges", fetch_ranges}};
+                  {"fetches_ranges", fetch_ranges},
+                  {"fetches_all", std::accumulate(gl.fetches_all.begin(), gl.fetches_all.end(), std::uint64_t{0})}};
     f.end.frame = index;
     f.end.draws = static_cast<std::uint32_t>(f.draws.size());
     return out;

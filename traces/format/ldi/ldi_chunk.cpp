@@ -133,6 +133,29 @@ ChunkSpec ldi_tests_chunk_spec() {
 
 namespace {
 
+std::string all_layers_rule(const TechniqueRecord& r) {
+  if (std::string problem = vector_lengths_problem(r, u(r, "count"), {"count"}, "test point"); !problem.empty()) return problem;
+  const auto& inside = std::get<std::vector<std::uint32_t>>(find_field(r, "gl_inside_all")->value);
+  for (std::size_t p = 0; p < inside.size(); ++p)
+    if (inside[p] > 1) return fmt::format("field 'gl_inside_all' of test point {} is {}, above 1", p, inside[p]);
+  return {};
+}
+
+}  // namespace
+
+ChunkSpec ldi_all_layers_chunk_spec() {
+  ChunkSpec spec{kLdiAllLayersChunk,
+                 "ldi",
+                 "LdiAllLayers",
+                 {{"count", FieldKind::U32, "test points: LDIT's count (every vector below has this many elements)"},
+                  {"gl_inside_all", FieldKind::VecU32, "GL's answer, the paper's reader (every layer of the texel read): 1 inside"},
+                  {"gl_fetches_all", FieldKind::VecU32, "layer texels that shader read: d inside the crop, 0 outside"}}};
+  spec.rule = all_layers_rule;
+  return spec;
+}
+
+namespace {
+
 // "HxV": the viewpoint grid, each side 1 .. 1024.
 bool valid_grid(std::string_view v) {
   const std::size_t x = v.find('x');
@@ -164,6 +187,8 @@ std::vector<HeaderKeySpec> ldi_header_keys() {
 }
 
 // This technique's part of the format (technique_chunks.h): the image and test-point chunks and the header keys.
-TechniqueFormat ldi_format() { return {{ldi_image_chunk_spec(), ldi_tests_chunk_spec()}, ldi_header_keys()}; }
+TechniqueFormat ldi_format() {
+  return {{ldi_image_chunk_spec(), ldi_tests_chunk_spec(), ldi_all_layers_chunk_spec()}, ldi_header_keys()};
+}
 
 }  // namespace nbsim::trace

@@ -19,6 +19,7 @@ namespace nbsim::trace {
 
 inline constexpr std::uint32_t kLdiImageChunk = fourcc("LDIL");
 inline constexpr std::uint32_t kLdiTestsChunk = fourcc("LDIT");
+inline constexpr std::uint32_t kLdiAllLayersChunk = fourcc("LDIA");
 
 // What a test point was chosen to probe (LDIT field `kind`; fixed values: they are in files).
 enum class LdiPointKind : std::uint32_t {
@@ -39,6 +40,11 @@ ChunkSpec ldi_image_chunk_spec();
 // LdiTests' rule: every vector has `count` elements, kind below kLdiPointKinds, answers 0 or 1,
 // reference >= -1.
 ChunkSpec ldi_tests_chunk_spec();
+// LdiAllLayers (LDIA, one per frame beside LDIT in captures since the paper's reader; older traces
+// have none): the paper's reader's answers at LDIT's points, which reads every layer of the texel:
+//   count U32 (LDIT's), gl_inside_all VecU32 (0 or 1), gl_fetches_all VecU32 (d inside the crop, 0
+//   outside). Rule: vector lengths, answers 0 or 1.
+ChunkSpec ldi_all_layers_chunk_spec();
 
 // Its header keys (the LDI's size, grid and limits; the shape and how it was placed).
 std::vector<HeaderKeySpec> ldi_header_keys();

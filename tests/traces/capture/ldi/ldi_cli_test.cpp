@@ -1,10 +1,14 @@
 // LdiCliTest: `nbsim capture ldi` from the outside: unusable meshes (empty, not closed, degenerate
 // triangles), a zero viewpoint grid and an LDI deeper than --max-layers exit 2 naming the problem and
-// write no file; a small capture prints its counts and `trace info` / `trace dump` read it back.
+// write no file; a small capture prints its counts and `trace info` / `trace dump` read it back; the
+// three parity readers (early exit, compressed, every layer) answer as GL's on shapes of growing
+// depth complexity, the paper's reader at d fetches a point in the crop.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "tests/common/refused.h"
@@ -78,6 +82,38 @@ TEST(LdiCliTest, CaptureOfAMeshFileReadsBack) {
   EXPECT_TRUE(has(dump.out, "LDIL")) << dump.out.substr(0, 2000);
   EXPECT_TRUE(has(dump.out, "LDIT")) << dump.out.substr(0, 2000);
   fs::remove_all(out.parent_path());
+}
+
+// Nested shells of 2 and 6 (depth complexity 4 and 12): every reader of the model answers as GL's
+// at every point with GL's fetch counts; the paper's reader reads every layer (its fetches grow with
+// d, O(d)) and the compressed one at most 1 + d/2 texels a point (O(d/2)).
+TEST(LdiCliTest, ThreeReadersAnswerAsGl) {
+  const fs::path dir = testing::scratch_path("nbsim_ldi_cli_readers", "x").parent_path();
+  std::map<int, nlohmann::json> by_shells;
+  for (const int shells : {2, 6}) {
+    const fs::path out = dir / ("nested" + std::to_string(shells) + ".nbt");
+    const CliResult c = run_nbsim("capture ldi --scene boxes --boxes 0 --path fly --size 8x8 --frames 1 --ldi-size 64 --grid 2x2 "
+                                  "--points 512 --shape nested --shape-param " + std::to_string(shells) + " -o " + out.string());
+    ASSERT_EQ(c.status, 0) << c.out << c.err;
+    const CliResult r = run_nbsim("compare --json " + out.string());
+    ASSERT_EQ(r.status, 0) << r.out << r.err;
+    const nlohmann::json l = nlohmann::json::parse(r.out)["ldi"];
+    SCOPED_TRACE(shells);
+    EXPECT_EQ(l["all_points"], l["test_points"]);
+    EXPECT_EQ(l["parity_mismatches_all"], 0);
+    EXPECT_EQ(l["fetch_mismatches_all"], 0);
+    EXPECT_EQ(l["parity_mismatches_layers"], 0);
+    EXPECT_EQ(l["parity_mismatches_ranges"], 0);
+    EXPECT_EQ(l["fetches_all"], l["gl_fetches_all"]);
+    EXPECT_EQ(l["misclassified_all"], l["misclassified_layers"]) << "the same answers, so the same misclassification";
+    EXPECT_GT(l["fetches_per_point_all"].get<double>(), l["fetches_per_point_ranges"].get<double>());
+    EXPECT_EQ(l["layers"], 2 * shells);
+    by_shells[shells] = l;
+  }
+  const auto per_point = [&](int shells, const char* reader) { return by_shells[shells][std::string("fetches_per_point_") + reader].get<double>(); };
+  EXPECT_GT(per_point(6, "all") / per_point(2, "all"), 2.0) << "every layer read: the fetches follow d (4 -> 12)";
+  EXPECT_LT(per_point(6, "ranges"), 1.0 + 12 / 2.0);
+  fs::remove_all(dir);
 }
 
 }  // namespace
