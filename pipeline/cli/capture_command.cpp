@@ -41,6 +41,7 @@ struct Args {
   // Registry options by name, with the CLI11 option that fills each.
   std::map<std::string, std::string> values;
   std::map<std::string, CLI::Option*> given;
+  CLI::Option *scene_opt = nullptr, *path_opt = nullptr;  // --scene (not for an alias) and --path
 };
 
 // Adds --NAME once for every option the plug-ins in `owners` (row, kind) declare, grouped by the
@@ -74,8 +75,8 @@ void add_capture_subcommand(CLI::App* cap, Action& action, const capture::Techni
   if (legacy) a->scene = alias->scene;
   CLI::App* cmd = legacy ? cap->add_subcommand(alias->name, fmt::format("Old spelling of `{}`, kept for recorded command lines", same))
                          : cap->add_subcommand(technique.info.name, technique.info.description);
-  if (!legacy) cmd->add_option("--scene", a->scene, "Scene, by name (below)")->capture_default_str();
-  cmd->add_option("--path", a->path, "Camera path, by name (below)")->capture_default_str();
+  if (!legacy) a->scene_opt = cmd->add_option("--scene", a->scene, "Scene, by name (below); a capture that draws no scene takes none")->capture_default_str();
+  a->path_opt = cmd->add_option("--path", a->path, "Camera path, by name (below); a capture that draws no scene takes none")->capture_default_str();
   cmd->add_option("--size", a->size, "Viewport, WxH")->capture_default_str();
   cmd->add_option("--frames", a->frames, "Frames along the camera path")->check(CLI::Range(1, 100000))->capture_default_str();
   cmd->add_flag("--reversed-z", a->reversed_z, "Reversed Z: ZERO_TO_ONE clip control, depth func GREATER, clear 0");
@@ -95,6 +96,8 @@ void add_capture_subcommand(CLI::App* cap, Action& action, const capture::Techni
       c.technique = technique_name;
       c.scene = a->scene;
       c.path = a->path;
+      c.scene_given = a->scene_opt && a->scene_opt->count() > 0;
+      c.path_given = a->path_opt->count() > 0;
       std::tie(c.width, c.height) = parse_size(a->size, "--size");
       c.frames = a->frames;
       c.reversed_z = a->reversed_z;

@@ -31,12 +31,41 @@ std::vector<const OptionSpec*> chosen_options(const SceneRow& s, const PathRow& 
   return out;
 }
 
+// Why the capture draws no scene (the technique's answer), or empty when it draws one.
+std::string no_scene_reason(const TechniqueRow& t, const OptionValues& options) { return t.no_scene ? t.no_scene(options) : ""; }
+
+bool declared_by(const PluginInfo& info, const std::string& name) {
+  return std::any_of(info.options.begin(), info.options.end(), [&](const OptionSpec& o) { return o.name == name; });
+}
+
+// A capture that draws no scene takes no --scene, --path or option only they read, except in the
+// spelling older captures were recorded with (the empty box scene along the fly path).
+void refuse_scene_options(const CaptureOptions& o, const SceneRow& s, const PathRow& p, const TechniqueRow& t, const std::string& why) {
+  const bool old_spelling = o.scene == "boxes" && o.path == "fly" && o.options.text(*std::find_if(s.info.options.begin(), s.info.options.end(), [](const OptionSpec& x) {
+                              return x.name == "boxes";
+                            })) == "0";
+  if (old_spelling) return;
+  const auto refuse = [&](const std::string& what) {
+    return InputError(fmt::format("{}: the {} capture draws no scene ({}), so it takes no {}", what, t.info.name, why, what));
+  };
+  if (o.scene_given) throw refuse("--scene " + o.scene);
+  if (o.path_given) throw refuse("--path " + o.path);
+  for (const auto& [name, value] : o.options.values())
+    if (!declared_by(t.info, name) && (declared_by(s.info, name) || declared_by(p.info, name))) throw refuse("--" + name + " " + value);
+}
+
 }  // namespace
 
 std::string canonical_command_line(const CaptureOptions& o, const std::string& out_path) {
   const SceneRow& s = find_scene(o.scene);
   const PathRow& p = find_path(o.path);
   const TechniqueRow& t = find_technique(o.technique);
+  if (!no_scene_reason(t, o.options).empty()) {  // no scene: its options and the path's are not the capture's
+    std::string line = fmt::format("nbsim capture {} --size {}x{} --frames {}", t.info.name, o.width, o.height, o.frames);
+    for (const OptionSpec& spec : t.info.options) line += fmt::format(" --{} {}", spec.name, o.options.text(spec));
+    if (o.reversed_z) line += " --reversed-z";
+    return line + " -o " + out_path;
+  }
   std::string line = fmt::format("nbsim capture {} --scene {} --path {} --size {}x{} --frames {}", t.info.name, s.info.name,
                                  p.info.name, o.width, o.height, o.frames);
   for (const OptionSpec* spec : chosen_options(s, p, t)) line += fmt::format(" --{} {}", spec->name, o.options.text(*spec));
@@ -55,11 +84,17 @@ CaptureSummary capture(const CaptureOptions& o, const std::string& out_path, con
   // Every value checked before the (slow) scene is built.
   for (const OptionSpec* spec : chosen_options(scene_row, path_row, technique_row)) o.options.text(*spec);
 
+  const std::string no_scene = no_scene_reason(technique_row, o.options);
+  if (!no_scene.empty()) refuse_scene_options(o, scene_row, path_row, technique_row, no_scene);
+
   const auto t0 = std::chrono::steady_clock::now();
-  const CaptureScene scene = scene_row.make(o.options);
+  // Only a capture that draws the scene builds it and walks the camera path.
+  const CaptureScene scene = no_scene.empty() ? scene_row.make(o.options) : CaptureScene{};
   if (!o.poses.empty() && o.poses.size() != static_cast<std::size_t>(o.frames))
     throw InputError(fmt::format("{} camera poses given for {} frames", o.poses.size(), o.frames));
-  const auto poses = o.poses.empty() ? path_row.make(scene, o.frames, o.options) : o.poses;
+  const auto poses = !o.poses.empty()    ? o.poses
+                     : no_scene.empty() ? path_row.make(scene, o.frames, o.options)
+                                        : std::vector<CameraPose>(static_cast<std::size_t>(o.frames));
   RendererOptions ro;
   ro.technique = o.technique;
   ro.width = o.width;
@@ -84,9 +119,9 @@ CaptureSummary capture(const CaptureOptions& o, const std::string& out_path, con
       {"technique", technique_row.info.name},
   };
   append(props, renderer.technique().variant_properties());
-  props.emplace_back("scene", scene_row.info.name);
+  props.emplace_back("scene", no_scene.empty() ? scene_row.info.name : "none");
   append(props, scene.properties);
-  props.emplace_back("path", path_row.info.name);
+  props.emplace_back("path", no_scene.empty() ? path_row.info.name : "none");
   props.emplace_back("frames", std::to_string(o.frames));
   props.emplace_back("fov_y_deg", fmt::format("{}", ro.projection.fov_y_deg));
   props.emplace_back("near", fmt::format("{}", ro.projection.near_m));

@@ -20,6 +20,9 @@ struct CaptureOptions {
   std::string technique = default_technique();
   std::string scene = "city";
   std::string path = "walk";
+  // Whether --scene and --path were given (a technique that draws no scene refuses them, but for
+  // the spelling older captures were recorded with: --scene boxes --boxes 0 --path fly).
+  bool scene_given = false, path_given = false;
   int width = 512;
   int height = 512;
   int frames = 60;

@@ -85,6 +85,11 @@ struct TechniqueRow {
   std::function<std::unique_ptr<Technique>(const TechniqueSetup&)> make;
   BenchPreset bench;
   std::vector<CaptureAlias> aliases;
+  // Whether a capture with these options draws the scene and follows the camera path: null, or an
+  // empty answer, when it does; otherwise why not (for the message that refuses --scene or --path).
+  // A capture that draws no scene builds none: TechniqueSetup::scene is empty, the poses are the
+  // default pose, and the header's scene and path are "none".
+  std::function<std::string(const OptionValues&)> no_scene;
 };
 
 // Each technique of the registration list (cmake/NbsimTechniques.cmake) defines its row,

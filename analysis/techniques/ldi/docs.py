@@ -11,7 +11,7 @@ FRESH = [("duck.dae", ["--mesh", f"{MODELS}/Collada/duck.dae"]),
 
 
 def fresh_capture(i, shape):
-    return ["capture", "ldi", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "8x8", "--frames", "3", "--seed", "7",
+    return ["capture", "ldi", "--size", "8x8", "--frames", "3", "--seed", "7",
             *shape, "--ldi-size", "200", "--points", "5000", "-o", f"f{i}.nbt"]
 
 

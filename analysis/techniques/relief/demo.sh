@@ -11,7 +11,7 @@ rtraces=()
 for f in fbm walls spikes saddle step; do
   for n in 32 64 128 256; do
     t="$out/relief/traces/${f}_$n.nbt"
-    [[ -f "$t" ]] || "$nbsim" capture relief --scene boxes --boxes 0 --path fly --size 128x128 --frames 4 --seed 5 --field "$f" \
+    [[ -f "$t" ]] || "$nbsim" capture relief --size 128x128 --frames 4 --seed 5 --field "$f" \
       --field-size "$n" -o "$t" > /dev/null
     rtraces+=("$t")
   done
@@ -29,7 +29,7 @@ for spec in "strict" "paper min 0" "paper min 0.01" "paper min 0.02" "paper min 
   t="$out/relief_figure12/traces/fbm_64_${kind}_${combine:-all}_${epsilon:-0}.nbt"
   radius=(--radius strict)
   [[ $kind == paper ]] && radius=(--radius paper --radius-combine "$combine" --radius-epsilon "$epsilon")
-  [[ -f "$t" ]] || "$nbsim" capture relief --scene boxes --boxes 0 --path fly --size 128x128 --frames 4 --seed 5 --field fbm \
+  [[ -f "$t" ]] || "$nbsim" capture relief --size 128x128 --frames 4 --seed 5 --field fbm \
     --field-size 64 --methods exact,robust,robust_clamp "${radius[@]}" -o "$t" > /dev/null
   ftraces+=("$t")
 done

@@ -22,7 +22,7 @@ SIZES = (32, 64, 128, 256)
 
 def fresh_capture(i, args):
     angles = [] if "--angles" in args else ["--angles", "15,65,86"]
-    return ["capture", "relief", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "160x160", "--frames", "3",
+    return ["capture", "relief", "--size", "160x160", "--frames", "3",
             *angles, *args, "-o", f"t{i}.nbt"]
 
 
@@ -54,7 +54,7 @@ def render_fresh(outputs):
 
 
 def reference_captures(extra=(), prefix=""):
-    return [["capture", "relief", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "128x128", "--frames", "4",
+    return [["capture", "relief", "--size", "128x128", "--frames", "4",
              "--seed", "5", "--field", f, "--field-size", str(s), *extra, "-o", f"{prefix}{f}_{s}.nbt"]
             for f in FIELDS for s in SIZES]
 
@@ -190,7 +190,7 @@ def fig12_commands():
     caps, runs = [], []
     for f, args in FIG12_FIELDS.items():
         for k, (_, radius) in enumerate(FIG12_RADII):
-            caps.append(["capture", "relief", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "256x256", "--frames", "4",
+            caps.append(["capture", "relief", "--size", "256x256", "--frames", "4",
                          *args, "--methods", "exact,robust,robust_clamp", *radius, "-o", f"f12_{f}_{k}.nbt"])
             runs.append(["replay", f"f12_{f}_{k}.nbt", "--out", f"f12_{f}_{k}"])
     return caps + runs
@@ -226,7 +226,7 @@ BLOCKS.append(Block("figure12", fig12_commands(), render_fig12, files=fig12_file
 # and the paper's (its maximum over directions, epsilon 0), and two stand-ins for its other
 # heightfields at 128²: walls (a grid) and a torus knot baked from above (an object).
 T1_SIZES = (32, 64, 128, 256)
-T1_COMMON = ["capture", "relief", "--scene", "boxes", "--boxes", "0", "--path", "fly", "--size", "1600x1200", "--frames", "1",
+T1_COMMON = ["capture", "relief", "--size", "1600x1200", "--frames", "1",
              "--angles", "45", "--methods", "binary,exact,robust"]
 T1_CASES = [(f"terrain {n}²", "terrain", n, r, ["--field", "fbm", "--field-size", str(n), "--seed", "3", *a])
             for n in T1_SIZES for r, a in (("strict", ["--radius", "strict"]), ("paper", ["--radius", "paper"]))] + \

@@ -85,7 +85,7 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
 
 nlohmann::ordered_json summary(const SummaryInputs& in) {
   nlohmann::ordered_json j = totals(in.group, in.stats.contains("gpu.memory") ? in.stats["gpu.memory"] : nlohmann::ordered_json::object(), in.cycles);
-  for (const char* key : {"shape", "seed"}) copy_property(in.header, key, j);
+  for (const char* key : {"shape", "ldi_seed"}) copy_property(in.header, key, j);
   return j;
 }
 

@@ -222,7 +222,36 @@ TEST(CaptureTest, TraceFileChecksItself) {
 // row, every frame is written, and a technique that reports what it drew drew every visible object.
 TEST(CaptureTest, EveryTechniqueRunsOnEverySceneAndPath) {
   int runs = 0;
-  for (const auto& t : technique_table())
+  for (const auto& t : technique_table()) {
+    if (t.no_scene && !t.no_scene(OptionValues{}).empty()) {
+      // A capture that draws no scene (by default) builds none, walks no path and refuses both.
+      CaptureOptions o;
+      o.technique = t.info.name;
+      o.width = 48;
+      o.height = 32;
+      o.frames = 2;
+      const auto file = nbsim::testing::scratch_path("nbsim_capture", "every_" + t.info.name + "_no_scene.nbt");
+      const CaptureSummary sum = capture(o, file.string());
+      EXPECT_EQ(sum.frames, 2);
+      trace::FrameReader frames(file);
+      EXPECT_EQ(*frames.trace().property("scene"), "none") << t.info.name;
+      EXPECT_EQ(*frames.trace().property("path"), "none") << t.info.name;
+      EXPECT_TRUE(frames.trace().scene() == nullptr || frames.trace().scene()->objects.empty()) << t.info.name << ": no scene built";
+      std::filesystem::remove(file);
+      for (const auto& sc : scene_table()) {
+        o.scene = sc.info.name;
+        o.scene_given = true;
+        try {
+          capture(o, file.string());
+          ADD_FAILURE() << t.info.name << " took --scene " << sc.info.name;
+        } catch (const InputError& e) {
+          EXPECT_NE(std::string(e.what()).find("draws no scene"), std::string::npos) << e.what();
+        }
+        EXPECT_FALSE(std::filesystem::exists(file));
+      }
+      ++runs;
+      continue;
+    }
     for (const auto& sc : scene_table())
       for (const auto& p : path_table()) {
         CaptureOptions o;
@@ -258,6 +287,7 @@ TEST(CaptureTest, EveryTechniqueRunsOnEverySceneAndPath) {
         EXPECT_EQ(count, 2);
         std::filesystem::remove(file);
       }
+  }
   EXPECT_GE(runs, 2) << "occlusion culling on the city along walk and fly at least";
 }
 

@@ -145,7 +145,7 @@ class Ldi final : public Technique {
                               "normalize_to_unit_cube with margin 0"},
             {"ldi_depth", "peel: clip control ZERO_TO_ONE, gl_Position = (ndc x, ndc y, linear depth, 1), layer = gl_FragCoord.z, "
                           "LEQUAL against DEPTH_COMPONENT32F cleared to 1.0, strict > previous layer, no culling"},
-            {"observer", "unused: the LDI technique ignores the scene, the camera path, --size and the projection"}};
+            {"observer", "unused: the LDI technique builds no scene, follows no camera path and ignores --size and the projection"}};
   }
 
   CapturedFrame render(std::uint32_t index, const CameraPose&) override {
@@ -271,8 +271,9 @@ const std::vector<OptionSpec>& ldi_options() {
 }
 
 BenchPreset ldi_bench_preset() {
-  // The LDI work does not look at the observer: the smallest scene and viewport the capture accepts.
-  return {"boxes", "fly", "8x8", {{"boxes", "0"}, {"shape", "knot"}, {"ldi-size", "256"}}, "shape", {}};
+  // The LDI work does not look at the observer: no scene is built (ldi_technique's no_scene), the
+  // smallest viewport the capture accepts.
+  return {"boxes", "fly", "8x8", {{"shape", "knot"}, {"ldi-size", "256"}}, "shape", {}};
 }
 
 std::unique_ptr<Technique> make_ldi(const TechniqueSetup& setup) { return std::make_unique<Ldi>(setup); }
@@ -281,11 +282,12 @@ std::unique_ptr<Technique> make_ldi(const TechniqueSetup& setup) { return std::m
 TechniqueRow ldi_technique() {
   return {{"ldi",
            "Layered depth images of a closed shape: viewpoint selection, depth peeling, crop, RG32UI depth-range compression and "
-           "the volumetric parity test with both readers against an exact reference (Trapp & Doellner)",
+           "the volumetric parity test with three readers against an exact reference (Trapp & Doellner)",
            ldi_options()},
           make_ldi,
           ldi_bench_preset(),
-          {}};
+          {},
+          [](const OptionValues&) { return std::string("an LDI capture renders one shape from its own viewpoints"); }};
 }
 
 }  // namespace nbsim::capture

@@ -348,8 +348,8 @@ class Relief final : public Technique {
             {"relief_view", "the box [0,1]^2 x [0,relief_box_height] seen from angle k mod count of relief_angles off its up axis, "
                             "azimuth 37 + 61 k + 13 seed degrees, framing the box; rays rebuilt from gl_FragCoord (model/relief/walk.h)"},
             {"observer", city_ ? "the box stands in the scene (relief_box_at); the observer's path and projection view it"
-                               : "unused: the relief technique views its box from its own camera; the scene, the camera path and "
-                                 "the projection are ignored, --size is the viewport"},
+                               : "unused: the relief technique views its box from its own camera; no scene is built and no camera "
+                                 "path followed, the projection is ignored, --size is the viewport"},
             {"relief_box_at", box_at_}};
   }
 
@@ -592,8 +592,8 @@ const std::vector<OptionSpec>& relief_options() {
 }
 
 BenchPreset relief_bench_preset() {
-  // The box is seen from its own camera: the smallest scene the capture accepts; --size is the viewport.
-  return {"boxes", "fly", "512x512", {{"boxes", "0"}, {"field", "fbm"}, {"field-size", "128"}}, "field", {}};
+  // The box is seen from its own camera: no scene is built (relief_technique's no_scene); --size is the viewport.
+  return {"boxes", "fly", "512x512", {{"field", "fbm"}, {"field-size", "128"}}, "field", {}};
 }
 
 std::unique_ptr<Technique> make_relief(const TechniqueSetup& setup) { return std::make_unique<Relief>(setup); }
@@ -607,7 +607,11 @@ TechniqueRow relief_technique() {
            relief_options()},
           make_relief,
           relief_bench_preset(),
-          {}};
+          {},
+          [](const OptionValues& o) {
+            return o.text(placement_option()) == "city" ? std::string()
+                                                        : std::string("the box is seen from its own camera (--angles); --placement city stands it in a scene");
+          }};
 }
 
 }  // namespace nbsim::capture

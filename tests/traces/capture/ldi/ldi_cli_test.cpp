@@ -84,6 +84,44 @@ TEST(LdiCliTest, CaptureOfAMeshFileReadsBack) {
   fs::remove_all(out.parent_path());
 }
 
+// An LDI capture draws no scene: it builds none (the header's scene and path are "none", no object),
+// refuses --scene, --path and the scene's options naming why, and still takes the spelling the
+// sample was recorded with (its recorded command line replays to the same LDI and answers).
+TEST(LdiCliTest, NoSceneBuilt) {
+  const fs::path dir = testing::scratch_path("nbsim_ldi_cli_noscene", "x").parent_path();
+  const fs::path out = dir / "knot.nbt";
+  const CliResult c = run_nbsim("capture ldi --shape knot --ldi-size 32 --grid 2x2 --points 64 --frames 1 -o " + out.string());
+  ASSERT_EQ(c.status, 0) << c.out << c.err;
+  const CliResult info = run_nbsim("trace info " + out.string());
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_TRUE(has(info.out, "scene: none")) << info.out;
+  EXPECT_TRUE(has(info.out, "path: none")) << info.out;
+  EXPECT_TRUE(has(info.out, "0 objects")) << info.out;
+  EXPECT_FALSE(has(info.out, "--scene")) << "the recorded command line names no scene: " << info.out;
+  for (const char* bad : {"--scene city", "--path walk", "--objects 10", "--scene boxes --boxes 3 --path fly"}) {
+    const CliResult r = run_nbsim(std::string("capture ldi --shape knot --ldi-size 32 --frames 1 ") + bad + " -o " + (dir / "bad.nbt").string());
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.out << r.err;
+    EXPECT_TRUE(has(r.err, "draws no scene")) << bad << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "bad.nbt")) << bad;
+  }
+  // The sample's recorded spelling (the empty box scene along the fly path) is still taken.
+  const fs::path sample = fs::path(NBSIM_SAMPLES) / "ldi_nested_128.nbt";
+  const CliResult old = run_nbsim("capture ldi --scene boxes --path fly --size 8x8 --frames 2 --seed 1 --boxes 0 --shape nested --shape-param 3 "
+                                  "--mesh none --ldi-size 128 --grid 8x8 --max-layers 64 --points 4096 --epsilon 1e-5 -o " +
+                                  (dir / "again.nbt").string());
+  ASSERT_EQ(old.status, 0) << old.out << old.err;
+  const auto ldi_of = [](const fs::path& t) {
+    const CliResult r = run_nbsim("compare --json " + t.string());
+    EXPECT_EQ(r.status, 0) << r.out << r.err;
+    return nlohmann::json::parse(r.out)["ldi"];
+  };
+  const nlohmann::json a = ldi_of(sample), b = ldi_of(dir / "again.nbt");
+  for (const char* k : {"peel_passes", "peel_fragments", "peel_samples", "layers", "m_crop", "m_comp", "test_points", "fetches_layers",
+                        "fetches_ranges", "misclassified_layers", "misclassified_ranges"})
+    EXPECT_EQ(a[k], b[k]) << k << ": the sample's command line reproduces it";
+  fs::remove_all(dir);
+}
+
 // Nested shells of 2 and 6 (depth complexity 4 and 12): every reader of the model answers as GL's
 // at every point with GL's fetch counts; the paper's reader reads every layer (its fetches grow with
 // d, O(d)) and the compressed one at most 1 + d/2 texels a point (O(d/2)).

@@ -26,6 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::CliResult;
+using testing::has;
 using testing::run_nbsim;
 
 const char* kPrefix = "capture relief --scene boxes --boxes 0 --path fly --size 48x48 --frames 1 ";
@@ -195,6 +196,24 @@ TEST(ReliefCliTest, PaperRadiusReplaysExactly) {
   exact(loose, "epsilon 0.05");
   EXPECT_LT(loose["methods"]["robust"]["lookups"].get<double>(), strict["methods"]["robust"]["lookups"].get<double>())
       << "larger radii, fewer lookups";
+  fs::remove_all(dir);
+}
+
+// Seen from its own camera the box draws no scene: none is built, and another scene or path than
+// the old spelling's (--scene boxes --boxes 0 --path fly, kPrefix) is refused naming why.
+TEST(ReliefCliTest, OwnCameraDrawsNoScene) {
+  const fs::path dir = testing::scratch_path("nbsim_relief_cli_noscene", "x").parent_path();
+  const CliResult c = run_nbsim("capture relief --size 48x48 --frames 1 --field fbm --field-size 16 -o " + (dir / "t.nbt").string());
+  ASSERT_EQ(c.status, 0) << c.out << c.err;
+  const CliResult info = run_nbsim("trace info " + (dir / "t.nbt").string());
+  EXPECT_TRUE(has(info.out, "scene: none")) << info.out;
+  for (const char* bad : {"--scene city", "--path walk", "--scene boxes --boxes 2"}) {
+    const CliResult r = run_nbsim(std::string("capture relief --size 48x48 --frames 1 --field fbm --field-size 16 ") + bad + " -o " +
+                                  (dir / "bad.nbt").string());
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_TRUE(has(r.err, "draws no scene (the box is seen from its own camera")) << bad << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "bad.nbt"));
+  }
   fs::remove_all(dir);
 }
 
