@@ -140,6 +140,23 @@ TriMesh make_nested_shells(const NestedParams& p) {
   return m;
 }
 
+TriMesh make_beads(const BeadsParams& p) {
+  require(p.core_shells >= 1 && p.beads >= 0 && p.rings >= 1 && p.segments >= 3,
+          "beads need core_shells >= 1, beads >= 0, rings >= 1 and segments >= 3");
+  TriMesh m = make_nested_shells({.shells = p.core_shells, .rings = p.rings, .segments = p.segments});
+  const double length = std::sqrt(p.axis[0] * p.axis[0] + p.axis[1] * p.axis[1] + p.axis[2] * p.axis[2]);
+  require(length > 0.0 && std::isfinite(length), "beads need a nonzero axis");
+  constexpr double kRadius = 0.5, kGap = 0.1;
+  for (int b = 0; b < p.beads; ++b) {
+    const std::size_t first = m.vertices.size();
+    append_sphere(m, p.rings, p.segments, kRadius, false);
+    const double along = 1.0 + kGap + kRadius + b * (2.0 * kRadius + kGap);
+    for (std::size_t v = first; v < m.vertices.size(); ++v)
+      for (int k = 0; k < 3; ++k) m.vertices[v][static_cast<std::size_t>(k)] += static_cast<float>(along * p.axis[static_cast<std::size_t>(k)] / length);
+  }
+  return m;
+}
+
 TriMesh make_box(float lo, float hi) { return make_box({lo, lo, lo}, {hi, hi, hi}); }
 
 TriMesh make_box(const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
@@ -177,6 +194,8 @@ constexpr ShapeEntry kShapes[] = {
      [](int k) { return make_nested_shells({.shells = k}); }},
     {"coil", "helical tube spring with capped ends, d = 2 turns along its axis", "turns", 4, 1, 16,
      [](int n) { return make_coil({.turns = n}); }},
+    {"beads", "K nested shells with M beads strung after them along x, d from 2K across to 2(K + M) along", "KM (two digits)", 12,
+     10, 99, [](int km) { return make_beads({.core_shells = km / 10, .beads = km % 10}); }},
 };
 }  // namespace
 

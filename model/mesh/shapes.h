@@ -59,6 +59,22 @@ struct CoilParams {
 };
 TriMesh make_coil(const CoilParams& p = {});
 
+// A core of `core_shells` nested shells (make_nested_shells, radius 1) with `beads` spheres of
+// radius 1/2 strung after it along `axis`, apart from the core and each other (gap 1/10). Across the
+// string a line meets at most the core (2 core_shells surfaces); along it, the core and every bead:
+// d ranges from 2 core_shells to 2 (core_shells + beads) over the viewing directions, the spread of
+// depth complexity over directions that Trapp & Doellner's Table 1 reports as d_min and d_max. The
+// default axis is a view of the default 8x8 viewpoint grid (the paper's; grid_frame h 0, v 4:
+// azimuth 22.5 degrees, y 1/8), so that the view along the string is one of the candidates.
+struct BeadsParams {
+  int core_shells = 1;  // >= 1
+  int beads = 2;        // >= 0
+  Vec3d axis = {0.9166333066528043, 0.125, 0.3796819473384877};  // the string's direction (normalized when used)
+  int rings = 15;       // per sphere
+  int segments = 24;    // per sphere
+};
+TriMesh make_beads(const BeadsParams& p = {});
+
 // An axis-aligned cube [lo, hi]^3: 8 shared corners (bit 0 = x, bit 1 = y, bit 2 = z), 12
 // triangles counter-clockwise seen from outside. The unit cube itself (the default) is the shape
 // that touches every face of the LDI's cube, and its edges fall on texel centres: the tie cases.
@@ -67,7 +83,9 @@ TriMesh make_box(float lo = 0.0f, float hi = 1.0f);
 TriMesh make_box(const std::array<float, 3>& lo, const std::array<float, 3>& hi);
 
 // The shape table (a capture's `--shape NAME [--shape-param N]`): one row per shape. `parameter`
-// names its one integer parameter ("" when it has none), with its default and limits.
+// names its one integer parameter ("" when it has none), with its default and limits. `beads`
+// takes two numbers in one: KM (two digits, K core shells 1..9, M beads 0..9), so beads:12 is one
+// shell and two beads (d 2 to 6).
 struct ShapeEntry {
   std::string_view name;
   std::string_view summary;

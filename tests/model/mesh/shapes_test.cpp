@@ -106,7 +106,7 @@ TEST(ShapesTest, TableBuildsEveryShape) {
     const TriMesh m = make_shape(e.name);
     expect_closed(m, std::string(e.name).c_str());
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"sphere", "knot", "nested", "coil"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"sphere", "knot", "nested", "coil", "beads"}));
   EXPECT_EQ(make_shape("sphere").vertices.size(), 994u);
   EXPECT_EQ(make_shape("nested", 5).triangles.size(), make_nested_shells({.shells = 5}).triangles.size());
   EXPECT_THROW(make_shape("teapot"), InputError);
@@ -119,7 +119,41 @@ TEST(ShapesTest, TableBuildsEveryShape) {
   try {
     make_shape("teapot");
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("sphere, knot, nested, coil"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("sphere, knot, nested, coil, beads"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(make_shape("beads", 9), InputError) << "KM: at least one core shell";
+  EXPECT_THROW(make_shape("beads", 100), InputError);
+  EXPECT_EQ(make_shape("beads", 43).vertices.size(), make_beads({.core_shells = 4, .beads = 3}).vertices.size());
+}
+
+// Beads: a core of K shells and M beads on a string: closed, the beads apart; a line along the
+// string through the centres crosses 2(K + M) surfaces, a line across it through the core 2K, one
+// across a bead 2.
+TEST(ShapesTest, BeadsSpreadTheirDepthOverDirections) {
+  for (const auto& [k, m] : {std::pair{1, 2}, std::pair{4, 3}, std::pair{5, 4}}) {
+    const BeadsParams p{.core_shells = k, .beads = m};
+    const TriMesh mesh = make_beads(p);
+    expect_closed(mesh, "beads");
+    double norm = 0;
+    for (double a : p.axis) norm += a * a;
+    norm = std::sqrt(norm);
+    const Vec3d axis = {p.axis[0] / norm, p.axis[1] / norm, p.axis[2] / norm};
+    // Along the string, slightly off the centres' line (not through a pole or a ring exactly).
+    const Vec3d off = {0.011, -0.013, 0.007};
+    const CrossingReference along(mesh, OrthoFrame::look_along(axis, {0.0, 1.0, 0.0}));
+    const CrossingCount c = along.count({off[0] - 50.0 * axis[0], off[1] - 50.0 * axis[1], off[2] - 50.0 * axis[2]});
+    EXPECT_EQ(c.in_front + c.beyond, static_cast<std::uint32_t>(2 * (k + m))) << "K " << k << ", M " << m;
+    // Across the string (perpendicular to the axis and to y): the core alone, or one bead alone.
+    const Vec3d across = {-axis[2], 0.0, axis[0]};
+    const double an = std::sqrt(across[0] * across[0] + across[2] * across[2]);
+    const Vec3d dir = {across[0] / an, 0.0, across[2] / an};
+    const CrossingReference side(mesh, OrthoFrame::look_along(dir, {0.0, 1.0, 0.0}));
+    const CrossingCount core = side.count({off[0] - 50.0 * dir[0], off[1], off[2] - 50.0 * dir[2]});
+    EXPECT_EQ(core.in_front + core.beyond, static_cast<std::uint32_t>(2 * k));
+    const double bead = 1.0 + 0.1 + 0.5;  // the first bead's centre along the axis
+    const Vec3d at = {bead * axis[0] + off[0] - 50.0 * dir[0], bead * axis[1] + off[1], bead * axis[2] + off[2] - 50.0 * dir[2]};
+    const CrossingCount one = side.count(at);
+    EXPECT_EQ(one.in_front + one.beyond, 2u);
   }
 }
 
