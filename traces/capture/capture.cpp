@@ -40,10 +40,11 @@ bool declared_by(const PluginInfo& info, const std::string& name) {
 
 // A capture that draws no scene takes no --scene, --path or option only they read, except in the
 // spelling older captures were recorded with (the empty box scene along the fly path).
-void refuse_scene_options(const CaptureOptions& o, const SceneRow& s, const PathRow& p, const TechniqueRow& t, const std::string& why) {
-  const bool old_spelling = o.scene == "boxes" && o.path == "fly" && o.options.text(*std::find_if(s.info.options.begin(), s.info.options.end(), [](const OptionSpec& x) {
-                              return x.name == "boxes";
-                            })) == "0";
+void refuse_scene_options(const CaptureOptions& o, const SceneRow& s, const PathRow& p, const TechniqueRow& t,
+                          const std::string& why) {
+  const auto& given = o.options.values();
+  const auto boxes = given.find("boxes");
+  const bool old_spelling = o.scene == "boxes" && o.path == "fly" && boxes != given.end() && boxes->second == "0";
   if (old_spelling) return;
   const auto refuse = [&](const std::string& what) {
     return InputError(fmt::format("{}: the {} capture draws no scene ({}), so it takes no {}", what, t.info.name, why, what));
