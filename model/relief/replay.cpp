@@ -197,6 +197,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
         fw.walk = lookups ? walk(r.method, view, params, *ray, lines) : walk(r.method, view, params, *ray);
         if (!referenced_[px]) reference_[px] = reference_of(gl.field, *ray), referenced_[px] = 1;
         fw.score = score_against(reference_[px], *ray, gl.field.size, fw.walk.hit && !fw.walk.capped, fw.walk.t, box_height, tolerance);
+        if (box_depth_ == BoxDepth::Exact && fw.walk.hit && !fw.walk.capped) fw.depth = hit_depth(gl_depth->texel_to_clip, *ray, fw.walk.t);
       }
     };
     pool_.run(run_count, walk_run, [&](std::size_t run) {
@@ -218,11 +219,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       const std::uint32_t code = w.capped ? 2u : w.hit ? 1u : 0u;
       if (writes) {
         hit_[px] = code == 1u ? 1 : 0;
-        if (box_depth_ == BoxDepth::Exact && code == 1u) {  // a hit has a ray: the pixel's, again
-          const float fx = static_cast<float>(px % static_cast<std::uint32_t>(width_)) + 0.5f;
-          const float fy = static_cast<float>(px / static_cast<std::uint32_t>(width_)) + 0.5f;
-          hit_depth_[px] = hit_depth(gl_depth->texel_to_clip, *fragment_ray(gl.ray, gl.field.size, fx, fy), w.t);
-        }
+        if (box_depth_ == BoxDepth::Exact && code == 1u) hit_depth_[px] = fw.depth;
       }
       c.lookups += w.lookups, c.steps += w.steps, c.bisections += w.bisections;
       c.longest_walk = std::max<std::uint64_t>(c.longest_walk, w.lookups);
@@ -254,7 +251,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       c.samples = w.depth.passed;
       c.depth_written = w.depth.written;
       if (box_depth_ == BoxDepth::Exact) c.depth_tests = w.depth.depth_tests;
-      std::fill(hit_.begin(), hit_.end(), std::uint8_t{0});
+      for (const std::uint32_t px : fragment_pixels_) hit_[px] = 0;  // only walked pixels were set
       const std::uint32_t crc = static_cast<std::uint32_t>(
           crc32(0L, reinterpret_cast<const Bytef*>(depth_.texels.data()), static_cast<uInt>(depth_.texels.size() * sizeof(float))));
       c.depth_mismatches = crc != gl_depth->depth_crc[box_draw - 1] ? 1 : 0;

@@ -148,6 +148,7 @@ class ReliefReplay {
     bool ray = false;  // the pixel's ray meets the box (else no walk)
     WalkResult walk;
     HitScore score;
+    float depth = 0.0f;  // a hit's exact depth (box depth exact), computed with the walk
   };
   static constexpr std::size_t kRunFragments = 256;
   std::vector<std::uint32_t> fragment_pixels_;

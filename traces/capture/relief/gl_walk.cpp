@@ -10,6 +10,7 @@
 #include "model/common/error.h"
 #include "traces/capture/glsl_nbuffer.h"
 #include "traces/capture/gl_program.h"
+#include "traces/capture/readback.h"
 #include "nbsim_shaders.h"
 #include "model/relief/roles.h"
 
@@ -215,10 +216,7 @@ GlFragments GlReliefWalker::draw(relief::Method method, const ReliefView& view, 
   glUseProgram(0);
   if (box_depth_ != relief::BoxDepth::None) {  // the depth the draw left, as a checksum (its read-back timed apart)
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<float> depth(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_));
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer ? framebuffer : o.fbo);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, width_, height_, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());  // bottom row first = y up
+    const std::vector<float> depth = read_depth(framebuffer ? framebuffer : o.fbo, width_, height_, scene::DepthWhich::Final).texels;
     out.depth_crc = static_cast<std::uint32_t>(
         crc32(0L, reinterpret_cast<const Bytef*>(depth.data()), static_cast<uInt>(depth.size() * sizeof(float))));
     out.readback_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -360,9 +360,10 @@ class Relief final : public Technique {
     f.begin.mode = scene::TestMode::None;
     double angle = angles_[index % angles_.size()];
     ReliefCamera cam;
+    // The observer's camera (placement city): the scene's draws and the box's texel-to-clip.
+    const glm::mat4 view = view_matrix(pose), proj = projection_matrix(projection_, static_cast<double>(width_) / height_);
     if (city_) {
       if (index == 0) place_box(pose);
-      const glm::mat4 view = view_matrix(pose), proj = projection_matrix(projection_, static_cast<double>(width_) / height_);
       std::array<double, 16> v{}, p{};
       for (std::size_t k = 0; k < 16; ++k) v[k] = glm::value_ptr(view)[k], p[k] = glm::value_ptr(proj)[k];
       cam = relief_view(v, p, world_to_texel_, width_, height_);
@@ -392,8 +393,7 @@ class Relief final : public Technique {
         (distance_to(scene_.scene.objects[o], eye) < box_distance ? before : after).push_back(o);
     }
     recorder_.begin_frame(16 + before.size() + methods_.size() * (1 + after.size()));
-    const glm::mat4 city_view_proj =
-        projection_matrix(projection_, static_cast<double>(width_) / height_) * view_matrix(pose);
+    const glm::mat4 city_view_proj = proj * view;
     const auto draw_scene = [&](const std::vector<std::uint32_t>& objects) {
       pass_->begin(*target_, city_view_proj, false, recorder_);
       for (std::uint32_t o : objects) {
@@ -424,8 +424,8 @@ class Relief final : public Technique {
     }
     f.draws = recorder_.collect();
     if (city_) {
-      std::memcpy(f.begin.view.data(), glm::value_ptr(view_matrix(pose)), 64);
-      std::memcpy(f.begin.proj.data(), glm::value_ptr(projection_matrix(projection_, static_cast<double>(width_) / height_)), 64);
+      std::memcpy(f.begin.view.data(), glm::value_ptr(view), 64);
+      std::memcpy(f.begin.proj.data(), glm::value_ptr(proj), 64);
       f.begin.eye = {pose.eye.x, pose.eye.y, pose.eye.z};
     }
     f.end.gl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() - readback_ms;
