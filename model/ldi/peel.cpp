@@ -34,20 +34,9 @@ constexpr const char* kTestsLabel = "LdiTests (LDIT)";
 constexpr const char* kAllLabel = "LdiAllLayers (LDIA)";
 constexpr std::uint32_t kLdiAllLayersRecordType = 0x4149444Cu;  // fourcc "LDIA" (traces/format/ldi/ldi_chunk.h)
 
-const scene::TechniqueField* find(const scene::TechniqueRecord& rec, std::string_view name) {
-  for (const scene::TechniqueField& f : rec.fields)
-    if (f.name == name) return &f;
-  return nullptr;
-}
-
-// A scalar field (u32 fields decode as uint64_t, i32 as int64_t, f64 as double).
 template <class T>
 T scalar(const scene::TechniqueRecord& rec, std::string_view name, const char* label, std::uint64_t frame) {
-  const scene::TechniqueField* f = find(rec, name);
-  if (!f) throw InputError(fmt::format("frame {}: the {} record has no field '{}'", frame, label, name));
-  const T* v = std::get_if<T>(&f->value);
-  if (!v) throw InputError(fmt::format("frame {}: the {} record's field '{}' has the wrong type", frame, label, name));
-  return *v;
+  return scene::record_scalar<T>(rec, name, label, frame);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "model/common/error.h"
@@ -38,6 +39,17 @@ void LdiUnitConfig::describe(config::Schema& s, LdiUnitConfig& c) {
   s.add("ldi.vpt_cycles_per_point", c.vpt_cycles_per_point, "cycles/point",
         "issue cost of one parity test, both readers (its texel fetches are memory traffic of client ldi)", 0.0, 1e6);
   s.add("ldi.vpt_latency_cycles", c.vpt_latency_cycles, "cycles", "latency of a frame's batch of parity tests", 0, kMaxLatency);
+  s.add("ldi.clip_lanes", c.clip_lanes, "lanes", "clipping draws: fragments the volume-test stage works on at once", kMinRate, kMaxRate);
+  s.add("ldi.clip_volume_test_cycles", c.clip_volume_test_cycles, "lane-cycles",
+        "clipping draws: rebuilding a fragment's point in one volume's LDI and checking its crop", 0.0, 1e6);
+  s.add("ldi.clip_layer_fetch_cycles", c.clip_layer_fetch_cycles, "lane-cycles", "clipping draws: one layer fetch (readers layers, all)",
+        0.0, 1e6);
+  s.add("ldi.clip_range_fetch_cycles", c.clip_range_fetch_cycles, "lane-cycles",
+        "clipping draws: one compressed fetch with its texel coordinates (reader ranges)", 0.0, 1e6);
+  s.add("ldi.clip_draw_latency_cycles", c.clip_draw_latency_cycles, "cycles", "fill and drain of one clipping draw", 0, kMaxLatency);
+  s.add("ldi.clip_cache_bytes", c.clip_cache_bytes, "bytes", "the LDI texel cache of clipping draws (0: every fetch misses)", 0, 1 << 26);
+  s.add("ldi.clip_cache_line_bytes", c.clip_cache_line_bytes, "bytes", "its line (a power of two)", 4, 4096);
+  s.add("ldi.clip_cache_ways", c.clip_cache_ways, "ways", "its associativity", 1, 64);
 }
 
 void LdiUnitConfig::validate() const {
@@ -49,8 +61,19 @@ void LdiUnitConfig::validate() const {
   rate("ldi.tests_per_cycle", tests_per_cycle);
   if (!(vpt_cycles_per_point >= 0.0 && vpt_cycles_per_point <= 1e6))
     throw InputError(fmt::format("ldi.vpt_cycles_per_point is {}, not in [0, 1e6]", vpt_cycles_per_point));
-  for (const auto& [key, v] : {std::pair{"ldi.pass_latency_cycles", pass_latency_cycles}, std::pair{"ldi.vpt_latency_cycles", vpt_latency_cycles}})
+  for (const auto& [key, v] : {std::pair{"ldi.pass_latency_cycles", pass_latency_cycles}, std::pair{"ldi.vpt_latency_cycles", vpt_latency_cycles},
+                               std::pair{"ldi.clip_draw_latency_cycles", clip_draw_latency_cycles}})
     if (v < 0 || v > kMaxLatency) throw InputError(fmt::format("{} is {}, not in [0, {}]", key, v, kMaxLatency));
+  rate("ldi.clip_lanes", clip_lanes);
+  for (const auto& [key, v] : {std::pair{"ldi.clip_volume_test_cycles", clip_volume_test_cycles},
+                               std::pair{"ldi.clip_layer_fetch_cycles", clip_layer_fetch_cycles},
+                               std::pair{"ldi.clip_range_fetch_cycles", clip_range_fetch_cycles}})
+    if (!(v >= 0.0 && v <= 1e6)) throw InputError(fmt::format("{} is {}, not in [0, 1e6]", key, v));
+  if (clip_cache_bytes < 0 || clip_cache_bytes > (1 << 26))
+    throw InputError(fmt::format("ldi.clip_cache_bytes is {}, not in [0, {}]", clip_cache_bytes, 1 << 26));
+  if (clip_cache_line_bytes < 4 || clip_cache_line_bytes > 4096 || (clip_cache_line_bytes & (clip_cache_line_bytes - 1)) != 0)
+    throw InputError(fmt::format("ldi.clip_cache_line_bytes is {}, not a power of two in [4, 4096]", clip_cache_line_bytes));
+  if (clip_cache_ways < 1 || clip_cache_ways > 64) throw InputError(fmt::format("ldi.clip_cache_ways is {}, not in [1, 64]", clip_cache_ways));
 }
 
 LdiUnit::LdiUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const LdiUnitConfig& config, memory::Channel& memory,
@@ -114,7 +137,37 @@ LdiUnit::LdiUnit(const sc_core::sc_module_name& name, stats::Registry& registry,
       vpt_cycles_(stats().counter("vpt_cycles", "cycles", "cycles of the parity tests (memory stalls included)")),
       peel_bytes_(stats().counter("peel_bytes", "bytes", "peel layer traffic: 4 B a previous-layer read, 4 B a layer texel written")),
       vpt_bytes_(stats().counter("vpt_bytes", "bytes", "parity-test traffic: 4 B a layer fetch, 8 B an RG32UI fetch (no cache)")),
-      memory_stall_cycles_(stats().counter("memory_stall_cycles", "cycles", "cycles waiting for the channel after the work was done")) {
+      memory_stall_cycles_(stats().counter("memory_stall_cycles", "cycles", "cycles waiting for the channel after the work was done")),
+      clip_frames_(stats().counter("clip_frames", "frames", "clipping and lens frames (LdiClip records)")),
+      clip_draws_(stats().counter("clip_draws", "draws", "draws that ran the volume test")),
+      clip_fragments_(stats().counter("clip_fragments", "fragments", "the model's rasterized fragments of those draws")),
+      gl_clip_fragments_(stats().counter("gl_clip_fragments", "fragments", "GL's (its fragment counter)")),
+      clip_samples_(stats().counter("clip_samples", "samples", "the model's samples passed of those draws")),
+      gl_clip_samples_(stats().counter("gl_clip_samples", "samples", "GL's samples passed")),
+      clip_discarded_(stats().counter("clip_discarded", "fragments", "fragments the model's volume test discarded")),
+      gl_clip_discarded_(stats().counter("gl_clip_discarded", "fragments", "fragments GL's volume test discarded")),
+      clip_fetches_(stats().counter("clip_fetches", "texels", "texels the model's reader fetched")),
+      gl_clip_fetches_(stats().counter("gl_clip_fetches", "texels", "texels GL's reader fetched")),
+      clip_depth_tests_(stats().counter("clip_depth_tests", "tests", "depth tests of those draws (the discarded fragments saved theirs)")),
+      clip_volume_tests_(stats().counter("clip_volume_tests", "tests", "(fragment, volume) tests: volumes are tested until one holds the point")),
+      clip_draw_mismatches_(stats().counter("clip_draw_mismatches", "draws",
+                                            "draws whose fragments, samples, discards, fetches or discard sums differ from GL's (expected 0)")),
+      clip_decision_mismatches_(stats().counter("clip_decision_mismatches", "draws",
+                                                "draws whose discarded fragments differ from GL's, by count or sums (expected 0)")),
+      clip_depth_mismatches_(stats().counter("clip_depth_mismatches", "frames", "frames whose final depth buffer differs from GL's (expected 0)")),
+      clip_volumes_(stats().counter("clip_volumes", "volumes", "volumes loaded (LdiVolume records)")),
+      clip_volume_mismatches_(stats().counter("clip_volume_mismatches", "volumes",
+                                              "volumes whose GL crop or compressed texture differ from the model's (expected 0)")),
+      clip_classified_(stats().counter("clip_classified", "fragments", "tested fragments with an exact reference (not near a surface)")),
+      clip_near_surface_(stats().counter("clip_near_surface", "fragments", "tested fragments within epsilon of a volume's surface")),
+      clip_misclassified_(stats().counter("clip_misclassified", "fragments", "classified fragments whose answer differs from the exact reference")),
+      clip_fetches_layers_(stats().counter("clip_fetches_layers", "texels", "what the early-exit reader fetches for the same tests")),
+      clip_fetches_all_(stats().counter("clip_fetches_all", "texels", "what the paper's reader (every layer) fetches for the same tests")),
+      clip_fetches_ranges_(stats().counter("clip_fetches_ranges", "texels", "what the compressed reader fetches for the same tests")),
+      clip_cache_hits_(stats().counter("clip_cache_hits", "fetches", "fetches the LDI texel cache held")),
+      clip_cache_misses_(stats().counter("clip_cache_misses", "fetches", "fetches that missed it (a line over the channel each)")),
+      clip_cycles_(stats().counter("clip_cycles", "cycles", "cycles of the clipping and lens draws (memory stalls included)")),
+      clip_bytes_(stats().counter("clip_bytes", "bytes", "LDI texel-cache line fills of those draws")) {
   config_.validate();
   for (std::size_t i = 0; i < kPointKinds; ++i) {
     const std::string kind = kPointKindNames[i];
@@ -142,7 +195,48 @@ std::uint64_t LdiUnit::timed(std::uint64_t cycles, std::uint64_t bytes) {
   return sim::local_cycles() - start;
 }
 
+std::uint64_t LdiUnit::clip_draw_cycles(const ClipDrawCounts& d, ClipReader reader) const {
+  const std::uint64_t setup = ceil_div(d.path.setup.triangles, config_.setup_triangles_per_cycle);
+  const std::uint64_t walk = ceil_div(d.path.depth.blocks, config_.blocks_per_cycle);
+  const double fetch = reader == ClipReader::Ranges ? config_.clip_range_fetch_cycles : config_.clip_layer_fetch_cycles;
+  const double lane_cycles = static_cast<double>(d.volume_tests) * config_.clip_volume_test_cycles + static_cast<double>(d.fetches) * fetch;
+  const auto vpt = static_cast<std::uint64_t>(std::ceil(lane_cycles / config_.clip_lanes));
+  const std::uint64_t tests = ceil_div(d.path.depth.depth_tests, config_.tests_per_cycle);
+  return std::max({setup, walk, vpt, tests}) + static_cast<std::uint64_t>(config_.clip_draw_latency_cycles);
+}
+
+void LdiUnit::run_clip_frame(const scene::Frame& f) {
+  if (!clip_) clip_ = std::make_unique<ClipReplay>(fused_, memory::CacheConfig{config_.clip_cache_bytes, config_.clip_cache_line_bytes, config_.clip_cache_ways});
+  const ClipFrameCounts k = clip_->run_frame(f);
+  ++frames_;
+  ++clip_frames_;
+  clip_volumes_ += k.volumes_loaded, clip_volume_mismatches_ += k.volume_mismatches;
+  clip_draw_mismatches_ += k.draw_mismatches, clip_decision_mismatches_ += k.decision_mismatches;
+  clip_depth_mismatches_ += k.depth_mismatch ? 1 : 0;
+  clip_fetches_layers_ += k.reader_fetches[0], clip_fetches_all_ += k.reader_fetches[1], clip_fetches_ranges_ += k.reader_fetches[2];
+  const std::uint64_t line = clip_->cache_line_bytes();
+  for (const ClipDrawCounts& d : k.draws) {
+    label_with([&] { return fmt::format("clipping draw {}, {} fragments", d.draw, d.path.depth.fragments); });
+    const std::uint64_t bytes = d.cache_misses * line;
+    clip_bytes_ += bytes;
+    clip_cycles_ += timed(clip_draw_cycles(d, k.reader), bytes);
+    if (!d.tested) continue;
+    ++clip_draws_;
+    clip_fragments_ += d.path.depth.fragments, gl_clip_fragments_ += d.gl_fragments;
+    clip_samples_ += d.path.depth.passed, gl_clip_samples_ += d.gl_samples;
+    clip_discarded_ += d.discarded, gl_clip_discarded_ += d.gl_discarded;
+    clip_fetches_ += d.fetches, gl_clip_fetches_ += d.gl_fetches;
+    clip_depth_tests_ += d.path.depth.depth_tests, clip_volume_tests_ += d.volume_tests;
+    clip_classified_ += d.classified, clip_near_surface_ += d.near_surface, clip_misclassified_ += d.misclassified;
+    clip_cache_hits_ += d.cache_hits, clip_cache_misses_ += d.cache_misses;
+  }
+}
+
 void LdiUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor&) {
+  if (ClipReplay::is_clip_frame(*f)) {
+    run_clip_frame(*f);
+    return;
+  }
   const std::array<int, 2> size = read_ldi_size(*f);  // the peel's render target
   if (!peel_ || peel_->width() != size[0] || peel_->height() != size[1]) peel_.emplace(size[0], size[1], fused_);
   const LdiFrameCounts k = ldi::run_frame(*f, *peel_);

@@ -41,4 +41,15 @@ const std::vector<T>& record_field(const TechniqueRecord& rec, std::string_view 
   throw InputError(fmt::format("frame {}: the {} record has no field '{}'", frame, label, name));
 }
 
+// A scalar field (u32 fields decode as uint64_t, i32 as int64_t, f64 as double, strings as std::string).
+template <class T>
+T record_scalar(const TechniqueRecord& rec, std::string_view name, std::string_view label, std::uint64_t frame) {
+  for (const TechniqueField& f : rec.fields)
+    if (f.name == name) {
+      if (const T* v = std::get_if<T>(&f.value)) return *v;
+      throw InputError(fmt::format("frame {}: the {} record's field '{}' has the wrong type", frame, label, name));
+    }
+  throw InputError(fmt::format("frame {}: the {} record has no field '{}'", frame, label, name));
+}
+
 }  // namespace nbsim::scene

@@ -184,4 +184,13 @@ std::vector<char> find_visible(const SceneObjects& s, const FrameView& v, const 
   return visible;
 }
 
+double distance_to(const Aabb& b, const glm::dvec3& p) {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double out = std::max({0.0, static_cast<double>(b.lo[k]) - p[static_cast<int>(k)], p[static_cast<int>(k)] - static_cast<double>(b.hi[k])});
+    sum += out * out;
+  }
+  return std::sqrt(sum);
+}
+
 }  // namespace nbsim::scene

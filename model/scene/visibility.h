@@ -10,6 +10,8 @@
 #include <functional>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "model/scene/frame.h"
 
 namespace nbsim::scene {
@@ -50,6 +52,10 @@ bool outside_frustum(const Aabb& b, const FrameView& v);
 
 // Objects whose bounds meet the frustum (BVH traversal from node 0), sorted by id.
 std::vector<std::uint32_t> frustum_objects(const SceneObjects& s, const FrameView& v);
+
+// The distance from `p` to the nearest point of `b` (0 inside): the order an engine sorts its
+// opaque draws in, front to back.
+double distance_to(const Aabb& b, const glm::dvec3& p);
 
 // One bounds test a traversal asks for: an object (node < 0) or a BVH node.
 struct TestItem {

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <sstream>
+
 #include <algorithm>
 #include <charconv>
 
@@ -98,6 +100,25 @@ CoveringSpec read_covering(const OptionValues& values, const OptionSpec& coverin
 
 std::pair<std::string, std::string> covering_property(const CoveringSpec& spec) {
   return {std::string(kCoveringProperty), covering_name(spec)};
+}
+
+double parse_real(const std::string& text, const std::string& what, double lo, double hi) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !(v >= lo && v <= hi)) throw InputError(fmt::format("{} '{}' is not a number in [{}, {}]", what, text, lo, hi));
+  return v;
+}
+
+std::vector<std::string> split_list(const std::string& text, char separator) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, separator);) out.push_back(item);
+  return out;
 }
 
 const OptionSpec& seed_option() {

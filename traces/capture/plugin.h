@@ -66,6 +66,12 @@ CoveringSpec read_covering(const OptionValues& values, const OptionSpec& coverin
 // The header property of a covering: {kCoveringProperty, "paper/top"}.
 std::pair<std::string, std::string> covering_property(const CoveringSpec& spec);
 
+// A Text option's number: `text` whole as a double in [lo, hi], or an InputError
+// "<what> '<text>' is not a number in [lo, hi]" (`what` names the option, e.g. "--box-at").
+double parse_real(const std::string& text, const std::string& what, double lo, double hi);
+// A Text option's list: the items between `separator`s (empty items kept, none for "").
+std::vector<std::string> split_list(const std::string& text, char separator);
+
 // --seed: one option that the scenes and the camera paths that are random share, so that one seed
 // fixes the scene and the path together.
 const OptionSpec& seed_option();

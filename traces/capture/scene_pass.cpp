@@ -27,7 +27,7 @@ GLuint make_vao(GLuint vbo, GLuint ebo) {
 
 }  // namespace
 
-ScenePass::ScenePass(const CaptureScene& scene, bool with_boxes) : scene_(scene) {
+ScenePass::ScenePass(const CaptureScene& scene, bool with_boxes, const char* fragment_source, const char* fragment_name) : scene_(scene) {
   glCreateBuffers(1, &scene_vbo_);
   glCreateBuffers(1, &scene_ebo_);
   glNamedBufferStorage(scene_vbo_, static_cast<GLsizeiptr>(scene.vertices.size() * sizeof(glm::vec3)), scene.vertices.data(), 0);
@@ -53,7 +53,8 @@ ScenePass::ScenePass(const CaptureScene& scene, bool with_boxes) : scene_(scene)
   }
 
   program_ = link_program({compile_shader(GL_VERTEX_SHADER, shaders::common_scene_vert, "common/scene.vert"),
-                           compile_shader(GL_FRAGMENT_SHADER, shaders::common_count_frag, "common/count.frag")},
+                           fragment_source ? compile_shader(GL_FRAGMENT_SHADER, fragment_source, fragment_name ? fragment_name : "fragment")
+                                           : compile_shader(GL_FRAGMENT_SHADER, shaders::common_count_frag, "common/count.frag")},
                           "scene", true);
   u_view_proj_ = glGetUniformLocation(program_, "view_proj");
   u_draw_slot_ = glGetUniformLocation(program_, "draw_slot");

@@ -22,7 +22,11 @@ namespace nbsim::capture {
 class ScenePass {
  public:
   // with_boxes: also upload the 8 corners of every object's and BVH node's bounds.
-  ScenePass(const CaptureScene& scene, bool with_boxes);
+  // `fragment_source` (named `fragment_name` in compile errors) replaces count.frag: a technique's
+  // own fragment stage over the same draws. It must count fragments as count.frag does
+  // (draw_recorder.h) and declare the uniforms draw_slot and object_id; its other uniforms are the
+  // technique's, set on program() after begin().
+  ScenePass(const CaptureScene& scene, bool with_boxes, const char* fragment_source = nullptr, const char* fragment_name = nullptr);
   ~ScenePass();
   ScenePass(const ScenePass&) = delete;
   ScenePass& operator=(const ScenePass&) = delete;
@@ -46,6 +50,7 @@ class ScenePass {
   // The scene's vertex array (positions at attribute 0, the indices bound), for a technique's own
   // programs over the same geometry.
   GLuint scene_vertex_array() const noexcept { return scene_vao_; }
+  GLuint program() const noexcept { return program_; }
 
  private:
   std::size_t draw(DrawRecorder& recorder, scene::DrawRecord record, bool box, std::uint32_t index_count,

@@ -26,10 +26,14 @@ Program build(const ProgramContext& c) {
 }
 
 // The ldi program's counters in run.json's per-frame values (differences at frame ends).
-constexpr std::array<const char*, 18> kLdiFrameCounts = {
+constexpr std::array<const char*, 33> kLdiFrameCounts = {
     "peel_passes", "peel_fragments", "gl_peel_fragments", "peel_samples", "gl_peel_samples", "peel_pass_mismatches", "layers",
     "gl_layers", "layer_texel_mismatches", "crop_mismatch", "compressed_mismatches", "test_points", "parity_mismatches_layers",
-    "parity_mismatches_ranges", "misclassified_layers", "misclassified_ranges", "parity_mismatches_all", "fetches_all"};
+    "parity_mismatches_ranges", "misclassified_layers", "misclassified_ranges", "parity_mismatches_all", "fetches_all",
+    // Clipping and lens frames (model/ldi/clip.h): per frame, the misclassification against the exact reference among them.
+    "clip_draws", "clip_fragments", "clip_discarded", "clip_depth_tests", "clip_samples", "clip_fetches", "clip_fetches_layers",
+    "clip_fetches_all", "clip_fetches_ranges", "clip_classified", "clip_misclassified", "clip_draw_mismatches", "clip_depth_mismatches",
+    "clip_cycles", "clip_bytes"};
 
 void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) {
   for (const char* name : kLdiFrameCounts) pf[name] = stat(now, name) - stat(last, name);
@@ -73,9 +77,31 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
                 {"misclassified_ranges", stat(p, ("misclassified_ranges_" + k).c_str())}};
   }
   j["by_kind"] = kinds;
+  // Clipping and lens frames.
+  for (const char* name : {"clip_frames", "clip_draws", "clip_fragments", "gl_clip_fragments", "clip_samples", "gl_clip_samples",
+                           "clip_discarded", "gl_clip_discarded", "clip_fetches", "gl_clip_fetches", "clip_depth_tests", "clip_volume_tests",
+                           "clip_draw_mismatches", "clip_decision_mismatches", "clip_depth_mismatches", "clip_volumes",
+                           "clip_volume_mismatches", "clip_classified", "clip_near_surface", "clip_misclassified", "clip_fetches_layers",
+                           "clip_fetches_all", "clip_fetches_ranges", "clip_cache_hits", "clip_cache_misses", "clip_cycles", "clip_bytes"})
+    j[name] = stat(p, name);
+  const std::uint64_t clip_tests = stat(p, "clip_fragments");
+  const auto per_test = [clip_tests](std::uint64_t v) {
+    return clip_tests ? nlohmann::ordered_json(static_cast<double>(v) / static_cast<double>(clip_tests)) : nlohmann::ordered_json(nullptr);
+  };
+  j["clip_discard_rate"] = per_test(stat(p, "clip_discarded"));
+  j["clip_fetches_per_test_layers"] = per_test(stat(p, "clip_fetches_layers"));
+  j["clip_fetches_per_test_all"] = per_test(stat(p, "clip_fetches_all"));
+  j["clip_fetches_per_test_ranges"] = per_test(stat(p, "clip_fetches_ranges"));
+  const std::uint64_t clip_classified = stat(p, "clip_classified");
+  j["clip_misclassification_rate"] = clip_classified ? nlohmann::ordered_json(static_cast<double>(stat(p, "clip_misclassified")) /
+                                                                              static_cast<double>(clip_classified))
+                                                     : nlohmann::ordered_json(nullptr);
+  const std::uint64_t clip_frames = stat(p, "clip_frames");
+  j["clip_cycles_per_frame"] = clip_frames ? nlohmann::ordered_json(static_cast<double>(stat(p, "clip_cycles")) / static_cast<double>(clip_frames))
+                                           : nlohmann::ordered_json(nullptr);
   j["peel_cycles"] = stat(p, "peel_cycles");
   j["vpt_cycles"] = stat(p, "vpt_cycles");
-  j["cycles"] = stat(p, "peel_cycles") + stat(p, "vpt_cycles");
+  j["cycles"] = stat(p, "peel_cycles") + stat(p, "vpt_cycles") + stat(p, "clip_cycles");
   j["cycles_total"] = cycles;
   j["memory_bytes"] = stat(memory, "bytes_ldi");
   j["peel_bytes"] = stat(p, "peel_bytes");
@@ -85,7 +111,7 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
 
 nlohmann::ordered_json summary(const SummaryInputs& in) {
   nlohmann::ordered_json j = totals(in.group, in.stats.contains("gpu.memory") ? in.stats["gpu.memory"] : nlohmann::ordered_json::object(), in.cycles);
-  for (const char* key : {"shape", "ldi_seed"}) copy_property(in.header, key, j);
+  for (const char* key : {"shape", "ldi_seed", "ldi_application", "ldi_reader", "ldi_volumes"}) copy_property(in.header, key, j);
   return j;
 }
 
@@ -94,11 +120,27 @@ nlohmann::ordered_json summary(const SummaryInputs& in) {
 bool exact(const nlohmann::ordered_json& s) {
   const auto counter = [&s](const char* name) { return s.value(name, std::uint64_t{0}); };
   return relative_error(counter("peel_fragments"), counter("gl_peel_fragments")) <= kCounterErrorLimit &&
-         relative_error(counter("peel_samples"), counter("gl_peel_samples")) <= kCounterErrorLimit;
+         relative_error(counter("peel_samples"), counter("gl_peel_samples")) <= kCounterErrorLimit &&
+         relative_error(counter("clip_fragments"), counter("gl_clip_fragments")) <= kCounterErrorLimit &&
+         relative_error(counter("clip_samples"), counter("gl_clip_samples")) <= kCounterErrorLimit &&
+         counter("clip_draw_mismatches") == 0 && counter("clip_depth_mismatches") == 0 && counter("clip_volume_mismatches") == 0;
 }
 
 std::string describe(const nlohmann::ordered_json& l) {
   std::string s;
+  if (l.value("clip_frames", std::uint64_t{0}) > 0) {
+    const auto u = [&l](const char* name) { return l[name].get<std::uint64_t>(); };
+    s += fmt::format("  ldi volume test    {} draws, fragments model {} GL {}, discarded model {} GL {}, samples model {} GL {}\n", u("clip_draws"),
+                     u("clip_fragments"), u("gl_clip_fragments"), u("clip_discarded"), u("gl_clip_discarded"), u("clip_samples"),
+                     u("gl_clip_samples"));
+    s += fmt::format("  ldi volume test    {} draws and {} final depth buffers unlike GL's; {} of {} classified fragments misclassified "
+                     "({} near a surface)\n",
+                     u("clip_draw_mismatches"), u("clip_depth_mismatches"), u("clip_misclassified"), u("clip_classified"), u("clip_near_surface"));
+    s += fmt::format("  ldi readers        fetches a test: layers {:.3f}, all (the paper's) {:.3f}, ranges {:.3f}; {:.0f} cycles a frame\n",
+                     l["clip_fetches_per_test_layers"].get<double>(), l["clip_fetches_per_test_all"].get<double>(),
+                     l["clip_fetches_per_test_ranges"].get<double>(), l["clip_cycles_per_frame"].get<double>());
+    return s;
+  }
   s += fmt::format("  ldi peel           {} passes, fragments model {} GL {}, samples model {} GL {}, {} passes differ\n",
                    l["peel_passes"].get<std::uint64_t>(), l["peel_fragments"].get<std::uint64_t>(),
                    l["gl_peel_fragments"].get<std::uint64_t>(), l["peel_samples"].get<std::uint64_t>(),

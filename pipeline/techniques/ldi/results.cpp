@@ -4,7 +4,8 @@
 namespace nbsim::techniques {
 
 // Layered depth images (Trapp & Doellner): the model replays GL's peel passes, crops, compresses and
-// runs both parity tests on its own LDI. Its keys (ldi.*) set timing only, so every point of a sweep
+// runs the parity tests on its own LDI; in clipping and lens traces it runs the volume test on every
+// scene fragment (model/ldi/clip.h), where the ldi.clip_* keys (test costs, texel cache) matter. Its keys (ldi.*) set timing only, so every point of a sweep
 // answers alike: the errors are correctness counts against GL (the peel's counters, the layers, the
 // parity answers; all 0) and the misclassification against the exact reference, which the LDI's
 // side (a capture option: one trace per side) and not the model sets. No reference setting; no
@@ -45,6 +46,16 @@ TechniqueResults ldi_results() {
              K::Error, l("misclassification_rate_layers")),
       metric("misclassified", "points", "test points misclassified (uncompressed reader)", K::Outcome, l("misclassified_layers")),
       metric("classified_points", "points", "test points not within epsilon of a surface", K::Outcome, l("classified_points")),
+      metric("clip_cycles", "cycles", "model cycles of the clipping and lens draws (their volume tests, depth tests and cache fills)", K::Cost,
+             l("clip_cycles")),
+      metric("clip_fetches", "texels", "texels the clipping and lens draws' reader fetched", K::Cost, l("clip_fetches")),
+      metric("clip_discarded", "fragments", "fragments the volume test discarded (their depth tests saved)", K::Outcome, l("clip_discarded")),
+      metric("clip_misclassified", "fragments", "clipping and lens fragments misclassified against the exact reference", K::Outcome,
+             l("clip_misclassified")),
+      zero(metric("clip_draw_mismatches", "draws", "clipping and lens draws whose counters or discarded fragments differ from GL's; 0",
+                  K::Error, l("clip_draw_mismatches"))),
+      zero(metric("clip_depth_mismatches", "frames", "clipping and lens frames whose final depth buffer differs from GL's; 0", K::Error,
+                  l("clip_depth_mismatches"))),
       memory,
   };
   t.headline_cost = "ldi_cycles";

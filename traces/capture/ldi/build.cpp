@@ -287,25 +287,11 @@ LdiBuild build_ldi_along(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, 
   return b;
 }
 
-GlVptAnswers gl_vpt(const LdiBuild& b, const std::vector<std::int32_t>& x, const std::vector<std::int32_t>& y,
-                    const std::vector<float>& z) {
-  if (x.size() != y.size() || x.size() != z.size()) throw std::invalid_argument("gl_vpt: point vectors of unequal length");
-  const std::size_t count = x.size();
-  GlVptAnswers a;
-  a.inside_layers.resize(count);
-  a.fetches_layers.resize(count);
-  a.inside_ranges.resize(count);
-  a.fetches_ranges.resize(count);
-  a.inside_all.resize(count);
-  a.fetches_all.resize(count);
-  if (count == 0) return a;
+void upload_vpt_textures(const LdiBuild& b, GLuint cropped, GLuint compressed) {
   const Rect& r = b.crop.rect;
   const int d = b.crop.depth_complexity;
   const ldi::Ldi& l = b.peel.ldi;
-  Textures tex;
-  const GLuint cropped = tex.make(GL_TEXTURE_2D_ARRAY), compressed = tex.make(GL_TEXTURE_2D);
-  const bool any = r.w > 0 && r.h > 0 && d > 0;
-  if (any) {
+  if (r.w > 0 && r.h > 0 && d > 0) {
     // The cropped layered texture: GL's layers inside GL's crop, d deep.
     std::vector<float> texels(static_cast<std::size_t>(r.w) * r.h * d);
     for (int k = 0; k < d; ++k)
@@ -329,6 +315,26 @@ GlVptAnswers gl_vpt(const LdiBuild& b, const std::vector<std::int32_t>& x, const
     glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   }
+}
+
+GlVptAnswers gl_vpt(const LdiBuild& b, const std::vector<std::int32_t>& x, const std::vector<std::int32_t>& y,
+                    const std::vector<float>& z) {
+  if (x.size() != y.size() || x.size() != z.size()) throw std::invalid_argument("gl_vpt: point vectors of unequal length");
+  const std::size_t count = x.size();
+  GlVptAnswers a;
+  a.inside_layers.resize(count);
+  a.fetches_layers.resize(count);
+  a.inside_ranges.resize(count);
+  a.fetches_ranges.resize(count);
+  a.inside_all.resize(count);
+  a.fetches_all.resize(count);
+  if (count == 0) return a;
+  const Rect& r = b.crop.rect;
+  const int d = b.crop.depth_complexity;
+  const bool any = r.w > 0 && r.h > 0 && d > 0;
+  Textures tex;
+  const GLuint cropped = tex.make(GL_TEXTURE_2D_ARRAY), compressed = tex.make(GL_TEXTURE_2D);
+  upload_vpt_textures(b, cropped, compressed);
   std::vector<std::int32_t> points(4 * count);
   for (std::size_t p = 0; p < count; ++p) {
     points[4 * p] = x[p];

@@ -23,6 +23,7 @@
 #include "model/ldi/ldi.h"
 #include "model/mesh/crossings.h"
 #include "model/mesh/mesh.h"
+#include "traces/capture/gl_program.h"
 #include "traces/capture/ldi/peel.h"
 
 namespace nbsim::capture {
@@ -67,6 +68,11 @@ LdiBuild build_ldi(const mesh::TriMesh& m, const LdiBuildConfig& config, DrawRec
 // direction 0, viewpoint_ms 0): for axis-aligned views (a shape touching the cube's faces) and tests.
 LdiBuild build_ldi_along(const mesh::TriMesh& m, const mesh::OrthoFrame& frame, int size_texels, int max_layers,
                          DrawRecorder* recorder = nullptr);
+
+// Fills two fresh GL texture names (GL_TEXTURE_2D_ARRAY, GL_TEXTURE_2D) with b's parity-test
+// textures: the cropped layered R32F texture (GL's layers inside GL's crop, d deep) and the RG32UI
+// compressed one, nearest filtering; a 1x1 stand-in each when the LDI has no layer.
+void upload_vpt_textures(const LdiBuild& b, GLuint cropped, GLuint compressed);
 
 // GL's volumetric parity test (shaders/ldi/vpt.comp) of points (x, y: texels of the LDI, possibly
 // outside it; z: linear depth) with both readers: the cropped layered texture built from b's LDI and

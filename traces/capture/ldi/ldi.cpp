@@ -17,6 +17,7 @@
 #include "model/mesh/shapes.h"
 #include "traces/capture/draw_recorder.h"
 #include "traces/capture/ldi/build.h"
+#include "traces/capture/ldi/clip.h"
 #include "traces/capture/ldi/mesh_loader.h"
 #include "traces/capture/ldi/test_points.h"
 #include "traces/format/ldi/ldi_chunk.h"
@@ -101,30 +102,52 @@ std::array<double, 9> random_rotation(std::uint64_t seed, std::uint32_t frame) {
   return m;
 }
 
+// The options every ldi capture reads: the shape (or mesh), the build settings, the epsilon.
+struct ShapeOptions {
+  std::string shape, mesh_file;
+  int shape_param = 0;
+  mesh::TriMesh mesh;
+  LdiBuildConfig config;
+  int points = 0;
+  double epsilon = 1e-5;
+  std::uint64_t seed = 1;
+};
+
+ShapeOptions read_shape_options(const OptionValues& o) {
+  ShapeOptions r;
+  r.mesh_file = o.text(mesh_option());
+  r.shape = o.text(shape_option());
+  const int param = static_cast<int>(o.integer(shape_param_option()));
+  if (r.mesh_file != "none") {
+    if (o.has("shape") || o.has("shape-param")) throw InputError("give --shape or --mesh, not both");
+    r.mesh = load_mesh(r.mesh_file);
+    r.shape = "mesh:" + std::filesystem::path(r.mesh_file).filename().string();
+    mesh::require_closed(r.mesh, fmt::format("--mesh '{}'", r.mesh_file));
+  } else {
+    r.mesh = mesh::make_shape(r.shape, param > 0 ? std::optional<int>(param) : std::nullopt);
+    mesh::require_closed(r.mesh, fmt::format("--shape {}", r.shape));
+  }
+  r.shape_param = param;
+  std::tie(r.config.grid_h, r.config.grid_v) = parse_grid(o.text(grid_option()));
+  r.config.size_texels = static_cast<int>(o.integer(ldi_size_option()));
+  r.config.max_layers = static_cast<int>(o.integer(max_layers_option()));
+  r.points = static_cast<int>(o.integer(points_option()));
+  r.epsilon = parse_epsilon(o.text(epsilon_option()));
+  r.seed = static_cast<std::uint64_t>(o.integer(seed_option()));
+  return r;
+}
+
 class Ldi final : public Technique {
  public:
-  explicit Ldi(const TechniqueSetup& s) {
-    const OptionValues& o = s.options;
-    mesh_file_ = o.text(mesh_option());
-    shape_ = o.text(shape_option());
-    const int param = static_cast<int>(o.integer(shape_param_option()));
-    if (mesh_file_ != "none") {
-      if (o.has("shape") || o.has("shape-param")) throw InputError("give --shape or --mesh, not both");
-      mesh_ = load_mesh(mesh_file_);
-      shape_ = "mesh:" + std::filesystem::path(mesh_file_).filename().string();
-      mesh::require_closed(mesh_, fmt::format("--mesh '{}'", mesh_file_));
-    } else {
-      mesh_ = mesh::make_shape(shape_, param > 0 ? std::optional<int>(param) : std::nullopt);
-      mesh::require_closed(mesh_, fmt::format("--shape {}", shape_));
-    }
-    shape_param_ = param;
-    std::tie(config_.grid_h, config_.grid_v) = parse_grid(o.text(grid_option()));
-    config_.size_texels = static_cast<int>(o.integer(ldi_size_option()));
-    config_.max_layers = static_cast<int>(o.integer(max_layers_option()));
-    points_ = static_cast<int>(o.integer(points_option()));
-    epsilon_ = parse_epsilon(o.text(epsilon_option()));
-    seed_ = static_cast<std::uint64_t>(o.integer(seed_option()));
-  }
+  explicit Ldi(ShapeOptions r)
+      : shape_(std::move(r.shape)),
+        mesh_file_(std::move(r.mesh_file)),
+        shape_param_(r.shape_param),
+        mesh_(std::move(r.mesh)),
+        config_(r.config),
+        points_(r.points),
+        epsilon_(r.epsilon),
+        seed_(r.seed) {}
 
   trace::Properties variant_properties() const override {
     trace::Properties p = {{"shape", shape_}};
@@ -264,9 +287,12 @@ class Ldi final : public Technique {
 }  // namespace
 
 const std::vector<OptionSpec>& ldi_options() {
-  static const std::vector<OptionSpec> options = {shape_option(),      shape_param_option(), mesh_option(),    ldi_size_option(),
-                                                  grid_option(),       max_layers_option(),  points_option(),  epsilon_option(),
-                                                  seed_option()};
+  static const std::vector<OptionSpec> options = [] {
+    std::vector<OptionSpec> v = {shape_option(), shape_param_option(), mesh_option(),    ldi_size_option(), grid_option(),
+                                 max_layers_option(), points_option(), epsilon_option(), seed_option()};
+    for (const OptionSpec& a : ldi_application_options()) v.push_back(a);
+    return v;
+  }();
   return options;
 }
 
@@ -276,7 +302,20 @@ BenchPreset ldi_bench_preset() {
   return {"boxes", "fly", "8x8", {{"shape", "knot"}, {"ldi-size", "256"}}, "shape", {}};
 }
 
-std::unique_ptr<Technique> make_ldi(const TechniqueSetup& setup) { return std::make_unique<Ldi>(setup); }
+std::unique_ptr<Technique> make_ldi(const TechniqueSetup& setup) {
+  const OptionValues& o = setup.options;
+  ShapeOptions r = read_shape_options(o);
+  if (!ldi_application_chosen(o)) {
+    // (Checked against the defaults, not for presence: a recorded command line spells every option out.)
+    for (const OptionSpec& a : ldi_application_options())
+      if (a.name != "application" && o.text(a) != a.default_value)
+        throw InputError(fmt::format("--{} is for --application clip or lens", a.name));
+    return std::make_unique<Ldi>(std::move(r));
+  }
+  if (o.text(points_option()) != points_option().default_value)
+    throw InputError("--points is for --application shape (clip and lens test every scene fragment)");
+  return make_ldi_application(setup, {std::move(r.mesh), r.shape, r.config, r.epsilon});
+}
 
 // This technique's row of the capture's table (technique.h).
 TechniqueRow ldi_technique() {
@@ -287,7 +326,11 @@ TechniqueRow ldi_technique() {
           make_ldi,
           ldi_bench_preset(),
           {},
-          [](const OptionValues&) { return std::string("an LDI capture renders one shape from its own viewpoints"); }};
+          [](const OptionValues& o) {
+            return ldi_application_chosen(o) ? std::string()
+                                             : std::string("an LDI capture renders one shape from its own viewpoints (--application clip "
+                                                           "or lens draws a scene)");
+          }};
 }
 
 }  // namespace nbsim::capture

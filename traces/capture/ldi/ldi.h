@@ -8,7 +8,7 @@
 // (shaders/ldi/vpt.comp) and the exact reference. Records: the peel draws, LDIL and LDIT
 // (traces/format/ldi/ldi_chunk.h).
 // The observer is not used: the scene, the camera path and --size only satisfy the capture driver
-// (the header says so in `observer`); use the cheapest scene (`--scene boxes --boxes 0`).
+// (the header says so in `observer`); no scene is built. --application clip or lens (clip.h) draws a scene instead.
 #pragma once
 
 #include <memory>

@@ -165,24 +165,9 @@ const OptionSpec& tolerance_option() {
   return spec;
 }
 
-double parse_number(const std::string& s, const char* option, double lo, double hi) {
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(s, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != s.size() || !(v >= lo && v <= hi)) throw InputError(fmt::format("--{} '{}' is not a number in [{}, {}]", option, s, lo, hi));
-  return v;
-}
+double parse_number(const std::string& s, const char* option, double lo, double hi) { return parse_real(s, std::string("--") + option, lo, hi); }
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  for (std::string item; std::getline(in, item, ',');) out.push_back(item);
-  return out;
-}
+std::vector<std::string> split(const std::string& s) { return split_list(s, ','); }
 
 std::vector<relief::Method> parse_methods(const std::string& s) {
   if (s == "all") return {relief::kAllMethods.begin(), relief::kAllMethods.end()};
@@ -388,9 +373,9 @@ class Relief final : public Technique {
     if (city_) {
       const scene::FrameView fv = scene::FrameView::make(f.begin, width_, height_, projection_.near_m, 0.0, false, false);
       const glm::dvec3 eye(pose.eye);
-      const double box_distance = distance_to(box_bounds_, eye);
+      const double box_distance = scene::distance_to(box_bounds_, eye);
       for (std::uint32_t o : scene::frustum_objects(scene_.scene, fv))
-        (distance_to(scene_.scene.objects[o], eye) < box_distance ? before : after).push_back(o);
+        (scene::distance_to(scene_.scene.objects[o], eye) < box_distance ? before : after).push_back(o);
     }
     recorder_.begin_frame(16 + before.size() + methods_.size() * (1 + after.size()));
     const glm::mat4 city_view_proj = proj * view;
@@ -542,15 +527,6 @@ class Relief final : public Technique {
     box_at_ = fmt::format("{},{},{}", x0, z0, side);
   }
 
-  // The distance from `eye` to the nearest point of `b` (0 inside).
-  static double distance_to(const scene::Aabb& b, const glm::dvec3& eye) {
-    double sum = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      const double out = std::max({0.0, static_cast<double>(b.lo[k]) - eye[k], eye[k] - static_cast<double>(b.hi[k])});
-      sum += out * out;
-    }
-    return std::sqrt(sum);
-  }
 
   static void counts_add(CapturedFrame& out, const std::string& name, std::uint64_t v) { out.counts.emplace_back(name, v); }
 

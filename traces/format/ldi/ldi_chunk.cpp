@@ -156,6 +156,96 @@ ChunkSpec ldi_all_layers_chunk_spec() {
 
 namespace {
 
+std::string volume_rule(const TechniqueRecord& r) {
+  const std::uint64_t w = u(r, "width"), h = u(r, "height"), layers = u(r, "layer_count"), side = u(r, "comp_side");
+  if (w < 1 || w > kMaxSide || h < 1 || h > kMaxSide)
+    return fmt::format("the LDI is {}x{} texels; each side must be 1 to {}", w, h, kMaxSide);
+  if (layers > kMaxLayers) return fmt::format("layer_count is {}, above {}", layers, kMaxLayers);
+  if (side > kMaxSide) return fmt::format("comp_side is {}, above {}", side, kMaxSide);
+  if (length<float>(r, "layers") != static_cast<std::size_t>(layers * w * h))
+    return fmt::format("field 'layers' has {} values, but layer_count x width x height is {}", length<float>(r, "layers"), layers * w * h);
+  if (length<float>(r, "mesh_vertices") % 3 != 0 || length<std::uint32_t>(r, "mesh_triangles") % 3 != 0)
+    return "the mesh's vertex and index counts must be multiples of 3";
+  if (length<std::uint32_t>(r, "compressed") != 2 * side * side)
+    return fmt::format("field 'compressed' has {} values, but comp_side {} needs {}", length<std::uint32_t>(r, "compressed"), side, 2 * side * side);
+  const std::int64_t cx = i(r, "crop_x"), cy = i(r, "crop_y"), cw = i(r, "crop_w"), ch = i(r, "crop_h");
+  if (cx < 0 || cy < 0 || cw < 0 || ch < 0 || cx + cw > static_cast<std::int64_t>(w) || cy + ch > static_cast<std::int64_t>(h))
+    return fmt::format("the crop ({}, {}, {}x{}) is not inside the {}x{} LDI", cx, cy, cw, ch, w, h);
+  return {};
+}
+
+std::string clip_rule(const TechniqueRecord& r) {
+  const std::uint64_t volumes = u(r, "volume_count");
+  if (volumes < 1 || volumes > 4) return fmt::format("volume_count is {}, not 1 to 4", volumes);
+  if (u(r, "reader") > 2) return fmt::format("reader is {}, not 0 (layers), 1 (all) or 2 (ranges)", u(r, "reader"));
+  if (length<float>(r, "view_proj") != 16) return fmt::format("field 'view_proj' has {} values, not 16", length<float>(r, "view_proj"));
+  if (length<float>(r, "window_to_texel") != 16 * volumes)
+    return fmt::format("field 'window_to_texel' has {} values, but {} volumes need {}", length<float>(r, "window_to_texel"), volumes, 16 * volumes);
+  const std::size_t draws = length<std::uint32_t>(r, "draws");
+  for (const char* name : {"keep_inside", "gl_discarded", "gl_fetches", "gl_hash_a", "gl_hash_b"})
+    if (length<std::uint32_t>(r, name) != draws)
+      return fmt::format("field '{}' has {} values, but there are {} draws", name, length<std::uint32_t>(r, name), draws);
+  for (std::uint32_t k : std::get<std::vector<std::uint32_t>>(find_field(r, "keep_inside")->value))
+    if (k > 1) return fmt::format("a keep_inside value is {}, not 0 or 1", k);
+  return {};
+}
+
+}  // namespace
+
+ChunkSpec ldi_volume_chunk_spec() {
+  ChunkSpec spec{
+      kLdiVolumeChunk,
+      "ldi",
+      "LdiVolume",
+      {{"volume", FieldKind::U32, "the volume's number: the order of the volume tests"},
+       {"shape", FieldKind::String, "its shape: a procedural shape's name (and parameter), or mesh:FILE"},
+       {"center_x", FieldKind::F64, "the centre of its unit cube in the world, metres"},
+       {"center_y", FieldKind::F64, "likewise, y (up)"},
+       {"center_z", FieldKind::F64, "likewise, z"},
+       {"size", FieldKind::F64, "the side of its unit cube in the world: world = centre + size (p - 0.5)"},
+       {"mesh_vertices", FieldKind::VecF32, "the closed mesh in the unit cube, x y z a vertex (the exact reference's)"},
+       {"mesh_triangles", FieldKind::VecU32, "its triangles, three vertex indices each, outward (counter-clockwise)"},
+       {"view", FieldKind::VecF32, "the LDI's orthographic frame in the unit cube (viewpoint selection's choice): direction, right, up"},
+       {"width", FieldKind::U32, "LDI width, texels"},
+       {"height", FieldKind::U32, "LDI height, texels"},
+       {"layer_count", FieldKind::U32, "the depth complexity d"},
+       {"layers", FieldKind::VecF32, "the LDI as GL peeled it (as LdiImage's layers)"},
+       {"crop_x", FieldKind::I32, "GL's crop: left texel"},
+       {"crop_y", FieldKind::I32, "bottom texel"},
+       {"crop_w", FieldKind::I32, "width, texels"},
+       {"crop_h", FieldKind::I32, "height, texels"},
+       {"comp_side", FieldKind::U32, "side of GL's compressed RG32UI texture"},
+       {"compressed", FieldKind::VecU32, "GL's compressed texture, comp_side^2 texels of two values"}}};
+  spec.rule = volume_rule;
+  return spec;
+}
+
+ChunkSpec ldi_clip_chunk_spec() {
+  ChunkSpec spec{
+      kLdiClipChunk,
+      "ldi",
+      "LdiClip",
+      {{"volume_count", FieldKind::U32, "volumes tested, in their LdiVolume order (1 to 4)"},
+       {"reader", FieldKind::U32, "the shader's reader: 0 layers (early exit), 1 all layers (the paper's), 2 ranges (compressed)"},
+       {"width", FieldKind::U32, "viewport width, pixels"},
+       {"height", FieldKind::U32, "viewport height, pixels"},
+       {"epsilon", FieldKind::F64, "the reference's near-surface distance, unit-cube units: nearer fragments are counted apart"},
+       {"view_proj", FieldKind::VecF32, "the scene's view-projection uniform, column-major (clip control NEGATIVE_ONE_TO_ONE)"},
+       {"window_to_texel", FieldKind::VecF32,
+        "per volume, the uniform taking (gl_FragCoord.xyz, 1) to homogeneous (LDI texel x, y, linear depth), column-major"},
+       {"draws", FieldKind::VecU32, "the draws that ran the volume test, in draw order (the others ran plain)"},
+       {"keep_inside", FieldKind::VecU32, "per tested draw: 0 discards inside any volume (clipping), 1 outside every volume (a lens's focus)"},
+       {"gl_discarded", FieldKind::VecU32, "per tested draw: GL's discarded fragments"},
+       {"gl_fetches", FieldKind::VecU32, "per tested draw: texels GL's reader fetched"},
+       {"gl_hash_a", FieldKind::VecU32, "per tested draw: the sum of a hash of each discarded fragment's pixel and depth bits (shaders/ldi/clip.frag)"},
+       {"gl_hash_b", FieldKind::VecU32, "per tested draw: a second such sum"},
+       {"depth_crc", FieldKind::U32, "CRC-32 of GL's depth buffer after the frame's draws (floats, y up)"}}};
+  spec.rule = clip_rule;
+  return spec;
+}
+
+namespace {
+
 // "HxV": the viewpoint grid, each side 1 .. 1024.
 bool valid_grid(std::string_view v) {
   const std::size_t x = v.find('x');
@@ -183,12 +273,17 @@ std::vector<HeaderKeySpec> ldi_header_keys() {
           whole_key(t, "mesh_vertices", 0, 0xFFFFFFFFu, "1086", "the shape's vertices"),
           whole_key(t, "mesh_triangles", 0, 0xFFFFFFFFu, "2160", "the shape's triangles"),
           text_key(t, "ldi_placement", "frame 0 unrotated, ...", "how each frame places the shape"),
-          text_key(t, "ldi_depth", "peel: clip control ZERO_TO_ONE, ...", "the peel's depth convention")};
+          text_key(t, "ldi_depth", "peel: clip control ZERO_TO_ONE, ...", "the peel's depth convention"),
+          choice_key(t, "ldi_application", {"clip", "lens"}, "clip", "the application in a scene (absent: one shape's LDI and test points)"),
+          choice_key(t, "ldi_reader", {"all", "layers", "ranges"}, "all", "the reader of the applications' fragment shader"),
+          text_key(t, "ldi_volumes", "auto", "the applications' volumes as given (auto, or SHAPE@X,Y,Z,SIZE;...)"),
+          real_key(t, "ldi_lens_height", 0.0, 1.0, false, "0.25", "the lens's flattening of the objects inside its volumes")};
 }
 
 // This technique's part of the format (technique_chunks.h): the image and test-point chunks and the header keys.
 TechniqueFormat ldi_format() {
-  return {{ldi_image_chunk_spec(), ldi_tests_chunk_spec(), ldi_all_layers_chunk_spec()}, ldi_header_keys()};
+  return {{ldi_image_chunk_spec(), ldi_tests_chunk_spec(), ldi_all_layers_chunk_spec(), ldi_volume_chunk_spec(), ldi_clip_chunk_spec()},
+          ldi_header_keys()};
 }
 
 }  // namespace nbsim::trace

@@ -20,6 +20,8 @@ namespace nbsim::trace {
 inline constexpr std::uint32_t kLdiImageChunk = fourcc("LDIL");
 inline constexpr std::uint32_t kLdiTestsChunk = fourcc("LDIT");
 inline constexpr std::uint32_t kLdiAllLayersChunk = fourcc("LDIA");
+inline constexpr std::uint32_t kLdiVolumeChunk = fourcc("LDIV");
+inline constexpr std::uint32_t kLdiClipChunk = fourcc("LDIC");
 
 // What a test point was chosen to probe (LDIT field `kind`; fixed values: they are in files).
 enum class LdiPointKind : std::uint32_t {
@@ -45,6 +47,17 @@ ChunkSpec ldi_tests_chunk_spec();
 //   count U32 (LDIT's), gl_inside_all VecU32 (0 or 1), gl_fetches_all VecU32 (d inside the crop, 0
 //   outside). Rule: vector lengths, answers 0 or 1.
 ChunkSpec ldi_all_layers_chunk_spec();
+
+// LdiVolume (LDIV): one volume of the clipping and lens applications (model/ldi/clip.h), in the
+// frame that built it (frame 0): its closed mesh in the unit cube, its placement in the world, and
+// its LDI as GL peeled it with GL's crop and compressed texture. Rule: the mesh's vectors are
+// triples, the layers layer_count x width x height, the crop inside the LDI, compressed 2 comp_side^2.
+ChunkSpec ldi_volume_chunk_spec();
+// LdiClip (LDIC): one a frame of those applications: the reader, the uniforms of the volume test,
+// the draws it ran on with GL's per-draw answers, and the final depth buffer's CRC-32. Rule:
+// volume_count 1 to 4, reader 0 to 2, view_proj 16 values, window_to_texel 16 a volume, per-draw
+// vectors as long as `draws`, keep_inside 0 or 1.
+ChunkSpec ldi_clip_chunk_spec();
 
 // Its header keys (the LDI's size, grid and limits; the shape and how it was placed).
 std::vector<HeaderKeySpec> ldi_header_keys();
