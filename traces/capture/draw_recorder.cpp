@@ -94,6 +94,12 @@ std::size_t DrawRecorder::begin_draw(scene::DrawRecord record, std::size_t captu
     glBindBufferRange(GL_TRANSFORM_FEEDBACK_BUFFER, 0, tf_buffer_, static_cast<GLintptr>(tf_used_), static_cast<GLsizeiptr>(bytes));
     tf_used_ += bytes;
   }
+  // Each recorded draw starts a scene of its own: llvmpipe (Mesa 22.3) miscounts a GL_SAMPLES_PASSED query
+  // when its scene is flushed between BeginQuery and EndQuery (the binner full: a 1600x1200 frame of
+  // city draws gave one draw of 43 fragments, all hidden, 102,365 samples passed), and a flush here,
+  // outside any query, leaves each query one draw's binning. Measured cost: about 4 % of GL's time
+  // at 1600x1200 (1,196 draws a frame).
+  glFlush();
   glBeginQuery(GL_SAMPLES_PASSED, q_samples_[slot]);
   glBeginQuery(GL_CLIPPING_INPUT_PRIMITIVES, q_clip_in_[slot]);
   glBeginQuery(GL_CLIPPING_OUTPUT_PRIMITIVES, q_clip_out_[slot]);

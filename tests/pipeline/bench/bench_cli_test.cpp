@@ -80,24 +80,27 @@ TEST(BenchReplayCliTest, BadArgumentsExitTwo) {
                            {"--technique ldi --ldi-size 0", "--ldi-size"}});
 }
 
-// A small LDI capture (the knot at 64x64) replayed in the same run: the peel passes' fragments and
-// samples equal GL's, and the model's parity answers GL's (within_thresholds covers both).
+// The LDI bench is the clipping application (three knots, LDIs of 64x64, in the city's walk at the
+// preset's 512x512) replayed in the same run: every clipping draw's counters, discards and final
+// depth buffer equal GL's (within_thresholds covers them).
 TEST(BenchReplayCliTest, LdiRatioPrinted) {
   const CliResult r = run_nbsim("bench replay --technique ldi --frames 2 --ldi-size 64");
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("technique"), "ldi");
-  EXPECT_EQ(j.at("mode"), "knot") << "the ldi bench's default shape";
+  EXPECT_EQ(j.at("mode"), "all") << "the ldi bench's default reader, the paper's";
   EXPECT_EQ(j.at("options").at("ldi-size"), "64");
   EXPECT_TRUE(j.at("within_thresholds").get<bool>());
   const nlohmann::json& s = j.at("ldi_summary");
-  EXPECT_EQ(s.at("peel_fragments"), s.at("gl_peel_fragments"));
-  EXPECT_EQ(s.at("peel_samples"), s.at("gl_peel_samples"));
-  EXPECT_EQ(s.at("parity_mismatches_layers"), 0);
-  EXPECT_EQ(s.at("parity_mismatches_ranges"), 0);
+  EXPECT_EQ(s.at("clip_frames"), 2);
+  EXPECT_EQ(s.at("clip_fragments"), s.at("gl_clip_fragments"));
+  EXPECT_EQ(s.at("clip_samples"), s.at("gl_clip_samples"));
+  EXPECT_EQ(s.at("clip_discarded"), s.at("gl_clip_discarded"));
+  EXPECT_EQ(s.at("clip_draw_mismatches"), 0);
+  EXPECT_EQ(s.at("clip_depth_mismatches"), 0);
   const std::string ratio = std::to_string(j.at("ratio").get<double>());
   ::testing::Test::RecordProperty("ldi_replay_ratio", ratio);
-  std::printf("bench replay ldi knot 64x64, 2 frames: ratio %s (gl %.1f ms, replay %.1f ms)\n", ratio.c_str(),
+  std::printf("bench replay ldi clipping (knots, LDIs 64x64), 2 frames: ratio %s (gl %.1f ms, replay %.1f ms)\n", ratio.c_str(),
               j.at("gl_ms").get<double>(), j.at("replay_ms").get<double>());
 }
 

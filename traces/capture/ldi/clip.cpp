@@ -277,11 +277,12 @@ class LdiApplication final : public Technique {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, decisions_);
       draw_all(focus, true);
     }
+    glFinish();  // GL's time: the draws, not the read-backs after them
+    f.end.gl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::vector<std::uint32_t> words(4 * draws);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     if (draws) glGetNamedBufferSubData(decisions_, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
     f.draws = recorder_.collect();
-    f.end.gl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     const std::vector<float> depth = read_depth(target_->framebuffer(), width_, height_, scene::DepthWhich::Final).texels;
     glUseProgram(0);
 

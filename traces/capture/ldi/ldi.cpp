@@ -297,9 +297,9 @@ const std::vector<OptionSpec>& ldi_options() {
 }
 
 BenchPreset ldi_bench_preset() {
-  // The LDI work does not look at the observer: no scene is built (ldi_technique's no_scene), the
-  // smallest viewport the capture accepts.
-  return {"boxes", "fly", "8x8", {{"shape", "knot"}, {"ldi-size", "256"}}, "shape", {}};
+  // The paper's clipping in the city (clip.h): every scene fragment runs the volume test, three knots
+  // along the walk; --mode picks the reader (the paper's, every layer, by default).
+  return {"city", "walk", "512x512", {{"application", "clip"}, {"shape", "knot"}, {"ldi-size", "128"}, {"reader", "all"}}, "reader", {}};
 }
 
 std::unique_ptr<Technique> make_ldi(const TechniqueSetup& setup) {
