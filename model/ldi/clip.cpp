@@ -70,6 +70,10 @@ ClipVolume read_volume(const scene::TechniqueRecord& rec, std::uint64_t frame, s
 
 }  // namespace
 
+std::uint32_t depth_crc(const std::vector<float>& texels) {
+  return static_cast<std::uint32_t>(crc32(0L, reinterpret_cast<const Bytef*>(texels.data()), static_cast<uInt>(texels.size() * sizeof(float))));
+}
+
 std::optional<ClipReader> parse_clip_reader(const std::string& name) {
   for (std::size_t i = 0; i < kClipReaderNames.size(); ++i)
     if (name == kClipReaderNames[i]) return static_cast<ClipReader>(i);
@@ -301,9 +305,7 @@ ClipFrameCounts ClipReplay::run_frame(const scene::Frame& f) {
   if (next != draws.size())
     throw InputError(fmt::format("frame {}: the {} record names draw {}, which the frame does not have (or not in order)", frame, kClipLabel,
                                  draws[next]));
-  const std::uint32_t crc = static_cast<std::uint32_t>(
-      crc32(0L, reinterpret_cast<const Bytef*>(depth_->texels.data()), static_cast<uInt>(depth_->texels.size() * sizeof(float))));
-  out.depth_mismatch = crc != static_cast<std::uint32_t>(scalar<std::uint64_t>(rec, "depth_crc", kClipLabel, frame));
+  out.depth_mismatch = depth_crc(depth_->texels) != static_cast<std::uint32_t>(scalar<std::uint64_t>(rec, "depth_crc", kClipLabel, frame));
   return out;
 }
 

@@ -64,6 +64,9 @@ constexpr std::uint32_t mix_bits(std::uint32_t x) noexcept {
   return x;
 }
 
+// CRC-32 (zlib) of a depth buffer's float bits: LDIC's depth_crc.
+std::uint32_t depth_crc(const std::vector<float>& texels);
+
 struct ClipVolume {
   std::string shape;
   std::array<double, 3> center{};  // the unit cube's centre in the world

@@ -13,8 +13,6 @@
 #include <filesystem>
 #include <sstream>
 
-#include <zlib.h>
-
 #include "model/common/error.h"
 #include "model/ldi/clip.h"
 #include "model/mesh/shapes.h"
@@ -313,8 +311,7 @@ class LdiApplication final : public Technique {
                    {"gl_fetches", fetches},
                    {"gl_hash_a", hash_a},
                    {"gl_hash_b", hash_b},
-                   {"depth_crc", static_cast<std::uint64_t>(static_cast<std::uint32_t>(
-                                     crc32(0L, reinterpret_cast<const Bytef*>(depth.data()), static_cast<uInt>(depth.size() * sizeof(float)))))}};
+                   {"depth_crc", static_cast<std::uint64_t>(ldi::depth_crc(depth))}};
     f.technique_records.push_back(std::move(clip));
     std::uint64_t all_discarded = 0, all_fetches = 0;
     for (std::size_t k = 0; k < discarded.size(); ++k) all_discarded += discarded[k], all_fetches += fetches[k];
