@@ -305,6 +305,7 @@ NBSIM_ROW_LOOP_CLONES void reduce_rows(FarOp op, const float* src, float* dst, i
 void NBuffer::build(const DepthImage& depth) {
   NBSIM_CHECK(depth.width == width_ && depth.height == height_, "depth image size differs from the N-buffer's");
   if (has_rect_levels()) return build_rect(depth);
+  if (on_demand_) std::fill(current_.begin(), current_.end(), std::uint8_t{1});
   // Level i's rows [y0, y1) need level i - 1's rows [y0, y1 + s): bands go from the top down.
   int banded = 1;  // levels [1, banded) are built band by band
   while (banded < levels_ && (1 << (banded - 1)) <= build_band_max_step) ++banded;
@@ -378,7 +379,77 @@ UpdateStats NBuffer::new_stats() const {
   UpdateStats s;
   s.texels_recomputed.assign(static_cast<std::size_t>(levels_), 0);
   s.texels_changed.assign(static_cast<std::size_t>(levels_), 0);
+  s.texels_invalidated.assign(static_cast<std::size_t>(levels_), 0);
   return s;
+}
+
+void NBuffer::set_on_demand(bool on) {
+  if (on && has_rect_levels()) throw InputError("an on-demand N-buffer has square levels only (levels=rect cannot be computed on demand)");
+  on_demand_ = on;
+  if (on) current_.assign(static_cast<std::size_t>(levels_) * pixels(), 1);  // the levels as they stand are current
+  else current_.clear();
+}
+
+long long NBuffer::current_texels(int level) const noexcept {
+  if (!on_demand_) return static_cast<long long>(pixels());
+  const auto begin = current_.begin() + static_cast<std::ptrdiff_t>(offset(level));
+  return std::count(begin, begin + static_cast<std::ptrdiff_t>(pixels()), std::uint8_t{1});
+}
+
+void NBuffer::ensure(int level, int x, int y, UpdateStats& stats) {
+  NBSIM_CHECK(level >= 0 && level < levels_ && x >= 0 && y >= 0 && x < width_ && y < height_, "N-buffer texel out of range");
+  if (!on_demand_ || level == 0) return;
+  const std::size_t k = offset(level) + static_cast<std::size_t>(y) * width_ + x;
+  if (current_[k]) return;
+  // Its four sources (inside the image) first, then the texel: level - 1 at x, x + s and y, y + s.
+  const int s = 1 << (level - 1);
+  const bool right = x + s < width_, up = y + s < height_;
+  ensure(level - 1, x, y, stats);
+  if (right) ensure(level - 1, x + s, y, stats);
+  if (up) ensure(level - 1, x, y + s, stats);
+  if (right && up) ensure(level - 1, x + s, y + s, stats);
+  const float* src = level_ptr(level - 1);
+  const std::size_t j = static_cast<std::size_t>(y) * width_ + x;
+  float v = src[j];
+  if (right) v = farther(config_.op, v, src[j + s]);
+  if (up) {
+    const std::size_t u = j + static_cast<std::size_t>(s) * width_;
+    v = farther(config_.op, v, src[u]);
+    if (right) v = farther(config_.op, v, src[u + s]);
+  }
+  ++stats.texels_recomputed[static_cast<std::size_t>(level)];
+  float& dst = data_[k];
+  if (dst != v) ++stats.texels_changed[static_cast<std::size_t>(level)];
+  dst = v;
+  current_[k] = 1;
+}
+
+void NBuffer::ensure_all(UpdateStats& stats) {
+  if (!on_demand_) return;
+  for (int i = 1; i < levels_; ++i)
+    for (int y = 0; y < height_; ++y)
+      for (int x = 0; x < width_; ++x) ensure(i, x, y, stats);
+}
+
+void NBuffer::invalidate_from(std::vector<Texel>& changed, UpdateStats& stats) {
+  std::vector<Texel> next;
+  for (int i = 1; i < levels_ && !changed.empty(); ++i) {
+    const int s = 1 << (i - 1);
+    next.clear();
+    std::uint8_t* cur = current_.data() + offset(i);
+    for (const Texel t : changed)
+      for (int dy = 0; dy <= s; dy += s)
+        for (int dx = 0; dx <= s; dx += s) {
+          const int x = t.x - dx, y = t.y - dy;
+          if (x < 0 || y < 0) continue;
+          std::uint8_t& c = cur[static_cast<std::size_t>(y) * width_ + x];
+          if (!c) continue;  // stale already, and so is every texel that reads it
+          c = 0;
+          next.push_back({x, y});
+        }
+    stats.texels_invalidated[static_cast<std::size_t>(i)] += static_cast<long long>(next.size());
+    std::swap(changed, next);
+  }
 }
 
 UpdateStats NBuffer::update(const DepthImage& depth, const Rect& dirty) {
@@ -387,6 +458,21 @@ UpdateStats NBuffer::update(const DepthImage& depth, const Rect& dirty) {
   const Rect r = clip(dirty, width_, height_);
   if (r.empty()) return stats;
 
+  if (on_demand_) {  // level 0 pixel by pixel, then the texels that read a changed one are marked stale
+    std::vector<Texel> changed;
+    float* l0 = level_ptr(0);
+    for (int y = r.y; y < r.y1(); ++y)
+      for (int x = r.x; x < r.x1(); ++x) {
+        const std::size_t k = static_cast<std::size_t>(y) * width_ + x;
+        const float v = quantize_toward_far(depth.texels[k], config_.format, config_.op);
+        if (l0[k] != v) changed.push_back({x, y});
+        l0[k] = v;
+      }
+    stats.texels_recomputed[0] = r.area();
+    stats.texels_changed[0] = static_cast<long long>(changed.size());
+    invalidate_from(changed, stats);
+    return stats;
+  }
   // Level 0: copy the dirty pixels, note the bounding box of those that changed.
   Rect changed;
   std::vector<float> row(static_cast<std::size_t>(width_));
@@ -461,6 +547,10 @@ UpdateStats NBuffer::update(std::span<const PixelWrite> writes) {
   }
   changed.resize(kept);
   stats.texels_changed[0] = static_cast<long long>(changed.size());
+  if (on_demand_) {
+    invalidate_from(changed, stats);
+    return stats;
+  }
   if (has_rect_levels()) {  // the changed pixels' box goes up the rectangle levels
     Rect box;
     for (const Texel t : changed) grow(box, t.x, t.y);

@@ -84,6 +84,9 @@ struct PixelWrite {
 struct UpdateStats {
   std::vector<long long> texels_recomputed;  // texels read-modify-written (4 reads each above level 0)
   std::vector<long long> texels_changed;     // of those, texels whose stored value changed
+  // On demand (NBuffer::set_on_demand): level texels marked stale because a pixel they read changed
+  // (a flag cleared, no texel read or written).
+  std::vector<long long> texels_invalidated;
 
   long long total_recomputed() const noexcept;
   long long total_changed() const noexcept;
@@ -107,6 +110,23 @@ class NBuffer {
   // The covering query() reads for a rectangle already clipped to the image; its level is the
   // plane read (for rectangle levels, the plane of its 2^log2_w x 2^log2_h rectangles).
   Covering covering(const Rect& clipped, CoveringSpec spec) const;
+
+  // On demand ("model only what a scene needs"): levels above 0 are computed when a query reads
+  // them. update() writes level 0 and marks stale the level texels that read a changed pixel (the
+  // texels still current, and recursively those that read them: a current texel's four sources are
+  // always current, so the marking stops where it meets a stale texel); ensure() computes a stale
+  // texel from the level below, recursively, and keeps it until a pixel under it changes. Every
+  // answer equals a full build's. build() still builds every level (a clear writes them all).
+  // Square levels only: InputError for rectangle levels.
+  void set_on_demand(bool on);
+  bool on_demand() const noexcept { return on_demand_; }
+  // Makes texel (level, x, y) current (in the image), counting the texels it computed in `stats`.
+  void ensure(int level, int x, int y, UpdateStats& stats);
+  // Makes every texel current (before the levels are read out whole).
+  void ensure_all(UpdateStats& stats);
+  // Texels of `level` that are current (every one when not on demand).
+  long long current_texels(int level) const noexcept;
+  UpdateStats new_stats() const;
 
   // Incremental updates; the result equals a full rebuild from the new level 0.
   // The pixels of `depth` inside `dirty` replace level 0's (depth must be the N-buffer's size).
@@ -142,7 +162,8 @@ class NBuffer {
   float* level_ptr(int i) noexcept { return data_.data() + offset(i); }
   void build_level(int dst);
   void build_rect(const DepthImage& depth);
-  UpdateStats new_stats() const;
+  // On demand: marks stale the texels above level 0 that read the changed level-0 texels.
+  void invalidate_from(std::vector<Texel>& changed, UpdateStats& stats);
   // Rectangle levels: plane `p` from its parent plane over the texels [x0, x1) x [y0, y1); returns
   // the changed texels' count and grows `changed` by their box.
   long long rect_reduce(int p, const Rect& region, Rect& changed);
@@ -161,6 +182,9 @@ class NBuffer {
   std::vector<std::uint8_t> horizontal_;
   std::vector<int> plane_of_;
   int levels_x_ = 1, levels_y_ = 1;
+  // On demand: a flag per texel of every level (level 0's always 1): the texel is current.
+  bool on_demand_ = false;
+  std::vector<std::uint8_t> current_;
 };
 
 }  // namespace nbsim

@@ -30,7 +30,8 @@ NBufferUnit::NBufferUnit(const sc_core::sc_module_name& name, stats::Registry& r
 void NBufferUnit::wait_until(std::uint64_t done, stats::Counter& counter) { counter += sim::spend_until(done); }
 
 UpdateWork NBufferUnit::post(UpdateWork w) {
-  const std::uint64_t texels = w.recomputed();
+  const NBufferUnitConfig& c = core_.config();
+  const std::uint64_t texels = w.engine_texels(c.update_texels_per_cycle, c.invalidations_per_cycle);
   const std::uint64_t bytes = w.bytes_read + w.bytes_written;
   if (texels == 0 && bytes == 0) return w;
   queued_texels_ += texels;

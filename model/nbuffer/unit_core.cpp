@@ -107,7 +107,8 @@ void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c, const 
         -1, kMaxAspectLog2);
   s.add(key("update_policy"), c.update_policy,
         "when depth changes reach the levels: eager (at once), batched (at the end of a pass), lazy (when a query "
-        "reads them)",
+        "reads them), on_demand (level 0 at once; a level texel computed when a query reads it, kept until a pixel under "
+        "it changes; square levels only)",
         name_list(kUpdatePolicyNames));
   s.add(key("lookup_latency_cycles"), c.lookup_latency_cycles, "cycles",
         "latency of a query's lookups (address, tag check, data, compare) on cache hits", 0, kMaxLatencyCycles);
@@ -117,6 +118,9 @@ void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c, const 
         "texels the update engine recomputes per cycle", kMinRate, kMaxUpdateRate);
   s.add(key("update_latency_cycles"), c.update_latency_cycles, "cycles",
         "fill and drain latency of one batch of the update engine", 0, kMaxLatencyCycles);
+  s.add(key("invalidations_per_cycle"), c.invalidations_per_cycle, "flags/cycle",
+        "update_policy=on_demand: stale flags the update engine clears per cycle when a pixel under them changes",
+        kMinRate, kMaxUpdateRate * 16);
   s.add(key("cache_size_bytes"), c.cache.size_bytes, "bytes",
         "texel cache of the query port, a multiple of cache_line_bytes x cache_ways; 0 disables it", 0, kMaxCacheBytes);
   s.add(key("cache_line_bytes"), c.cache.line_bytes, "bytes",
@@ -143,7 +147,9 @@ void NBufferUnitConfig::validate() const {
   if (levels == "rect" && level_cap != -1)
     bad(fmt::format("{}.levels=rect builds every level: {}.level_cap must be -1, got {}", key_prefix, key_prefix, level_cap));
   if (!parse_update_policy(update_policy))
-    bad(fmt::format("{}.update_policy must be one of eager, batched, lazy, got '{}'", key_prefix, update_policy));
+    bad(fmt::format("{}.update_policy must be one of eager, batched, lazy, on_demand, got '{}'", key_prefix, update_policy));
+  if (update_policy == "on_demand" && levels == "rect")
+    bad(fmt::format("{}.update_policy=on_demand computes square levels only: {}.levels must be square", key_prefix, key_prefix));
   if (level_cap < -1 || level_cap > kMaxLevelCap)
     bad(fmt::format("{}.level_cap must be -1 (all levels) or 0 to {}, got {}", key_prefix, kMaxLevelCap, level_cap));
   if (capped_max_lookups < 0 || capped_max_lookups > kMaxCappedLookups)
@@ -158,6 +164,9 @@ void NBufferUnitConfig::validate() const {
       update_texels_per_cycle > kMaxUpdateRate)
     bad(fmt::format("{}.update_texels_per_cycle must be {} to {}, got {}", key_prefix, kMinRate, kMaxUpdateRate,
                     update_texels_per_cycle));
+  if (!std::isfinite(invalidations_per_cycle) || invalidations_per_cycle < kMinRate || invalidations_per_cycle > kMaxUpdateRate * 16)
+    bad(fmt::format("{}.invalidations_per_cycle must be {} to {}, got {}", key_prefix, kMinRate, kMaxUpdateRate * 16,
+                    invalidations_per_cycle));
   const int line = cache.line_bytes;
   if (line < kMinLineBytes || line > kMaxLineBytes || (line & (line - 1)) != 0)
     bad(fmt::format("{}.cache_line_bytes must be a power of two from {} to {}, got {}", key_prefix, kMinLineBytes,
@@ -199,6 +208,18 @@ UpdatePolicy NBufferUnitConfig::policy() const {
 // ---------------------------------------------------------------------------------------------
 // Work
 
+std::uint64_t UpdateWork::invalidated() const noexcept {
+  std::uint64_t n = 0;
+  for (auto v : texels_invalidated) n += v;
+  return n;
+}
+
+std::uint64_t UpdateWork::engine_texels(double texels_per_cycle, double invalidations_per_cycle) const noexcept {
+  const std::uint64_t flags = invalidated();
+  if (flags == 0) return recomputed();
+  return recomputed() + static_cast<std::uint64_t>(std::ceil(static_cast<double>(flags) * texels_per_cycle / invalidations_per_cycle));
+}
+
 std::uint64_t UpdateWork::recomputed() const noexcept {
   std::uint64_t n = 0;
   for (auto v : texels_recomputed) n += v;
@@ -218,6 +239,7 @@ UpdateWork& UpdateWork::operator+=(const UpdateWork& o) {
   };
   add(texels_recomputed, o.texels_recomputed);
   add(texels_changed, o.texels_changed);
+  add(texels_invalidated, o.texels_invalidated);
   depth_pixels_reduced += o.depth_pixels_reduced;
   bytes_read += o.bytes_read;
   bytes_written += o.bytes_written;
@@ -259,6 +281,8 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
                            level_labels(nb_))),
       changed_(g.vector("texels_changed", "texels", "recomputed texels whose stored value changed, per level",
                         level_labels(nb_))),
+      invalidated_(g.vector("texels_invalidated", "texels",
+                            "update_policy=on_demand: level texels marked stale (a flag cleared), per level", level_labels(nb_))),
       reduced_pixels_(
           g.counter("depth_pixels_reduced", "pixels",
                     "depth pixels read to form reduced-resolution level-0 texels (resolution_divisor > 1)")),
@@ -293,6 +317,7 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
   bins_x_ = ceil_div(nb_.width(), kBinPx);
   bins_y_ = ceil_div(nb_.height(), kBinPx);
   bins_.resize(static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(bins_y_));
+  if (policy_ == UpdatePolicy::OnDemand) nb_.set_on_demand(true);
 }
 
 Rect NBufferUnitCore::to_reduced(const Rect& r) const noexcept {
@@ -317,6 +342,7 @@ UpdateWork NBufferUnitCore::new_work() const {
   UpdateWork w;
   w.texels_recomputed.assign(static_cast<std::size_t>(nb_.level_count()), 0);
   w.texels_changed.assign(static_cast<std::size_t>(nb_.level_count()), 0);
+  w.texels_invalidated.assign(static_cast<std::size_t>(nb_.level_count()), 0);
   return w;
 }
 
@@ -333,6 +359,11 @@ void NBufferUnitCore::account(const UpdateStats& s, UpdateWork& w) {
     w.texels_changed[i] += chg;
     recomputed_.add(i, rec);
     changed_.add(i, chg);
+    if (i < s.texels_invalidated.size()) {
+      const auto inv = static_cast<std::uint64_t>(s.texels_invalidated[i]);
+      w.texels_invalidated[i] += inv;
+      invalidated_.add(i, inv);
+    }
     const std::uint64_t rd = i > 0 ? rec * bpt : 0, wr = chg * bpt;
     w.bytes_read += rd;
     w.bytes_written += wr;
@@ -466,7 +497,7 @@ UpdateWork NBufferUnitCore::depth_changed(const DepthImage& depth, const Rect& d
   reduced_pixels_ += w.depth_pixels_reduced;
 
   const auto area = static_cast<std::uint64_t>(rr.area());
-  if (policy_ == UpdatePolicy::Eager) {
+  if (policy_ == UpdatePolicy::Eager || policy_ == UpdatePolicy::OnDemand) {
     account(nb_.update(level0_source(), rr), w);
     applied_.add(kEager, area);
   } else if (mark(rr) && policy_ == UpdatePolicy::Batched) {
@@ -498,7 +529,7 @@ UpdateWork NBufferUnitCore::depth_changed(std::span<const PixelWrite> writes) {
     for (const Texel& t : scratch_) reduce_block(t.x, t.y, w);
   reduced_pixels_ += w.depth_pixels_reduced;
 
-  if (policy_ == UpdatePolicy::Eager) {
+  if (policy_ == UpdatePolicy::Eager || policy_ == UpdatePolicy::OnDemand) {
     w += apply_writes(scratch_);
     applied_.add(kEager, scratch_.size());
   } else if (mark(scratch_) && policy_ == UpdatePolicy::Batched) {
@@ -545,6 +576,13 @@ UpdateWork NBufferUnitCore::end_of_frame() {
 }
 
 UpdateWork NBufferUnitCore::flush() {
+  if (policy_ == UpdatePolicy::OnDemand) {  // every stale texel computed
+    UpdateStats st = nb_.new_stats();
+    nb_.ensure_all(st);
+    UpdateWork w = new_work();
+    account(st, w);
+    return w;
+  }
   const std::uint64_t before = pending_count_;
   UpdateWork w = apply_pending({0, 0, nb_.width(), nb_.height()});
   applied_.add(kFlush, before);
@@ -589,6 +627,13 @@ QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth) {
       }
       a.update = apply_pending({x0, y0, x1 - x0 + cov.width_px(), y1 - y0 + cov.height_px()});
     }
+    if (policy_ == UpdatePolicy::OnDemand) {
+      UpdateStats st = nb_.new_stats();
+      for (int i = 0; i < cov.count; ++i)
+        nb_.ensure(cov.level, cov.squares[static_cast<std::size_t>(i)].x, cov.squares[static_cast<std::size_t>(i)].y, st);
+      a.update = new_work();
+      account(st, a.update);
+    }
     const QueryResult q = nb_.query(rr, covering_);
     NBSIM_CHECK(q.complete && q.level == cov.level, "N-buffer query read another level than its covering");
     a.value = neutral_depth(op_);
@@ -612,14 +657,18 @@ QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth) {
     ++tiled_queries_;
     if (policy_ == UpdatePolicy::Lazy)
       a.update = apply_pending({rr.x, row_y, std::max(rr.w, side), std::max(rr.h, side)});
+    UpdateStats st = nb_.new_stats();
+    if (policy_ == UpdatePolicy::OnDemand) a.update = new_work();
     a.value = neutral_depth(op_);
     for (long long j = 0; j < ny; ++j) {
       const int y = j + 1 < ny ? rr.y + static_cast<int>(j) * side : ny == 1 ? row_y : rr.y1() - side;
       for (long long i = 0; i < nx; ++i) {
         const int x = i + 1 < nx ? rr.x + static_cast<int>(i) * side : std::max(rr.x, rr.x1() - side);
+        nb_.ensure(top, x, y, st);
         read_texel(a, top, x, y);
       }
     }
+    if (policy_ == UpdatePolicy::OnDemand) account(st, a.update);
   }
   if (policy_ == UpdatePolicy::Lazy)
     applied_.add(kLazy, a.update.texels_recomputed.empty() ? 0 : a.update.texels_recomputed[0]);

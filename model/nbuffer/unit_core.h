@@ -10,6 +10,10 @@
 // levels are conservative only while the pending changes all move depth nearer); lazy applies the
 // pending changes a query's squares cover just before answering it. All three reach the same
 // levels once applied; in between, batched answers are conservative and possibly less tight.
+// on_demand (NBuffer::set_on_demand) writes level 0 at once and only marks stale the level texels
+// that read a changed pixel; a query computes the stale texels it reads (recursively, from the level
+// below) and they stay until a pixel under them changes: the upkeep follows the queries, not the
+// pixels, and every answer equals eager's. Square levels only.
 #pragma once
 
 #include <array>
@@ -33,10 +37,10 @@
 namespace nbsim::nbuffer {
 
 // When depth-buffer changes reach the levels. Fixed values (they may end up in run outputs).
-enum class UpdatePolicy : std::uint8_t { Eager = 0, Batched = 1, Lazy = 2 };
+enum class UpdatePolicy : std::uint8_t { Eager = 0, Batched = 1, Lazy = 2, OnDemand = 3 };
 
 // Names of UpdatePolicy, indexed by its value (model/common/names.h).
-inline constexpr std::array<std::string_view, 3> kUpdatePolicyNames = {"eager", "batched", "lazy"};
+inline constexpr std::array<std::string_view, 4> kUpdatePolicyNames = {"eager", "batched", "lazy", "on_demand"};
 std::string_view to_string(UpdatePolicy p) noexcept;
 std::optional<UpdatePolicy> parse_update_policy(std::string_view s) noexcept;
 
@@ -57,11 +61,12 @@ struct NBufferUnitConfig {
   // The levels' neighbourhoods (nbuffer.h LevelShape): square or rect; rect: max_aspect_log2.
   std::string levels = "square";
   int max_aspect_log2 = -1;
-  std::string update_policy = "eager";    // eager, batched or lazy
+  std::string update_policy = "eager";    // eager, batched, lazy or on_demand
   int lookup_latency_cycles = 8;          // address, tag check and data of one lookup batch
   double lookups_per_cycle = 4.0;         // the four squares of a query in one cycle
   double update_texels_per_cycle = 16.0;  // texels recomputed per cycle by the update engine
   int update_latency_cycles = 16;         // fill and drain of the update engine per batch
+  double invalidations_per_cycle = 64.0;  // on_demand: stale flags the update engine clears per cycle (no texel moves)
   // Texel cache of the query port: 16 KiB, 256-byte lines (an 8x8 tile of f32 texels), 4 ways.
   memory::CacheConfig cache{16 * 1024, 256, 4};
 
@@ -100,12 +105,17 @@ constexpr bool hidden_behind(FarOp op, float nearest, float farthest) noexcept {
 struct UpdateWork {
   std::vector<std::uint64_t> texels_recomputed;  // per level (index = level); empty: nothing done
   std::vector<std::uint64_t> texels_changed;     // per level: recomputed texels whose value changed
+  std::vector<std::uint64_t> texels_invalidated; // per level: texels marked stale (on_demand: a flag, no texel moved)
   std::uint64_t depth_pixels_reduced = 0;        // depth pixels read to form reduced level-0 texels
   std::uint64_t bytes_read = 0;                  // level texels streamed in from memory
   std::uint64_t bytes_written = 0;               // changed texels written back
 
   std::uint64_t recomputed() const noexcept;
   std::uint64_t changed() const noexcept;
+  std::uint64_t invalidated() const noexcept;
+  // The engine's texel slots this work takes: the recomputed texels, and the stale flags at
+  // `invalidations_per_cycle` where the texels go at `texels_per_cycle`.
+  std::uint64_t engine_texels(double texels_per_cycle, double invalidations_per_cycle) const noexcept;
   UpdateWork& operator+=(const UpdateWork& o);
 };
 
@@ -124,7 +134,7 @@ struct QueryAnswer {
   std::array<Texel, 4> texels{};
   std::uint64_t cache_hits = 0, cache_misses = 0;
   std::uint64_t bytes_read = 0;  // cache-line fills for the misses
-  UpdateWork update;             // lazy policy: pending changes applied before answering
+  UpdateWork update;             // lazy policy: pending changes applied before answering; on_demand: stale texels computed
 };
 
 // Bytes per storage texel as the unit moves them (u24 as a 32-bit D24X8 word).
@@ -227,6 +237,7 @@ class NBufferUnitCore {
   stats::Counter& bytes_written_;
   stats::VectorCounter& recomputed_;
   stats::VectorCounter& changed_;
+  stats::VectorCounter& invalidated_;
   stats::Counter& reduced_pixels_;
   stats::VectorCounter& changes_;
   stats::VectorCounter& applied_;

@@ -18,7 +18,7 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   config::Schema s;
   NBufferUnitConfig::describe(s, c);
   const auto d = s.describe();
-  ASSERT_EQ(d.size(), 16u);
+  ASSERT_EQ(d.size(), 17u);
   auto find = [&](const std::string& key) {
     for (const auto& e : d)
       if (e["key"] == key) return e;
@@ -33,6 +33,7 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   EXPECT_EQ(find("nbuffer.levels")["default"], "square");
   EXPECT_EQ(find("nbuffer.max_aspect_log2")["default"], -1);
   EXPECT_EQ(find("nbuffer.update_policy")["default"], "eager");
+  EXPECT_EQ(find("nbuffer.invalidations_per_cycle")["default"], 64.0);
   EXPECT_EQ(find("nbuffer.lookup_latency_cycles")["unit"], "cycles");
   EXPECT_EQ(find("nbuffer.lookups_per_cycle")["default"], 4.0);
   EXPECT_EQ(find("nbuffer.cache_size_bytes")["default"], 16384);

@@ -19,7 +19,7 @@ namespace nbsim::nbuffer {
 namespace {
 
 constexpr FarOp kOps[] = {FarOp::Max, FarOp::Min};
-constexpr const char* kPolicies[] = {"eager", "batched", "lazy"};
+constexpr const char* kPolicies[] = {"eager", "batched", "lazy", "on_demand"};
 constexpr int kDivisors[] = {1, 2, 4, 8};
 
 std::string where(FarOp op, const std::string& policy, int d, const std::string& format) {
@@ -152,7 +152,8 @@ TEST(NBufferUnitCoreTest, ConservativeForEveryPolicyAndDivisor) {
           cfg.covering = std::string(kCoveringKindNames[static_cast<std::size_t>(variant % 3)]);
           cfg.align = std::string(kCoveringAlignNames[static_cast<std::size_t>(variant % 2)]);
           // And rectangle levels (all of them, or |i - j| <= 1) in a quarter of the configurations.
-          if (variant % 4 == 3) cfg.levels = "rect", cfg.max_aspect_log2 = variant % 8 == 3 ? -1 : 1;
+          // (on_demand computes square levels only.)
+          if (variant % 4 == 3 && std::string(policy) != "on_demand") cfg.levels = "rect", cfg.max_aspect_log2 = variant % 8 == 3 ? -1 : 1;
           const int w = size.w, h = size.h;
           Rig rig(op, cfg, w, h);
           std::mt19937 rng(1000u + static_cast<unsigned>(d) * 7u + static_cast<unsigned>(op) * 3u +
@@ -184,7 +185,7 @@ TEST(NBufferUnitCoreTest, ConservativeForEveryPolicyAndDivisor) {
         }
 }
 
-// Once applied (end_of_pass for batched, flush for lazy), every policy's levels equal a fresh
+// Once applied (end_of_pass for batched, flush for lazy and on_demand), every policy's levels equal a fresh
 // build over the reduced depth buffer, for every storage format.
 TEST(NBufferUnitCoreTest, LevelsEqualFreshBuildOnceApplied) {
   for (const FarOp op : kOps)
@@ -212,8 +213,8 @@ TEST(NBufferUnitCoreTest, LevelsEqualFreshBuildOnceApplied) {
         }
 }
 
-// The three policies fed the same changes: eager and lazy answer alike at every query; batched
-// answers at least as far before end_of_pass and alike after it.
+// The four policies fed the same changes: eager, lazy and on_demand answer alike at every query;
+// batched answers at least as far before end_of_pass and alike after it.
 TEST(NBufferUnitCoreTest, PoliciesAgreeOnceApplied) {
   for (const FarOp op : kOps)
     for (const int d : {1, 2, 8}) {
@@ -234,8 +235,9 @@ TEST(NBufferUnitCoreTest, PoliciesAgreeOnceApplied) {
           }
           const Rect r = ref::random_rect(qrng, 33, 41, false);
           const float e = rigs[0]->core->query(r, 0.5f).value, b = rigs[1]->core->query(r, 0.5f).value,
-                      l = rigs[2]->core->query(r, 0.5f).value;
+                      l = rigs[2]->core->query(r, 0.5f).value, o = rigs[3]->core->query(r, 0.5f).value;
           if (e != l) fails.add(ref::str(r) + ": lazy answered " + std::to_string(l) + ", eager " + std::to_string(e));
+          if (e != o) fails.add(ref::str(r) + ": on_demand answered " + std::to_string(o) + ", eager " + std::to_string(e));
           if (!at_least_as_far(op, b, e))
             fails.add(ref::str(r) + ": batched answered " + std::to_string(b) + ", nearer than eager's " +
                       std::to_string(e));
@@ -244,10 +246,10 @@ TEST(NBufferUnitCoreTest, PoliciesAgreeOnceApplied) {
         for (int q = 0; q < 10; ++q) {
           const Rect r = ref::random_rect(qrng, 33, 41, false);
           const float e = rigs[0]->core->query(r, 0.5f).value, b = rigs[1]->core->query(r, 0.5f).value,
-                      l = rigs[2]->core->query(r, 0.5f).value;
-          if (e != b || e != l)
+                      l = rigs[2]->core->query(r, 0.5f).value, o = rigs[3]->core->query(r, 0.5f).value;
+          if (e != b || e != l || e != o)
             fails.add(ref::str(r) + " after end_of_pass: eager " + std::to_string(e) + ", batched " +
-                      std::to_string(b) + ", lazy " + std::to_string(l));
+                      std::to_string(b) + ", lazy " + std::to_string(l) + ", on_demand " + std::to_string(o));
         }
       }
       EXPECT_EQ(fails.count(), 0) << "op " << to_string(op) << ", divisor " << d << ": " << fails.summary();
