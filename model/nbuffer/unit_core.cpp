@@ -121,6 +121,13 @@ void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c, const 
   s.add(key("invalidations_per_cycle"), c.invalidations_per_cycle, "flags/cycle",
         "update_policy=on_demand: stale flags the update engine clears per cycle when a pixel under them changes",
         kMinRate, kMaxUpdateRate * 16);
+  s.add(key("fast_clear"), c.fast_clear,
+        "a depth clear tags every level's tiles cleared (no texel written, as a depth buffer's fast clear and the Hi-Z "
+        "baselines' clear) instead of writing every level");
+  s.add(key("level0"), c.level0,
+        "level 0: copy (the paper's: the depth map copied into the levels, every change written again) or depth (the "
+        "depth buffer is level 0, nothing copied; needs resolution_divisor 1 and format f32)",
+        std::vector<std::string>{"copy", "depth"});
   s.add(key("cache_size_bytes"), c.cache.size_bytes, "bytes",
         "texel cache of the query port, a multiple of cache_line_bytes x cache_ways; 0 disables it", 0, kMaxCacheBytes);
   s.add(key("cache_line_bytes"), c.cache.line_bytes, "bytes",
@@ -148,6 +155,11 @@ void NBufferUnitConfig::validate() const {
     bad(fmt::format("{}.levels=rect builds every level: {}.level_cap must be -1, got {}", key_prefix, key_prefix, level_cap));
   if (!parse_update_policy(update_policy))
     bad(fmt::format("{}.update_policy must be one of eager, batched, lazy, on_demand, got '{}'", key_prefix, update_policy));
+  if (level0 != "copy" && level0 != "depth") bad(fmt::format("{}.level0 must be copy or depth, got '{}'", key_prefix, level0));
+  if (level0 == "depth" && (resolution_divisor != 1 || format != "f32"))
+    bad(fmt::format("{}.level0=depth reads the depth buffer as level 0: it needs {}.resolution_divisor=1 and {}.format=f32 (got {} "
+                    "and {})",
+                    key_prefix, key_prefix, key_prefix, resolution_divisor, format));
   if (update_policy == "on_demand" && levels == "rect")
     bad(fmt::format("{}.update_policy=on_demand computes square levels only: {}.levels must be square", key_prefix, key_prefix));
   if (level_cap < -1 || level_cap > kMaxLevelCap)
@@ -290,7 +302,8 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
           g.vector("depth_changes", "changes", "depth-buffer changes reported, by kind", {"rect", "writes", "clear"})),
       applied_(g.vector("texels_applied", "texels", "level-0 texels handed to the update engine, by what triggered it",
                         {"eager", "forced", "end_of_pass", "lazy", "flush"})),
-      frames_(g.counter("frames", "frames", "frames ended")) {
+      frames_(g.counter("frames", "frames", "frames ended")),
+      fast_clears_(g.counter("fast_clears", "clears", "depth clears taken as a tag on every level (fast_clear): no texel written")) {
   g.formula("lookups_per_query", "lookups/query", "lookups per query that reached the levels", [this] {
     return stats::ratio(
         static_cast<double>(lookups_.total()),
@@ -352,7 +365,9 @@ UpdateWork NBufferUnitCore::new_work() const {
 // buffer of the rows it streams) and writes the texels that changed.
 void NBufferUnitCore::account(const UpdateStats& s, UpdateWork& w) {
   const auto bpt = static_cast<std::uint64_t>(texel_bytes(format_));
+  const bool shared_level0 = config_.level0 == "depth";  // level 0 is the depth buffer: no copy to write
   for (std::size_t i = 0; i < s.texels_recomputed.size(); ++i) {
+    if (i == 0 && shared_level0) continue;
     const auto rec = static_cast<std::uint64_t>(s.texels_recomputed[i]);
     const auto chg = static_cast<std::uint64_t>(s.texels_changed[i]);
     w.texels_recomputed[i] += rec;
@@ -549,15 +564,20 @@ UpdateWork NBufferUnitCore::depth_cleared(float depth) {
   pending_count_ = 0;
   nb_.build(level0_source());
   // Every texel of every level takes the clear value (each square holds its in-image anchor), so
-  // a clear writes all levels without reading any.
+  // a clear writes all levels without reading any; a fast clear tags them instead (no work).
   UpdateWork w = new_work();
+  if (config_.fast_clear) {
+    ++fast_clears_;
+    return w;
+  }
   const auto plane = static_cast<std::uint64_t>(nb_.width()) * static_cast<std::uint64_t>(nb_.height());
-  for (std::size_t i = 0; i < w.texels_recomputed.size(); ++i) {
+  const std::size_t first = config_.level0 == "depth" ? 1 : 0;  // the depth buffer clears level 0 itself
+  for (std::size_t i = first; i < w.texels_recomputed.size(); ++i) {
     w.texels_recomputed[i] = w.texels_changed[i] = plane;
     recomputed_.add(i, plane);
     changed_.add(i, plane);
   }
-  w.bytes_written = plane * w.texels_recomputed.size() * static_cast<std::uint64_t>(texel_bytes(format_));
+  w.bytes_written = plane * (w.texels_recomputed.size() - first) * static_cast<std::uint64_t>(texel_bytes(format_));
   bytes_written_ += w.bytes_written;
   return w;
 }

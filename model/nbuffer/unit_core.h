@@ -67,6 +67,14 @@ struct NBufferUnitConfig {
   double update_texels_per_cycle = 16.0;  // texels recomputed per cycle by the update engine
   int update_latency_cycles = 16;         // fill and drain of the update engine per batch
   double invalidations_per_cycle = 64.0;  // on_demand: stale flags the update engine clears per cycle (no texel moves)
+  // A depth clear sets a per-tile clear tag on every level (as a depth buffer's fast clear, and as
+  // the Hi-Z baselines clear) instead of the update engine writing every level's texels. Off: a
+  // clear writes every level (the unit as first modelled).
+  bool fast_clear = false;
+  // Level 0: copy (the paper's: the depth map copied into the levels' storage, every depth change
+  // written again) or depth (the depth buffer itself is level 0: no copy written, level 1 reads the
+  // depth buffer; needs resolution_divisor 1 and format f32).
+  std::string level0 = "copy";
   // Texel cache of the query port: 16 KiB, 256-byte lines (an 8x8 tile of f32 texels), 4 ways.
   memory::CacheConfig cache{16 * 1024, 256, 4};
 
@@ -242,6 +250,7 @@ class NBufferUnitCore {
   stats::VectorCounter& changes_;
   stats::VectorCounter& applied_;
   stats::Counter& frames_;
+  stats::Counter& fast_clears_;
 };
 
 }  // namespace nbsim::nbuffer

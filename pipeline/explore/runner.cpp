@@ -54,11 +54,28 @@ bool point_done(const fs::path& out, const Point& p) {
   return !j.is_discarded() && j.contains("summary");
 }
 
+bool record_refused(const fs::path& out, const Point& p) {
+  if (p.refused.empty()) return false;
+  const fs::path dir = point_dir(out, p);
+  fs::create_directories(dir);
+  fs::remove(dir / "run.json");
+  std::ofstream cfg(dir / "config.json");
+  cfg << p.settings.dump(2) << '\n';
+  std::ofstream e(dir / "error.txt");
+  e << "refused before any replay, the design cannot be built: " << p.refused << '\n';
+  if (!cfg || !e) throw std::runtime_error(fmt::format("cannot write the refused point's files in {}", dir.string()));
+  return true;
+}
+
 RunReport run_points(const std::vector<Point>& points, const std::map<std::string, TraceFile>& traces, const RunOptions& o) {
   RunReport report;
   std::vector<const Point*> pending;
   std::vector<ChildJob> jobs;
   for (const Point& p : points) {
+    if (record_refused(o.out, p)) {
+      ++report.failed;
+      continue;
+    }
     if (point_done(o.out, p)) {
       ++report.resumed;
       continue;

@@ -43,8 +43,12 @@ struct RunOptions {
 struct RunReport {
   std::size_t ran = 0;      // children started this time (including failures)
   std::size_t resumed = 0;  // points done before, not run again
-  std::size_t failed = 0;   // points that failed this time
+  std::size_t failed = 0;   // points that failed this time (refused design points included)
 };
+
+// Records a refused design point (Point::refused) as failed: its folder, config.json and an
+// error.txt naming why; returns false when the point is not refused.
+bool record_refused(const std::filesystem::path& out, const Point& p);
 
 // The folder of one point.
 std::filesystem::path point_dir(const std::filesystem::path& out, const Point& p);

@@ -242,6 +242,10 @@ SlurmReport run_points_slurm(const std::vector<Point>& points, const SlurmOption
   SlurmReport report;
   std::vector<const Point*> pending;
   for (const Point& p : points) {
+    if (record_refused(o.out, p)) {  // never submitted
+      ++report.failed;
+      continue;
+    }
     if (point_done(o.out, p)) {
       ++report.resumed;
       continue;

@@ -199,23 +199,38 @@ std::vector<std::string> parameter_keys(const SweepSpec& spec) {
 }
 
 void check_points(const SweepSpec& spec, std::vector<Point>& points, const ConfigCheck& check, const std::string& origin) {
+  // Each value on its own (a key this build lacks, a value out of its limits: the whole sweep is
+  // refused); a combination that cannot be built is the point's own failure, below.
   check(sorted(spec.set), origin + ": set");
   for (const auto& [key, values] : spec.axes)
     for (std::size_t i = 0; i < values.size(); ++i) {
-      nlohmann::json one = sorted(spec.set);
+      nlohmann::json one = nlohmann::json::object();
       one[key] = values[i];
       check(one, fmt::format("{}: axes.{}[{}]", origin, key, i));
     }
-  for (std::size_t i = 0; i < spec.points.size(); ++i) {
-    nlohmann::json one = sorted(spec.set);
-    for (const auto& [k, v] : spec.points[i].items())
-      if (k != "trace") one[k] = sorted(v);
-    check(one, fmt::format("{}: points[{}]", origin, i));
-  }
+  for (std::size_t i = 0; i < spec.points.size(); ++i)
+    for (const auto& [k, v] : spec.points[i].items()) {
+      if (k == "trace") continue;
+      nlohmann::json one = nlohmann::json::object();
+      one[k] = sorted(v);
+      check(one, fmt::format("{}: points[{}].{}", origin, i, k));
+    }
   const std::vector<std::string> keys = parameter_keys(spec);
   std::set<std::string> seen;
   for (Point& p : points) {
-    const nlohmann::json effective = check(p.settings, fmt::format("{}: point ({})", origin, describe_settings(p.trace, p.settings)));
+    nlohmann::json effective;
+    try {
+      effective = check(p.settings, fmt::format("{}: point ({})", origin, describe_settings(p.trace, p.settings)));
+    } catch (const InputError& e) {
+      // Every value passed on its own above: the combination cannot be built. Recorded, not run.
+      p.refused = e.what();
+      for (const auto& k : keys) p.parameters[k] = p.settings.contains(k) ? p.settings[k] : nlohmann::json();
+      p.effective = p.settings;
+      p.id = point_id(p.trace, p.settings);
+      if (!seen.insert(p.id).second)
+        throw InputError(fmt::format("{}: the point ({}) is listed twice", origin, describe_settings(p.trace, p.settings)));
+      continue;
+    }
     for (auto& [k, v] : p.settings.items()) {
       NBSIM_CHECK(effective.contains(k), "the config check returned no value for '" + k + "'");
       v = effective[k];
@@ -243,7 +258,8 @@ void add_reference_points(std::vector<Point>& points, const std::vector<std::str
                           const std::string& origin) {
   const auto config_key = [](const Point& p) { return p.trace + '\n' + p.effective.dump(); };
   std::map<std::string, std::size_t> by_config;
-  for (std::size_t i = 0; i < points.size(); ++i) by_config.emplace(config_key(points[i]), i);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (points[i].refused.empty()) by_config.emplace(config_key(points[i]), i);
 
   // The id of the point whose config is `p`'s with `overrides`, added when the sweep lacks it.
   const auto reference = [&](std::size_t i, const nlohmann::json& overrides) -> std::string {
@@ -275,6 +291,7 @@ void add_reference_points(std::vector<Point>& points, const std::vector<std::str
   const nlohmann::json defaults = check(nlohmann::json::object(), origin + ": defaults");
   const std::size_t sweep_points = points.size();
   for (std::size_t i = 0; i < sweep_points; ++i) {
+    if (!points[i].refused.empty()) continue;  // never run: nothing to measure against
     const techniques::TechniqueResults* t = techniques::find_technique_results(points[i].technique);
     if (t && t->reference && has_reference(*t->reference, points[i].effective)) {
       // One reference for every variant the setting does not name (e.g. every test mode, so a

@@ -46,6 +46,10 @@ struct Point {
   // technique's reference setting (results.csv names its column after the declaration's
   // ReferenceSetting::column), timing_reference the generic timing one.
   std::string technique_reference, timing_reference;
+  // A design point that cannot be built (its values are each valid, the combination is not: e.g.
+  // nbuffer.level0=depth with a resolution divisor): the config check's message. It is recorded as
+  // a failed point (its error.txt) and never run; the sweep goes on.
+  std::string refused;
 };
 
 // Tunable. Most points a sweep may expand to (traces x the product of the axis sizes, or the

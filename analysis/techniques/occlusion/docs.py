@@ -232,7 +232,82 @@ def render_fidelity(outputs):
     return "\n\n".join(out)
 
 
+def upkeep_label(r):
+    clear = "fast clear" if r["nbuffer.fast_clear"] == "true" else "clear writes"
+    return f"{r['nbuffer.update_policy']}, {clear}, level 0 {r['nbuffer.level0']}"
+
+
+def render_upkeep(outputs):
+    text = outputs[-1]
+    import csv
+    import io
+    every = list(csv.DictReader(io.StringIO(text)))
+    rows = sweep_rows(text)
+    refused = [r for r in every if r["status"] == "failed"]
+    lines = ["| design (divisor 1 / 4) | upkeep texels a frame | total depth tests a frame | cycles a frame | efficiency lost (points of %) |",
+             "|---|---:|---:|---:|---:|"]
+    key = lambda r: (["eager", "batched", "lazy", "on_demand"].index(r["nbuffer.update_policy"]), r["nbuffer.fast_clear"], r["nbuffer.level0"])
+    by = {}
+    for r in rows:
+        by.setdefault(key(r), {})[r["nbuffer.resolution_divisor"]] = r
+    for k in sorted(by):
+        d = by[k]
+        def both(col, scale=1.0, fmt=None):
+            return " / ".join((fmt or (lambda v: n(v)))(float(d[x][col]) * scale) if x in d else "refused" for x in ("1", "4"))
+        lines.append(f"| {upkeep_label(next(iter(d.values())))} | {both('update_texels_per_frame')} | "
+                     f"{both('total_depth_tests_per_frame')} | {both('cycles_per_frame')} | "
+                     f"{both('efficiency_lost', 100.0, lambda v: f'{v:.2f}')} |")
+    full = {(r["nbuffer.update_policy"], r["nbuffer.fast_clear"], r["nbuffer.level0"]): r for r in rows if r["nbuffer.resolution_divisor"] == "1"}
+    upd = lambda p: float(full[(p, "false", "copy")]["update_texels_per_frame"])
+    best = min(rows, key=lambda r: float(r["cycles_per_frame"]))
+    lines += ["", f"At full resolution with the clear writing every level and level 0 a copy, on-demand levels compute "
+              f"{n(upd('on_demand'))} texels a frame against eager's {n(upd('eager'))} ({upd('eager') / upd('on_demand'):.1f}x), "
+              f"batched's {n(upd('batched'))} and lazy's {n(upd('lazy'))}, for the same culling. The cheapest point: "
+              f"{upkeep_label(best)}, divisor {best['nbuffer.resolution_divisor']}, {n(float(best['cycles_per_frame']))} cycles a "
+              f"frame. {len(refused)} points (level 0 shared at divisor 4) were refused by name and recorded as failed. "
+              f"False culls over every point: {sum(int(r['false_culls']) for r in rows)}."]
+    return "\n".join(lines)
+
+
+def pays_label(r):
+    if r["cull.mode"] == "hiz_tile":
+        return f"tile Hi-Z {r['hiz.tile_px']}x{r['hiz.tile_px']}"
+    shared = ", level 0 shared" if r["nbuffer.level0"] == "depth" else ""
+    return (f"N-buffer div {r['nbuffer.resolution_divisor']}, {r['nbuffer.format']}, {int(r['nbuffer.cache_size_bytes']) // 1024} KiB "
+            f"cache{shared}")
+
+
+def render_pays(outputs):
+    rows = sweep_rows(outputs[-1])
+    front = pareto_front(rows, "cycles_per_frame", "efficiency_lost")
+    lines = ["| design (N-buffers: on demand, fast clears) | cycles a frame | culling efficiency | efficiency lost (points of %) |",
+             "|---|---:|---:|---:|"]
+    for r in front:
+        lines.append(f"| {pays_label(r)} | {n(float(r['cycles_per_frame']))} | {100 * float(r['culling_efficiency']):.2f}% | "
+                     f"{100 * float(r['efficiency_lost']):.2f} |")
+    lines.append("")
+    nb = [r for r in rows if r["cull.mode"] == "nb_hier"]
+    for h in sorted((r for r in rows if r["cull.mode"] == "hiz_tile"), key=lambda r: int(r["hiz.tile_px"])):
+        lost, cyc = float(h["efficiency_lost"]), float(h["cycles_per_frame"])
+        ok = [r for r in nb if float(r["efficiency_lost"]) <= lost]
+        if not ok:
+            lines.append(f"Against {pays_label(h)}: no N-buffer design loses as little culling.")
+            continue
+        b = min(ok, key=lambda r: float(r["cycles_per_frame"]))
+        c = float(b["cycles_per_frame"])
+        verdict = "beats it" if c < cyc else "does not beat it"
+        lines.append(f"Against {pays_label(h)} ({n(cyc)} cycles, {100 * lost:.2f} points lost): the cheapest N-buffer design that "
+                     f"loses no more culling is {pays_label(b)}, {n(c)} cycles ({c / cyc:.3f}x), {100 * float(b['efficiency_lost']):.2f} "
+                     f"points lost: it {verdict} in this space.")
+        lines.append("")
+    return "\n".join(lines)
+
+
 BLOCKS += [
+    Block("upkeep", [["explore", "pipeline/sweeps/nbuffer_upkeep.json", "--out", "upkeep", "--jobs", "2"]], render_upkeep,
+          files=("upkeep/results.csv",), page="exploration.md"),
+    Block("pays", [["explore", "pipeline/sweeps/nbuffer_pays.json", "--out", "pays", "--jobs", "2"]], render_pays,
+          files=("pays/results.csv",), page="exploration.md"),
     Block("design", [["explore", "pipeline/sweeps/nbuffer_design.json", "--out", "design", "--jobs", "2"]], render_design,
           files=("design/results.csv",), page="exploration.md"),
     Block("hiz", [["explore", "pipeline/sweeps/hiz_baselines.json", "--out", "hiz", "--jobs", "2"]], render_hiz,

@@ -18,7 +18,7 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   config::Schema s;
   NBufferUnitConfig::describe(s, c);
   const auto d = s.describe();
-  ASSERT_EQ(d.size(), 17u);
+  ASSERT_EQ(d.size(), 19u);
   auto find = [&](const std::string& key) {
     for (const auto& e : d)
       if (e["key"] == key) return e;
@@ -34,6 +34,8 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   EXPECT_EQ(find("nbuffer.max_aspect_log2")["default"], -1);
   EXPECT_EQ(find("nbuffer.update_policy")["default"], "eager");
   EXPECT_EQ(find("nbuffer.invalidations_per_cycle")["default"], 64.0);
+  EXPECT_EQ(find("nbuffer.fast_clear")["default"], false);
+  EXPECT_EQ(find("nbuffer.level0")["default"], "copy");
   EXPECT_EQ(find("nbuffer.lookup_latency_cycles")["unit"], "cycles");
   EXPECT_EQ(find("nbuffer.lookups_per_cycle")["default"], 4.0);
   EXPECT_EQ(find("nbuffer.cache_size_bytes")["default"], 16384);
@@ -112,6 +114,12 @@ TEST(NBufferUnitConfigTest, ValidateRefusesInconsistentValues) {
       {[](NBufferUnitConfig& c) { c.levels = "rect", c.max_aspect_log2 = 0; }, "nbuffer.max_aspect_log2 must be -1"},
       {[](NBufferUnitConfig& c) { c.levels = "rect", c.level_cap = 3; },
        "nbuffer.levels=rect builds every level: nbuffer.level_cap must be -1, got 3"},
+      {[](NBufferUnitConfig& c) { c.levels = "rect", c.update_policy = "on_demand"; },
+       "nbuffer.update_policy=on_demand computes square levels only"},
+      {[](NBufferUnitConfig& c) { c.level0 = "depth", c.resolution_divisor = 4; }, "nbuffer.level0=depth reads the depth buffer"},
+      {[](NBufferUnitConfig& c) { c.level0 = "depth", c.format = "u16"; }, "nbuffer.level0=depth reads the depth buffer"},
+      {[](NBufferUnitConfig& c) { c.level0 = "texture"; }, "nbuffer.level0 must be copy or depth"},
+      {[](NBufferUnitConfig& c) { c.invalidations_per_cycle = 0.0; }, "nbuffer.invalidations_per_cycle must be"},
   };
   for (const Row& row : rows) {
     NBufferUnitConfig c;

@@ -504,5 +504,35 @@ TEST(NBufferUnitCoreTest, RefusesBadSizes) {
   EXPECT_THROW(NBufferUnitCore({}, 8, 20000, FarOp::Max, reg.group("b")), InputError);
 }
 
+// The upkeep variants: a fast clear writes no level texel; level0=depth writes no copy of level 0
+// (its changes reach level 1 as before); the answers are the same either way.
+TEST(NBufferUnitCoreTest, FastClearAndSharedLevel0CostLess) {
+  std::uint64_t recomputed[2][2] = {}, written[2][2] = {};
+  float answer[2][2] = {};
+  for (int fast = 0; fast < 2; ++fast)
+    for (int shared = 0; shared < 2; ++shared) {
+      NBufferUnitConfig cfg;
+      cfg.fast_clear = fast == 1;
+      cfg.level0 = shared ? "depth" : "copy";
+      stats::Registry reg;
+      NBufferUnitCore core(cfg, 32, 32, FarOp::Max, reg.group("u"));
+      UpdateWork w = core.depth_cleared(1.0f);
+      DepthImage d(32, 32, 1.0f);
+      for (int y = 4; y < 12; ++y)
+        for (int x = 4; x < 12; ++x) d.at(x, y) = 0.25f;
+      w += core.depth_changed(d, {4, 4, 8, 8});
+      recomputed[fast][shared] = w.recomputed();
+      written[fast][shared] = w.bytes_written;
+      answer[fast][shared] = core.query({4, 4, 8, 8}, 0.5f).value;
+    }
+  const auto plane = 32u * 32u;
+  const std::uint64_t levels = 5;  // 32x32: levels 0 .. 4 (squares up to 16x16)
+  EXPECT_EQ(recomputed[0][0] - recomputed[1][0], levels * plane) << "a clear writes every level, a fast clear none";
+  EXPECT_EQ(recomputed[1][0] - recomputed[1][1], 64u) << "the 8x8 change copied into level 0, or not";
+  EXPECT_LT(written[1][1], written[1][0]);
+  for (int fast = 0; fast < 2; ++fast)
+    for (int shared = 0; shared < 2; ++shared) EXPECT_EQ(answer[fast][shared], 0.25f);
+}
+
 }  // namespace
 }  // namespace nbsim::nbuffer

@@ -172,6 +172,30 @@ TEST(ExploreCliTest, FailingPointRecorded) {
   EXPECT_FALSE(fs::exists(out / "points" / rows[1].at("point_id") / "run.json"));
 }
 
+// A design point that cannot be built (each value valid, the combination not: level 0 shared with
+// the depth buffer at a reduced resolution) is refused by name before any replay and recorded as a
+// failed point; the sweep runs the others.
+TEST(ExploreCliTest, ImpossibleDesignRecordedAsFailed) {
+  const fs::path out = scratch("impossible");
+  const nlohmann::json sweep = {{"traces", {kSample}},
+                                {"set", {{"cull.mode", "nb_hier"}, {"nbuffer.level0", "depth"}}},
+                                {"axes", {{"nbuffer.resolution_divisor", {1, 4}}}}};
+  const CliResult r = run_nbsim("explore " + write_sweep("impossible.json", sweep).string() + " --jobs 2 --out " + out.string());
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "2 points (0 of them references): 1 run, 0 resumed, 1 failed")) << r.out;
+  const auto rows = read_csv(out / "results.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& row : rows) {
+    if (row.at("nbuffer.resolution_divisor") == "1") {
+      EXPECT_EQ(row.at("status"), "ok");
+    } else {
+      EXPECT_EQ(row.at("status"), "failed");
+      EXPECT_TRUE(has(row.at("error"), "nbuffer.level0=depth reads the depth buffer")) << row.at("error");
+      EXPECT_FALSE(fs::exists(out / "points" / row.at("point_id") / "run.json")) << "never run";
+    }
+  }
+}
+
 // A sweep naming a file that is not a trace is refused at validation, naming the file, before
 // any point runs (rather than passing validation and then failing every point).
 TEST(ExploreCliTest, NotATraceRefused) {
