@@ -303,7 +303,58 @@ def render_pays(outputs):
     return "\n".join(lines)
 
 
+# Per technique: its trace, its error column, the prefix of its N-buffer units' keys, and the key
+# and value that select its N-buffer culling (other values: its other culling).
+TECHNIQUE_TRACES = (("occlusion culling", "city_walk_512", "efficiency_lost", "nbuffer", "cull.mode", "nb_hier"),
+                    ("particles", "particles_walk", "efficiency_lost", "nbuffer", "particles.mode", "nb"),
+                    ("shadows", "shadows_city", "culled_lost_fraction", "litmap_min", None, None))
+
+
+def design_of(r, prefix):
+    clear = "fast clear" if r[f"{prefix}.fast_clear"] == "true" else "clear writes"
+    return f"{r[f'{prefix}.update_policy']}, {clear}, div {r[f'{prefix}.resolution_divisor']}, {r[f'{prefix}.format']}"
+
+
+def other_of(r, mode_key, nb_value):
+    if not mode_key or r[mode_key] == nb_value:
+        return ""
+    m = r[mode_key]
+    return m + (f" {r['hiz.tile_px']}x{r['hiz.tile_px']}" if m == "hiz_tile" else "")
+
+
+def render_techniques(outputs):
+    import math
+    rows = sweep_rows(outputs[-1])
+    lines = ["| technique | the best N-buffer design (cycles a frame, error) | the default design (eager, clear writes, div 1, f32) | "
+             "the others (cycles a frame, error) |", "|---|---|---|---|"]
+    ratio = {}
+    for name, trace, err, prefix, mode_key, nb_value in TECHNIQUE_TRACES:
+        rs = [r for r in rows if trace in r["trace"]]
+        nb = [r for r in rs if not other_of(r, mode_key, nb_value)]
+        default = next(r for r in nb if design_of(r, prefix) == "eager, clear writes, div 1, f32")
+        # The cheapest design that errs no more than the default (full resolution: no loss).
+        exact = [r for r in nb if float(r[err]) <= float(default[err])]
+        best = min(exact, key=lambda r: float(r["cycles_per_frame"]))
+        others = [r for r in rs if other_of(r, mode_key, nb_value)]
+        cell = lambda r: f"{n(float(r['cycles_per_frame']))}, {100 * float(r[err] or 0):.2f}"
+        lines.append(f"| {name} | {design_of(best, prefix)}: {cell(best)} | {cell(default)} | "
+                     f"{'; '.join(f'{other_of(r, mode_key, nb_value)}: {cell(r)}' for r in others) or '-'} |")
+        for r in nb:
+            ratio.setdefault(design_of(r, prefix), []).append((float(r["cycles_per_frame"]) / float(default["cycles_per_frame"]),
+                                                      float(r[err]) - float(default[err])))
+    mean = {d: (math.exp(sum(math.log(c) for c, _ in v) / len(v)), max(e for _, e in v)) for d, v in ratio.items() if len(v) == 3}
+    lossless = {d: v for d, v in mean.items() if v[1] <= 0}
+    overall = min(lossless, key=lambda d: lossless[d][0])
+    cheapest = min(mean, key=lambda d: mean[d][0])
+    return ("\n".join(lines) + "\n\nErrors in points of %: culling efficiency lost (occlusion culling, particles) and casters culled fewer "
+            f"than the reference (shadows). Across the three techniques (geometric mean of each one's cycles over its default "
+            f"design's), the cheapest design that loses nothing anywhere is {overall}: {mean[overall][0]:.3f}x; the cheapest of all, "
+            f"{cheapest}: {mean[cheapest][0]:.3f}x, losing up to {100 * mean[cheapest][1]:.2f} points.")
+
+
 BLOCKS += [
+    Block("techniques", [["explore", "pipeline/sweeps/nbuffer_techniques.json", "--out", "techniques", "--jobs", "2"]], render_techniques,
+          files=("techniques/results.csv",), page="exploration.md"),
     Block("upkeep", [["explore", "pipeline/sweeps/nbuffer_upkeep.json", "--out", "upkeep", "--jobs", "2"]], render_upkeep,
           files=("upkeep/results.csv",), page="exploration.md"),
     Block("pays", [["explore", "pipeline/sweeps/nbuffer_pays.json", "--out", "pays", "--jobs", "2"]], render_pays,
