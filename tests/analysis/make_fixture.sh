@@ -43,7 +43,7 @@ for r in table["rows"]:
     json.dump(keep, open(os.path.join(dst, r["mode"], "run.json"), "w"), indent=1)
 EOF
 
-# Sweeps: small.json as it is; nbuffer_resolution and fidelity on the two small samples only.
+# Sweeps: small.json and nbuffer_techniques.json as they are; nbuffer_resolution and fidelity on the two small samples only.
 sweep() {  # name, sweep file
   "$nbsim" explore "$2" --jobs 2 --out "$tmp/sweeps/$1" >/dev/null
   mkdir -p "$out/sweeps/$1"
@@ -61,6 +61,8 @@ EOF
 sweep small pipeline/sweeps/small.json
 sweep nbuffer_resolution "$(small_traces pipeline/sweeps/nbuffer_resolution.json)"
 sweep fidelity "$(small_traces pipeline/sweeps/fidelity.json)"
+# The report's leading section: one N-buffer design on every technique (the samples it names, about 20 s).
+sweep nbuffer_techniques pipeline/sweeps/nbuffer_techniques.json
 
 # Particles: four tiny captures (128x128, 4 frames, 2,000 sprites of 16 px), one per culling mode, and
 # the table nbsim particles writes (particles.json alone: the replays' folders are not read).

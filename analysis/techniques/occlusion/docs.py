@@ -6,9 +6,17 @@ import os
 import tempfile
 from pathlib import Path
 
+import importlib.util
+import pathlib
+
 from doc_results import Block, pareto_front, thousands as n
 
 PAGE = "results.md"
+
+# The cross-technique reading of the N-buffer design sweep, shared with the report (pays.py).
+_spec = importlib.util.spec_from_file_location("nbsim_occlusion_pays", pathlib.Path(__file__).with_name("pays.py"))
+pays = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(pays)
 WALK = "traces/samples/city_walk_512.nbt"
 SAMPLES = sorted(p.name for p in (Path(__file__).resolve().parents[3] / "traces" / "samples").glob("*.nbt"))
 GRAINS = [("nb_hier", "object"), ("nb_hier", "primitive"), ("hiz_tile", "object"), ("hiz_tile", "primitive")]
@@ -303,53 +311,17 @@ def render_pays(outputs):
     return "\n".join(lines)
 
 
-# Per technique: its trace, its error column, the prefix of its N-buffer units' keys, and the key
-# and value that select its N-buffer culling (other values: its other culling).
-TECHNIQUE_TRACES = (("occlusion culling", "city_walk_512", "efficiency_lost", "nbuffer", "cull.mode", "nb_hier"),
-                    ("particles", "particles_walk", "efficiency_lost", "nbuffer", "particles.mode", "nb"),
-                    ("shadows", "shadows_city", "culled_lost_fraction", "litmap_min", None, None))
-
-
-def design_of(r, prefix):
-    clear = "fast clear" if r[f"{prefix}.fast_clear"] == "true" else "clear writes"
-    return f"{r[f'{prefix}.update_policy']}, {clear}, div {r[f'{prefix}.resolution_divisor']}, {r[f'{prefix}.format']}"
-
-
-def other_of(r, mode_key, nb_value):
-    if not mode_key or r[mode_key] == nb_value:
-        return ""
-    m = r[mode_key]
-    return m + (f" {r['hiz.tile_px']}x{r['hiz.tile_px']}" if m == "hiz_tile" else "")
-
-
 def render_techniques(outputs):
-    import math
     rows = sweep_rows(outputs[-1])
+    per, overall = pays.summarize(rows)
     lines = ["| technique | the best N-buffer design (cycles a frame, error) | the default design (eager, clear writes, div 1, f32) | "
              "the others (cycles a frame, error) |", "|---|---|---|---|"]
-    ratio = {}
-    for name, trace, err, prefix, mode_key, nb_value in TECHNIQUE_TRACES:
-        rs = [r for r in rows if trace in r["trace"]]
-        nb = [r for r in rs if not other_of(r, mode_key, nb_value)]
-        default = next(r for r in nb if design_of(r, prefix) == "eager, clear writes, div 1, f32")
-        # The cheapest design that errs no more than the default (full resolution: no loss).
-        exact = [r for r in nb if float(r[err]) <= float(default[err])]
-        best = min(exact, key=lambda r: float(r["cycles_per_frame"]))
-        others = [r for r in rs if other_of(r, mode_key, nb_value)]
-        cell = lambda r: f"{n(float(r['cycles_per_frame']))}, {100 * float(r[err] or 0):.2f}"
-        lines.append(f"| {name} | {design_of(best, prefix)}: {cell(best)} | {cell(default)} | "
-                     f"{'; '.join(f'{other_of(r, mode_key, nb_value)}: {cell(r)}' for r in others) or '-'} |")
-        for r in nb:
-            ratio.setdefault(design_of(r, prefix), []).append((float(r["cycles_per_frame"]) / float(default["cycles_per_frame"]),
-                                                      float(r[err]) - float(default[err])))
-    mean = {d: (math.exp(sum(math.log(c) for c, _ in v) / len(v)), max(e for _, e in v)) for d, v in ratio.items() if len(v) == 3}
-    lossless = {d: v for d, v in mean.items() if v[1] <= 0}
-    overall = min(lossless, key=lambda d: lossless[d][0])
-    cheapest = min(mean, key=lambda d: mean[d][0])
-    return ("\n".join(lines) + "\n\nErrors in points of %: culling efficiency lost (occlusion culling, particles) and casters culled fewer "
-            f"than the reference (shadows). Across the three techniques (geometric mean of each one's cycles over its default "
-            f"design's), the cheapest design that loses nothing anywhere is {overall}: {mean[overall][0]:.3f}x; the cheapest of all, "
-            f"{cheapest}: {mean[cheapest][0]:.3f}x, losing up to {100 * mean[cheapest][1]:.2f} points.")
+    cell = lambda c, e: f"{n(c)}, {100 * e:.2f}"
+    for t in per:
+        lines.append(f"| {t['technique']} | {t['best']}: {cell(t['best_cycles'], t['best_error'])} | "
+                     f"{cell(t['default_cycles'], t['default_error'])} | "
+                     f"{'; '.join(f'{o}: {cell(c, e)}' for o, c, e in t['others']) or '-'} |")
+    return "\n".join(lines) + "\n\n" + overall
 
 
 BLOCKS += [

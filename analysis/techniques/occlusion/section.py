@@ -17,7 +17,14 @@ from report_plots import FIGSIZE, THOUSANDS, spans_decades  # first: it selects 
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.ticker import MaxNLocator
-from report_data import BadInput, Missing, load_json, pct, trace_name
+from report_data import BadInput, Missing, load_json, pct, read_csv, trace_name
+import importlib.util
+import pathlib
+
+# The cross-technique reading of the N-buffer design sweep, shared with docs/exploration.md (pays.py).
+_spec = importlib.util.spec_from_file_location("nbsim_occlusion_pays", pathlib.Path(__file__).with_name("pays.py"))
+pays = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(pays)
 
 NAME = "occlusion"
 ORDER = 0  # the sections' order on the page and in headline.md: first, right after Table 1 and Figure 4
@@ -238,6 +245,32 @@ def walkthrough(rep):
                        "(blue) and the N-buffer modes (red) frame by frame, and which frames of the walk "
                        "cost the most."))
 
+
+def nbuffer_pays(rep):
+    path = rep.root / "sweeps" / "nbuffer_techniques" / "results.csv"
+    if not path.exists():
+        raise Missing(["sweeps/nbuffer_techniques/results.csv"])
+    rep.used(path, "the N-buffer unit that pays")
+    _, rows = read_csv(path, ["trace", "status", "role", "cycles_per_frame", "efficiency_lost"])
+    per, sentence = pays.summarize([r for r in rows if r["status"] == "ok" and r["role"] == "sweep"])
+    if not per:
+        raise BadInput(f"{path}: no technique with an N-buffer unit ran its default design")
+    cell = lambda c, e: f"{c:,.0f} ({100 * e:.2f})"
+    table = rep.table("nbuffer_pays",
+                      [("technique", "technique", None), ("the best N-buffer design", "best", None),
+                       ("cycles a frame (error, points of %)", "best_cell", None), ("the default design", "default_cell", None),
+                       ("the other culling: cycles a frame (error)", "others_cell", None)],
+                      [{"technique": t["technique"], "best": t["best"], "best_cell": cell(t["best_cycles"], t["best_error"]),
+                        "default_cell": cell(t["default_cycles"], t["default_error"]),
+                        "others_cell": "; ".join(f"{o}: {cell(c, e)}" for o, c, e in t["others"]) or "-"} for t in per])
+    return (f"<p>One N-buffer unit design (update policy, clear, resolution divisor, storage format) replayed on every technique "
+            f"that has an N-buffer unit, every update, clear and query counted in the cycles; per technique the cheapest design that "
+            f"loses no more than the default unit, beside its other culling. {html.escape(sentence)}</p>" + table)
+
+
+# Sections before Table 1 (report.py): the headline question, whether an N-buffer unit pays.
+LEADING = [("nbuffer-pays", "The N-buffer unit that pays: the best design per technique, upkeep counted", nbuffer_pays,
+            "sweeps/nbuffer_techniques/results.csv")]
 
 # (anchor, title, build(rep), main input relative to DIR): the page's sections in this order.
 SECTIONS = [
