@@ -21,6 +21,7 @@
 #include "pipeline/cli/progress.h"
 #include "pipeline/explore/child.h"
 #include "pipeline/explore/results.h"
+#include "pipeline/explore/search.h"
 #include "pipeline/explore/runner.h"
 #include "pipeline/explore/slurm.h"
 #include "pipeline/explore/sweep.h"
@@ -66,6 +67,8 @@ struct ExploreOptions {
   std::string point;  // --point N|ID
   bool collect = false;
   bool max_points_set = false, jobs_set = false, slurm_waits_set = false;
+  std::string search = "grid";  // grid: every point; front: explore::FrontSearch
+  explore::SearchOptions search_options;
 };
 
 // Ctrl-C and SIGTERM while a Slurm sweep waits: the wait loop sees the flag and cancels the arrays.
@@ -215,64 +218,86 @@ int run_explore(const ExploreOptions& given) {
   std::size_t ran = 0, resumed = 0, failed = 0;
   std::string how;
   bool cancelled = false;
-  if (o.engine == "slurm") {
-    explore::SlurmOptions so;
-    so.out = out;
-    so.exe = ro.exe;
-    so.sweep_file = o.sweep;
-    so.workdir = fs::current_path();
-    so.partition = o.partition;
-    so.max_running = o.max_running;
-    so.sbatch_args = o.sbatch_args;
-    if (o.max_points_set) so.task_args = {"--max-points", std::to_string(o.max_points)};
-    so.poll_seconds = o.poll_seconds;
-    so.cluster_timeout_seconds = o.cluster_timeout;
-    so.cluster = *cluster;
-    std::vector<fs::path> shared = {out, fs::path(o.sweep), ro.exe};
-    for (const auto& [name, t] : s.traces) shared.push_back(t.path);
-    for (const auto& note : explore::node_local_paths(shared))
-      fmt::print(stderr, "explore: note: {}: the output folder, the sweep, the traces and nbsim must be on a file system the nodes share\n", note);
-    std::optional<ProgressBar> bar;
-    so.progress = [&bar](const explore::SlurmProgress& p) {
-      if (!bar) bar.emplace("explore (slurm)", static_cast<long long>(p.total));
-      bar->update(static_cast<long long>(p.finished), fmt::format("{} running, {} failed", p.running, p.failed));
-    };
-    struct sigaction sa {}, old_int {}, old_term {};
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int);
-    sigaction(SIGTERM, &sa, &old_term);
-    g_stop_signal = 0;
-    so.cancel_requested = [] { return g_stop_signal != 0; };
-    explore::SlurmReport r;
-    try {
-      r = explore::run_points_slurm(points, so);
-    } catch (...) {
+  // Runs a set of points on the engine (the whole sweep, or a round of the front search).
+  const auto run_set = [&](const std::vector<explore::Point>& pts) {
+    if (o.engine == "slurm") {
+      explore::SlurmOptions so;
+      so.out = out;
+      so.exe = ro.exe;
+      so.sweep_file = o.sweep;
+      so.workdir = fs::current_path();
+      so.partition = o.partition;
+      so.max_running = o.max_running;
+      so.sbatch_args = o.sbatch_args;
+      if (o.max_points_set) so.task_args = {"--max-points", std::to_string(o.max_points)};
+      so.poll_seconds = o.poll_seconds;
+      so.cluster_timeout_seconds = o.cluster_timeout;
+      so.cluster = *cluster;
+      std::vector<fs::path> shared = {out, fs::path(o.sweep), ro.exe};
+      for (const auto& [name, t] : s.traces) shared.push_back(t.path);
+      for (const auto& note : explore::node_local_paths(shared))
+        fmt::print(stderr, "explore: note: {}: the output folder, the sweep, the traces and nbsim must be on a file system the nodes share\n", note);
+      std::optional<ProgressBar> bar;
+      so.progress = [&bar](const explore::SlurmProgress& p) {
+        if (!bar) bar.emplace("explore (slurm)", static_cast<long long>(p.total));
+        bar->update(static_cast<long long>(p.finished), fmt::format("{} running, {} failed", p.running, p.failed));
+      };
+      struct sigaction sa {}, old_int {}, old_term {};
+      sa.sa_handler = on_stop_signal;
+      sigemptyset(&sa.sa_mask);
+      sigaction(SIGINT, &sa, &old_int);
+      sigaction(SIGTERM, &sa, &old_term);
+      g_stop_signal = 0;
+      so.cancel_requested = [] { return g_stop_signal != 0; };
+      explore::SlurmReport r;
+      try {
+        r = explore::run_points_slurm(pts, so);
+      } catch (...) {
+        sigaction(SIGINT, &old_int, nullptr);
+        sigaction(SIGTERM, &old_term, nullptr);
+        throw;
+      }
       sigaction(SIGINT, &old_int, nullptr);
       sigaction(SIGTERM, &old_term, nullptr);
-      throw;
+      if (bar) bar->finish();
+      ran += r.submitted, resumed += r.resumed, failed += r.failed, cancelled = cancelled || r.cancelled;
+      how = r.jobs.empty() ? std::string("on Slurm (nothing to submit)")
+                           : fmt::format("on Slurm (array job{} {})", r.jobs.size() > 1 ? "s" : "", fmt::join(r.jobs, ","));
+    } else {
+      std::optional<ProgressBar> bar;
+      ro.progress = [&bar](std::size_t done, std::size_t total) {
+        if (!bar) bar.emplace("explore", static_cast<long long>(total));
+        bar->update(static_cast<long long>(done));
+      };
+      const explore::RunReport r = explore::run_points(pts, s.traces, ro);
+      if (bar) bar->finish();
+      ran += r.ran, resumed += r.resumed, failed += r.failed;
+      how = fmt::format("with {} jobs", ro.jobs);
     }
-    sigaction(SIGINT, &old_int, nullptr);
-    sigaction(SIGTERM, &old_term, nullptr);
-    if (bar) bar->finish();
-    ran = r.submitted, resumed = r.resumed, failed = r.failed, cancelled = r.cancelled;
-    how = r.jobs.empty() ? std::string("on Slurm (nothing to submit)")
-                         : fmt::format("on Slurm (array job{} {})", r.jobs.size() > 1 ? "s" : "", fmt::join(r.jobs, ","));
+  };
+  std::vector<explore::Point> written = points;  // the points results.csv lists
+  if (o.search == "front") {
+    explore::FrontSearch search(points, s.spec.axes.size(), o.search_options);
+    explore::ResultsTable table;
+    for (;;) {
+      const std::vector<std::size_t> round = search.next(table);
+      if (round.empty() || cancelled) break;
+      std::vector<explore::Point> pts;
+      for (std::size_t i : round) pts.push_back(points[i]);
+      fmt::print("explore: search round {}: {} points\n", search.round() - 1, pts.size());
+      run_set(pts);
+      table = explore::results_table(out, points, s.parameters, s.traces, NBSIM_VERSION);
+    }
+    written.clear();
+    for (std::size_t i : search.chosen()) written.push_back(points[i]);
+    how += fmt::format("; front search: {} of {} points in {} rounds", written.size(), points.size(), search.round());
   } else {
-    std::optional<ProgressBar> bar;
-    ro.progress = [&bar](std::size_t done, std::size_t total) {
-      if (!bar) bar.emplace("explore", static_cast<long long>(total));
-      bar->update(static_cast<long long>(done));
-    };
-    const explore::RunReport r = explore::run_points(points, s.traces, ro);
-    if (bar) bar->finish();
-    ran = r.ran, resumed = r.resumed, failed = r.failed;
-    how = fmt::format("with {} jobs", ro.jobs);
+    run_set(points);
   }
-  explore::write_results_csv(out / "results.csv", out, points, s.parameters, s.traces, NBSIM_VERSION);
+  explore::write_results_csv(out / "results.csv", out, written, s.parameters, s.traces, NBSIM_VERSION);
 
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  print_failures(out, points);
+  print_failures(out, written);
   fmt::print("explore: {} points ({} of them references): {} run, {} resumed, {} failed, {:.1f} s {}; wrote {}\n",
              points.size(), points.size() - s.sweep_points, ran, resumed, failed, seconds, how, (out / "results.csv").string());
   if (cancelled) {
@@ -317,6 +342,25 @@ void add_explore_command(CLI::App& app, Action& action) {
   cmd->add_flag("--collect", o->collect,
                 "Run nothing: write sweep.json and results.csv from the points done or failed in DIR (after a Slurm run, "
                 "or tasks run with --point)");
+  cmd->add_option("--search", o->search,
+                  "grid: run every point; front: run a few random points of each trace, then the grid neighbours of each "
+                  "trace's Pareto front of its technique's headline cost against its error, round after round, until a "
+                  "round adds nothing (axes sweeps; results.csv lists the points run)")
+      ->check(CLI::IsMember({"grid", "front"}))
+      ->capture_default_str();
+  cmd->add_option("--search-start", o->search_options.start, "--search front: random points of each trace in the first round")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
+      ->capture_default_str();
+  cmd->add_option("--search-rounds", o->search_options.rounds, "--search front: rounds at most, the first included")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  cmd->add_option("--search-seed", o->search_options.seed, "--search front: seed of the first round's choice")
+      ->capture_default_str();
+  cmd->add_option("--search-cost", o->search_options.cost,
+                  "--search front: the results.csv column of the cost (default: each technique's headline cost, e.g. "
+                  "total_depth_tests_per_frame; cycles_per_frame for the cycles)");
+  cmd->add_option("--search-error", o->search_options.error,
+                  "--search front: the results.csv column of the error (default: each technique's headline error)");
   cmd->add_flag("--dry-run", o->dry_run, "Validate and expand the sweep, write sweep.json and list the points; run nothing");
   cmd->add_option("--max-points", o->max_points,
                   "Refuse a sweep of more points than this (traces x axis sizes, or listed points x traces; reference "

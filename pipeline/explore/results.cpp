@@ -145,11 +145,35 @@ std::string csv_field(const std::string& text) {
   return q + '"';
 }
 
+const std::string& ResultsTable::cell(std::size_t row, const std::string& column) const {
+  static const std::string none;
+  const auto it = std::find(header.begin(), header.end(), column);
+  if (it == header.end() || row >= rows.size()) return none;
+  return rows[row][static_cast<std::size_t>(it - header.begin())];
+}
+
 void write_results_csv(const fs::path& file, const fs::path& out, const std::vector<Point>& points,
                        const std::vector<std::string>& parameters, const std::map<std::string, TraceFile>& traces,
                        const std::string& version) {
   // The file is written only when whole: a run.json that cannot be read leaves no partial results.csv.
+  const ResultsTable t = results_table(out, points, parameters, traces, version);
   std::ostringstream csv;
+  for (const auto* row : {&t.header}) {
+    for (std::size_t i = 0; i < row->size(); ++i) csv << (i ? "," : "") << csv_field((*row)[i]);
+    csv << '\n';
+  }
+  for (const auto& row : t.rows) {
+    for (std::size_t i = 0; i < row.size(); ++i) csv << (i ? "," : "") << csv_field(row[i]);
+    csv << '\n';
+  }
+  std::ofstream f(file);
+  f << csv.str();
+  if (!f) throw std::runtime_error(fmt::format("cannot write {}", file.string()));
+}
+
+ResultsTable results_table(const fs::path& out, const std::vector<Point>& points, const std::vector<std::string>& parameters,
+                           const std::map<std::string, TraceFile>& traces, const std::string& version) {
+  ResultsTable table;
   // Every finished run first: the error columns compare a point with its reference points.
   std::map<std::string, nlohmann::json> runs;
   for (const Point& p : points)
@@ -184,13 +208,12 @@ void write_results_csv(const fs::path& file, const fs::path& out, const std::vec
   };
   const std::vector<std::string> columns = metric_columns(sweep_techniques(points));
 
-  std::vector<std::string> header = {"point_id", "role", "trace", "trace_crc32", "nbsim_version"};
+  std::vector<std::string>& header = table.header;
+  header = {"point_id", "role", "trace", "trace_crc32", "nbsim_version"};
   header.insert(header.end(), parameters.begin(), parameters.end());
   header.push_back("status");
   header.insert(header.end(), columns.begin(), columns.end());
   header.push_back("error");
-  for (std::size_t i = 0; i < header.size(); ++i) csv << (i ? "," : "") << csv_field(header[i]);
-  csv << '\n';
   for (const Point& p : points) {
     const fs::path dir = point_dir(out, p);
     const auto run = point_done(out, p) ? read_json(dir / "run.json") : std::nullopt;
@@ -216,12 +239,9 @@ void write_results_csv(const fs::path& file, const fs::path& out, const std::vec
       row.insert(row.end(), columns.size(), "");
       row.push_back(error);
     }
-    for (std::size_t i = 0; i < row.size(); ++i) csv << (i ? "," : "") << csv_field(row[i]);
-    csv << '\n';
+    table.rows.push_back(std::move(row));
   }
-  std::ofstream f(file);
-  f << csv.str();
-  if (!f) throw std::runtime_error(fmt::format("cannot write {}", file.string()));
+  return table;
 }
 
 void write_sweep_json(const fs::path& file, const std::string& sweep_file, const SweepSpec& spec, const std::vector<Point>& points,

@@ -34,6 +34,15 @@ std::vector<const techniques::TechniqueResults*> sweep_techniques(const std::vec
 void write_technique_results_json(const std::filesystem::path& file, const std::vector<Point>& points,
                                   const std::map<std::string, TraceFile>& traces);
 
+// results.csv as a table: the header, then one row of cells a point (what write_results_csv writes).
+struct ResultsTable {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  // The cell of `row` in `column`, "" when the header has no such column.
+  const std::string& cell(std::size_t row, const std::string& column) const;
+};
+ResultsTable results_table(const std::filesystem::path& out, const std::vector<Point>& points, const std::vector<std::string>& parameters,
+                           const std::map<std::string, TraceFile>& traces, const std::string& version);
 // Writes results.csv. `version` fills nbsim_version for failed points (which have no run.json).
 void write_results_csv(const std::filesystem::path& file, const std::filesystem::path& out, const std::vector<Point>& points,
                        const std::vector<std::string>& parameters, const std::map<std::string, TraceFile>& traces,

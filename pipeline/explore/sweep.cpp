@@ -143,12 +143,14 @@ SweepSpec parse_sweep(const nlohmann::ordered_json& j, const std::string& origin
 
 std::vector<Point> expand(const SweepSpec& spec) {
   std::vector<nlohmann::json> combos;  // flat settings, with "trace" when a listed point names one
+  std::vector<std::vector<int>> grids;  // each combo's axis indices (axes sweeps)
   if (!spec.axes.empty()) {
     std::vector<std::size_t> index(spec.axes.size(), 0);
     for (;;) {
       nlohmann::json c = sorted(spec.set);
       for (std::size_t a = 0; a < spec.axes.size(); ++a) c[spec.axes[a].first] = spec.axes[a].second[index[a]];
       combos.push_back(std::move(c));
+      grids.emplace_back(index.begin(), index.end());
       std::size_t a = spec.axes.size();
       while (a > 0 && ++index[a - 1] == spec.axes[a - 1].second.size()) index[--a] = 0;
       if (a == 0) break;
@@ -162,10 +164,12 @@ std::vector<Point> expand(const SweepSpec& spec) {
   }
   std::vector<Point> points;
   for (const auto& trace : spec.traces) {
-    for (const auto& c : combos) {
+    for (std::size_t ci = 0; ci < combos.size(); ++ci) {
+      const nlohmann::json& c = combos[ci];
       if (c.contains("trace") && c["trace"].get<std::string>() != trace) continue;
       Point p;
       p.trace = trace;
+      if (ci < grids.size()) p.grid = grids[ci];
       p.settings = c;
       p.settings.erase("trace");
       p.id = point_id(p.trace, p.settings);

@@ -50,6 +50,9 @@ struct Point {
   // nbuffer.level0=depth with a resolution divisor): the config check's message. It is recorded as
   // a failed point (its error.txt) and never run; the sweep goes on.
   std::string refused;
+  // An axes sweep's point: its value's index on each axis, in the file's axis order (empty for a
+  // listed point or a reference point). The front search (search.h) steps along them.
+  std::vector<int> grid;
 };
 
 // Tunable. Most points a sweep may expand to (traces x the product of the axis sizes, or the

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -194,6 +195,52 @@ TEST(ExploreCliTest, ImpossibleDesignRecordedAsFailed) {
       EXPECT_FALSE(fs::exists(out / "points" / row.at("point_id") / "run.json")) << "never run";
     }
   }
+}
+
+// The front search (--search front) on a 24-point grid: a few random points, then the grid
+// neighbours of the front round after round; it finds the whole grid's Pareto front (total depth
+// tests, or cycles with --search-cost, against culling efficiency lost) running fewer points, and
+// results.csv lists only the points it ran. A listed sweep has no grid to search.
+TEST(ExploreCliTest, FrontSearchFindsTheGridsFront) {
+  const nlohmann::json sweep = {{"traces", {kSample}},
+                                {"set", {{"cull.mode", "nb_hier"}}},
+                                {"axes",
+                                 {{"nbuffer.resolution_divisor", {1, 2, 4, 8}},
+                                  {"nbuffer.format", {"f32", "u16"}},
+                                  {"nbuffer.update_policy", {"eager", "lazy", "on_demand"}}}}};
+  const fs::path f = write_sweep("front.json", sweep);
+  const fs::path grid = scratch("front_grid");
+  ASSERT_EQ(run_nbsim("explore " + f.string() + " --jobs 2 --out " + grid.string()).status, 0);
+  const auto front = [](const fs::path& csv, const std::string& cost) {
+    std::vector<std::map<std::string, std::string>> ok;
+    for (const auto& r : read_csv(csv))
+      if (r.at("status") == "ok" && r.at("role") == "sweep") ok.push_back(r);
+    std::set<std::string> ids;
+    const auto v = [&](const std::map<std::string, std::string>& r, const std::string& k) { return std::stod(r.at(k)); };
+    for (const auto& r : ok) {
+      bool dominated = false;
+      for (const auto& o : ok)
+        dominated = dominated || (v(o, cost) <= v(r, cost) && v(o, "efficiency_lost") <= v(r, "efficiency_lost") &&
+                                  (v(o, cost) < v(r, cost) || v(o, "efficiency_lost") < v(r, "efficiency_lost")));
+      if (!dominated) ids.insert(r.at("point_id"));
+    }
+    return ids;
+  };
+  for (const std::string cost : {"total_depth_tests_per_frame", "cycles_per_frame"}) {
+    SCOPED_TRACE(cost);
+    const fs::path out = scratch("front_search_" + cost);
+    const CliResult r = run_nbsim("explore " + f.string() + " --jobs 2 --search front --search-start 3 --search-cost " + cost +
+                                  " --out " + out.string());
+    ASSERT_EQ(r.status, 0) << r.out << r.err;
+    EXPECT_TRUE(has(r.out, "search round 0: 5 points")) << "3 random points and their 2 references: " << r.out;
+    const auto rows = read_csv(out / "results.csv");
+    if (cost == "total_depth_tests_per_frame") EXPECT_LT(rows.size(), 24u) << "the search ran fewer points than the grid";
+    EXPECT_EQ(front(out / "results.csv", cost), front(grid / "results.csv", cost));
+  }
+  const fs::path listed = write_sweep("listed.json", {{"traces", {kSample}}, {"points", {{{"cull.mode", "nb"}}}}});
+  const CliResult bad = run_nbsim("explore " + listed.string() + " --search front --out " + scratch("listed_out").string());
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(has(bad.err, "--search front steps along a sweep's axes")) << bad.err;
 }
 
 // A sweep naming a file that is not a trace is refused at validation, naming the file, before

@@ -201,6 +201,23 @@ TEST_F(SlurmCliTest, SweepEqualsLocalRun) {
   EXPECT_EQ(rows_without_host_time(local_out / "results.csv"), a);
 }
 
+// The front search through the cluster: each round is an array of its points; it runs the same
+// points as the local search and gives the same rows.
+TEST_F(SlurmCliTest, FrontSearchEqualsLocal) {
+  nlohmann::json sweep = {{"traces", {kSample}}, {"set", {{"cull.mode", "nb_hier"}}}, {"axes", nlohmann::json::object()}};
+  sweep["axes"]["nbuffer.resolution_divisor"] = {1, 2, 4};
+  sweep["axes"]["nbuffer.update_policy"] = {"eager", "on_demand"};
+  const fs::path f = write_sweep("front.json", sweep);
+  const fs::path slurm_out = scratch("front_slurm"), local_out = scratch("front_local");
+  CliResult r = run_nbsim("explore " + f.string() + " --out " + slurm_out.string() +
+                          " --engine slurm --poll-seconds 0.3 --search front --search-start 2");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "front search: ")) << r.out;
+  r = run_nbsim("explore " + f.string() + " --out " + local_out.string() + " --jobs 2 --search front --search-start 2");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_EQ(rows_without_host_time(slurm_out / "results.csv"), rows_without_host_time(local_out / "results.csv"));
+}
+
 // A point whose replay fails on the node is recorded with the replay's own message, as a local
 // run records it; the other point completes; exit status 1.
 TEST_F(SlurmCliTest, FailingPointRecorded) {
