@@ -75,6 +75,9 @@ class DrawRecorder {
   GLuint counts_ssbo_ = 0, tf_buffer_ = 0, tf_object_ = 0;
   std::size_t counts_capacity_ = 0, tf_capacity_ = 0;  // slots, bytes
   std::vector<GLuint> q_samples_, q_clip_in_, q_clip_out_;
+  // Query-wrapped draws since the last flush, times the viewport's 64x64 bins (begin_draw).
+  static constexpr std::uint64_t kFlushBinDraws = 32768;
+  std::uint64_t scene_bin_draws_ = 0;
 };
 
 }  // namespace nbsim::capture
