@@ -49,6 +49,12 @@ Cache::Result Cache::access(std::uint64_t address, bool write) {
     return r;
   }
   const std::uint64_t line = pow2_ ? address >> line_shift_ : address / static_cast<std::uint64_t>(c_.line_bytes);
+  if (last_ != kNoLine && lines_[last_].tag == line && lines_[last_].used) {
+    lines_[last_].dirty = lines_[last_].dirty || write;
+    ++hits_;
+    r.hit = true;
+    return r;
+  }
   const std::uint64_t set = pow2_ ? line & set_mask_ : line % sets_;
   Line* ways = &lines_[set * static_cast<std::uint64_t>(c_.ways)];
   ++clock_;
@@ -60,6 +66,7 @@ Cache::Result Cache::access(std::uint64_t address, bool write) {
       l.dirty = l.dirty || write;
       ++hits_;
       r.hit = true;
+      last_ = static_cast<std::size_t>(&l - lines_.data());
       return r;
     }
     if (l.used < victim->used) victim = &l;  // invalid lines (used == 0) go first
@@ -70,6 +77,7 @@ Cache::Result Cache::access(std::uint64_t address, bool write) {
     ++writebacks_;
   }
   *victim = {line, clock_, write};
+  last_ = static_cast<std::size_t>(victim - lines_.data());
   return r;
 }
 
@@ -81,7 +89,10 @@ std::uint64_t Cache::flush() {
   return n;
 }
 
-void Cache::invalidate() { std::fill(lines_.begin(), lines_.end(), Line{}); }
+void Cache::invalidate() {
+  std::fill(lines_.begin(), lines_.end(), Line{});
+  last_ = kNoLine;
+}
 
 LineCache::LineCache(CacheConfig c) : c_(c) {
   NBSIM_CHECK(c.size_bytes >= 0 && c.line_bytes > 1 && c.ways > 0, "line cache config not validated");

@@ -74,6 +74,10 @@ class Cache {
   std::vector<Line> lines_;
   std::uint64_t clock_ = 0;
   std::uint64_t hits_ = 0, misses_ = 0, writebacks_ = 0;
+  // The line of the last access, valid until invalidate(): accessing it again is a hit that changes
+  // no LRU order (it is already the most recent of its set), so access() takes it without the search.
+  static constexpr std::size_t kNoLine = ~std::size_t{0};
+  std::size_t last_ = kNoLine;  // an index into lines_, so that a copied cache stays right
 };
 
 // The same LRU set-associative cache for a client that only reads and knows its lines: the same
