@@ -106,23 +106,11 @@ std::optional<DepthFormat> parse_depth_format(std::string_view n) noexcept {
   return std::nullopt;
 }
 
-std::uint32_t to_unorm24(float z) noexcept {
-  const float p = z * 16777215.0f;  // one float rounding, as the JIT's fmul
-  if (!(p > 0.0f)) return 0;        // 0, negative zero and NaN
-  if (p >= 16777215.0f) return 16777215u;
-  // Round to nearest, ties to even (cvtps2dq): below 2^23 the sum with 2^23 rounds p to an integer
-  // in float arithmetic (its ulp is 1 there); from 2^23 on every float is an integer already.
-  // Bit-identical to std::nearbyint in the default rounding mode, without a library call.
-  constexpr float k2p23 = 8388608.0f;
-  const float r = p < k2p23 ? (p + k2p23) - k2p23 : p;
-  return static_cast<std::uint32_t>(r);
-}
 
 // q / (2^24 - 1) rounded to float. The double product with the reciprocal is within a few double
 // ulps of the quotient, and the quotient (odd denominator) is never within 2^-49 relative of a
 // float rounding boundary, so rounding either to float gives the same float (checked for every q,
 // DepthTestTest.Unorm24FloatsAreOneToOne), without a division per fragment.
-float from_unorm24(std::uint32_t q) noexcept { return static_cast<float>(static_cast<double>(q) * (1.0 / 16777215.0)); }
 
 DepthCounters& DepthCounters::operator+=(const DepthCounters& o) {
   fragments += o.fragments;

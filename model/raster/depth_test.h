@@ -58,10 +58,20 @@ std::optional<DepthFormat> parse_depth_format(std::string_view gl_name) noexcept
 // llvmpipe's 24-bit value of a fragment depth in [0, 1] (lp_bld_conv.c
 // lp_build_clamped_float_to_unsigned_norm, width 24 = float mantissa + 1): the product
 // z * 16777215 rounded to float, then to the nearest integer, ties to even. NaN gives 0.
-std::uint32_t to_unorm24(float z) noexcept;
+inline std::uint32_t to_unorm24(float z) noexcept {
+  const float p = z * 16777215.0f;  // one float rounding, as the JIT's fmul
+  if (!(p > 0.0f)) return 0;        // 0, negative zero and NaN
+  if (p >= 16777215.0f) return 16777215u;
+  // Round to nearest, ties to even (cvtps2dq): below 2^23 the sum with 2^23 rounds p to an integer
+  // in float arithmetic (its ulp is 1 there); from 2^23 on every float is an integer already.
+  // Bit-identical to std::nearbyint in the default rounding mode, without a library call.
+  constexpr float k2p23 = 8388608.0f;
+  const float r = p < k2p23 ? (p + k2p23) - k2p23 : p;
+  return static_cast<std::uint32_t>(r);
+}
 // The float the buffer holds for a 24-bit value: q / (2^24 - 1) rounded to float (adjacent values
 // stay apart: their distance is above one float ulp in [0, 1]).
-float from_unorm24(std::uint32_t q) noexcept;
+inline float from_unorm24(std::uint32_t q) noexcept { return static_cast<float>(static_cast<double>(q) * (1.0 / 16777215.0)); }
 // A fragment depth as a buffer of `format` stores it.
 inline float stored_depth(DepthFormat format, float z) noexcept {
   return format == DepthFormat::Unorm24 ? from_unorm24(to_unorm24(z)) : z;

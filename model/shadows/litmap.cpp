@@ -55,7 +55,23 @@ std::array<std::array<float, 4>, 4> reprojection_rows(const glm::mat4& observer_
 
 LitmapReprojection::LitmapReprojection(const glm::mat4& observer_view_proj, const glm::mat4& light_vp, int litmap_size,
                                        const ReprojectSettings& settings, const DepthImage& observer)
-    : rows_(reprojection_rows(observer_view_proj, light_vp, litmap_size)), settings_(settings), observer_(&observer) {}
+    : rows_(reprojection_rows(observer_view_proj, light_vp, litmap_size)), settings_(settings), observer_(&observer) {
+  // The 3x3 maximum, separably (max is associative): rows first, then columns, edges repeated.
+  const int w = observer.width, h = observer.height;
+  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
+  std::vector<float> across(observer.texels.size());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      across[at(x, y)] = std::max({observer.texels[at(std::max(x - 1, 0), y)], observer.texels[at(x, y)],
+                                   observer.texels[at(std::min(x + 1, w - 1), y)]});
+  const float n = settings_.near_m, f = settings_.far_m, slack = 1.0f + settings_.tolerance_rel;
+  unseen_beyond_.resize(observer.texels.size());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float farthest = std::max({0.0f, across[at(x, std::max(y - 1, 0))], across[at(x, y)], across[at(x, std::min(y + 1, h - 1))]});
+      unseen_beyond_[at(x, y)] = view_distance(farthest, n, f) * slack + settings_.tolerance_m;
+    }
+}
 
 bool LitmapReprojection::discards(int x, int y, float frag_z) const {
   const float fx = static_cast<float>(x) + 0.5f, fy = static_cast<float>(y) + 0.5f;
@@ -67,13 +83,8 @@ bool LitmapReprojection::discards(int x, int y, float frag_z) const {
   const int w = observer_->width, h = observer_->height;
   const int px = std::clamp(static_cast<int>((nx * 0.5f + 0.5f) * static_cast<float>(w)), 0, w - 1);
   const int py = std::clamp(static_cast<int>((ny * 0.5f + 0.5f) * static_cast<float>(h)), 0, h - 1);
-  float farthest = 0.0f;
-  for (int j = -1; j <= 1; ++j)
-    for (int i = -1; i <= 1; ++i) farthest = std::max(farthest, observer_->at(std::clamp(px + i, 0, w - 1), std::clamp(py + j, 0, h - 1)));
-  const float n = settings_.near_m, f = settings_.far_m;
-  const float seen = view_distance(farthest, n, f);
-  const float slack = 1.0f + settings_.tolerance_rel;
-  return view_distance(nz * 0.5f + 0.5f, n, f) > seen * slack + settings_.tolerance_m;
+  return view_distance(nz * 0.5f + 0.5f, settings_.near_m, settings_.far_m) >
+         unseen_beyond_[static_cast<std::size_t>(py) * static_cast<std::size_t>(w) + static_cast<std::size_t>(px)];
 }
 
 ReceiverSplat::ReceiverSplat(const glm::mat4& observer_view_proj, const glm::dmat4& light_clip, int width, int height) {

@@ -66,6 +66,10 @@ class LitmapReprojection final : public raster::FragmentShader {
   std::array<std::array<float, 4>, 4> rows_{};
   ReprojectSettings settings_;
   const DepthImage* observer_;
+  // Per observer pixel, made once: the view distance of the farthest depth of its 3x3 neighbourhood
+  // (edges repeated) times (1 + tolerance_rel) plus tolerance_m; a fragment landing there is unseen
+  // when its own view distance is larger (the same floats as computing it per fragment).
+  std::vector<float> unseen_beyond_;
 };
 
 // The reprojection rows alone (the capture's uniforms).
