@@ -121,10 +121,38 @@ class AxisCuts {
   bool live_ = false;
 };
 
+// The t where the ray leaves the cell range [first, last] along one axis (+inf when it never does):
+// the boundary x - 0.5 = last + 1 going up, = first going down.
+double leave_range(double o, double d, int first, int last) noexcept {
+  if (d > 0.0) return (last + 1 + 0.5 - o) / d;
+  if (d < 0.0) return (first + 0.5 - o) / d;
+  return std::numeric_limits<double>::infinity();
+}
+
 }  // namespace
 
+ReferenceBlocks::ReferenceBlocks(const Heightfield& field) {
+  const int n = field.size, cells = n + 4;  // cell indices -2 .. n + 1
+  blocks_ = (cells + kBlock - 1) / kBlock;
+  // Each cell's highest corner, then each block's maximum over its cells and their neighbours.
+  std::vector<double> cell(static_cast<std::size_t>(cells) * cells);
+  for (int cj = -2; cj <= n + 1; ++cj)
+    for (int ci = -2; ci <= n + 1; ++ci)
+      cell[static_cast<std::size_t>(cj + 2) * cells + static_cast<std::size_t>(ci + 2)] =
+          std::max(std::max(field.at(ci, cj), field.at(ci + 1, cj)), std::max(field.at(ci, cj + 1), field.at(ci + 1, cj + 1)));
+  max_.assign(static_cast<std::size_t>(blocks_) * blocks_, 0.0);
+  for (int bj = 0; bj < blocks_; ++bj)
+    for (int bi = 0; bi < blocks_; ++bi) {
+      double m = 0.0;  // heights are in [0, 1]
+      for (int cj = std::max(-2, first_cell(bj) - 1); cj <= std::min(n + 1, last_cell(bj) + 1); ++cj)
+        for (int ci = std::max(-2, first_cell(bi) - 1); ci <= std::min(n + 1, last_cell(bi) + 1); ++ci)
+          m = std::max(m, cell[static_cast<std::size_t>(cj + 2) * cells + static_cast<std::size_t>(ci + 2)]);
+      max_[static_cast<std::size_t>(bj) * blocks_ + static_cast<std::size_t>(bi)] = m;
+    }
+}
+
 ReferenceHit reference_hit(const Heightfield& field, const std::array<double, 3>& origin, const std::array<double, 3>& direction,
-                           double t_enter, double t_exit) {
+                           double t_enter, double t_exit, const ReferenceBlocks* blocks) {
   NBSIM_CHECK(std::isfinite(t_enter) && std::isfinite(t_exit) && t_enter <= t_exit,
               fmt::format("reference_hit needs a finite interval with t_enter <= t_exit, got [{}, {}]", t_enter, t_exit));
   const auto [ox, oy, oz] = origin;
@@ -138,14 +166,36 @@ ReferenceHit reference_hit(const Heightfield& field, const std::array<double, 3>
   const int n = field.size;
   AxisCuts xs(ox, dx, t_enter, t_exit, n), ys(oy, dy, t_enter, t_exit, n);
   double ta = t_enter;
+  // Every piece ending at or before clear_until lies in a block (with its ring) the ray crosses
+  // clearly above, from a t at or after which the pieces start: skipped like the per-cell test
+  // below would skip each (z = oz + t dz rounds monotonically in t, so z at the piece's ends is
+  // no lower than at the block stretch's ends, and each piece's cell is in the block or its ring).
+  double clear_until = -std::numeric_limits<double>::infinity();
+  int near_bi = -1, near_bj = -1;  // the block last found not clear (blocks are >= 0): its cells go one by one
   for (;;) {
     const double tx = xs.peek(), ty = ys.peek();
     const bool last = !(tx < t_exit) && !(ty < t_exit);
     const double tb = last ? t_exit : tx <= ty ? xs.take() : ys.take();
+    if (tb > ta && tb <= clear_until) {
+      if (last) break;
+      ta = tb;
+      continue;
+    }
     if (tb > ta) {  // else a corner (its neighbours cover it), or t_enter == t_exit (checked above)
       const double tm = 0.5 * (ta + tb);
       const double cx = std::clamp(ox + tm * dx - 0.5, -2.0, n + 1.0), cy = std::clamp(oy + tm * dy - 0.5, -2.0, n + 1.0);
       const int ci = static_cast<int>(std::floor(cx)), cj = static_cast<int>(std::floor(cy));
+      if (const int bi = ReferenceBlocks::block_of(ci), bj = ReferenceBlocks::block_of(cj); blocks && (bi != near_bi || bj != near_bj)) {
+        const double tl = std::min({leave_range(ox, dx, ReferenceBlocks::first_cell(bi), ReferenceBlocks::last_cell(bi)),
+                                    leave_range(oy, dy, ReferenceBlocks::first_cell(bj), ReferenceBlocks::last_cell(bj)), t_exit});
+        if (tl >= tb && std::min(oz + ta * dz, oz + tl * dz) > blocks->max(bi, bj) + kClear) {
+          clear_until = tl;
+          if (last) break;
+          ta = tb;
+          continue;
+        }
+        near_bi = bi, near_bj = bj;
+      }
       const double h00 = field.at(ci, cj), h10 = field.at(ci + 1, cj), h01 = field.at(ci, cj + 1), h11 = field.at(ci + 1, cj + 1);
       // A piece the ray crosses clearly above the patch's highest corner (the bilinear patch is no
       // higher inside the cell, the ray is straight) can hold no root nor touch: most of a ray's

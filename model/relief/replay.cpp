@@ -104,6 +104,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   const std::uint64_t pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
   const std::vector<GlReliefFragments> records = read_relief_fragments(f, pixels);
   const FieldView view = gl.view();
+  const ReferenceBlocks blocks(gl.field);
   WalkParams params = gl.params;  // the record's tunables with the capture's covering
   params.covering = covering_;
   reference_.resize(pixels);
@@ -195,7 +196,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
         if (!ray) continue;
         fw.ray = true;
         fw.walk = lookups ? walk(r.method, view, params, *ray, lines) : walk(r.method, view, params, *ray);
-        if (!referenced_[px]) reference_[px] = reference_of(gl.field, *ray), referenced_[px] = 1;
+        if (!referenced_[px]) reference_[px] = reference_of(gl.field, *ray, &blocks), referenced_[px] = 1;
         fw.score = score_against(reference_[px], *ray, gl.field.size, fw.walk.hit && !fw.walk.capped, fw.walk.t, box_height, tolerance);
         if (box_depth_ == BoxDepth::Exact && fw.walk.hit && !fw.walk.capped) fw.depth = hit_depth(gl_depth->texel_to_clip, *ray, fw.walk.t);
       }

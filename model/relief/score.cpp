@@ -8,7 +8,7 @@
 
 namespace nbsim::relief {
 
-ReferenceHit reference_of(const Heightfield& field, const FragmentRay& ray) {
+ReferenceHit reference_of(const Heightfield& field, const FragmentRay& ray, const ReferenceBlocks* blocks) {
   const std::array<double, 3> o = {ray.o[0], ray.o[1], ray.o[2]}, d = {ray.d[0], ray.d[1], ray.d[2]};
   // The reference's own interval: the double ray clipped to the box in double (the float interval,
   // taken over, would leave a ray that ends on the box's floor a hair above it: the floor of height
@@ -22,7 +22,7 @@ ReferenceHit reference_of(const Heightfield& field, const FragmentRay& ray) {
     t_out = std::min(t_out, std::max(t1, t2));
   }
   if (!(t_in <= t_out) || !std::isfinite(t_out)) t_in = t_out = static_cast<double>(ray.t_in);  // a grazing float ray: its one point
-  return reference_hit(field, o, d, t_in, t_out);
+  return reference_hit(field, o, d, t_in, t_out, blocks);
 }
 
 HitScore score_against(const ReferenceHit& ref, const FragmentRay& ray, int size, bool hit, float t, double box_height,

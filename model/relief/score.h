@@ -27,8 +27,9 @@ struct HitScore {
 HitScore score_hit(const Heightfield& field, const FragmentRay& ray, bool hit, float t, double box_height, double tolerance);
 
 // The two halves of score_hit, for a caller that scores several walks of one ray (the methods of a
-// frame share their rays): the reference of the ray, then a walk's score against it.
-ReferenceHit reference_of(const Heightfield& field, const FragmentRay& ray);
+// frame share their rays): the reference of the ray, then a walk's score against it. `blocks` (of
+// `field`, may be null) only makes the reference faster.
+ReferenceHit reference_of(const Heightfield& field, const FragmentRay& ray, const ReferenceBlocks* blocks = nullptr);
 HitScore score_against(const ReferenceHit& reference, const FragmentRay& ray, int size, bool hit, float t, double box_height,
                        double tolerance);
 

@@ -309,13 +309,13 @@ TEST(ReliefRecordsTest, DepthRecord) {
   using F = scene::Frame;
   constexpr std::uint32_t D = kReliefDepthRecordType;
   const std::pair<std::function<void(F&)>, const char*> damages[] = {
-      {[](F& f) { vec<float>(f, D, "texel_to_clip").pop_back(); }, "texel_to_clip has 15 values, not 16"},
-      {[](F& f) { vec<float>(f, D, "texel_to_clip")[3] = INFINITY; }, "texel_to_clip[3] is inf"},
-      {[](F& f) { vec<std::uint32_t>(f, D, "depth_crc").pop_back(); }, "has 2 draws but 1 CRCs"},
-      {[](F& f) { vec<std::uint32_t>(f, D, "draws") = {0, 2}; }, "relief_box draw 1 has no depth CRC"},
-      {[](F& f) { vec<std::uint32_t>(f, D, "draws") = {1, 2, 3}, vec<std::uint32_t>(f, D, "depth_crc") = {1, 2, 3}; },
+      {[](F& frame) { vec<float>(frame, D, "texel_to_clip").pop_back(); }, "texel_to_clip has 15 values, not 16"},
+      {[](F& frame) { vec<float>(frame, D, "texel_to_clip")[3] = INFINITY; }, "texel_to_clip[3] is inf"},
+      {[](F& frame) { vec<std::uint32_t>(frame, D, "depth_crc").pop_back(); }, "has 2 draws but 1 CRCs"},
+      {[](F& frame) { vec<std::uint32_t>(frame, D, "draws") = {0, 2}; }, "relief_box draw 1 has no depth CRC"},
+      {[](F& frame) { vec<std::uint32_t>(frame, D, "draws") = {1, 2, 3}, vec<std::uint32_t>(frame, D, "depth_crc") = {1, 2, 3}; },
        "lists 3 draws, but the frame has 2 relief_box draws"},
-      {[](F& f) { field_of(f, D, "draws").name = "draw"; }, "has no field 'draws'"},
+      {[](F& frame) { field_of(frame, D, "draws").name = "draw"; }, "has no field 'draws'"},
   };
   for (const auto& [damage, message] : damages) {
     F bad = f;

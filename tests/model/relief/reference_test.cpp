@@ -4,8 +4,12 @@
 // below the surface, a clear miss.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 #include <optional>
 
 #include "model/relief/heightfield.h"
@@ -188,6 +192,47 @@ TEST(ReliefReferenceTest, AxisParallelRays) {
     compared += check_ray(f, {-0.5, c, 1.0}, {1.0, 0.0, -0.12}, 0.5, 6.5, "along x") == BruteForce::Crossing;
   }
   EXPECT_GE(compared, 6) << "too few axis-parallel crossings compared";
+}
+
+// The block maxima change only the speed: the same answer, bit for bit, on every kind of field
+// (smooth terrain, walls, spikes on a floor, a step, random noise) and sizes that leave partial
+// blocks, for random rays from above the box and from its sides, axis-parallel ones, rays along
+// cell boundaries and rays grazing just above a field's highest texel.
+TEST(ReliefReferenceTest, BlocksGiveTheSameAnswer) {
+  Rng rng(20261205);
+  int hits = 0, rays = 0;
+  for (const int n : {5, 16, 37, 64}) {
+    std::vector<Heightfield> fields;
+    for (const char* kind : {"fbm", "walls", "spikes", "step"}) fields.push_back(make_heightfield(kind, n, 0, 7));
+    fields.push_back(random_field(n, rng));
+    for (const Heightfield& f : fields) {
+      const ReferenceBlocks blocks(f);
+      const float top = *std::max_element(f.heights.begin(), f.heights.end());
+      for (int k = 0; k < 1500; ++k) {
+        Vec o{rng.uniform(-2.0, n + 2.0), rng.uniform(-2.0, n + 2.0), rng.uniform(0.0, 1.6)};
+        Vec d{rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-0.3, 0.05)};
+        switch (k % 6) {
+          case 1: d[rng.below(2)] = 0.0; break;                                    // axis-parallel
+          case 2: o[0] = std::floor(o[0]) + 0.5, d[0] = 0.0; break;                // along a cell boundary
+          case 3: o[2] = static_cast<double>(top) + 1e-6 * rng.uniform(), d[2] = 0.0; break;  // grazing the top
+          case 4: o[2] = static_cast<double>(top) + 0.01, d[2] = -1e-3; break;     // slowly descending
+          default: break;
+        }
+        if (d[0] == 0.0 && d[1] == 0.0) d[0] = 0.5;
+        const auto interval = box_interval(n, o, d);
+        if (!interval) continue;
+        ++rays;
+        const ReferenceHit plain = reference_hit(f, o, d, interval->first, interval->second);
+        const ReferenceHit fast = reference_hit(f, o, d, interval->first, interval->second, &blocks);
+        hits += plain.hit;
+        ASSERT_EQ(plain.hit, fast.hit) << "n " << n << " ray " << k;
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(plain.t), std::bit_cast<std::uint64_t>(fast.t)) << "n " << n << " ray " << k;
+      }
+    }
+  }
+  EXPECT_GT(rays, 10000);
+  EXPECT_GT(hits, rays / 10) << "too few hits compared";
+  EXPECT_LT(hits, rays - rays / 10) << "too few misses compared";
 }
 
 // Above everything: no hit, also for a descending ray that leaves the box first.

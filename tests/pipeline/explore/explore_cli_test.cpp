@@ -234,7 +234,9 @@ TEST(ExploreCliTest, FrontSearchFindsTheGridsFront) {
     ASSERT_EQ(r.status, 0) << r.out << r.err;
     EXPECT_TRUE(has(r.out, "search round 0: 5 points")) << "3 random points and their 2 references: " << r.out;
     const auto rows = read_csv(out / "results.csv");
-    if (cost == "total_depth_tests_per_frame") EXPECT_LT(rows.size(), 24u) << "the search ran fewer points than the grid";
+    if (cost == "total_depth_tests_per_frame") {
+      EXPECT_LT(rows.size(), 24u) << "the search ran fewer points than the grid";
+    }
     EXPECT_EQ(front(out / "results.csv", cost), front(grid / "results.csv", cost));
   }
   const fs::path listed = write_sweep("listed.json", {{"traces", {kSample}}, {"points", {{{"cull.mode", "nb"}}}}});

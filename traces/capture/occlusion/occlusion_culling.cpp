@@ -260,7 +260,8 @@ TechniqueRow occlusion_technique() {
            occlusion_culling_options()},
           make_occlusion_culling,
           occlusion_culling_bench_preset(),
-          {{"city", "city"}}};
+          {{"city", "city"}},
+          {}};
 }
 
 }  // namespace nbsim::capture

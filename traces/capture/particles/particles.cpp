@@ -408,6 +408,7 @@ TechniqueRow particles_technique() {
            particles_options()},
           make_particles,
           particles_bench_preset(),
+          {},
           {}};
 }
 

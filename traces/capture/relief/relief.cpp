@@ -443,6 +443,7 @@ class Relief final : public Technique {
     // One RLFF a box draw, in draw order; the capture's own score of each method (the methods share
     // the frame's rays: each pixel's reference is computed once).
     std::map<std::uint32_t, relief::ReferenceHit> references;
+    const relief::ReferenceBlocks blocks(field_);
     std::size_t box = 0;
     std::vector<std::uint32_t> depth_draws, depth_crcs;  // RLFD: the depth each box draw left
     for (const scene::DrawRecord& d : f.draws) {
@@ -457,7 +458,7 @@ class Relief final : public Technique {
         const float py = static_cast<float>(g.pixel[k] / static_cast<std::uint32_t>(width_)) + 0.5f;
         if (const auto ray = relief::fragment_ray(cam.view.ray, field_.size, px, py)) {
           const auto [at, fresh] = references.try_emplace(g.pixel[k]);
-          if (fresh) at->second = relief::reference_of(field_, *ray);
+          if (fresh) at->second = relief::reference_of(field_, *ray, &blocks);
           errors += relief::score_against(at->second, *ray, field_.size, g.hit[k] == trace::kReliefHit, g.t[k], box_height_, tolerance_)
                         .error != relief::HitError::None;
         }

@@ -826,6 +826,7 @@ TechniqueRow shadows_technique() {
            shadows_options()},
           make_shadows,
           shadows_bench_preset(),
+          {},
           {}};
 }
 

@@ -145,8 +145,9 @@ TEST(ReliefCliTest, ExactDepthOfItsOwnBox) {
                               "--field fbm --field-size 32 --angles 85 --box-depth exact"}) {
     const nlohmann::json r = capture_and_compare(dir / "exact.nbt", options);
     expect_exact_replay(r, options);
-    if (r.is_object())
+    if (r.is_object()) {
       for (const auto& [name, m] : r["methods"].items()) EXPECT_EQ(m["depth_written"], m["samples"]) << options << " " << name;
+    }
   }
   fs::remove_all(dir);
 }
