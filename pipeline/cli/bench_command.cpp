@@ -123,6 +123,10 @@ void add_bench_commands(CLI::App& app, Action& action) {
     CLI::Option* path = rep->add_option("--path", g->path, "Camera path (default: the technique's bench preset)");
     CLI::Option* mode = rep->add_option("--mode", g->mode, "The technique's variant: the value of its bench preset's mode option");
     rep->add_option("--set", ro->sets, "Override one model config key of the replay, unit.field=value (repeatable)");
+    rep->add_option("--repetitions", ro->repetitions,
+                    "Capture-and-replay pairs run one after the other; the pair of median ratio is reported (the host's speed drifts)")
+        ->check(CLI::Range(1, 100))
+        ->capture_default_str();
     // Every capture option of every technique, scene and camera path, passed on to the capture
     // over the technique's preset (the capture refuses one its technique, scene and path lack).
     std::vector<const capture::PluginInfo*> plugins;
@@ -148,7 +152,8 @@ void add_bench_commands(CLI::App& app, Action& action) {
     }
     rep->footer("Prints one JSON object: gl_ms (llvmpipe's technique passes, as the capture times them: not its reference\n"
                 "passes), replay_ms (the SystemC model), ratio replay/gl, depth_tests_per_s and cycles_per_s of the model,\n"
-                "measured in the same run; the capture options used (options), and <technique>_summary: the replay's\n"
+                "measured in the same run (of --repetitions capture-and-replay pairs, the pair of median ratio; ratios: every\n"
+                "pair's); the capture options used (options), and <technique>_summary: the replay's\n"
                 "technique totals. Each technique's bench preset (what is captured unless told otherwise):\n" + presets);
     rep->callback([&action, ro, g, size, scene, path, mode] {
       if (size->count()) ro->size = g->size;

@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "tests/common/refused.h"
 #include "tests/common/run_nbsim.h"
@@ -18,7 +20,8 @@ using testing::CliResult;
 using testing::has;
 using testing::run_nbsim;
 
-// A small particles capture replayed in the same run: the ratio is there and the replay is exact.
+// A small particles capture replayed in the same run, three pairs (the default): the ratio is
+// the median pair's, every pair's is listed, and the replay is exact.
 TEST(BenchReplayCliTest, ParticlesRatioPrinted) {
   const CliResult r = run_nbsim("bench replay --technique particles --size 128x96 --frames 2 --particles 2000 --sprite 24");
   ASSERT_EQ(r.status, 0) << r.err;
@@ -35,6 +38,13 @@ TEST(BenchReplayCliTest, ParticlesRatioPrinted) {
   EXPECT_GT(j.at("gl_ms").get<double>(), 0.0) << "llvmpipe's technique passes are timed";
   EXPECT_GT(j.at("replay_ms").get<double>(), 0.0);
   EXPECT_GT(j.at("ratio").get<double>(), 0.0);
+  EXPECT_EQ(j.at("repetitions"), 3);
+  std::vector<double> ratios = j.at("ratios").get<std::vector<double>>();
+  ASSERT_EQ(ratios.size(), 3u);
+  std::sort(ratios.begin(), ratios.end());
+  EXPECT_EQ(j.at("ratio").get<double>(), ratios[1]) << "the median pair's ratio";
+  EXPECT_DOUBLE_EQ(j.at("ratio").get<double>(), j.at("replay_ms").get<double>() / j.at("gl_ms").get<double>())
+      << "gl_ms and replay_ms are the median pair's";
   EXPECT_EQ(j.at("draws_exact"), j.at("draws")) << "every draw's fragments and passed samples equal GL's";
   EXPECT_TRUE(j.at("within_thresholds").get<bool>());
   ASSERT_TRUE(j.at("particles_summary").is_object()) << r.out;
@@ -47,7 +57,7 @@ TEST(BenchReplayCliTest, ParticlesRatioPrinted) {
 // A small shadows capture (boxes, flown over) replayed in the same run: the volume draws with their
 // stencil state are exact and the stencil buffer equals GL's (within_thresholds covers it).
 TEST(BenchReplayCliTest, ShadowsRatioPrinted) {
-  const CliResult r = run_nbsim("bench replay --technique shadows --scene boxes --size 128x96 --frames 2");
+  const CliResult r = run_nbsim("bench replay --technique shadows --scene boxes --size 128x96 --frames 2 --repetitions 1");
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("technique"), "shadows");
@@ -55,6 +65,7 @@ TEST(BenchReplayCliTest, ShadowsRatioPrinted) {
   EXPECT_EQ(j.at("scene"), "boxes");
   EXPECT_GT(j.at("gl_ms").get<double>(), 0.0);
   EXPECT_GT(j.at("ratio").get<double>(), 0.0);
+  EXPECT_EQ(j.at("ratios").size(), 1u);
   EXPECT_GT(j.at("draws").get<int>(), 0);
   EXPECT_EQ(j.at("draws_exact"), j.at("draws"));
   EXPECT_TRUE(j.at("within_thresholds").get<bool>());
@@ -77,14 +88,15 @@ TEST(BenchReplayCliTest, BadArgumentsExitTwo) {
                            {"--shape knot", "option --shape is not an option of city, walk, occlusion_culling"},
                            {"--technique ldi --shape teapot", "teapot"},
                            {"--technique occlusion_culling --size 8", "--size"},
-                           {"--technique ldi --ldi-size 0", "--ldi-size"}});
+                           {"--technique ldi --ldi-size 0", "--ldi-size"},
+                           {"--repetitions 0", "--repetitions"}});
 }
 
 // The LDI bench is the clipping application (three knots, LDIs of 64x64, in the city's walk at the
 // preset's 512x512) replayed in the same run: every clipping draw's counters, discards and final
 // depth buffer equal GL's (within_thresholds covers them).
 TEST(BenchReplayCliTest, LdiRatioPrinted) {
-  const CliResult r = run_nbsim("bench replay --technique ldi --frames 2 --ldi-size 64");
+  const CliResult r = run_nbsim("bench replay --technique ldi --frames 2 --ldi-size 64 --repetitions 1");
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("technique"), "ldi");
