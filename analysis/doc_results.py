@@ -14,7 +14,7 @@ Usage:
   /usr/bin/python3 analysis/doc_results.py --list                      # the blocks and their commands
 --collect runs every block's commands (each block in a temporary folder of its own, where its
 captures write; N blocks at a time, default one per core) and prints their outputs as one JSON
-object; AnalysisTest.DocResultsCurrent pipes it into --check.
+object; AnalysisTest.DocResultsCurrent.<module> (one test per module, --only <module>) pipes it into --check.
 
 A docs.py module has PAGE (the file name under docs/) and BLOCKS, a list of Block: NAME (the marker
 name), PAGE when the block is in another page than the module's, COMMANDS (lists of nbsim arguments, or of a tool's of TOOLS with its name first; a command
