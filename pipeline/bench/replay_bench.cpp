@@ -115,14 +115,13 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
     double gl_ms = 0.0, replay_ms = 0.0, ratio = 0.0;
   };
   std::vector<Pair> pairs;
-  capture::CaptureSummary cap;
   pipeline::ReplaySummary s;  // the last repetition's, replayed in this process
   std::vector<Timing> timings;
   for (int k = 0; k < o.repetitions; ++k) {
     const bool last = k + 1 == o.repetitions;
     Pair p;
     try {
-      cap = capture::capture(c, file.string());
+      p.gl_ms = capture::capture(c, file.string()).gl_ms;
       if (last) {
         s = pipeline::replay(r);
         p.replay_ms = s.host_seconds * 1e3;
@@ -135,7 +134,6 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
       throw;
     }
     std::filesystem::remove(file);
-    p.gl_ms = cap.gl_ms;
     p.ratio = p.gl_ms > 0 ? p.replay_ms / p.gl_ms : 0.0;
     pairs.push_back(p);
   }
@@ -143,10 +141,9 @@ nlohmann::ordered_json run_replay_bench(const ReplayBenchOptions& o) {
     NBSIM_CHECK(timings[k].cycles == s.cycles && timings[k].depth_tests == s.depth_tests,
                 fmt::format("bench replay: repetition {} replayed to {} cycles and {} depth tests, the last to {} and {}", k + 1,
                             timings[k].cycles, timings[k].depth_tests, s.cycles, s.depth_tests));
-  std::vector<std::size_t> order(pairs.size());
-  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return pairs[a].ratio < pairs[b].ratio; });
-  const Pair& median = pairs[order[(order.size() - 1) / 2]];  // the lower median of an even count
+  std::vector<Pair> by_ratio = pairs;
+  std::sort(by_ratio.begin(), by_ratio.end(), [](const Pair& a, const Pair& b) { return a.ratio < b.ratio; });
+  const Pair median = by_ratio[(by_ratio.size() - 1) / 2];  // the lower median of an even count
 
   nlohmann::ordered_json j;
   j["bench"] = "replay";
