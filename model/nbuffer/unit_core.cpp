@@ -23,6 +23,7 @@ constexpr double kMinRate = 1.0 / 64.0, kMaxLookupRate = 1024.0, kMaxUpdateRate 
 constexpr int kMaxCacheBytes = 1 << 30, kMinLineBytes = 4, kMaxLineBytes = 4096, kMaxWays = 64;
 constexpr int kMaxSidePx = 16384;
 constexpr int kMaxAspectLog2 = 14;
+constexpr int kMaxDirtyTile = 64;
 
 constexpr std::string_view kOutcomeLabels[] = {"hidden", "visible", "incomplete", "offscreen"};
 
@@ -128,6 +129,15 @@ void NBufferUnitConfig::describe(config::Schema& s, NBufferUnitConfig& c, const 
         "level 0: copy (the paper's: the depth map copied into the levels, every change written again) or depth (the "
         "depth buffer is level 0, nothing copied; needs resolution_divisor 1 and format f32)",
         std::vector<std::string>{"copy", "depth"});
+  s.add(key("dirty_tile"), c.dirty_tile, "texels",
+        "update_policy batched or lazy: pending changes tracked per dirty_tile x dirty_tile tile of level-0 texels (1: a "
+        "flag per texel); a dirty tile hands all its texels to the update engine; a power of two",
+        1, kMaxDirtyTile);
+  s.add(key("demand_levels"), c.demand_levels,
+        "keep current only the levels up to the highest one the previous frame's queries needed (a frame runs from "
+        "depth clear to depth clear); a query needing more tiles the highest kept level (capped_max_lookups)");
+  s.add(key("demand_margin"), c.demand_margin, "levels", "demand_levels: levels kept above the previous frame's highest",
+        0, kMaxLevelCap);
   s.add(key("cache_size_bytes"), c.cache.size_bytes, "bytes",
         "texel cache of the query port, a multiple of cache_line_bytes x cache_ways; 0 disables it", 0, kMaxCacheBytes);
   s.add(key("cache_line_bytes"), c.cache.line_bytes, "bytes",
@@ -162,6 +172,20 @@ void NBufferUnitConfig::validate() const {
                     key_prefix, key_prefix, key_prefix, resolution_divisor, format));
   if (update_policy == "on_demand" && levels == "rect")
     bad(fmt::format("{}.update_policy=on_demand computes square levels only: {}.levels must be square", key_prefix, key_prefix));
+  if (dirty_tile < 1 || dirty_tile > kMaxDirtyTile || (dirty_tile & (dirty_tile - 1)) != 0)
+    bad(fmt::format("{}.dirty_tile must be a power of two from 1 to {}, got {}", key_prefix, kMaxDirtyTile, dirty_tile));
+  if (dirty_tile != 1 && update_policy != "batched" && update_policy != "lazy")
+    bad(fmt::format("{}.dirty_tile={} tracks pending changes, which only update_policy batched or lazy keeps: {}.update_policy={} "
+                    "needs {}.dirty_tile=1",
+                    key_prefix, dirty_tile, key_prefix, update_policy, key_prefix));
+  if (demand_levels && update_policy == "on_demand")
+    bad(fmt::format("{}.demand_levels has nothing to cap under {}.update_policy=on_demand, which computes only the texels "
+                    "queries read",
+                    key_prefix, key_prefix));
+  if (demand_levels && levels == "rect")
+    bad(fmt::format("{}.levels=rect builds every level: {}.demand_levels must be false", key_prefix, key_prefix));
+  if (demand_margin < 0 || demand_margin > kMaxLevelCap)
+    bad(fmt::format("{}.demand_margin must be 0 to {}, got {}", key_prefix, kMaxLevelCap, demand_margin));
   if (level_cap < -1 || level_cap > kMaxLevelCap)
     bad(fmt::format("{}.level_cap must be -1 (all levels) or 0 to {}, got {}", key_prefix, kMaxLevelCap, level_cap));
   if (capped_max_lookups < 0 || capped_max_lookups > kMaxCappedLookups)
@@ -303,7 +327,9 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
       applied_(g.vector("texels_applied", "texels", "level-0 texels handed to the update engine, by what triggered it",
                         {"eager", "forced", "end_of_pass", "lazy", "flush"})),
       frames_(g.counter("frames", "frames", "frames ended")),
-      fast_clears_(g.counter("fast_clears", "clears", "depth clears taken as a tag on every level (fast_clear): no texel written")) {
+      fast_clears_(g.counter("fast_clears", "clears", "depth clears taken as a tag on every level (fast_clear): no texel written")),
+      kept_levels_(g.counter("levels_kept", "levels", "levels kept current after each depth clear, summed over the clears")),
+      demand_frames_(g.counter("level_frames", "clears", "depth clears after which the kept levels were chosen")) {
   g.formula("lookups_per_query", "lookups/query", "lookups per query that reached the levels", [this] {
     return stats::ratio(
         static_cast<double>(lookups_.total()),
@@ -311,6 +337,11 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
   });
   g.formula("cache_hit_rate", "", "texel cache hits per lookup", [this] {
     return stats::ratio(static_cast<double>(hits_.value()), static_cast<double>(hits_.value() + misses_.value()));
+  });
+  g.formula("tracking_bits", "bits", "state kept to know what is stale (pending or current flags)",
+            [this] { return static_cast<double>(tracking_bits()); });
+  g.formula("levels_kept_per_frame", "levels", "levels kept current per depth clear (demand_levels)", [this] {
+    return stats::ratio(static_cast<double>(kept_levels_.value()), static_cast<double>(demand_frames_.value()));
   });
   g.formula("hidden_fraction", "", "queries answered hidden per query", [this] {
     return stats::ratio(static_cast<double>(queries_.value(0)), static_cast<double>(queries_.total()));
@@ -331,6 +362,22 @@ NBufferUnitCore::NBufferUnitCore(const NBufferUnitConfig& config, int width_px, 
   bins_y_ = ceil_div(nb_.height(), kBinPx);
   bins_.resize(static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(bins_y_));
   if (policy_ == UpdatePolicy::OnDemand) nb_.set_on_demand(true);
+  dirty_tile_ = config_.dirty_tile;
+  if (dirty_tile_ > 1) {
+    dtiles_x_ = ceil_div(nb_.width(), dirty_tile_);
+    dtiles_y_ = ceil_div(nb_.height(), dirty_tile_);
+    tile_dirty_.assign(static_cast<std::size_t>(dtiles_x_) * static_cast<std::size_t>(dtiles_y_), 0);
+  }
+  kept_top_ = nb_.top_level();
+}
+
+std::uint64_t NBufferUnitCore::tracking_bits() const noexcept {
+  const auto plane = static_cast<std::uint64_t>(nb_.width()) * static_cast<std::uint64_t>(nb_.height());
+  switch (policy_) {
+    case UpdatePolicy::Eager: return 0;
+    case UpdatePolicy::OnDemand: return plane * static_cast<std::uint64_t>(nb_.level_count() - 1);
+    default: return dirty_tile_ > 1 ? tile_dirty_.size() : plane;
+  }
 }
 
 Rect NBufferUnitCore::to_reduced(const Rect& r) const noexcept {
@@ -366,7 +413,8 @@ UpdateWork NBufferUnitCore::new_work() const {
 void NBufferUnitCore::account(const UpdateStats& s, UpdateWork& w) {
   const auto bpt = static_cast<std::uint64_t>(texel_bytes(format_));
   const bool shared_level0 = config_.level0 == "depth";  // level 0 is the depth buffer: no copy to write
-  for (std::size_t i = 0; i < s.texels_recomputed.size(); ++i) {
+  const std::size_t kept = std::min(s.texels_recomputed.size(), static_cast<std::size_t>(kept_top_) + 1);
+  for (std::size_t i = 0; i < kept; ++i) {  // levels above the kept ones are not maintained (demand_levels)
     if (i == 0 && shared_level0) continue;
     const auto rec = static_cast<std::uint64_t>(s.texels_recomputed[i]);
     const auto chg = static_cast<std::uint64_t>(s.texels_changed[i]);
@@ -397,7 +445,37 @@ void NBufferUnitCore::reduce_block(int rx, int ry, UpdateWork& w) {
   w.depth_pixels_reduced += static_cast<std::uint64_t>(x1 - rx * d) * static_cast<std::uint64_t>(y1 - ry * d);
 }
 
+std::uint64_t NBufferUnitCore::tile_area(int tx, int ty) const noexcept {
+  const int w = std::min(dirty_tile_, nb_.width() - tx * dirty_tile_), h = std::min(dirty_tile_, nb_.height() - ty * dirty_tile_);
+  return static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+}
+
+void NBufferUnitCore::mark_tile(int x, int y) {
+  const int tx = x / dirty_tile_, ty = y / dirty_tile_;
+  std::uint8_t& f = tile_dirty_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(dtiles_x_) + static_cast<std::size_t>(tx)];
+  if (f) return;
+  f = 1;
+  pending_count_ += tile_area(tx, ty);
+}
+
+UpdateWork NBufferUnitCore::apply_tiles(const Rect& r) {
+  std::vector<Texel> take;
+  const int tx1 = (r.x1() - 1) / dirty_tile_, ty1 = (r.y1() - 1) / dirty_tile_;
+  for (int ty = r.y / dirty_tile_; ty <= ty1; ++ty)
+    for (int tx = r.x / dirty_tile_; tx <= tx1; ++tx) {
+      std::uint8_t& f = tile_dirty_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(dtiles_x_) + static_cast<std::size_t>(tx)];
+      if (!f) continue;
+      f = 0;
+      pending_count_ -= tile_area(tx, ty);
+      const int x1 = std::min((tx + 1) * dirty_tile_, nb_.width()), y1 = std::min((ty + 1) * dirty_tile_, nb_.height());
+      for (int y = ty * dirty_tile_; y < y1; ++y)
+        for (int x = tx * dirty_tile_; x < x1; ++x) take.push_back({x, y});
+    }
+  return apply_writes(take);
+}
+
 void NBufferUnitCore::mark_one(int x, int y) {
+  if (dirty_tile_ > 1) return mark_tile(x, y);
   const std::size_t k =
       static_cast<std::size_t>(y) * static_cast<std::size_t>(nb_.width()) + static_cast<std::size_t>(x);
   if (pending_[k]) return;
@@ -475,6 +553,7 @@ UpdateWork NBufferUnitCore::apply_writes(std::span<const Texel> texels) {
 UpdateWork NBufferUnitCore::apply_pending(const Rect& region) {
   const Rect r = clip(region, nb_.width(), nb_.height());
   if (r.empty() || pending_count_ == 0) return new_work();
+  if (dirty_tile_ > 1) return apply_tiles(r);
   std::vector<Texel> take;
   const int bx1 = (r.x1() - 1) / kBinPx, by1 = (r.y1() - 1) / kBinPx;
   for (int by = r.y / kBinPx; by <= by1; ++by)
@@ -516,9 +595,15 @@ UpdateWork NBufferUnitCore::depth_changed(const DepthImage& depth, const Rect& d
     account(nb_.update(level0_source(), rr), w);
     applied_.add(kEager, area);
   } else if (mark(rr) && policy_ == UpdatePolicy::Batched) {
-    unmark(rr);  // the rectangle is applied whole, its pending texels with it
-    account(nb_.update(level0_source(), rr), w);
-    applied_.add(kForced, area);
+    if (dirty_tile_ > 1) {
+      const std::uint64_t before = pending_count_;
+      w += apply_tiles(rr);  // the dirty tiles the rectangle meets, which hold every texel it changed
+      applied_.add(kForced, before - pending_count_);
+    } else {
+      unmark(rr);  // the rectangle is applied whole, its pending texels with it
+      account(nb_.update(level0_source(), rr), w);
+      applied_.add(kForced, area);
+    }
   }
   return w;
 }
@@ -548,9 +633,15 @@ UpdateWork NBufferUnitCore::depth_changed(std::span<const PixelWrite> writes) {
     w += apply_writes(scratch_);
     applied_.add(kEager, scratch_.size());
   } else if (mark(scratch_) && policy_ == UpdatePolicy::Batched) {
-    unmark(scratch_);
-    w += apply_writes(scratch_);
-    applied_.add(kForced, scratch_.size());
+    if (dirty_tile_ > 1) {
+      const std::uint64_t before = pending_count_;
+      for (const Texel& t : scratch_) w += apply_tiles({t.x, t.y, 1, 1});  // each written texel's dirty tile
+      applied_.add(kForced, before - pending_count_);
+    } else {
+      unmark(scratch_);
+      w += apply_writes(scratch_);
+      applied_.add(kForced, scratch_.size());
+    }
   }
   return w;
 }
@@ -561,8 +652,16 @@ UpdateWork NBufferUnitCore::depth_cleared(float depth) {
   if (divisor_ > 1) std::fill(reduced_.texels.begin(), reduced_.texels.end(), depth);
   std::fill(pending_.begin(), pending_.end(), std::uint8_t{0});
   for (auto& bin : bins_) bin.clear();
+  std::fill(tile_dirty_.begin(), tile_dirty_.end(), std::uint8_t{0});
   pending_count_ = 0;
   nb_.build(level0_source());
+  // A frame ends at a clear: the next keeps the levels this one's queries needed (none asked: as
+  // they were). The clear below writes exactly those levels, so a level kept again costs its clear.
+  if (config_.demand_levels && demand_seen_ >= 0)
+    kept_top_ = std::min(nb_.top_level(), demand_seen_ + config_.demand_margin);
+  demand_seen_ = -1;
+  kept_levels_ += static_cast<std::uint64_t>(kept_top_) + 1;
+  ++demand_frames_;
   // Every texel of every level takes the clear value (each square holds its in-image anchor), so
   // a clear writes all levels without reading any; a fast clear tags them instead (no work).
   UpdateWork w = new_work();
@@ -572,12 +671,13 @@ UpdateWork NBufferUnitCore::depth_cleared(float depth) {
   }
   const auto plane = static_cast<std::uint64_t>(nb_.width()) * static_cast<std::uint64_t>(nb_.height());
   const std::size_t first = config_.level0 == "depth" ? 1 : 0;  // the depth buffer clears level 0 itself
-  for (std::size_t i = first; i < w.texels_recomputed.size(); ++i) {
+  const std::size_t end = static_cast<std::size_t>(kept_top_) + 1;  // demand_levels: the kept levels only
+  for (std::size_t i = first; i < end; ++i) {
     w.texels_recomputed[i] = w.texels_changed[i] = plane;
     recomputed_.add(i, plane);
     changed_.add(i, plane);
   }
-  w.bytes_written = plane * (w.texels_recomputed.size() - first) * static_cast<std::uint64_t>(texel_bytes(format_));
+  w.bytes_written = plane * (end - first) * static_cast<std::uint64_t>(texel_bytes(format_));
   bytes_written_ += w.bytes_written;
   return w;
 }
@@ -637,8 +737,9 @@ QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth) {
   a.kase = cov.kase;
   a.level = cov.level;
   cases_.add(static_cast<std::size_t>(cov.kase));
+  demand_seen_ = std::max(demand_seen_, cov.level);
 
-  if (cov.level <= nb_.top_level()) {
+  if (cov.level <= kept_top_) {
     if (policy_ == UpdatePolicy::Lazy) {
       int x0 = cov.squares[0].x, y0 = cov.squares[0].y, x1 = x0, y1 = y0;
       for (int i = 1; i < cov.count; ++i) {
@@ -660,10 +761,10 @@ QueryAnswer NBufferUnitCore::query(const Rect& r, float nearest_depth) {
     for (const Texel& t : q.read()) read_texel(a, q.level, t.x, t.y);
     NBSIM_CHECK(a.value == q.value, "N-buffer unit's lookups disagree with the N-buffer's answer");
   } else {
-    // The level needed is above level_cap: tile the rectangle with top-level squares anchored at
-    // its left/bottom edge every S pixels and once more flush with its right/top edge (a rectangle
+    // The level needed is above level_cap or the kept levels (demand_levels): tile the rectangle
+    // with top-level squares anchored at its left/bottom edge every S pixels and once more flush with its right/top edge (a rectangle
     // less tall than S: one row, flush with its top edge under the top alignment, as a covering).
-    const int top = nb_.top_level(), side = 1 << top;
+    const int top = kept_top_, side = 1 << top;
     const long long nx = rr.w > side ? ceil_div(rr.w, side) : 1, ny = rr.h > side ? ceil_div(rr.h, side) : 1;
     if (nx * ny > config_.capped_max_lookups) {
       a.complete = false;

@@ -14,6 +14,16 @@
 // that read a changed pixel; a query computes the stale texels it reads (recursively, from the level
 // below) and they stay until a pixel under them changes: the upkeep follows the queries, not the
 // pixels, and every answer equals eager's. Square levels only.
+// Dirty tracking (dirty_tile, batched and lazy): the pending changes are kept per texel (1, a flag
+// per storage texel) or per dirty_tile x dirty_tile tile of texels (a flag per tile: 1/64 of the
+// state for 8x8); applying a dirty tile hands all its texels to the update engine, which compares
+// each with level 0 and carries only the changed ones up, so a tile costs its area at level 0 and
+// nothing more above it.
+// Demand-capped levels (demand_levels): between two depth clears the unit keeps current only the
+// levels up to the highest one the queries since the clear before needed (plus demand_margin);
+// a query that needs a higher level tiles the highest kept one (capped_max_lookups) or answers
+// Incomplete. The clear is where the kept levels change: it writes (or, fast_clear, tags) exactly
+// the levels the next frame keeps, so raising a level costs what clearing it costs.
 #pragma once
 
 #include <array>
@@ -75,6 +85,12 @@ struct NBufferUnitConfig {
   // written again) or depth (the depth buffer itself is level 0: no copy written, level 1 reads the
   // depth buffer; needs resolution_divisor 1 and format f32).
   std::string level0 = "copy";
+  // batched and lazy: pending changes tracked per dirty_tile x dirty_tile texels (1: per texel).
+  int dirty_tile = 1;
+  // Levels kept current only up to the highest one the previous frame's queries needed (frames
+  // run from depth clear to depth clear), plus demand_margin levels.
+  bool demand_levels = false;
+  int demand_margin = 0;
   // Texel cache of the query port: 16 KiB, 256-byte lines (an 8x8 tile of f32 texels), 4 ways.
   memory::CacheConfig cache{16 * 1024, 256, 4};
 
@@ -187,7 +203,13 @@ class NBufferUnitCore {
   const DepthImage& level0_source() const noexcept { return divisor_ == 1 ? depth_ : reduced_; }
   // The storage-resolution rectangle covering every reduced texel that r's pixels fall in.
   Rect to_reduced(const Rect& r) const noexcept;
+  // Texels the pending changes will hand to the update engine (per-tile tracking: the dirty tiles' texels).
   std::uint64_t pending_texels() const noexcept { return pending_count_; }
+  // The highest level kept current (demand_levels: this frame's cap; otherwise the top level).
+  int kept_top_level() const noexcept { return kept_top_; }
+  // Bits of state the unit keeps to know what is stale: pending flags (batched, lazy; per texel or
+  // per dirty tile) or current flags of every level above 0 (on_demand); 0 for eager.
+  std::uint64_t tracking_bits() const noexcept;
   // Byte address of a level texel in the unit's memory: planes of cache-line-sized tiles.
   std::uint64_t texel_address(int level, int x, int y) const noexcept;
   std::uint64_t cache_hits() const noexcept { return cache_.hits(); }
@@ -205,6 +227,10 @@ class NBufferUnitCore {
   void unmark(const Rect& rr);
   void unmark(std::span<const Texel> texels);
   void mark_one(int x, int y);
+  void mark_tile(int x, int y);
+  std::uint64_t tile_area(int tx, int ty) const noexcept;
+  // The texel rectangle a query's lazy update must bring up to date, applied.
+  UpdateWork apply_tiles(const Rect& region);
   // Applies the pending texels of every bin that meets `region` (storage coordinates).
   UpdateWork apply_pending(const Rect& region);
   UpdateWork apply_writes(std::span<const Texel> texels);
@@ -233,6 +259,12 @@ class NBufferUnitCore {
   std::uint32_t epoch_ = 0;
   std::vector<Texel> scratch_;
   std::vector<PixelWrite> writes_;
+  // Per-tile tracking (dirty_tile > 1): a flag per tile of dirty_tile x dirty_tile texels.
+  int dirty_tile_ = 1, dtiles_x_ = 1, dtiles_y_ = 1;
+  std::vector<std::uint8_t> tile_dirty_;
+  // Demand-capped levels: the levels kept this frame, and the highest level needed since the last clear.
+  int kept_top_ = 0;
+  int demand_seen_ = -1;
 
   // Statistics (declared in the unit's group).
   stats::VectorCounter& queries_;
@@ -251,6 +283,8 @@ class NBufferUnitCore {
   stats::VectorCounter& applied_;
   stats::Counter& frames_;
   stats::Counter& fast_clears_;
+  stats::Counter& kept_levels_;
+  stats::Counter& demand_frames_;
 };
 
 }  // namespace nbsim::nbuffer

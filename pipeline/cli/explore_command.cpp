@@ -36,13 +36,13 @@ namespace fs = std::filesystem;
 
 // The real config check: the settings on a default GpuConfig, then the units' own validation;
 // returns every key's effective value, flat.
-nlohmann::json check_config(const nlohmann::json& settings, const std::string& origin) {
+nlohmann::json check_config(const nlohmann::json& settings, const std::string& origin, explore::CheckScope scope) {
   pipeline::GpuConfig c;
   config::Schema schema;
   pipeline::GpuConfig::describe(schema, c);
   schema.apply(settings, origin);
   try {
-    c.validate();
+    if (scope == explore::CheckScope::Whole) c.validate();
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", origin, e.what()));
   }

@@ -203,28 +203,46 @@ std::vector<std::string> parameter_keys(const SweepSpec& spec) {
 }
 
 void check_points(const SweepSpec& spec, std::vector<Point>& points, const ConfigCheck& check, const std::string& origin) {
-  // Each value on its own (a key this build lacks, a value out of its limits: the whole sweep is
-  // refused); a combination that cannot be built is the point's own failure, below.
-  check(sorted(spec.set), origin + ": set");
+  // Each value on its own: against its key's type and limits (a key this build lacks, a value out
+  // of its limits: the whole sweep is refused at once), then beside the other keys' defaults. A
+  // value that breaks a rule there (a tracking tile beside the default eager policy, say) is only
+  // doubtful: its points are refused one by one below, and the sweep only when all of them are (the
+  // value then cannot be built in this sweep at all, and the message names it).
+  struct Doubt {
+    nlohmann::json settings;  // the value (or the set's values), typed
+    std::string message;
+  };
+  std::vector<Doubt> doubts;
+  const auto check_value = [&](const nlohmann::json& one, const std::string& where) {
+    const nlohmann::json typed = check(one, where, CheckScope::Values);
+    try {
+      check(one, where, CheckScope::Whole);
+    } catch (const InputError& e) {
+      Doubt d{nlohmann::json::object(), e.what()};
+      for (const auto& [k, v] : one.items()) d.settings[k] = typed.contains(k) ? typed[k] : v;
+      doubts.push_back(std::move(d));
+    }
+  };
+  check_value(sorted(spec.set), origin + ": set");
   for (const auto& [key, values] : spec.axes)
     for (std::size_t i = 0; i < values.size(); ++i) {
       nlohmann::json one = nlohmann::json::object();
       one[key] = values[i];
-      check(one, fmt::format("{}: axes.{}[{}]", origin, key, i));
+      check_value(one, fmt::format("{}: axes.{}[{}]", origin, key, i));
     }
   for (std::size_t i = 0; i < spec.points.size(); ++i)
     for (const auto& [k, v] : spec.points[i].items()) {
       if (k == "trace") continue;
       nlohmann::json one = nlohmann::json::object();
       one[k] = sorted(v);
-      check(one, fmt::format("{}: points[{}].{}", origin, i, k));
+      check(one, fmt::format("{}: points[{}].{}", origin, i, k), CheckScope::Values);
     }
   const std::vector<std::string> keys = parameter_keys(spec);
   std::set<std::string> seen;
   for (Point& p : points) {
     nlohmann::json effective;
     try {
-      effective = check(p.settings, fmt::format("{}: point ({})", origin, describe_settings(p.trace, p.settings)));
+      effective = check(p.settings, fmt::format("{}: point ({})", origin, describe_settings(p.trace, p.settings)), CheckScope::Whole);
     } catch (const InputError& e) {
       // Every value passed on its own above: the combination cannot be built. Recorded, not run.
       p.refused = e.what();
@@ -247,6 +265,15 @@ void check_points(const SweepSpec& spec, std::vector<Point>& points, const Confi
     p.id = point_id(p.trace, p.settings);
     if (!seen.insert(p.id).second)
       throw InputError(fmt::format("{}: the point ({}) is listed twice", origin, describe_settings(p.trace, p.settings)));
+  }
+  for (const Doubt& d : doubts) {
+    const auto holds = [&d](const Point& p) {
+      for (const auto& [k, v] : d.settings.items())
+        if (!p.settings.contains(k) || p.settings[k] != v) return false;
+      return true;
+    };
+    if (std::none_of(points.begin(), points.end(), [&](const Point& p) { return p.refused.empty() && holds(p); }))
+      throw InputError(d.message);
   }
 }
 
@@ -279,7 +306,8 @@ void add_reference_points(std::vector<Point>& points, const std::vector<std::str
       changed = true;
     }
     if (!changed) return points[i].id;
-    r.effective = check(r.settings, fmt::format("{}: reference point ({})", origin, describe_settings(r.trace, r.settings)));
+    r.effective =
+        check(r.settings, fmt::format("{}: reference point ({})", origin, describe_settings(r.trace, r.settings)), CheckScope::Whole);
     for (auto& [k, v] : r.settings.items()) v = r.effective[k];
     if (const auto found = by_config.find(config_key(r)); found != by_config.end()) return points[found->second].id;
     for (const auto& k : parameters) r.parameters[k] = r.effective[k];
@@ -292,7 +320,7 @@ void add_reference_points(std::vector<Point>& points, const std::vector<std::str
     return points[added].id;
   };
 
-  const nlohmann::json defaults = check(nlohmann::json::object(), origin + ": defaults");
+  const nlohmann::json defaults = check(nlohmann::json::object(), origin + ": defaults", CheckScope::Whole);
   const std::size_t sweep_points = points.size();
   for (std::size_t i = 0; i < sweep_points; ++i) {
     if (!points[i].refused.empty()) continue;  // never run: nothing to measure against

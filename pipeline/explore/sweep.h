@@ -73,10 +73,14 @@ std::vector<Point> expand(const SweepSpec& spec);
 // A stable id: 16 hex digits of the FNV-1a 64-bit hash of the trace and the sorted settings.
 std::string point_id(const std::string& trace, const nlohmann::json& settings);
 
+// What a config check looks at: each value against its key's type and limits only, or also the
+// config whole (the units' consistency rules, e.g. a key that needs another's value).
+enum class CheckScope { Values, Whole };
+
 // Applies flat settings to a default config and returns every key's effective value, flat
-// ({"unit.field": value}); throws InputError naming the key when one is unknown or bad. `origin`
-// prefixes the message.
-using ConfigCheck = std::function<nlohmann::json(const nlohmann::json& settings, const std::string& origin)>;
+// ({"unit.field": value}); throws InputError naming the key when one is unknown or bad (and, for
+// CheckScope::Whole, when the combination breaks a unit's rule). `origin` prefixes the message.
+using ConfigCheck = std::function<nlohmann::json(const nlohmann::json& settings, const std::string& origin, CheckScope scope)>;
 
 // Validates every point before anything runs: each axis value on its own (so the message names
 // it), then each point whole. Replaces each setting by its typed value (2 -> 2.0 for a float key),

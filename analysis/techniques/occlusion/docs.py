@@ -277,6 +277,48 @@ def render_upkeep(outputs):
     return "\n".join(lines)
 
 
+def tracking_label(r):
+    tile = "per texel" if r["nbuffer.dirty_tile"] == "1" else f"per {r['nbuffer.dirty_tile']}x{r['nbuffer.dirty_tile']} tile"
+    demand = "levels the last frame needed" if r["nbuffer.demand_levels"] == "true" else "every level"
+    tracked = "" if r["nbuffer.update_policy"] == "eager" else f", {tile}"
+    return f"{r['nbuffer.update_policy']}{tracked}, {demand}"
+
+
+def render_tracking(outputs):
+    import csv
+    import io
+    every = list(csv.DictReader(io.StringIO(outputs[-1])))
+    rows = sweep_rows(outputs[-1])
+    refused = [r for r in every if r["status"] == "failed"]
+    lines = ["| design (nb / nb_hier) | upkeep texels a frame | cycles a frame | efficiency lost (points of %) |",
+             "|---|---:|---:|---:|"]
+    policies = ["eager", "batched", "lazy"]
+    key = lambda r: (policies.index(r["nbuffer.update_policy"]), int(r["nbuffer.dirty_tile"]), r["nbuffer.demand_levels"])
+    by = {}
+    for r in rows:
+        by.setdefault(key(r), {})[r["cull.mode"]] = r
+    for k in sorted(by):
+        d = by[k]
+        def both(col, scale=1.0, fmt=None):
+            return " / ".join((fmt or (lambda v: n(v)))(float(d[m][col]) * scale) if m in d else "-" for m in ("nb", "nb_hier"))
+        lines.append(f"| {tracking_label(next(iter(d.values())))} | {both('update_texels_per_frame')} | {both('cycles_per_frame')} | "
+                     f"{both('efficiency_lost', 100.0, lambda v: f'{v:.2f}')} |")
+    pick = lambda mode, policy, tile, demand: next(r for r in rows if r["cull.mode"] == mode and r["nbuffer.update_policy"] == policy
+                                                  and r["nbuffer.dirty_tile"] == tile and r["nbuffer.demand_levels"] == demand)
+    lazy1, lazy8 = pick("nb", "lazy", "1", "false"), pick("nb", "lazy", "8", "false")
+    eager, eager_d = pick("nb", "eager", "1", "false"), pick("nb", "eager", "1", "true")
+    hier, hier_d = pick("nb_hier", "eager", "1", "false"), pick("nb_hier", "eager", "1", "true")
+    u = lambda r: float(r["update_texels_per_frame"])
+    lost = lambda r: float(r["efficiency_lost"]) * 100.0
+    lines += ["", f"Per 8x8 tile, lazy updates on `nb` recompute {n(u(lazy8))} texels a frame against {n(u(lazy1))} per texel "
+              f"({u(lazy8) / u(lazy1):.3f}x), with 1/64 of the pending flags. Levels capped by the last frame's demand take eager "
+              f"`nb` from {n(u(eager))} to {n(u(eager_d))} upkeep texels ({u(eager_d) / u(eager):.3f}x; efficiency lost "
+              f"{lost(eager):.2f} and {lost(eager_d):.2f} points) and `nb_hier` from {n(u(hier))} to {n(u(hier_d))}. "
+              f"{len(refused)} points (a tracking tile beside eager updates, which keep nothing pending) were refused by name "
+              f"and recorded as failed. False culls over every point: {sum(int(r['false_culls']) for r in rows)}."]
+    return "\n".join(lines)
+
+
 def pays_label(r):
     if r["cull.mode"] == "hiz_tile":
         return f"tile Hi-Z {r['hiz.tile_px']}x{r['hiz.tile_px']}"
@@ -329,6 +371,8 @@ BLOCKS += [
           files=("techniques/results.csv",), page="exploration.md"),
     Block("upkeep", [["explore", "pipeline/sweeps/nbuffer_upkeep.json", "--out", "upkeep", "--jobs", "2"]], render_upkeep,
           files=("upkeep/results.csv",), page="exploration.md"),
+    Block("tracking", [["explore", "pipeline/sweeps/nbuffer_tracking.json", "--out", "tracking", "--jobs", "2"]], render_tracking,
+          files=("tracking/results.csv",), page="exploration.md"),
     Block("pays", [["explore", "pipeline/sweeps/nbuffer_pays.json", "--out", "pays", "--jobs", "2"]], render_pays,
           files=("pays/results.csv",), page="exploration.md"),
     Block("design", [["explore", "pipeline/sweeps/nbuffer_design.json", "--out", "design", "--jobs", "2"]], render_design,

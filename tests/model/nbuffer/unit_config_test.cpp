@@ -18,7 +18,7 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   config::Schema s;
   NBufferUnitConfig::describe(s, c);
   const auto d = s.describe();
-  ASSERT_EQ(d.size(), 19u);
+  ASSERT_EQ(d.size(), 22u);
   auto find = [&](const std::string& key) {
     for (const auto& e : d)
       if (e["key"] == key) return e;
@@ -36,6 +36,9 @@ TEST(NBufferUnitConfigTest, DescribesEveryKeyWithDefaults) {
   EXPECT_EQ(find("nbuffer.invalidations_per_cycle")["default"], 64.0);
   EXPECT_EQ(find("nbuffer.fast_clear")["default"], false);
   EXPECT_EQ(find("nbuffer.level0")["default"], "copy");
+  EXPECT_EQ(find("nbuffer.dirty_tile")["default"], 1);
+  EXPECT_EQ(find("nbuffer.demand_levels")["default"], false);
+  EXPECT_EQ(find("nbuffer.demand_margin")["default"], 0);
   EXPECT_EQ(find("nbuffer.lookup_latency_cycles")["unit"], "cycles");
   EXPECT_EQ(find("nbuffer.lookups_per_cycle")["default"], 4.0);
   EXPECT_EQ(find("nbuffer.cache_size_bytes")["default"], 16384);
@@ -119,6 +122,12 @@ TEST(NBufferUnitConfigTest, ValidateRefusesInconsistentValues) {
       {[](NBufferUnitConfig& c) { c.level0 = "depth", c.resolution_divisor = 4; }, "nbuffer.level0=depth reads the depth buffer"},
       {[](NBufferUnitConfig& c) { c.level0 = "depth", c.format = "u16"; }, "nbuffer.level0=depth reads the depth buffer"},
       {[](NBufferUnitConfig& c) { c.level0 = "texture"; }, "nbuffer.level0 must be copy or depth"},
+      {[](NBufferUnitConfig& c) { c.dirty_tile = 3, c.update_policy = "lazy"; }, "nbuffer.dirty_tile must be a power of two"},
+      {[](NBufferUnitConfig& c) { c.dirty_tile = 128, c.update_policy = "lazy"; }, "nbuffer.dirty_tile must be a power of two"},
+      {[](NBufferUnitConfig& c) { c.dirty_tile = 8; }, "nbuffer.dirty_tile=8 tracks pending changes"},
+      {[](NBufferUnitConfig& c) { c.demand_levels = true, c.update_policy = "on_demand"; }, "nbuffer.demand_levels has nothing to cap"},
+      {[](NBufferUnitConfig& c) { c.demand_levels = true, c.levels = "rect"; }, "nbuffer.levels=rect builds every level"},
+      {[](NBufferUnitConfig& c) { c.demand_margin = -1; }, "nbuffer.demand_margin must be 0 to"},
       {[](NBufferUnitConfig& c) { c.invalidations_per_cycle = 0.0; }, "nbuffer.invalidations_per_cycle must be"},
   };
   for (const Row& row : rows) {

@@ -534,5 +534,124 @@ TEST(NBufferUnitCoreTest, FastClearAndSharedLevel0CostLess) {
     for (int shared = 0; shared < 2; ++shared) EXPECT_EQ(answer[fast][shared], 0.25f);
 }
 
+
+// Dirty tiles (dirty_tile > 1) track pending changes per tile: lazy answers still equal a fresh
+// build at every query, batched ones once the pass ends, and the levels equal a fresh build once
+// flushed; a tile's texels all reach level 0 (at least the per-texel work there), for a fraction
+// of the per-texel flags.
+TEST(NBufferUnitCoreTest, DirtyTilesAnswerAsPerTexelTracking) {
+  for (const FarOp op : kOps)
+    for (const char* policy : {"batched", "lazy"})
+      for (const int tile : {2, 8, 64})
+        for (const int d : {1, 2}) {
+          const std::string at = where(op, policy, d, "f32") + ", dirty_tile " + std::to_string(tile);
+          NBufferUnitConfig per_texel, per_tile;
+          per_texel.update_policy = per_tile.update_policy = policy;
+          per_texel.resolution_divisor = per_tile.resolution_divisor = d;
+          per_tile.dirty_tile = tile;
+          Rig a(op, per_texel, 43, 37), b(op, per_tile, 43, 37);
+          ref::Failures fails;
+          std::mt19937 qrng(9u + static_cast<unsigned>(tile));
+          for (int pass = 0; pass < 10; ++pass) {
+            for (int step = 0; step < 10; ++step) {
+              std::mt19937 rng_a(static_cast<unsigned>(pass * 1000 + step * 7 + tile)), rng_b = rng_a;
+              a.random_change(rng_a);
+              b.random_change(rng_b);
+              const Rect r = ref::random_rect(qrng, 43, 37, true);
+              const float nearest = random_nearest(qrng, op, ref::farthest(b.truth, op, r));
+              const QueryAnswer qa = a.core->query(r, nearest), qb = b.core->query(r, nearest);
+              if (auto e = check(b, r, nearest, qb); !e.empty()) fails.add(e);
+              if (std::string(policy) == "lazy" && qb.outcome != QueryOutcome::Offscreen &&
+                  qb.value != b.fresh().query(b.core->to_reduced(r), b.core->covering()).value)
+                fails.add(ref::str(r) + ": a lazy per-tile answer differs from a fresh build");
+              if (qa.outcome != qb.outcome && std::string(policy) == "lazy")
+                fails.add(ref::str(r) + ": per-tile and per-texel lazy answers differ");
+            }
+            a.work += a.core->end_of_pass();
+            b.work += b.core->end_of_pass();
+            for (int q = 0; q < 5; ++q) {
+              const Rect r = ref::random_rect(qrng, 43, 37, false);
+              if (a.core->query(r, 0.5f).value != b.core->query(r, 0.5f).value)
+                fails.add(ref::str(r) + " after end_of_pass: per-tile and per-texel answers differ");
+            }
+          }
+          b.work += b.core->flush();
+          a.work += a.core->flush();
+          EXPECT_EQ(b.core->pending_texels(), 0u) << at;
+          const NBuffer want = b.fresh();
+          long long differ = 0;
+          for (int i = 0; i < want.level_count(); ++i)
+            for (int y = 0; y < want.height(); ++y)
+              for (int x = 0; x < want.width(); ++x) differ += b.core->levels().texel(i, x, y) != want.texel(i, x, y);
+          EXPECT_EQ(differ, 0) << at << ": texels differing from a fresh build";
+          EXPECT_EQ(fails.count(), 0) << at << ": " << fails.summary();
+          EXPECT_GE(b.work.texels_recomputed[0], a.work.texels_recomputed[0]) << at << ": a dirty tile reaches level 0 whole";
+          EXPECT_LT(b.core->tracking_bits(), a.core->tracking_bits()) << at;
+          EXPECT_EQ(a.core->tracking_bits(), static_cast<std::uint64_t>(a.core->levels().width() * a.core->levels().height()));
+        }
+}
+
+// Demand-capped levels: the levels kept after a clear are those the queries since the clear
+// before needed (plus the margin); no work is counted above them; a query needing more tiles the
+// highest kept level or answers Incomplete, and no answer is ever non-conservative.
+TEST(NBufferUnitCoreTest, DemandLevelsFollowThePreviousFrame) {
+  for (const FarOp op : kOps)
+    for (const char* policy : {"eager", "batched", "lazy"})
+      for (const int margin : {0, 1}) {
+        const std::string at = where(op, policy, 1, "f32") + ", margin " + std::to_string(margin);
+        NBufferUnitConfig cfg;
+        cfg.update_policy = policy;
+        cfg.demand_levels = true;
+        cfg.demand_margin = margin;
+        Rig rig(op, cfg, 64, 48);
+        const int full = rig.core->levels().top_level();
+        EXPECT_EQ(rig.core->kept_top_level(), full) << at << ": the first frame keeps every level";
+        ref::Failures fails;
+        std::mt19937 rng(41u + static_cast<unsigned>(margin));
+        int tiled_or_incomplete = 0;
+        for (int frame = 0; frame < 12; ++frame) {
+          // Each frame's queries stay below a side that changes from frame to frame.
+          const int side = 1 << ref::uniform_int(rng, 0, 5);
+          int needed = -1;
+          for (int step = 0; step < 12; ++step) {
+            const int kind = ref::uniform_int(rng, 0, 1);
+            const Rect c = {ref::uniform_int(rng, 0, 60), ref::uniform_int(rng, 0, 44), ref::uniform_int(rng, 1, 8),
+                            ref::uniform_int(rng, 1, 8)};
+            const Rect cc = clip(c, 64, 48);
+            for (int y = cc.y; y < cc.y1(); ++y)
+              for (int x = cc.x; x < cc.x1(); ++x) rig.truth.at(x, y) = new_depth(rng, op, rig.truth.at(x, y), kind == 1);
+            const UpdateWork w = rig.core->depth_changed(rig.truth, c);
+            rig.work += w;
+            for (std::size_t i = static_cast<std::size_t>(rig.core->kept_top_level()) + 1; i < w.texels_recomputed.size(); ++i)
+              if (w.texels_recomputed[i] != 0) fails.add("work counted above the kept levels");
+            const Rect r = {ref::uniform_int(rng, 0, 63), ref::uniform_int(rng, 0, 47), ref::uniform_int(rng, 1, side),
+                            ref::uniform_int(rng, 1, side)};
+            const float nearest = random_nearest(rng, op, ref::farthest(rig.truth, op, r));
+            const QueryAnswer a = rig.core->query(r, nearest);
+            if (auto e = check(rig, r, nearest, a); !e.empty()) fails.add(e);
+            if (a.outcome != QueryOutcome::Offscreen) {
+              const Covering cov = rig.core->levels().covering(a.reduced, rig.core->covering());
+              needed = std::max(needed, cov.level);
+              const bool above = cov.level > rig.core->kept_top_level();
+              tiled_or_incomplete += above;
+              if (above != (a.tiled || !a.complete)) fails.add(ref::str(r) + ": tiled or incomplete exactly when above the kept levels");
+            }
+          }
+          const float v = ref::unit_float(rng);
+          std::fill(rig.truth.texels.begin(), rig.truth.texels.end(), v);
+          const UpdateWork clear = rig.core->depth_cleared(v);
+          const int want = needed < 0 ? rig.core->kept_top_level() : std::min(full, needed + margin);
+          if (rig.core->kept_top_level() != want)
+            fails.add("frame " + std::to_string(frame) + ": kept " + std::to_string(rig.core->kept_top_level()) + ", want " +
+                      std::to_string(want));
+          // The clear writes exactly the kept levels.
+          for (std::size_t i = 0; i < clear.texels_recomputed.size(); ++i)
+            if ((clear.texels_recomputed[i] != 0) != (static_cast<int>(i) <= rig.core->kept_top_level()))
+              fails.add("frame " + std::to_string(frame) + ": the clear wrote level " + std::to_string(i) + " wrongly");
+        }
+        EXPECT_EQ(fails.count(), 0) << at << ": " << fails.summary();
+        EXPECT_GT(tiled_or_incomplete, 0) << at << ": no query needed more than the kept levels (test too weak)";
+      }
+}
 }  // namespace
 }  // namespace nbsim::nbuffer

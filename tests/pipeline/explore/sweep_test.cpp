@@ -19,7 +19,7 @@ using ojson = nlohmann::ordered_json;  // sweep files keep their key order
 namespace ex = nbsim::explore;
 
 // A small stand-in for GpuConfig: three keys of the three kinds, checked by the real Schema.
-json toy_check(const json& settings, const std::string& origin) {
+json toy_check(const json& settings, const std::string& origin, ex::CheckScope scope = ex::CheckScope::Whole) {
   struct {
     std::string mode = "trace";
     int divisor = 1;
@@ -32,6 +32,9 @@ json toy_check(const json& settings, const std::string& origin) {
   s.add("memory.bandwidth_bytes_per_cycle", c.bandwidth, "bytes/cycle", "bandwidth", 0.01, 1e6);
   s.add("hiz.tile_px", c.tile, "pixels", "tile", 1, 256);
   s.apply(settings, origin);
+  // A rule between two keys (a unit's consistency rule): checked on whole configs only.
+  if (scope == ex::CheckScope::Whole && c.tile > 64 && c.divisor == 1)
+    throw InputError(origin + ": hiz.tile_px above 64 needs nbuffer.resolution_divisor 2 or more");
   json flat = json::object();
   const nlohmann::ordered_json values = s.values();  // kept alive for the loop
   for (const auto& [unit, fields] : values.items())
@@ -230,6 +233,27 @@ TEST(SweepTest, CsvFieldQuoting) {
   EXPECT_EQ(ex::csv_field("a,b"), "\"a,b\"");
   EXPECT_EQ(ex::csv_field("say \"x\""), "\"say \"\"x\"\"\"");
   EXPECT_EQ(ex::csv_field("two\nlines"), "\"two\nlines\"");
+}
+
+// A value that is fine on its own but breaks a rule with the default of another key (a tracking
+// tile beside the default eager policy, say) does not refuse the sweep: only the points whose
+// combination breaks the rule are refused, by name.
+TEST(SweepTest, ValueNeedingAnotherKeyRefusesOnlyItsPoints) {
+  const auto points = expand_checked(ojson::parse(
+      R"({"traces": ["t.nbt"], "axes": {"hiz.tile_px": [8, 128], "nbuffer.resolution_divisor": [1, 2]}})"));
+  ASSERT_EQ(points.size(), 4u);
+  int refused = 0;
+  for (const auto& p : points) {
+    const bool bad = p.settings["hiz.tile_px"] == 128 && p.settings["nbuffer.resolution_divisor"] == 1;
+    EXPECT_EQ(!p.refused.empty(), bad) << p.settings.dump();
+    if (bad) EXPECT_NE(p.refused.find("hiz.tile_px above 64 needs nbuffer.resolution_divisor"), std::string::npos) << p.refused;
+    refused += !p.refused.empty();
+  }
+  EXPECT_EQ(refused, 1);
+  // The same value where no point of the sweep can build it: the sweep is refused, naming it.
+  const std::string e = error_of(ojson::parse(R"({"traces": ["t.nbt"], "axes": {"hiz.tile_px": [8, 128]}})"));
+  EXPECT_NE(e.find("axes.hiz.tile_px[1]"), std::string::npos) << e;
+  EXPECT_NE(e.find("hiz.tile_px above 64 needs nbuffer.resolution_divisor"), std::string::npos) << e;
 }
 
 }  // namespace
