@@ -41,10 +41,8 @@ struct Reader {
     if (i >= 0 && j >= 0 && i + 1 < n && j + 1 < n) {
       lookups += 4;
       const std::int64_t index = static_cast<std::int64_t>(j) * n + i;
-      sink(Texture::Height, index);
-      sink(Texture::Height, index + 1);
-      sink(Texture::Height, index + n);
-      sink(Texture::Height, index + n + 1);
+      sink.pair(Texture::Height, index);
+      sink.pair(Texture::Height, index + n);
       const float* p = f.heights.data() + index;
       h00 = p[0], h10 = p[1], h01 = p[n], h11 = p[n + 1];
       return;
@@ -75,12 +73,17 @@ struct ObserverSink {
   void border(Texture t) const {
     if (observer) observer(context, t, -1);
   }
+  void pair(Texture t, std::int64_t index) const {  // texels index and index + 1
+    (*this)(t, index);
+    (*this)(t, index + 1);
+  }
 };
 
 // The recording sink: virtual border texels need no memory and are left out.
 struct LinesSink {
   LookupLines& lines;
   void operator()(Texture t, std::int64_t index) const { lines.add(texel_address(t, index)); }
+  void pair(Texture t, std::int64_t index) const { lines.add_pair(texel_address(t, index), texel_address(t, index + 1)); }
   void border(Texture) const noexcept {}
 };
 

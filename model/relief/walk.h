@@ -163,6 +163,16 @@ class alignas(64) LookupLines {
     if (size_ == storage_.size()) storage_.resize(std::max<std::size_t>(4096, 2 * storage_.size()));
     storage_[size_++] = line;
   }
+  // add(a) then add(b), for two texels side by side: when they share a line (15 times in 16 for
+  // 64-byte lines), the second is the repeat add() would find, counted without the table.
+  void add_pair(std::uint64_t a, std::uint64_t b) {
+    add(a);
+    if (merge_ && (b >> line_shift_) == (a >> line_shift_)) {
+      ++repeats_;
+      return;
+    }
+    add(b);
+  }
   std::span<const std::uint64_t> lines() const noexcept { return {storage_.data(), size_}; }
   std::uint64_t repeats() const noexcept { return repeats_; }
 
