@@ -13,6 +13,7 @@
 #include "model/common/error.h"
 #include "model/sim/kernel.h"
 #include "model/sim/timeline.h"
+#include "pipeline/sim/prefetch.h"
 #include "io/json_spill.h"
 #include "traces/format/reader.h"
 #include "io/output_folder.h"
@@ -280,7 +281,10 @@ ReplaySummary replay(const ReplayOptions& o) {
   view.op = head.far_op();
   view.depth_func = view.op == FarOp::Min ? trace::DepthFunc::Greater : trace::DepthFunc::Less;
   view.scene = tr.scene();
-  Gpu gpu("gpu", registry, o.config, w, h, [frames] { return frames->next(); }, clear_depth, sink, head, view,
+  // Frames are read and decoded one ahead on a thread of their own (prefetch.h): the same frames in
+  // the same order, a damaged one refused by the same message when the replay reaches it.
+  auto ahead = std::make_shared<sim::Prefetch<trace::Frame>>([frames] { return frames->next(); });
+  Gpu gpu("gpu", registry, o.config, w, h, [ahead] { return ahead->next(); }, clear_depth, sink, head, view,
           o.out ? &*o.out : nullptr);
   if (o.config.program != "off")
     if (const ProgramRow* row = find_program(head.technique)) sink.results_ = &row->results;
