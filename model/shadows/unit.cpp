@@ -354,6 +354,7 @@ void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>&
   const LightFrustum light = light_of(c, frame);
   const glm::mat4 view_proj = observer_view_proj(f->begin);
   own_share_.clear();
+  std::uint32_t own_index = static_cast<std::uint32_t>(f->draws.size());  // the model's volumes follow the trace's draws
   reference_clip_.clear();
   std::vector<glm::vec4> positions;
   for (std::size_t i = 0; i < c.size(); ++i) {
@@ -396,7 +397,9 @@ void ShadowsUnit::issue_model_volumes(const std::shared_ptr<const scene::Frame>&
     append_volume(meshes_->vertices, meshes_->meshes[i], light, volume_ends(clamp_near, clamp_far, mode == Mode::Clamped), positions);
     if (positions.empty()) continue;
     auto d = std::make_shared<scene::DrawRecord>(volume_draw(c.object[i]));
-    d->index = static_cast<std::uint32_t>(f->draws.size() + own_share_.size());
+    // (Not the map's size: a finished draw's address may be reused for the next one, which then
+    // replaces its entry, so the size would depend on the allocator.)
+    d->index = own_index++;
     d->clip_positions.reserve(positions.size());
     for (const glm::vec4& p : positions) d->clip_positions.push_back(clip_position(view_proj, p));
     own_share_[d.get()] = &share;

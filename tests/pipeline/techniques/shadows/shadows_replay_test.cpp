@@ -13,11 +13,14 @@
 #include <fstream>
 #include <cmath>
 #include <map>
+#include <set>
+#include <utility>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include "tests/common/run_nbsim.h"
+#include "tests/pipeline/explore/read_csv.h"
 #include "traces/format/reader.h"
 #include "traces/format/writer.h"
 
@@ -165,6 +168,13 @@ TEST_P(ShadowsReplayTest, ModelBuiltVolumesReplayAnyMode) {
       for (const auto& b : s["fill_breakdown"]) casters += b["casters_per_frame"].get<double>(), fill += b["fill_per_frame"].get<double>();
       EXPECT_DOUBLE_EQ(casters, s["casters_per_frame"].get<double>()) << "the breakdown counts every caster once, by the model's decision";
       EXPECT_DOUBLE_EQ(fill, s["fill_per_frame"].get<double>()) << "and all of the model's fill";
+      // Each draw of a frame, the model's volumes included, has its own index in draws.csv.
+      const fs::path t = capture(scene, from);
+      const auto rows = nbsim::testing::read_csv(t.parent_path() / (t.stem().string() + "_as_" + as) / "draws.csv");
+      std::set<std::pair<std::string, std::string>> seen;
+      for (const auto& row : rows)
+        EXPECT_TRUE(seen.insert({row.at("frame"), row.at("draw")}).second) << "frame " << row.at("frame") << ": draw " << row.at("draw") << " twice";
+      EXPECT_FALSE(rows.empty());
     }
 }
 
