@@ -59,6 +59,11 @@ bool same_state(const geometry::GeometryState& a, const geometry::GeometryState&
   return a.clip == b.clip && a.face.cull == b.face.cull && a.face.front_ccw == b.face.front_ccw && a.depth_clamp == b.depth_clamp;
 }
 
+bool same_config(const RasterPathConfig& a, const RasterPathConfig& b) noexcept {
+  return a.width_px == b.width_px && a.height_px == b.height_px && a.batch_triangles == b.batch_triangles &&
+         a.fused_viewport == b.fused_viewport && a.fused_interpolation == b.fused_interpolation && a.depth_format == b.depth_format;
+}
+
 bool same_positions(std::span<const geometry::ClipPosition> a, const std::vector<geometry::ClipPosition>& b) noexcept {
   // Bit-identical (a NaN equals itself here, -0.0 differs from +0.0): memcmp of the floats.
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(geometry::ClipPosition)) == 0);
@@ -112,17 +117,41 @@ DrawCounters RasterPath::draw(std::span<const geometry::ClipPosition> clip_posit
 }
 
 DrawCounters RasterPath::draw_points(std::span<const geometry::ClipPosition> clip_positions,
-                                     std::span<const float> point_sizes, const DrawState& state) {
+                                     std::span<const float> point_sizes, const DrawState& state, PointRaster* shared) {
   DrawCounters k;
   cached_ = false;
+  if (shared && shared->valid && same_config(shared->config, config_) && same_state(state.geometry, shared->state) &&
+      same_positions(clip_positions, shared->positions) && point_sizes.size() == shared->sizes.size() &&
+      (point_sizes.empty() || std::memcmp(point_sizes.data(), shared->sizes.data(), point_sizes.size() * sizeof(float)) == 0)) {
+    k.geometry = shared->geometry, k.setup = shared->setup, k.tiles = shared->tiles;
+    for (const PointRaster::Block& b : shared->blocks)
+      test_.test_block(shared->planes[b.point], shared->front[b.point] != 0, b.x, b.y, b.mask, state.depth, state.stencil, k.depth,
+                       k.stencil);
+    return k;
+  }
+  if (shared) {
+    shared->valid = false;
+    shared->planes.clear(), shared->front.clear(), shared->blocks.clear();
+  }
   points_.clear();
   geometry_.process_points(clip_positions, point_sizes, state.geometry, points_, k.geometry);
   SetupTriangle t;
   for (const geometry::WindowPoint& p : points_) {
     if (point_setup_.setup(p, t, k.setup) != SetupResult::Accepted) continue;
+    const auto point = static_cast<std::uint32_t>(shared ? shared->planes.size() : 0);
+    if (shared) shared->planes.push_back(t.depth), shared->front.push_back(t.front_facing ? 1 : 0);
     rasterizer_.rasterize(t, k.tiles, [&](int x, int y, std::uint16_t mask) {
+      if (shared) shared->blocks.push_back({x, y, mask, point});
       test_.test_block(t.depth, t.front_facing, x, y, mask, state.depth, state.stencil, k.depth, k.stencil);
     });
+  }
+  if (shared) {
+    shared->valid = true;
+    shared->config = config_;
+    shared->state = state.geometry;
+    shared->positions.assign(clip_positions.begin(), clip_positions.end());
+    shared->sizes.assign(point_sizes.begin(), point_sizes.end());
+    shared->geometry = k.geometry, shared->setup = k.setup, shared->tiles = k.tiles;
   }
   return k;
 }

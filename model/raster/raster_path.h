@@ -59,10 +59,36 @@ class RasterPath {
 
   // Runs one draw (three clip positions a triangle) and returns its counters.
   DrawCounters draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state);
+  // A point draw's rasterization kept to be tested again into another path of the same
+  // configuration (two render targets drawn with the same points): its inputs, counters, each
+  // accepted point's depth plane and its blocks in rasterization order. Filled by draw_points.
+  struct PointRaster {
+    bool valid = false;
+    RasterPathConfig config;
+    geometry::GeometryState state;
+    std::vector<geometry::ClipPosition> positions;
+    std::vector<float> sizes;
+    geometry::GeometryCounters geometry;
+    SetupCounters setup;
+    TileCounters tiles;
+    std::vector<DepthPlane> planes;
+    std::vector<std::uint8_t> front;
+    struct Block {
+      std::int32_t x, y;
+      std::uint16_t mask;
+      std::uint32_t point;
+    };
+    std::vector<Block> blocks;
+  };
+
   // Runs one point-sprite draw (one clip position and one gl_PointSize a point). Throws
   // InputError when the counts differ or a position or size is NaN or infinite.
+  // With `shared` (a host-speed option, counts never depend on it): when it holds the
+  // rasterization of bit-identical points, sizes and geometry state by a path of the same
+  // configuration, only the depth (and stencil) tests run, over its blocks in the same order, with
+  // its geometry, setup and tile counters; otherwise the draw runs in full and fills it.
   DrawCounters draw_points(std::span<const geometry::ClipPosition> clip_positions, std::span<const float> point_sizes,
-                           const DrawState& state);
+                           const DrawState& state, PointRaster* shared = nullptr);
 
   // Rasterization reuse, a host-speed option (counts never depend on it): when on, a triangle draw
   // whose clip positions and geometry state are bit-identical to the previous triangle draw's skips

@@ -168,6 +168,7 @@ LitmapImages draw_litmaps(const scene::Frame& f, const LitmapMeshes& meshes, con
   std::vector<geometry::ClipPosition> clip;
   std::vector<float> sizes;
   std::optional<std::vector<geometry::ClipPosition>> splat;  // the same points for both litmaps
+  raster::RasterPath::PointRaster splat_raster;              // rasterized once, tested into each litmap
   for (const scene::DrawRecord& d : f.draws) {
     if (d.role != kLitmapRole && d.role != kReceiverSplatRole) continue;
     raster::DrawState state = raster::draw_state(d.state);
@@ -197,7 +198,7 @@ LitmapImages draw_litmaps(const scene::Frame& f, const LitmapMeshes& meshes, con
         ReceiverSplat(observer, light_camera.proj * light_camera.view, depth.width, depth.height).points(depth, *splat);
       }
       sizes.assign(splat->size(), 1.0f);
-      c = target.draw_points(*splat, sizes, state);
+      c = target.draw_points(*splat, sizes, state, &splat_raster);
       k.splat_points += splat->size();
       k.splat_fragments += c.depth.fragments;
     }

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -77,6 +78,52 @@ TEST(RasterPathTest, ReuseOfTheRasterizationChangesNothing) {
     EXPECT_EQ(r.depth.written, p.depth.written);
     ASSERT_EQ(on.texels, off.texels) << "the buffers after each draw are the same";
   }
+}
+
+// A point draw's rasterization shared between two paths (PointRaster, as the two litmaps share
+// their receiver splats) changes no count and no depth: a min and a max target drawn with and
+// without sharing end alike after each draw; moved points, other sizes or another path size are
+// rasterized anew.
+TEST(RasterPathTest, SharedPointRasterizationChangesNothing) {
+  std::vector<ClipPosition> a;
+  std::vector<float> ones, twos;
+  for (int i = 0; i < 300; ++i) {  // points of varied depth, some on pixel edges, some off screen
+    const float fi = static_cast<float>(i);
+    a.push_back({-1.1f + 0.0075f * fi, std::sin(fi) * 0.95f, 0.5f + 0.45f * std::cos(fi * 0.7f), 1});
+    ones.push_back(1.0f), twos.push_back(i % 3 == 0 ? 3.0f : 1.0f);
+  }
+  std::vector<ClipPosition> b = a;
+  b[7][1] = std::nextafter(b[7][1], 1.0f);
+  struct Step {
+    const std::vector<ClipPosition>* positions;
+    const std::vector<float>* sizes;
+  };
+  const Step steps[] = {{&a, &ones}, {&a, &ones}, {&b, &ones}, {&b, &twos}, {&a, &twos}};
+  DepthImage min_plain(80, 72, 1.0f), max_plain(80, 72, 0.0f), min_shared(80, 72, 1.0f), max_shared(80, 72, 0.0f);
+  DepthImage other(81, 72, 0.0f), other_plain(81, 72, 0.0f);
+  const RasterPathConfig c{80, 72, 85, true, true}, c81{81, 72, 85, true, true};
+  RasterPath p_min(c, min_plain), p_max(c, max_plain), s_min(c, min_shared), s_max(c, max_shared), s_other(c81, other),
+      p_other(c81, other_plain);
+  RasterPath::PointRaster shared;
+  DrawState lequal, gequal;
+  lequal.depth.func = DepthFunc::Lequal;
+  gequal.depth.func = DepthFunc::Gequal;
+  const auto same = [](const DrawCounters& x, const DrawCounters& y) {
+    return x.geometry.prims_out == y.geometry.prims_out && x.setup.culled == y.setup.culled &&
+           x.tiles.blocks4_partial == y.tiles.blocks4_partial && x.tiles.blocks4_empty == y.tiles.blocks4_empty &&
+           x.depth.fragments == y.depth.fragments && x.depth.passed == y.depth.passed && x.depth.written == y.depth.written;
+  };
+  for (const Step& st : steps) {
+    EXPECT_TRUE(same(s_min.draw_points(*st.positions, *st.sizes, lequal, &shared), p_min.draw_points(*st.positions, *st.sizes, lequal)));
+    EXPECT_TRUE(shared.valid);
+    EXPECT_TRUE(same(s_max.draw_points(*st.positions, *st.sizes, gequal, &shared), p_max.draw_points(*st.positions, *st.sizes, gequal)));
+    EXPECT_TRUE(same(s_other.draw_points(*st.positions, *st.sizes, gequal, &shared), p_other.draw_points(*st.positions, *st.sizes, gequal)))
+        << "another size: rasterized anew";
+    ASSERT_EQ(min_shared.texels, min_plain.texels);
+    ASSERT_EQ(max_shared.texels, max_plain.texels);
+    ASSERT_EQ(other.texels, other_plain.texels);
+  }
+  EXPECT_GT(std::count_if(max_plain.texels.begin(), max_plain.texels.end(), [](float v) { return v > 0.0f; }), 100);
 }
 
 // A bad target size is the user's error, not a crash.
