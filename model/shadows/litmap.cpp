@@ -7,7 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <future>
+#include <string_view>
+#include <thread>
 
 #include "model/common/error.h"
 #include "model/scene/technique_record.h"
@@ -155,6 +159,15 @@ DepthImage sampled_depth_image(const DepthImage& stored, raster::DepthFormat for
   return out;
 }
 
+int litmap_threads() {
+  if (const char* env = std::getenv("NBSIM_SHADOWS_THREADS")) {
+    const std::string_view v(env);
+    if (v == "1") return 1;
+    if (v == "2") return 2;
+  }
+  return std::thread::hardware_concurrency() >= 2 ? 2 : 1;
+}
+
 LitmapImages draw_litmaps(const scene::Frame& f, const LitmapMeshes& meshes, const LightFrustum& light_camera, int litmap_size,
                           const ReprojectSettings& settings, const DepthImage& depth, raster::RasterPathConfig path, bool compare_gl_counts, LitmapCounters& k) {
   if (!f.light) throw InputError(fmt::format("frame {}: no light camera (LGHT)", f.begin.frame));
@@ -165,10 +178,16 @@ LitmapImages draw_litmaps(const scene::Frame& f, const LitmapMeshes& meshes, con
   path.depth_format = raster::DepthFormat::Float32;  // DEPTH_COMPONENT32F litmaps
   raster::RasterPath min_path(path, out.min), max_path(path, out.max);
   const LitmapReprojection reprojection(observer, light, litmap_size, settings, depth);
-  std::vector<geometry::ClipPosition> clip;
-  std::vector<float> sizes;
-  std::optional<std::vector<geometry::ClipPosition>> splat;  // the same points for both litmaps
-  raster::RasterPath::PointRaster splat_raster;              // rasterized once, tested into each litmap
+  // Every draw checked in draw order first (the first bad one is the one named), then each litmap's
+  // draws in their order: the min and the max litmap are separate images, so with two host cores
+  // they are drawn at once (the counts and images are the same either way); on one core, one after
+  // the other, the receiver splats rasterized once for both (RasterPath::PointRaster).
+  struct Item {
+    const scene::DrawRecord* draw;
+    raster::DrawState state;
+  };
+  std::vector<Item> items[2];  // [0]: the min litmap's draws, [1]: the max litmap's
+  bool splats = false;
   for (const scene::DrawRecord& d : f.draws) {
     if (d.role != kLitmapRole && d.role != kReceiverSplatRole) continue;
     raster::DrawState state = raster::draw_state(d.state);
@@ -176,33 +195,56 @@ LitmapImages draw_litmaps(const scene::Frame& f, const LitmapMeshes& meshes, con
     if (!max && state.depth.func != raster::DepthFunc::Lequal)
       throw InputError(fmt::format("frame {}: a {} draw with depth func {} (LEQUAL: min litmap, GEQUAL: max litmap)", f.begin.frame,
                                    d.role == kLitmapRole ? "litmap" : "receiver_splat", static_cast<int>(d.state.func)));
-    raster::RasterPath& target = max ? max_path : min_path;
-    raster::DrawCounters c;
     if (d.role == kLitmapRole) {
       const auto o = static_cast<std::size_t>(d.object);
       if (d.object < 0 || o >= meshes.held.size() || !meshes.held[o])
         throw InputError(fmt::format("frame {}: litmap draw {} draws object {}, which the ShadowLitmapMeshes record does not hold",
                                      f.begin.frame, d.index, d.object));
-      clip.clear();
-      const auto [first, count] = meshes.range[o];
-      for (std::uint32_t t = first; t < first + count; ++t)
-        for (std::uint32_t v : meshes.triangles[t]) clip.push_back(clip_position(light, glm::vec4(meshes.vertices[v], 1.0f)));
       state.depth.shader = &reprojection;
-      c = target.draw(clip, state);
-      ++k.draws;
-      k.fragments += c.depth.fragments;
-      k.discarded += c.depth.shader_discarded;
-    } else {
-      if (!splat) {
-        splat.emplace();
-        ReceiverSplat(observer, light_camera.proj * light_camera.view, depth.width, depth.height).points(depth, *splat);
-      }
-      sizes.assign(splat->size(), 1.0f);
-      c = target.draw_points(*splat, sizes, state, &splat_raster);
-      k.splat_points += splat->size();
-      k.splat_fragments += c.depth.fragments;
     }
-    if (compare_gl_counts && c.depth.fragments != d.gl.fragments) ++k.fragment_diff;
+    splats = splats || d.role == kReceiverSplatRole;
+    items[max ? 1 : 0].push_back({&d, state});
+  }
+  std::vector<geometry::ClipPosition> splat;  // the same points for both litmaps
+  if (splats) ReceiverSplat(observer, light_camera.proj * light_camera.view, depth.width, depth.height).points(depth, splat);
+  const auto draw_into = [&](raster::RasterPath& target, const std::vector<Item>& list, LitmapCounters& c,
+                             raster::RasterPath::PointRaster* shared) {
+    std::vector<geometry::ClipPosition> clip;
+    std::vector<float> sizes;
+    for (const Item& it : list) {
+      const scene::DrawRecord& d = *it.draw;
+      raster::DrawCounters dc;
+      if (d.role == kLitmapRole) {
+        clip.clear();
+        const auto [first, count] = meshes.range[static_cast<std::size_t>(d.object)];
+        for (std::uint32_t t = first; t < first + count; ++t)
+          for (std::uint32_t v : meshes.triangles[t]) clip.push_back(clip_position(light, glm::vec4(meshes.vertices[v], 1.0f)));
+        dc = target.draw(clip, it.state);
+        ++c.draws;
+        c.fragments += dc.depth.fragments;
+        c.discarded += dc.depth.shader_discarded;
+      } else {
+        sizes.assign(splat.size(), 1.0f);
+        dc = target.draw_points(splat, sizes, it.state, shared);
+        c.splat_points += splat.size();
+        c.splat_fragments += dc.depth.fragments;
+      }
+      if (compare_gl_counts && dc.depth.fragments != d.gl.fragments) ++c.fragment_diff;
+    }
+  };
+  LitmapCounters counts[2];
+  if (litmap_threads() >= 2 && !items[0].empty() && !items[1].empty()) {
+    auto max_litmap = std::async(std::launch::async, [&] { draw_into(max_path, items[1], counts[1], nullptr); });
+    draw_into(min_path, items[0], counts[0], nullptr);
+    max_litmap.get();  // its error, if any, rethrown here
+  } else {
+    raster::RasterPath::PointRaster shared;  // rasterized once, tested into each litmap
+    draw_into(min_path, items[0], counts[0], &shared);
+    draw_into(max_path, items[1], counts[1], &shared);
+  }
+  for (const LitmapCounters& c : counts) {
+    k.draws += c.draws, k.fragments += c.fragments, k.discarded += c.discarded;
+    k.splat_points += c.splat_points, k.splat_fragments += c.splat_fragments, k.fragment_diff += c.fragment_diff;
   }
   return out;
 }

@@ -126,6 +126,11 @@ struct LitmapCounters {
 // is not always the float the model keeps for q (raster::from_unorm24).
 DepthImage sampled_depth_image(const DepthImage& stored, raster::DepthFormat format);
 
+// Threads drawing the model's litmaps (draw_litmaps): 2 (the min and the max litmap at once) when
+// the host has two cores or more, else 1; the environment variable NBSIM_SHADOWS_THREADS=1 or 2
+// sets it. Counts and images never depend on it.
+int litmap_threads();
+
 // Draws a frame's min and max litmaps of side `litmap_size` as the capture drew them: the frame's
 // Litmap and ReceiverSplat draws in order (LEQUAL: the min litmap, cleared to 1; GEQUAL: the max
 // litmap, cleared to 0), from `meshes`, the frame's light camera (LGHT for the litmap draws' float

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <set>
 #include <utility>
@@ -250,6 +251,28 @@ TEST(ShadowsModelLitmapsTest, OneChangedTexelCounted) {
   });
   const auto run = replay(bad, " --set shadows.litmaps=model", "own");
   EXPECT_EQ(run["summary"]["shadows"]["litmap_texel_diff"], 1);
+}
+
+// The model's litmaps drawn on one thread (the receiver splats rasterized once for both litmaps) or
+// on two (the min and the max litmap at once): the same statistics, frames and draws, on every scene.
+TEST(ShadowsModelLitmapsTest, OneOrTwoThreadsAlike) {
+  for (const std::string scene : {"boxes", "city"}) {
+    const fs::path t = capture(scene, "clamped");
+    std::map<std::string, std::pair<nlohmann::json, std::string>> runs;
+    for (const std::string threads : {"1", "2"}) {
+      const fs::path dir = t.parent_path() / (t.stem().string() + "_threads_" + threads);
+      const CliResult r = nbsim::testing::run_nbsim_env("NBSIM_SHADOWS_THREADS=" + threads + " ",
+                                                        "replay " + t.string() + " --out " + dir.string() +
+                                                            " --set shadows.litmaps=model --set shadows.volumes=clamped");
+      ASSERT_EQ(r.status, 0) << r.out << r.err;
+      std::ifstream in(dir / "run.json"), frames(dir / "frames.csv"), draws(dir / "draws.csv");
+      runs[threads] = {nlohmann::json::parse(in)["stats"],
+                       std::string(std::istreambuf_iterator<char>(frames), {}) + std::string(std::istreambuf_iterator<char>(draws), {})};
+    }
+    EXPECT_EQ(runs["1"].first, runs["2"].first) << scene << ": statistics";
+    EXPECT_EQ(runs["1"].second, runs["2"].second) << scene << ": frames.csv and draws.csv";
+    EXPECT_GT(runs["1"].first["gpu.shadows"]["litmap_draws"].get<double>(), 0.0) << scene;
+  }
 }
 
 // A lossy design of both N-buffers (u16, a quarter of the resolution) with the model's own clamped
