@@ -458,19 +458,21 @@ void NBufferUnitCore::mark_tile(int x, int y) {
   pending_count_ += tile_area(tx, ty);
 }
 
+void NBufferUnitCore::take_tile(int tx, int ty, std::vector<Texel>& take) {
+  std::uint8_t& f = tile_dirty_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(dtiles_x_) + static_cast<std::size_t>(tx)];
+  if (!f) return;
+  f = 0;
+  pending_count_ -= tile_area(tx, ty);
+  const int x1 = std::min((tx + 1) * dirty_tile_, nb_.width()), y1 = std::min((ty + 1) * dirty_tile_, nb_.height());
+  for (int y = ty * dirty_tile_; y < y1; ++y)
+    for (int x = tx * dirty_tile_; x < x1; ++x) take.push_back({x, y});
+}
+
 UpdateWork NBufferUnitCore::apply_tiles(const Rect& r) {
   std::vector<Texel> take;
   const int tx1 = (r.x1() - 1) / dirty_tile_, ty1 = (r.y1() - 1) / dirty_tile_;
   for (int ty = r.y / dirty_tile_; ty <= ty1; ++ty)
-    for (int tx = r.x / dirty_tile_; tx <= tx1; ++tx) {
-      std::uint8_t& f = tile_dirty_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(dtiles_x_) + static_cast<std::size_t>(tx)];
-      if (!f) continue;
-      f = 0;
-      pending_count_ -= tile_area(tx, ty);
-      const int x1 = std::min((tx + 1) * dirty_tile_, nb_.width()), y1 = std::min((ty + 1) * dirty_tile_, nb_.height());
-      for (int y = ty * dirty_tile_; y < y1; ++y)
-        for (int x = tx * dirty_tile_; x < x1; ++x) take.push_back({x, y});
-    }
+    for (int tx = r.x / dirty_tile_; tx <= tx1; ++tx) take_tile(tx, ty, take);
   return apply_writes(take);
 }
 
@@ -635,7 +637,9 @@ UpdateWork NBufferUnitCore::depth_changed(std::span<const PixelWrite> writes) {
   } else if (mark(scratch_) && policy_ == UpdatePolicy::Batched) {
     if (dirty_tile_ > 1) {
       const std::uint64_t before = pending_count_;
-      for (const Texel& t : scratch_) w += apply_tiles({t.x, t.y, 1, 1});  // each written texel's dirty tile
+      std::vector<Texel> take;  // the written texels' dirty tiles, applied as one batch
+      for (const Texel& t : scratch_) take_tile(t.x / dirty_tile_, t.y / dirty_tile_, take);
+      w += apply_writes(take);
       applied_.add(kForced, before - pending_count_);
     } else {
       unmark(scratch_);

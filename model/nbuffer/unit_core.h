@@ -229,8 +229,11 @@ class NBufferUnitCore {
   void mark_one(int x, int y);
   void mark_tile(int x, int y);
   std::uint64_t tile_area(int tx, int ty) const noexcept;
-  // The texel rectangle a query's lazy update must bring up to date, applied.
+  // Per-tile tracking: hands every texel of each dirty tile that meets `region` (storage
+  // coordinates, clipped) to the update engine and clears those tiles.
   UpdateWork apply_tiles(const Rect& region);
+  // Clears dirty tile (tx, ty) and appends its texels to `take` (nothing when it is clean).
+  void take_tile(int tx, int ty, std::vector<Texel>& take);
   // Applies the pending texels of every bin that meets `region` (storage coordinates).
   UpdateWork apply_pending(const Rect& region);
   UpdateWork apply_writes(std::span<const Texel> texels);

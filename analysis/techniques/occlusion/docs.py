@@ -245,23 +245,36 @@ def upkeep_label(r):
     return f"{r['nbuffer.update_policy']}, {clear}, level 0 {r['nbuffer.level0']}"
 
 
-def render_upkeep(outputs):
-    text = outputs[-1]
+def refused_rows(text):
+    """The points of a sweep's results.csv that were refused (status failed)."""
     import csv
     import io
-    every = list(csv.DictReader(io.StringIO(text)))
+    return [r for r in csv.DictReader(io.StringIO(text)) if r["status"] == "failed"]
+
+
+def grouped(rows, key, column):
+    """Rows grouped by key(row), in key order: each group maps its rows' values of `column` to them."""
+    by = {}
+    for r in rows:
+        by.setdefault(key(r), {})[r[column]] = r
+    return [by[k] for k in sorted(by)]
+
+
+def side_by_side(group, values, col, scale=1.0, fmt=None, missing="-"):
+    """One cell: `col` of the group's row for each of `values`, " / " between them."""
+    return " / ".join((fmt or n)(float(group[v][col]) * scale) if v in group else missing for v in values)
+
+
+def render_upkeep(outputs):
+    text = outputs[-1]
     rows = sweep_rows(text)
-    refused = [r for r in every if r["status"] == "failed"]
+    refused = refused_rows(text)
     lines = ["| design (divisor 1 / 4) | upkeep texels a frame | total depth tests a frame | cycles a frame | efficiency lost (points of %) |",
              "|---|---:|---:|---:|---:|"]
     key = lambda r: (["eager", "batched", "lazy", "on_demand"].index(r["nbuffer.update_policy"]), r["nbuffer.fast_clear"], r["nbuffer.level0"])
-    by = {}
-    for r in rows:
-        by.setdefault(key(r), {})[r["nbuffer.resolution_divisor"]] = r
-    for k in sorted(by):
-        d = by[k]
+    for d in grouped(rows, key, "nbuffer.resolution_divisor"):
         def both(col, scale=1.0, fmt=None):
-            return " / ".join((fmt or (lambda v: n(v)))(float(d[x][col]) * scale) if x in d else "refused" for x in ("1", "4"))
+            return side_by_side(d, ("1", "4"), col, scale, fmt, "refused")
         lines.append(f"| {upkeep_label(next(iter(d.values())))} | {both('update_texels_per_frame')} | "
                      f"{both('total_depth_tests_per_frame')} | {both('cycles_per_frame')} | "
                      f"{both('efficiency_lost', 100.0, lambda v: f'{v:.2f}')} |")
@@ -285,22 +298,15 @@ def tracking_label(r):
 
 
 def render_tracking(outputs):
-    import csv
-    import io
-    every = list(csv.DictReader(io.StringIO(outputs[-1])))
     rows = sweep_rows(outputs[-1])
-    refused = [r for r in every if r["status"] == "failed"]
+    refused = refused_rows(outputs[-1])
     lines = ["| design (nb / nb_hier) | upkeep texels a frame | cycles a frame | efficiency lost (points of %) |",
              "|---|---:|---:|---:|"]
     policies = ["eager", "batched", "lazy"]
     key = lambda r: (policies.index(r["nbuffer.update_policy"]), int(r["nbuffer.dirty_tile"]), r["nbuffer.demand_levels"])
-    by = {}
-    for r in rows:
-        by.setdefault(key(r), {})[r["cull.mode"]] = r
-    for k in sorted(by):
-        d = by[k]
+    for d in grouped(rows, key, "cull.mode"):
         def both(col, scale=1.0, fmt=None):
-            return " / ".join((fmt or (lambda v: n(v)))(float(d[m][col]) * scale) if m in d else "-" for m in ("nb", "nb_hier"))
+            return side_by_side(d, ("nb", "nb_hier"), col, scale, fmt)
         lines.append(f"| {tracking_label(next(iter(d.values())))} | {both('update_texels_per_frame')} | {both('cycles_per_frame')} | "
                      f"{both('efficiency_lost', 100.0, lambda v: f'{v:.2f}')} |")
     pick = lambda mode, policy, tile, demand: next(r for r in rows if r["cull.mode"] == mode and r["nbuffer.update_policy"] == policy
