@@ -83,6 +83,73 @@ std::vector<CameraPose> ground_path(const PathSite& site, int frames, std::uint3
   return poses;
 }
 
+std::vector<CameraPose> tour_path(const PathSite& site, int frames, std::uint32_t seed) {
+  NBSIM_CHECK(site.has_waypoint_links(), "tour_path() on a site without waypoint links");
+  const std::size_t n = site.waypoints.size();
+  std::vector<std::vector<std::uint32_t>> next(n);
+  for (const auto& l : site.waypoint_links) {
+    NBSIM_CHECK(l[0] < n && l[1] < n, "a waypoint link to no waypoint");
+    next[l[0]].push_back(l[1]);
+    next[l[1]].push_back(l[0]);
+  }
+  // The connected groups (by flood fill); the walk starts in the largest, at a seeded waypoint.
+  std::vector<std::uint32_t> group(n, UINT32_MAX), size;
+  for (std::uint32_t s = 0; s < n; ++s) {
+    if (group[s] != UINT32_MAX || next[s].empty()) continue;
+    const auto id = static_cast<std::uint32_t>(size.size());
+    size.push_back(0);
+    std::vector<std::uint32_t> todo{s};
+    group[s] = id;
+    while (!todo.empty()) {
+      const std::uint32_t v = todo.back();
+      todo.pop_back();
+      ++size[id];
+      for (std::uint32_t w : next[v])
+        if (group[w] == UINT32_MAX) group[w] = id, todo.push_back(w);
+    }
+  }
+  const auto largest = static_cast<std::uint32_t>(std::max_element(size.begin(), size.end()) - size.begin());
+  std::vector<std::uint32_t> members;
+  for (std::uint32_t v = 0; v < n; ++v)
+    if (group[v] == largest) members.push_back(v);
+  std::mt19937 rng(seed ^ 0x70a4u);
+  auto pick = [&](std::size_t count) { return std::uniform_int_distribution<std::size_t>(0, count - 1)(rng); };
+  std::uint32_t from = members[pick(members.size())], to = next[from][pick(next[from].size())];
+  glm::vec3 pos = site.waypoints[from];
+  // The view as heading and pitch, each turned a quarter of the way to the link ahead every frame,
+  // so that a U-turn at a dead end turns round smoothly too. Pitched at most about 30 degrees; a
+  // steep or vertical link keeps the heading.
+  auto heading_of = [](glm::vec3 d, float current) { return glm::length(glm::vec2(d.x, d.z)) > 0.5f ? std::atan2(d.z, d.x) : current; };
+  auto pitch_of = [](glm::vec3 d) { return std::asin(std::clamp(d.y, -0.5f, 0.5f)); };
+  const glm::vec3 first = glm::normalize(site.waypoints[to] - pos);
+  float heading = heading_of(first, 0.0f), pitch = pitch_of(first);
+  const float step = 1.2f, ease = 0.25f;
+  std::vector<CameraPose> poses;
+  poses.reserve(static_cast<std::size_t>(frames));
+  for (int f = 0; f < frames; ++f) {
+    const glm::vec3 goal = site.waypoints[to], d = goal - pos;
+    const float dist = glm::length(d);
+    if (dist <= step) {  // reached a waypoint: the next link, not back unless it is a dead end
+      pos = goal;
+      std::vector<std::uint32_t> ways;
+      for (std::uint32_t w : next[to])
+        if (w != from) ways.push_back(w);
+      if (ways.empty()) ways.push_back(from);
+      from = to;
+      to = ways[pick(ways.size())];
+    } else {
+      pos += d / dist * step;
+    }
+    const glm::vec3 want = glm::normalize(site.waypoints[to] - pos);
+    const float turn = std::remainder(heading_of(want, heading) - heading, glm::two_pi<float>());
+    heading += ease * turn;
+    pitch += ease * (pitch_of(want) - pitch);
+    const glm::vec3 look(std::cos(pitch) * std::cos(heading), std::sin(pitch), std::cos(pitch) * std::sin(heading));
+    poses.push_back({pos, pos + look});
+  }
+  return poses;
+}
+
 glm::mat4 view_matrix(const CameraPose& pose) { return glm::lookAt(pose.eye, pose.target, glm::vec3(0, 1, 0)); }
 
 glm::mat4 projection_matrix(const Projection& p, double aspect) {

@@ -1,12 +1,14 @@
-// Cameras of the capture: a pose per frame, the projection of the depth convention, and the two
+// Cameras of the capture: a pose per frame, the projection of the depth convention, and the
 // camera paths over a scene's site: a street-level walkthrough that follows the street grid and
-// turns at crossings, and a flyover that circles the site looking down. The paths are chosen by
-// name from the table in paths.cpp; this file computes them.
+// turns at crossings, a flyover that circles the site looking down, an observer on foot, and a
+// tour along the links between the site's waypoints (an enclosed scene such as a game level). The
+// paths are chosen by name from the table in paths.cpp; this file computes them.
 #pragma once
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string_view>
@@ -17,12 +19,19 @@ namespace nbsim::capture {
 // Where a camera path may go: the scene's ground square [0, extent_m] x [0, extent_m], at the
 // height `ground` gives (y = 0 when it is empty) and, when the scene has streets, the grid of
 // street crossings at multiples of street_pitch_m (crossings 0..blocks_per_side on x and on z).
+// An enclosed site (a level's interior: walls everywhere, so a straight line across it or the
+// ground's height mean nothing) has instead waypoints at eye height and the links between two of
+// them that a camera can walk along without crossing a triangle.
 struct PathSite {
   double extent_m = 0.0;
   double street_pitch_m = 0.0;  // distance between street centre lines; 0 when there are no streets
   int blocks_per_side = 0;
   std::function<float(float x, float z)> ground;  // the ground's height at (x, z), m
+  bool enclosed = false;
+  std::vector<glm::vec3> waypoints;                          // world space, at eye height
+  std::vector<std::array<std::uint32_t, 2>> waypoint_links;  // indices into waypoints, clear segments
   bool has_streets() const noexcept { return street_pitch_m > 0.0 && blocks_per_side > 0; }
+  bool has_waypoint_links() const noexcept { return !waypoint_links.empty(); }
   float ground_at(float x, float z) const { return ground ? ground(x, z) : 0.0f; }
 };
 
@@ -48,6 +57,11 @@ std::vector<CameraPose> fly_path(const PathSite& site, int frames);
 // or stands well above the eye is mostly out of view while the ground around is in it (the set-up
 // the N-buffer paper's terrain experiment assumes: birds above the observer, the ground in view).
 std::vector<CameraPose> ground_path(const PathSite& site, int frames, std::uint32_t seed);
+// A tour of an enclosed site: a random walk on the waypoint links (the site must have some), 1.2 m
+// a frame, from a waypoint of the largest connected group chosen by the seed; at each waypoint the
+// next link is drawn among the others than the one it came by (back only at a dead end); the view
+// looks ahead along the link, its heading and pitch turning a quarter of the way each frame.
+std::vector<CameraPose> tour_path(const PathSite& site, int frames, std::uint32_t seed);
 
 glm::mat4 view_matrix(const CameraPose& pose);
 // GL projection for the depth convention: [-1, 1] clip z (LESS) or reversed Z in [0, 1] (GREATER).

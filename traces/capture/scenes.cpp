@@ -11,6 +11,7 @@
 
 #include "traces/capture/boxes.h"
 #include "traces/capture/city.h"
+#include "traces/capture/q3bsp_scene.h"
 #include "traces/capture/terrain.h"
 
 namespace nbsim::capture {
@@ -60,6 +61,20 @@ CaptureScene make_boxes_scene(const OptionValues& options) {
   return make_boxes(p);
 }
 
+const OptionSpec kBsp = text_option("bsp",
+                                    "Quake 3 level file (.bsp; from a .pk3: unzip -p PAK.pk3 maps/NAME.bsp > NAME.bsp)", "none");
+const OptionSpec kPatchSegments =
+    integer_option("patch-segments", "Quads a side of each tessellated 3x3 Bezier patch of the level", kDefaultPatchSegments, 1,
+                   kMaxPatchSegments);
+
+CaptureScene make_q3bsp(const OptionValues& options) {
+  const std::string path = options.text(kBsp);
+  if (path == "none") throw InputError("scene q3bsp needs --bsp FILE.bsp (a Quake 3 level, e.g. OpenArena's)");
+  BspOptions o;
+  o.patch_segments = static_cast<int>(options.integer(kPatchSegments));
+  return make_q3bsp_scene(load_bsp(path, o), path, o.patch_segments);
+}
+
 }  // namespace
 
 std::uint16_t scene_class(CaptureScene& scene, std::string_view name) {
@@ -79,6 +94,9 @@ const std::vector<SceneRow>& scene_table() {
        make_terrain_scene},
       {{"boxes", "Boxes on a plane: the N-buffer paper's simpler scenes (4.4)", {seed_option(), kBoxes}},
        make_boxes_scene},
+      {{"q3bsp", "A Quake 3 level (OpenArena's .bsp maps): world polygons, meshes and tessellated patches, objects by BSP leaf",
+        {kBsp, kPatchSegments}},
+       make_q3bsp},
   };
   return table;
 }

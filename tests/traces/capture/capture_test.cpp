@@ -21,6 +21,7 @@
 #include "traces/capture/scenes.h"
 #include "traces/capture/technique.h"
 #include "traces/format/reader.h"
+#include "tests/common/bsp_writer.h"
 #include "tests/common/scratch.h"
 
 namespace nbsim::capture {
@@ -218,10 +219,13 @@ TEST(CaptureTest, TraceFileChecksItself) {
 
 
 // Every technique of the table runs on every scene along every camera path the scene's site allows
-// (tiny captures with the rows' default options, scenes at most 300 objects): the header names the
-// row, every frame is written, and a technique that reports what it drew drew every visible object.
+// (tiny captures with the rows' default options, scenes at most 300 objects, a level file's scene
+// on the room of tests/common/bsp_writer.h): the header names the row, every frame is written, and
+// a technique that reports what it drew drew every visible object.
 TEST(CaptureTest, EveryTechniqueRunsOnEverySceneAndPath) {
   int runs = 0;
+  const std::filesystem::path level = nbsim::testing::scratch_path("nbsim_capture", "room.bsp");
+  nbsim::testing::write_bsp(nbsim::testing::room_map(), level);
   for (const auto& t : technique_table()) {
     if (t.no_scene && !t.no_scene(OptionValues{}).empty()) {
       // A capture that draws no scene (by default) builds none, walks no path and refuses both.
@@ -261,8 +265,10 @@ TEST(CaptureTest, EveryTechniqueRunsOnEverySceneAndPath) {
         o.width = 48;
         o.height = 32;
         o.frames = 2;
-        for (const auto& spec : sc.info.options)
+        for (const auto& spec : sc.info.options) {
           if (spec.name == "objects") o.options.set("objects", "300");
+          if (spec.name == "bsp") o.options.set("bsp", level.string());  // a scene read from a level file: the test room
+        }
         const auto file =
             nbsim::testing::scratch_path("nbsim_capture", "every_" + t.info.name + "_" + sc.info.name + "_" + p.info.name + ".nbt");
         CaptureSummary sum;

@@ -1,0 +1,21 @@
+// The q3bsp scene: a Quake 3 level (q3bsp.h reads it) as a CaptureScene. Objects group the
+// world's faces by BSP leaf (each face in the first leaf that lists it) and face type, so that a
+// walkthrough culls what the level's own partition separates: class "structure" (polygons),
+// "patch" (tessellated Bezier patches) and "mesh" (models baked into the map). The level is moved
+// so that its bounds start at the origin (x, y and z >= 0, extent_m the larger horizontal side,
+// for the flyover); its site is enclosed, with waypoints at the spawn points and items (raised to
+// eye height above the floor) and their clear links for the camera path `tour` (waypoints.h).
+#pragma once
+
+#include <string>
+
+#include "traces/capture/q3bsp.h"
+#include "traces/capture/scenes.h"
+#include "traces/capture/waypoints.h"
+
+namespace nbsim::capture {
+
+// `name` (the file's name) goes into the header property "bsp".
+CaptureScene make_q3bsp_scene(const BspMap& map, const std::string& name, int patch_segments, const WaypointParams& waypoints = {});
+
+}  // namespace nbsim::capture
