@@ -66,13 +66,19 @@ const OptionSpec kBsp = text_option("bsp",
 const OptionSpec kPatchSegments =
     integer_option("patch-segments", "Quads a side of each tessellated 3x3 Bezier patch of the level", kDefaultPatchSegments, 1,
                    kMaxPatchSegments);
+const OptionSpec kObjectCell = integer_option(
+    "object-cell", "The level's objects: faces by BSP leaf, type and cube of this side (m) holding their centre; 0: by leaf and type only",
+    8, 0, 100000);
 
 CaptureScene make_q3bsp(const OptionValues& options) {
   const std::string path = options.text(kBsp);
   if (path == "none") throw InputError("scene q3bsp needs --bsp FILE.bsp (a Quake 3 level, e.g. OpenArena's)");
   BspOptions o;
   o.patch_segments = static_cast<int>(options.integer(kPatchSegments));
-  return make_q3bsp_scene(load_bsp(path, o), path, o.patch_segments);
+  Q3BspSceneParams p;
+  p.patch_segments = o.patch_segments;
+  p.object_cell_m = static_cast<double>(options.integer(kObjectCell));
+  return make_q3bsp_scene(load_bsp(path, o), path, p);
 }
 
 }  // namespace
@@ -94,8 +100,8 @@ const std::vector<SceneRow>& scene_table() {
        make_terrain_scene},
       {{"boxes", "Boxes on a plane: the N-buffer paper's simpler scenes (4.4)", {seed_option(), kBoxes}},
        make_boxes_scene},
-      {{"q3bsp", "A Quake 3 level (OpenArena's .bsp maps): world polygons, meshes and tessellated patches, objects by BSP leaf",
-        {kBsp, kPatchSegments}},
+      {{"q3bsp", "A Quake 3 level (OpenArena's .bsp maps): world polygons, meshes and tessellated patches, objects by BSP leaf and cell",
+        {kBsp, kPatchSegments, kObjectCell}},
        make_q3bsp},
   };
   return table;

@@ -66,7 +66,7 @@ BspWriter test_map() {
   w.face(2, 0, net3, {}, {}, {3, 3});
   std::vector<BspWriter::Vertex> net5;
   for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 5; ++i) net5.push_back(vtx(200.0f + 16.0f * static_cast<float>(i), 16.0f * static_cast<float>(j), (i % 2) * 8.0f));
+    for (int i = 0; i < 5; ++i) net5.push_back(vtx(200.0f + 16.0f * static_cast<float>(i), 16.0f * static_cast<float>(j), static_cast<float>(i % 2) * 8.0f));
   w.face(2, 0, net5, {}, {}, {5, 3});
   w.face(1, 1, {vtx(0, 0, 100), vtx(10, 0, 100), vtx(10, 10, 100)}, {0, 1, 2}, {0, 0, 1});
   w.face(4, 0, {vtx(5, 5, 5)}, {});
@@ -91,6 +91,13 @@ BspMap read(const BspWriter& w, int segments = kDefaultPatchSegments) {
 glm::vec3 normal_of(const BspMap& m, std::uint32_t k) {
   const glm::vec3 a = m.vertices[m.indices[k]], b = m.vertices[m.indices[k + 1]], c = m.vertices[m.indices[k + 2]];
   return glm::cross(b - a, c - a);
+}
+
+// Scene parameters with objects in cubes of `m` metres (0: by leaf and type only).
+Q3BspSceneParams cells(double m) {
+  Q3BspSceneParams p;
+  p.object_cell_m = m;
+  return p;
 }
 
 // Polygons, meshes and patches are read, billboards, nodraw, sky, leafless and brush-model faces not.
@@ -164,10 +171,10 @@ TEST(Q3BspTest, PatchInterpolatesItsCorners) {
   EXPECT_FALSE(has_vertex(quake_to_scene({132.0f, -32.0f, 40.0f}), 1e-3f)) << "the middle control point is not on the surface";
 }
 
-// The scene: objects by (leaf, type), tight bounds, the BVH holding every object once.
+// The scene: objects by (leaf, type[, cell]), tight bounds, the BVH holding every object once.
 TEST(Q3BspTest, SceneObjectsBoundsAndBvhAgree) {
   const BspMap m = read(test_map());
-  const CaptureScene s = make_q3bsp_scene(m, "dir/test.bsp", kDefaultPatchSegments);
+  const CaptureScene s = make_q3bsp_scene(m, "dir/test.bsp", cells(0.0));
   ASSERT_EQ(s.objects.size(), 3u) << "(leaf 1, polygon), (leaf 1, mesh), (leaf 2, patch)";
   ASSERT_EQ(s.object_class.size(), 3u);
   EXPECT_EQ(s.class_names[s.object_class[0]], "structure");
@@ -209,6 +216,8 @@ TEST(Q3BspTest, SceneObjectsBoundsAndBvhAgree) {
   EXPECT_EQ(prop("objects"), "3");
   EXPECT_EQ(prop("triangles"), std::to_string(2 + 2 + 128 + 256));
   EXPECT_EQ(prop("patch_segments"), "8");
+  EXPECT_EQ(make_q3bsp_scene(m, "test.bsp").objects.size(), 3u) << "8 m cells: the patches' centres share one";
+  EXPECT_EQ(make_q3bsp_scene(m, "test.bsp", cells(1.0)).objects.size(), 4u) << "1 m cells split leaf 2's patches";
 }
 
 // The message read_bsp throws on `bytes` ("" when it reads).
@@ -313,7 +322,7 @@ double distance_to_segment(glm::vec3 p, glm::vec3 a, glm::vec3 b) {
 
 // Waypoints at eye height above the floor, links only where the pillar does not stand between.
 TEST(Q3BspTest, WaypointsLinkAroundThePillar) {
-  const CaptureScene s = make_q3bsp_scene(read(room_map()), "room.bsp", kDefaultPatchSegments);
+  const CaptureScene s = make_q3bsp_scene(read(room_map()), "room.bsp");
   ASSERT_EQ(s.site.waypoints.size(), 5u);
   for (const glm::vec3& p : s.site.waypoints) EXPECT_NEAR(p.y, 1.7f, 1e-4f) << "eye height above the floor";
   auto linked = [&](std::uint32_t a, std::uint32_t b) {
@@ -333,7 +342,7 @@ TEST(Q3BspTest, WaypointsLinkAroundThePillar) {
 // The tour: every pose on a clear link, 1.2 m a frame at most, and deterministic for a seed; the
 // paths that need an open site or streets are refused by name.
 TEST(Q3BspTest, TourStaysOnClearLinks) {
-  const CaptureScene s = make_q3bsp_scene(read(room_map()), "room.bsp", kDefaultPatchSegments);
+  const CaptureScene s = make_q3bsp_scene(read(room_map()), "room.bsp");
   const TriangleCaster caster(s.vertices, s.indices);
   for (const auto& l : s.site.waypoint_links)
     EXPECT_TRUE(caster.segment_clear(s.site.waypoints[l[0]], s.site.waypoints[l[1]])) << "link " << l[0] << "-" << l[1];
@@ -346,7 +355,9 @@ TEST(Q3BspTest, TourStaysOnClearLinks) {
     for (const auto& l : s.site.waypoint_links)
       best = std::min(best, distance_to_segment(poses[f].eye, s.site.waypoints[l[0]], s.site.waypoints[l[1]]));
     EXPECT_LT(best, 1e-4) << "frame " << f << " is off the links";
-    if (f > 0) EXPECT_LE(glm::length(poses[f].eye - poses[f - 1].eye), 1.2f + 1e-4f) << "frame " << f;
+    if (f > 0) {
+      EXPECT_LE(glm::length(poses[f].eye - poses[f - 1].eye), 1.2f + 1e-4f) << "frame " << f;
+    }
     EXPECT_GT(glm::length(poses[f].target - poses[f].eye), 0.5f);
   }
   int ahead = 0;
@@ -366,13 +377,13 @@ TEST(Q3BspTest, TourStaysOnClearLinks) {
   EXPECT_EQ(find_path("fly").make(s, 10, opts).size(), 10u);
   BspWriter lonely = room_map();
   lonely.entities = "{ \"classname\" \"info_player_start\" \"origin\" \"64 64 24\" }";
-  const CaptureScene one = make_q3bsp_scene(read(lonely), "one.bsp", kDefaultPatchSegments);
+  const CaptureScene one = make_q3bsp_scene(read(lonely), "one.bsp");
   EXPECT_THROW(find_path("tour").make(one, 10, opts), InputError) << "one waypoint, no link";
 }
 
 // The BVH caster against every triangle one by one, on random segments through the room.
 TEST(Q3BspTest, CasterAgreesWithBruteForce) {
-  const CaptureScene s = make_q3bsp_scene(read(room_map()), "room.bsp", kDefaultPatchSegments);
+  const CaptureScene s = make_q3bsp_scene(read(room_map()), "room.bsp");
   const TriangleCaster caster(s.vertices, s.indices);
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-1.0f, 14.0f);
@@ -406,7 +417,7 @@ TEST(Q3BspTest, OpenArenaLevelLoads) {
   if (std::system(cmd.c_str()) != 0 || std::filesystem::file_size(bsp) == 0) GTEST_SKIP() << "unzip could not extract oa_dm5.bsp";
   const auto t0 = std::chrono::steady_clock::now();
   const BspMap m = load_bsp(bsp.string());
-  const CaptureScene s = make_q3bsp_scene(m, bsp.string(), kDefaultPatchSegments);
+  const CaptureScene s = make_q3bsp_scene(m, bsp.string());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::size_t patches = 0, meshes = 0;
   for (const BspFace& f : m.faces) patches += f.type == BspFaceType::Patch, meshes += f.type == BspFaceType::Mesh;
