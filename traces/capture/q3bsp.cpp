@@ -6,15 +6,28 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <array>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
 #include <string_view>
 
 #include "model/common/error.h"
+
+extern char** environ;
 
 namespace nbsim::capture {
 
@@ -330,12 +343,62 @@ BspMap read_bsp(std::span<const std::uint8_t> bytes, const std::string& name, co
   return Reader(bytes, name, options).read();
 }
 
-BspMap load_bsp(const std::string& path, const BspOptions& options) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(fmt::format("q3bsp file '{}' cannot be read (missing or not readable)", path));
-  const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) throw InputError(fmt::format("q3bsp file '{}' cannot be read", path));
-  return read_bsp(bytes, path, options);
+std::vector<std::uint8_t> read_bsp_bytes(const std::string& path) {
+  const std::size_t colon = path.find(".pk3:");
+  if (colon == std::string::npos) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(fmt::format("q3bsp file '{}' cannot be read (missing or not readable)", path));
+    std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (in.bad()) throw InputError(fmt::format("q3bsp file '{}' cannot be read", path));
+    return bytes;
+  }
+  const std::string pak = path.substr(0, colon + 4), member = path.substr(colon + 5);
+  if (member.empty() || member.find_first_of("*?[]") != std::string::npos)
+    throw InputError(fmt::format("q3bsp file '{}': the member name '{}' must name one file (no wildcard)", path, member));
+  if (!std::filesystem::is_regular_file(pak)) throw InputError(fmt::format("q3bsp file '{}': no archive '{}'", path, pak));
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error(fmt::format("cannot make a pipe to read '{}': {}", path, std::strerror(errno)));
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  std::string arg0 = "unzip", arg1 = "-p", arg2 = pak, arg3 = member;
+  char* argv[] = {arg0.data(), arg1.data(), arg2.data(), arg3.data(), nullptr};
+  pid_t pid = 0;
+  const int spawned = ::posix_spawnp(&pid, "unzip", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(fds[1]);
+  if (spawned != 0) {
+    ::close(fds[0]);
+    throw InputError(fmt::format("q3bsp file '{}': cannot run unzip ({}); extract it with unzip -p {} {} > FILE.bsp", path,
+                                 std::strerror(spawned), pak, member));
+  }
+  std::vector<std::uint8_t> bytes;
+  constexpr std::size_t kMaxBytes = std::size_t{1} << 30;  // a level is a few MB; 1 GiB means a wrong member
+  bool too_big = false;
+  for (;;) {
+    std::uint8_t buf[1 << 16];
+    const ssize_t n = ::read(fds[0], buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    bytes.insert(bytes.end(), buf, buf + n);
+    if (bytes.size() > kMaxBytes) {
+      too_big = true;
+      ::kill(pid, SIGKILL);
+      break;
+    }
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (too_big) throw InputError(fmt::format("q3bsp file '{}': the member is larger than {} bytes", path, kMaxBytes));
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw InputError(fmt::format("q3bsp file '{}': unzip -p {} {} failed (exit status {}; 11: no such member, 9: not a zip archive)",
+                                 path, pak, member, WIFEXITED(status) ? WEXITSTATUS(status) : -1));
+  return bytes;
 }
+
+BspMap load_bsp(const std::string& path, const BspOptions& options) { return read_bsp(read_bsp_bytes(path), path, options); }
 
 }  // namespace nbsim::capture

@@ -84,7 +84,12 @@ glm::vec3 quake_to_scene(glm::vec3 quake);
 // not a whole number of records, an index out of range, a patch with an even side or one below 3,
 // a position that is not finite, a malformed entities lump, or a map with no drawable triangle.
 BspMap read_bsp(std::span<const std::uint8_t> bytes, const std::string& name, const BspOptions& options = {});
-// Reads the file at `path` (InputError when it cannot be read).
+// Reads the file at `path` (InputError when it cannot be read). `PAK.pk3:maps/NAME.bsp` reads the
+// member maps/NAME.bsp of the zip archive PAK.pk3 (a game's package) through `unzip -p`, run
+// without a shell; a member name with a wildcard (* ? [ ]) is refused, so that exactly one file is
+// read, and a missing unzip, archive or member is an InputError.
 BspMap load_bsp(const std::string& path, const BspOptions& options = {});
+// The bytes of `path` as load_bsp reads them (the file, or the archive member).
+std::vector<std::uint8_t> read_bsp_bytes(const std::string& path);
 
 }  // namespace nbsim::capture

@@ -61,8 +61,8 @@ CaptureScene make_boxes_scene(const OptionValues& options) {
   return make_boxes(p);
 }
 
-const OptionSpec kBsp = text_option("bsp",
-                                    "Quake 3 level file (.bsp; from a .pk3: unzip -p PAK.pk3 maps/NAME.bsp > NAME.bsp)", "none");
+const OptionSpec kBsp = text_option(
+    "bsp", "Quake 3 level: a .bsp file, or PAK.pk3:maps/NAME.bsp for a member of a game package (read with unzip -p)", "none");
 const OptionSpec kPatchSegments =
     integer_option("patch-segments", "Quads a side of each tessellated 3x3 Bezier patch of the level", kDefaultPatchSegments, 1,
                    kMaxPatchSegments);

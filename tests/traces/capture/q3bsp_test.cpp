@@ -24,7 +24,6 @@
 #include "model/common/error.h"
 #include "tests/common/bsp_writer.h"
 #include "tests/common/input_error.h"
-#include "tests/common/scratch.h"
 #include "traces/capture/paths.h"
 #include "traces/capture/q3bsp.h"
 #include "traces/capture/q3bsp_scene.h"
@@ -407,17 +406,16 @@ TEST(Q3BspTest, CasterAgreesWithBruteForce) {
   EXPECT_GT(blocked, 300) << "the random segments must test both answers";
 }
 
-// A real level (OpenArena's oa_dm5: polygons, meshes and patches) loads, and its tour's links are
-// clear. Skipped without Debian's openarena-data or unzip.
+// A real level (OpenArena's oa_dm5: polygons, meshes and patches) loads straight from its package,
+// and its tour's links are clear; a missing member, a wildcard and a missing package are refused by
+// name. Skipped without Debian's openarena-data or unzip.
 TEST(Q3BspTest, OpenArenaLevelLoads) {
   const std::string pak = "/usr/share/games/openarena/baseoa/pak1-maps.pk3";
   if (!std::filesystem::exists(pak)) GTEST_SKIP() << pak << " absent (openarena-data)";
-  const std::filesystem::path bsp = nbsim::testing::scratch_path("nbsim_q3bsp", "oa_dm5.bsp");
-  const std::string cmd = "unzip -p '" + pak + "' maps/oa_dm5.bsp > '" + bsp.string() + "' 2>/dev/null";
-  if (std::system(cmd.c_str()) != 0 || std::filesystem::file_size(bsp) == 0) GTEST_SKIP() << "unzip could not extract oa_dm5.bsp";
+  if (std::system("unzip -v > /dev/null 2>&1") != 0) GTEST_SKIP() << "unzip is not installed";
   const auto t0 = std::chrono::steady_clock::now();
-  const BspMap m = load_bsp(bsp.string());
-  const CaptureScene s = make_q3bsp_scene(m, bsp.string());
+  const BspMap m = load_bsp(pak + ":maps/oa_dm5.bsp");
+  const CaptureScene s = make_q3bsp_scene(m, pak + ":maps/oa_dm5.bsp");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::size_t patches = 0, meshes = 0;
   for (const BspFace& f : m.faces) patches += f.type == BspFaceType::Patch, meshes += f.type == BspFaceType::Mesh;
@@ -425,12 +423,17 @@ TEST(Q3BspTest, OpenArenaLevelLoads) {
   EXPECT_GT(meshes, 10u);
   EXPECT_GT(s.objects.size(), 100u);
   EXPECT_GT(s.site.waypoint_links.size(), 20u);
+  EXPECT_EQ(s.properties.front().second, "oa_dm5.bsp");
   const TriangleCaster caster(s.vertices, s.indices);
   for (const auto& l : s.site.waypoint_links)
     EXPECT_TRUE(caster.segment_clear(s.site.waypoints[l[0]], s.site.waypoints[l[1]])) << "link " << l[0] << "-" << l[1];
   EXPECT_EQ(find_path("tour").make(s, 60, OptionValues{}).size(), 60u);
   std::printf("oa_dm5: %zu faces, %zu triangles, %zu objects, %zu waypoints, %zu links; read and linked in %.3f s\n", m.faces.size(),
               s.indices.size() / 3, s.objects.size(), s.site.waypoints.size(), s.site.waypoint_links.size(), seconds);
+  using nbsim::testing::input_error;
+  EXPECT_NE(input_error([&] { load_bsp(pak + ":maps/no_such_level.bsp"); }).find("exit status 11"), std::string::npos);
+  EXPECT_NE(input_error([&] { load_bsp(pak + ":maps/*.bsp"); }).find("no wildcard"), std::string::npos);
+  EXPECT_NE(input_error([&] { load_bsp("/nonexistent.pk3:maps/oa_dm5.bsp"); }).find("no archive '/nonexistent.pk3'"), std::string::npos);
 }
 
 }  // namespace
