@@ -357,7 +357,8 @@ std::vector<std::uint8_t> read_bsp_bytes(const std::string& path) {
     throw InputError(fmt::format("q3bsp file '{}': the member name '{}' must name one file (no wildcard)", path, member));
   if (!std::filesystem::is_regular_file(pak)) throw InputError(fmt::format("q3bsp file '{}': no archive '{}'", path, pak));
   int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error(fmt::format("cannot make a pipe to read '{}': {}", path, std::strerror(errno)));
+  if (::pipe2(fds, O_CLOEXEC) != 0)
+    throw std::runtime_error(fmt::format("cannot make a pipe to read '{}': {}", path, std::strerror(errno)));
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);

@@ -1,12 +1,16 @@
 // CaptureCliTest: `nbsim capture` from the outside. The new spelling (TECHNIQUE --scene --path) and
 // the old one (`capture city`) record identical traces; --help lists the techniques, scenes and
-// paths from their tables; bad names and option values exit 2 with a message naming them.
+// paths from their tables; bad names and option values exit 2 with a message naming them; a level
+// file's scene replays draw by draw.
 #include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
 
 #include <cstring>
 #include <filesystem>
 #include <string>
 
+#include "tests/common/bsp_writer.h"
 #include "tests/common/refused.h"
 #include "tests/common/run_nbsim.h"
 #include "traces/format/reader.h"
@@ -115,6 +119,42 @@ TEST(CaptureCliTest, BadInputExitsTwo) {
                            {"capture occlusion_culling --levels-every often --frames 1", "--levels-every 'often' is not an integer"},
                            {"capture occlusion_culling --size 0x5 --frames 1", "--size"}},
                           " -o " + out.string(), out);
+  fs::remove_all(out.parent_path());
+}
+
+// A level file's scene (the room of tests/common/bsp_writer.h) walked along `tour` replays with
+// every draw, fragment, passed sample and depth pixel equal to GL's, as the city does; a level
+// path refuses the walk and a missing or damaged level file by name.
+TEST(CaptureCliTest, LevelTourReplaysDrawByDraw) {
+  const fs::path room = testing::scratch_path("nbsim_capture_cli_level", "room.bsp");
+  const fs::path out = testing::scratch_path("nbsim_capture_cli_level", "room.nbt");
+  testing::write_bsp(testing::room_map(), room);
+  const CliResult c = run_nbsim("capture occlusion_culling --scene q3bsp --bsp " + room.string() +
+                                " --path tour --size 96x64 --frames 12 -o " + out.string());
+  ASSERT_EQ(c.status, 0) << c.err;
+  const CliResult r = run_nbsim("compare " + out.string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j.at("draws").get<int>(), 12);
+  EXPECT_EQ(j.at("draws_exact"), j.at("draws")) << r.out;
+  EXPECT_EQ(j.at("depth_pixels_matching"), j.at("depth_pixels")) << r.out;
+  EXPECT_TRUE(j.at("within_thresholds").get<bool>()) << r.out;
+  fs::path damaged = room;
+  damaged.replace_filename("short.bsp");
+  fs::copy_file(room, damaged, fs::copy_options::overwrite_existing);
+  fs::resize_file(damaged, 200);
+  const fs::path never = out.parent_path() / "never.nbt";
+  const std::string room_arg = " --bsp " + room.string(), damaged_arg = " --bsp " + damaged.string();
+  testing::expect_refused("capture occlusion_culling --scene q3bsp",
+                          {{" --path tour", "scene q3bsp needs --bsp"},
+                           {" --bsp /nonexistent.bsp --path tour", "'/nonexistent.bsp' cannot be read"}},
+                          " --frames 1 -o " + never.string(), never);
+  testing::expect_refused("capture occlusion_culling --scene q3bsp", {{" --path walk", "use --path tour or fly"}},
+                          room_arg + " --frames 1 -o " + never.string(), never);
+  testing::expect_refused("capture occlusion_culling --scene q3bsp", {{" --path tour", "outside the file"}},
+                          damaged_arg + " --frames 1 -o " + never.string(), never);
+  testing::expect_refused("", {{"capture occlusion_culling --scene city --path tour", "needs a scene with waypoints"}},
+                          " --frames 1 -o " + never.string(), never);
   fs::remove_all(out.parent_path());
 }
 

@@ -65,7 +65,8 @@ BspWriter test_map() {
   w.face(2, 0, net3, {}, {}, {3, 3});
   std::vector<BspWriter::Vertex> net5;
   for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 5; ++i) net5.push_back(vtx(200.0f + 16.0f * static_cast<float>(i), 16.0f * static_cast<float>(j), static_cast<float>(i % 2) * 8.0f));
+    for (int i = 0; i < 5; ++i)
+      net5.push_back(vtx(200.0f + 16.0f * static_cast<float>(i), 16.0f * static_cast<float>(j), static_cast<float>(i % 2) * 8.0f));
   w.face(2, 0, net5, {}, {}, {5, 3});
   w.face(1, 1, {vtx(0, 0, 100), vtx(10, 0, 100), vtx(10, 10, 100)}, {0, 1, 2}, {0, 0, 1});
   w.face(4, 0, {vtx(5, 5, 5)}, {});
