@@ -14,7 +14,9 @@
 //   skipped.
 // - Faces whose shader cannot hide anything are skipped: surface flags nodraw (0x80, caulk, clip,
 //   triggers) and sky (0x4); content flags fog (0x40), water (0x20) and translucent (0x20000000,
-//   glass, beams, liquids drawn blended). Lava and slime stay (opaque in OpenArena).
+//   glass, beams, liquids drawn blended). Lava and slime stay (opaque in OpenArena). The shader
+//   scripts are not read, so a blended or alpha-tested surface that carries none of these flags
+//   (a flame, a grate) is drawn as a solid surface.
 // - Faces that no BSP leaf lists are skipped: the game draws the world leaf by leaf, so these
 //   are never drawn.
 // - The entities lump (text): the spawn points and items an observer walks between, each with its
