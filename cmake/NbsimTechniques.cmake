@@ -15,7 +15,7 @@
 #   analysis/techniques/<name>/  its report sections and README rows (found by the report itself)
 # The shared code names no technique: it expands NBSIM_EACH_TECHNIQUE (generated below) where it
 # needs the list, and the CMake files loop over NBSIM_TECHNIQUES.
-set(NBSIM_TECHNIQUES occlusion particles shadows ldi relief)
+set(NBSIM_TECHNIQUES occlusion particles shadows ldi relief apps)
 
 # The generated headers: NBSIM_EACH_TECHNIQUE(X) expands X(name) once per technique, in the list's
 # order (nbsim/technique_list.h); nbsim/technique_roles_list.h includes each model/<name>/roles.h.

@@ -86,7 +86,7 @@ GeometryStage::GeometryStage(const GeometryConfig& config) : config_(config) {
   const float half_h = static_cast<float>(config.height_px) * 0.5f;
   for (int c = 0; c < 2; ++c) {
     Viewport& v = viewports_[static_cast<std::size_t>(c)];
-    v.scale = {half_w, half_h, c == 0 ? 0.5f : 1.0f};
+    v.scale = {half_w, config.flip_y ? -half_h : half_h, c == 0 ? 0.5f : 1.0f};
     v.translate = {half_w, half_h, c == 0 ? 0.5f : 0.0f};
   }
 }

@@ -68,6 +68,10 @@ struct GeometryConfig {
   // Window coordinates of shaded vertices with one fused multiply-add (LLVM on FMA hosts) or a
   // separately rounded multiply and add (hosts without FMA).
   bool fused_viewport = true;
+  // The viewport's y scale negated (rows counted from the top): how llvmpipe draws a window-system
+  // framebuffer, relative to an FBO (the state tracker inverts the viewport for FBOs only). The clip
+  // planes see the positions as given, so a triangle is clipped as GL clips it.
+  bool flip_y = false;
 };
 
 // The per-draw state the stage reads.

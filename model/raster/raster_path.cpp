@@ -16,6 +16,7 @@ geometry::GeometryConfig geometry_config(const RasterPathConfig& c) {
   g.height_px = c.height_px;
   g.batch_triangles = c.batch_triangles;
   g.fused_viewport = c.fused_viewport;
+  g.flip_y = c.window_framebuffer;
   return g;
 }
 
@@ -47,7 +48,7 @@ RasterPath::RasterPath(const RasterPathConfig& config, DepthImage& depth, Stenci
 RasterPath::RasterPath(const RasterPathConfig& config, DepthImage& depth, StencilImage* stencil)
     : config_(config),
       geometry_(geometry_config(config)),
-      setup_(SetupConfig{config.width_px, config.height_px}),
+      setup_(SetupConfig{config.width_px, config.height_px, config.window_framebuffer}),
       point_setup_(SetupConfig{config.width_px, config.height_px}),
       rasterizer_(config.width_px, config.height_px),
       own_stencil_(stencil ? nullptr : std::make_unique<StencilImage>(check_size(config, depth).width, depth.height, 0)),

@@ -26,6 +26,10 @@ struct RasterPathConfig {
   bool fused_viewport = true;       // geometry::GeometryConfig::fused_viewport
   bool fused_interpolation = true;  // EarlyDepthTest: depth plane evaluated with FMA
   DepthFormat depth_format = DepthFormat::Float32;  // Unorm24: the buffer holds llvmpipe's 24-bit depths
+  // A window-system framebuffer as llvmpipe draws it (model/apps/replay.h): rows flipped in the
+  // viewport transform (geometry::GeometryConfig::flip_y) and the bottom-edge fill rule
+  // (SetupConfig::bottom_edge_rule). Off: an FBO, as every other technique draws into.
+  bool window_framebuffer = false;
 };
 
 // The GL state of one draw that the path reads.

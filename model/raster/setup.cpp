@@ -152,12 +152,13 @@ SetupResult TriangleSetup::setup(const geometry::WindowTriangle& triangle, const
     y[i] = f.y[static_cast<std::size_t>(order[i])];
   }
 
-  // Bounding box (bottom_edge_rule = 0, so no adjustment), inclusive.
+  // Bounding box, inclusive (with bottom_edge_rule its rows round one subpixel up).
+  const int adj = config_.bottom_edge_rule ? 1 : 0;
   PixelBox box;
   box.x0 = std::min({x[0], x[1], x[2]}) >> kSubpixelBits;
   box.x1 = (std::max({x[0], x[1], x[2]}) - 1) >> kSubpixelBits;
-  box.y0 = std::min({y[0], y[1], y[2]}) >> kSubpixelBits;
-  box.y1 = (std::max({y[0], y[1], y[2]}) - 1) >> kSubpixelBits;
+  box.y0 = (std::min({y[0], y[1], y[2]}) + adj) >> kSubpixelBits;
+  box.y1 = (std::max({y[0], y[1], y[2]}) - 1 + adj) >> kSubpixelBits;
   const PixelBox region{0, 0, config_.width_px - 1, config_.height_px - 1};
   if (box.x0 > region.x1 || box.x1 < region.x0 || box.y0 > region.y1 || box.y1 < region.y0) {
     counters.offscreen += 1;
@@ -175,7 +176,7 @@ SetupResult TriangleSetup::setup(const geometry::WindowTriangle& triangle, const
     const std::int32_t dcdx = y[i] - y[j];  // |dcdx|, |dcdy| < 2^23: checked above
     const std::int32_t dcdy = x[i] - x[j];
     p.c = static_cast<std::int64_t>(dcdx) * x[i] - static_cast<std::int64_t>(dcdy) * y[i];
-    if (dcdx < 0 || (dcdx == 0 && dcdy >= 0)) p.c += 1;  // fill rule (see setup.h)
+    if (dcdx < 0 || (dcdx == 0 && (config_.bottom_edge_rule ? dcdy < 0 : dcdy >= 0))) p.c += 1;  // fill rule (see setup.h)
     p.dcdx = dcdx * kSubpixelOne;
     p.dcdy = dcdy * kSubpixelOne;
     p.eo = (p.dcdx < 0 ? -static_cast<std::int64_t>(p.dcdx) : 0) + (p.dcdy > 0 ? p.dcdy : 0);

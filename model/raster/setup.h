@@ -10,7 +10,8 @@
 // - lp_setup_tri.c do_triangle_ccw: edge i runs from vertex i to i + 1; dcdx = y_i - y_i+1,
 //   dcdy = x_i - x_i+1, c = dcdx x_i - dcdy y_i, plus one on left edges and on horizontal edges
 //   with dcdy > 0 (the top-left rule of a y-down raster, which for GL's y-up FBOs is
-//   bottom-left; st_atom_rasterizer.c sets bottom_edge_rule = 0 for FBOs). A pixel is covered
+//   bottom-left; st_atom_rasterizer.c sets bottom_edge_rule = 0 for FBOs; with
+//   SetupConfig::bottom_edge_rule, horizontal edges with dcdy < 0 instead). A pixel is covered
 //   when c - dcdx x + dcdy y > 0 for every plane (lp_rast_tri_tmp.h tests c - 1 >= 0).
 // - The bounding box (x0 = min >> 8, x1 = (max - 1) >> 8, likewise y), the draw-region reject and
 //   the scissor planes added when the box passes the render target's right or top border
@@ -123,6 +124,11 @@ struct SetupCounters {
 struct SetupConfig {
   int width_px = 0;  // render target, 1 .. 16384
   int height_px = 0;
+  // llvmpipe's bottom_edge_rule (st_atom_rasterizer.c sets it for a window-system framebuffer,
+  // which Gallium draws upside down; 0 for FBOs): a horizontal edge with dcdy < 0 is the included
+  // one instead of dcdy > 0, and the bounding box's rows round one subpixel up
+  // (lp_setup_tri.c do_triangle_ccw).
+  bool bottom_edge_rule = false;
 };
 
 // The fixed-point position llvmpipe snaps a window coordinate to.

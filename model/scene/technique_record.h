@@ -14,6 +14,13 @@
 
 namespace nbsim::scene {
 
+// A technique record's type from its four characters, as the trace format spells them
+// (traces/format/records.h fourcc): the first character in the lowest byte.
+constexpr std::uint32_t record_type(const char (&s)[5]) noexcept {
+  return static_cast<std::uint32_t>(static_cast<unsigned char>(s[0])) | static_cast<std::uint32_t>(static_cast<unsigned char>(s[1])) << 8 |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(s[2])) << 16 | static_cast<std::uint32_t>(static_cast<unsigned char>(s[3])) << 24;
+}
+
 // The frame's one decoded record of `type`; `label` names it ("ParticleCulling (PRTC)") and
 // `why_needed` ends the message when it is missing.
 inline const TechniqueRecord& single_record(const Frame& f, std::uint32_t type, std::string_view label,

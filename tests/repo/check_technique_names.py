@@ -3,7 +3,7 @@
 
 The shared folders (the replay's top level, the command line, benches, sweeps, the results
 declarations, the report, the trace format's core and the capture's core), the build files of
-the layers and of the tests do not name a technique (particles, shadows, LDIs, relief, occlusion culling): a
+the layers and of the tests do not name a technique (particles, shadows, LDIs, relief, occlusion culling, apps): a
 technique's code lives in its own folders (a folder named after it, below any of them), and the one
 registration list names them all:
 
@@ -28,11 +28,12 @@ SHARED = ["pipeline/sim", "pipeline/cli", "pipeline/bench", "pipeline/explore", 
 # Shared files outside those folders: the layers' build files and the draw roles' table.
 SHARED_FILES = ["CMakeLists.txt", "model/CMakeLists.txt", "model/sim/CMakeLists.txt", "traces/CMakeLists.txt",
                 "pipeline/CMakeLists.txt", "model/scene/technique_roles.h"]
-TECHNIQUE_DIRS = {"occlusion", "particles", "shadows", "ldi", "relief"}
+TECHNIQUE_DIRS = {"occlusion", "particles", "shadows", "ldi", "relief", "apps"}
 REGISTRATION = {"cmake/NbsimTechniques.cmake"}
 SUFFIXES = {".h", ".cpp", ".py", ".txt", ".cmake"}
 # "ldi" only at the start of a word or identifier part (LdiUnit, model::ldi, ldi_table), not in "building".
-MENTION = re.compile(r"particle|shadow|relief|occlusion|(?<![a-z])ldi", re.IGNORECASE)
+# "apps" only as a word part of its own (apps_program, model::apps), not in "mapps".
+MENTION = re.compile(r"particle|shadow|relief|occlusion|(?<![a-z])ldi|(?<![a-z])apps(?![a-z])", re.IGNORECASE)
 
 offences = []
 listed = 0

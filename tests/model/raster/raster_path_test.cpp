@@ -43,6 +43,37 @@ TEST(RasterPathTest, RepeatedDrawTiesAtEqualDepth) {
   }
 }
 
+// A window-system framebuffer (RasterPathConfig::window_framebuffer) is drawn upside down with the
+// bottom-edge fill rule, as llvmpipe draws one: the image GL reads back (rows mirrored) is the one an
+// FBO gets, pixel for pixel, also where an edge runs through pixel centres (where the fill rule
+// decides). Without the rule's change, the rows on the horizontal edges would differ.
+TEST(RasterPathTest, WindowFramebufferIsTheFboImageUpsideDown) {
+  constexpr int kW = 32, kH = 32;
+  // A rectangle from window y 8.5 to 23.5 (clip y -0.46875 .. 0.46875: edges through pixel centres),
+  // and a tilted triangle with no ties.
+  const std::vector<std::vector<ClipPosition>> draws = {
+      {{-0.5f, -0.46875f, 0.25f, 1}, {0.5f, -0.46875f, 0.25f, 1}, {0.5f, 0.46875f, -0.25f, 1},
+       {-0.5f, -0.46875f, 0.25f, 1}, {0.5f, 0.46875f, -0.25f, 1}, {-0.5f, 0.46875f, -0.25f, 1}},
+      {{-0.83f, -0.71f, 0.3f, 1}, {0.77f, -0.52f, -0.1f, 1}, {0.11f, 0.93f, 0.6f, 1}}};
+  for (const auto& positions : draws) {
+    DepthImage fbo(kW, kH, 1.0f), window(kW, kH, 1.0f);
+    RasterPathConfig c{kW, kH, 85, true, true};
+    RasterPath fbo_path(c, fbo);
+    c.window_framebuffer = true;
+    RasterPath window_path(c, window);
+    DrawState st;
+    st.geometry.face.cull = CullFace::None;
+    const DrawCounters a = fbo_path.draw(positions, st);
+    const DrawCounters b = window_path.draw(positions, st);
+    EXPECT_GT(a.depth.passed, 100u);
+    EXPECT_EQ(a.depth.passed, b.depth.passed);
+    int differing = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) differing += (fbo.at(x, y) == 1.0f) != (window.at(x, kH - 1 - y) == 1.0f) ? 1 : 0;
+    EXPECT_EQ(differing, 0) << "covered pixels of the read-back image";
+  }
+}
+
 // Rasterization reuse (set_reuse_rasterization) changes no count and no depth: a sequence of draws
 // (the same triangles again, then moved ones, then the first again, under other depth funcs) gives
 // the same counters and buffer with it on as off; a moved vertex or another face state is not reused.

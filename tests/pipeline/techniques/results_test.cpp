@@ -210,6 +210,10 @@ nlohmann::json real_run(const std::string& technique) {
     const CliResult c = run_nbsim("capture relief --scene boxes --boxes 0 --path fly --size 48x48 --frames 2 --field fbm "
                                   "--field-size 16 --angles 30,85 -o " + trace);
     EXPECT_EQ(c.status, 0) << c.out << c.err;
+  } else if (technique == "apps") {
+    trace = scratch("apps.nbt").string();
+    const CliResult c = run_nbsim("capture apps --scene boxes --path fly --size 48x32 --frames 2 -o " + trace);
+    EXPECT_EQ(c.status, 0) << c.out << c.err;
   } else {
     ADD_FAILURE() << technique << ": no real run.json to check its row against (add its trace to real_run)";
     return nlohmann::json();

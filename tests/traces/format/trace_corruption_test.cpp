@@ -256,7 +256,7 @@ TEST(TraceCorruptionTest, FieldValuesOutOfRange) {
     std::string message;
   };
   const Row rows[] = {
-      {ChunkType::Draw, [](Bytes& p) { p[4] = 15; }, "field 'role' is 15"},                     // DrawRole 0..14
+      {ChunkType::Draw, [](Bytes& p) { p[4] = 16; }, "field 'role' is 16"},                     // DrawRole 0..15
       {ChunkType::Draw, [](Bytes& p) { p[15] = 2; }, "field 'state.write' is 2, not 0 or 1"},   // bools are 0/1
       {ChunkType::Draw, [](Bytes& p) { p[14] = 8; }, "state.func"},                             // DepthFunc 0..7
       {ChunkType::Draw, [](Bytes& p) { p[13] = 32; }, "field 'level' is 32"},                  // levels below 32
@@ -270,7 +270,7 @@ TEST(TraceCorruptionTest, FieldValuesOutOfRange) {
       {ChunkType::Levels, [](Bytes& p) { p[19] = 2; }, "field 'op' is 2"},                      // FarOp 0..1
       {ChunkType::Levels, [](Bytes& p) { put_le32(p, 28, 33); }, "field 'levels' is 33"},       // at most 32 levels
       {ChunkType::Draw, [](Bytes& p) { p[80 + 48] = 2; }, "field 'topology' is 2"},            // Topology 0..1
-      {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 4] = 15; }, "field 'role' is 15"},              // each draw checked
+      {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 4] = 16; }, "field 'role' is 16"},              // each draw checked
       // The batch's first draw: 128 bytes of version 1 fields, topology, 3 point sizes, stencil.test,
       // stencil.front.func, ref, value_mask, write_mask, then stencil.front.fail at 4 + 159.
       {ChunkType::DrawBatch, [](Bytes& p) { p[4 + 159] = 8; }, "field 'stencil.front.fail' is 8"},  // StencilOp 0..7

@@ -1,0 +1,113 @@
+// AppsUnit; see unit.h.
+#include "model/apps/unit.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "model/common/error.h"
+
+namespace nbsim::apps {
+
+namespace {
+
+constexpr double kMinRate = 0.01, kMaxRate = 4096.0;
+
+std::uint64_t ceil_div(double work, double per_cycle) {
+  if (work <= 0.0) return 0;
+  return static_cast<std::uint64_t>(std::ceil(work / per_cycle));
+}
+
+}  // namespace
+
+void AppsUnitConfig::describe(config::Schema& s, AppsUnitConfig& c) {
+  s.add("apps.setup_triangles_per_cycle", c.setup_triangles_per_cycle, "triangles/cycle", "a replayed draw's triangles through setup a cycle",
+        kMinRate, kMaxRate);
+  s.add("apps.tests_per_cycle", c.tests_per_cycle, "tests/cycle", "depth tests of a replayed draw a cycle", kMinRate, kMaxRate);
+  s.add("apps.draw_overhead_cycles", c.draw_overhead_cycles, "cycles", "a draw's state and launch (flagged draws cost this only)", 0, 100000);
+}
+
+void AppsUnitConfig::validate() const {
+  for (const auto& [key, v] : {std::pair{"apps.setup_triangles_per_cycle", setup_triangles_per_cycle}, std::pair{"apps.tests_per_cycle", tests_per_cycle}})
+    if (!(v >= kMinRate && v <= kMaxRate)) throw InputError(fmt::format("{} is {}, not in [{}, {}]", key, v, kMinRate, kMaxRate));
+  if (draw_overhead_cycles < 0 || draw_overhead_cycles > 100000)
+    throw InputError(fmt::format("apps.draw_overhead_cycles is {}, not in [0, 100000]", draw_overhead_cycles));
+}
+
+AppsUnit::AppsUnit(const sc_core::sc_module_name& name, stats::Registry& registry, const AppsUnitConfig& config, std::ostream* log)
+    : sim::Unit(name, registry),
+      config_((config.validate(), config)),
+      log_(log),
+      frames_(stats().counter("frames", "frames", "frames replayed")),
+      draws_(stats().counter("draws", "draws", "draw calls recorded")),
+      replayed_(stats().counter("replayed", "draws", "draws the model replayed (not flagged)")),
+      compared_(stats().counter("compared", "draws", "replayed draws compared with GL's samples passed (their target not stale)")),
+      matched_(stats().counter("matched", "draws", "compared draws whose samples passed equal GL's")),
+      mismatched_(stats().counter("mismatched", "draws", "compared draws whose samples passed differ from GL's (expected 0)")),
+      after_stale_(stats().counter("after_stale", "draws", "replayed draws after a stale change of their target: not compared")),
+      depth_changes_(stats().counter("depth_changes", "draws", "flagged draws whose recorded depth change was applied")),
+      clears_(stats().counter("clears", "clears", "depth and stencil clears applied")),
+      triangles_(stats().counter("triangles", "triangles", "captured triangles of the replayed draws")),
+      fragments_(stats().counter("fragments", "fragments", "the model's rasterized fragments of the replayed draws")),
+      depth_tests_(stats().counter("depth_tests", "tests", "the model's depth tests of the replayed draws")),
+      samples_(stats().counter("samples", "samples", "the model's samples passed of the replayed draws")),
+      gl_samples_(stats().counter("gl_samples", "samples", "GL's samples passed of every draw")),
+      gl_samples_compared_(stats().counter("gl_samples_compared", "samples", "GL's samples passed of the compared draws")),
+      frames_depth_compared_(stats().counter("frames_depth_compared", "frames", "frames whose final depth was compared with GL's")),
+      depth_pixels_(stats().counter("depth_pixels", "pixels", "pixels of the final depth compared")),
+      depth_mismatches_(stats().counter("depth_mismatches", "pixels", "of those, pixels whose depth differs from GL's (expected 0)")),
+      unhandled_frames_(stats().counter("unhandled_frames", "frames", "frames in which the program used a GL feature not captured")),
+      cycles_(stats().counter("cycles", "cycles", "cycles of every draw")) {
+  for (int r = 1; r < kReasons; ++r)
+    flagged_[static_cast<std::size_t>(r)] = &stats().counter(fmt::format("flagged_{}", to_string(static_cast<Reason>(r))), "draws",
+                                                              fmt::format("draws flagged: {}", to_string(static_cast<Reason>(r))));
+  if (log_) *log_ << "frame,draw,framebuffer,reason,stale,depth_change,triangles,fragments,depth_tests,samples,gl_samples,match\n";
+}
+
+void AppsUnit::depth_cleared(float) {
+  ++cleared_;
+  cleared_event_.notify(sc_core::SC_ZERO_TIME);
+}
+
+void AppsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::CommandProcessor&) {
+  const AppFrameCounts k = replay_.run_frame(*f);
+  ++begun_;
+  while (cleared_ < begun_) wait(cleared_event_);  // the frame before is counted as its own
+  ++frames_;
+  clears_ += k.clears;
+  if (!k.unhandled.empty()) ++unhandled_frames_;
+  if (k.depth_compared) ++frames_depth_compared_, depth_pixels_ += k.depth_pixels, depth_mismatches_ += k.depth_mismatches;
+  for (const AppDrawCounts& d : k.draws) {
+    ++draws_;
+    gl_samples_ += d.gl_samples;
+    std::uint64_t spent = static_cast<std::uint64_t>(config_.draw_overhead_cycles);
+    if (d.reason == Reason::Replayed) {
+      ++replayed_;
+      triangles_ += d.triangles, fragments_ += d.fragments, depth_tests_ += d.depth_tests, samples_ += d.samples;
+      if (d.stale) {
+        ++after_stale_;
+      } else {
+        ++compared_;
+        gl_samples_compared_ += d.gl_samples;
+        if (d.samples == d.gl_samples) ++matched_;
+        else ++mismatched_;
+      }
+      spent += std::max(ceil_div(static_cast<double>(d.triangles), config_.setup_triangles_per_cycle),
+                        ceil_div(static_cast<double>(d.depth_tests), config_.tests_per_cycle));
+    } else {
+      ++*flagged_[static_cast<std::size_t>(d.reason)];
+      depth_changes_ += d.depth_change ? 1 : 0;
+    }
+    label_with([&] { return fmt::format("app draw {} ({})", d.draw, to_string(d.reason)); });
+    work(spent);
+    cycles_ += spent;
+    if (log_)
+      *log_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", d.frame, d.draw, d.framebuffer, to_string(d.reason), d.stale ? 1 : 0,
+                           d.depth_change ? 1 : 0, d.triangles, d.fragments, d.depth_tests, d.samples, d.gl_samples,
+                           d.reason != Reason::Replayed || d.stale ? "" : d.samples == d.gl_samples ? "1" : "0");
+  }
+}
+
+}  // namespace nbsim::apps
