@@ -80,7 +80,8 @@ def render(d):
         rows += module.rows(d["techniques"][name])
     rows.append(("Fidelity",
                  f"{len(exact)} of the {len(cmp)} sample traces replay with every draw's fragments and passed samples "
-                 "equal to llvmpipe's",
+                 "equal to llvmpipe's (of a recorded program, every draw the model replays; it flags the others by "
+                 "reason)",
                  f"`nbsim compare TRACE` for each of `{SAMPLES}/*.nbt`", "[testing](docs/testing.md)"))
     lines = ["| what | result | command | more |", "|---|---|---|---|"]
     lines += [f"| {a} | {b} | {c} | {e} |" for a, b, c, e in rows]

@@ -1,6 +1,6 @@
 // The interposer's recording (traces/apitrace/interposer.cpp): what the library loaded into
 // eglretrace writes while an apitrace trace replays, and what `nbsim capture apitrace` reads back
-// and turns into an nbsim trace (traces/apitrace/convert.h). One layout, used by both sides: plain
+// and turns into an nbsim trace (traces/capture/apps/convert.h). One layout, used by both sides: plain
 // little-endian records, each a RecordHead then its payload, in call order.
 //
 //   file   := FileHead record* End
