@@ -66,7 +66,8 @@ DrawFields draw_fields(const scene::TechniqueRecord& r, std::size_t draws, std::
 }
 
 // The first reason the model cannot redo draw `k` exactly.
-Reason reason_of(const DrawFields& d, std::size_t k, const scene::DrawRecord& draw, std::optional<raster::DepthFormat> format) {
+Reason reason_of(const DrawFields& d, std::size_t k, const scene::DrawRecord& draw, std::optional<raster::DepthFormat> format,
+                 bool ignore_discard = false) {
   const std::uint32_t fl = (*d.flags)[k];
   const int w = static_cast<int>((*d.width)[k]), h = static_cast<int>((*d.height)[k]);
   if ((*d.skipped)[k] != 0 || (fl & kOverflow)) return Reason::NotCaptured;
@@ -74,7 +75,7 @@ Reason reason_of(const DrawFields& d, std::size_t k, const scene::DrawRecord& dr
   if ((*d.primitive)[k] == kGlLines) return Reason::Lines;
   if ((*d.primitive)[k] != kGlTriangles) return Reason::NotCaptured;
   if (w <= 0 || h <= 0) return Reason::NoTarget;
-  if (fl & (kDiscards | kAlphaTest)) return Reason::Discard;
+  if (!ignore_discard && (fl & (kDiscards | kAlphaTest))) return Reason::Discard;
   if (fl & kWritesDepth) return Reason::FragDepth;
   if ((fl & kPolygonOffsetFill) && ((*d.factor)[k] != 0.0f || (*d.units)[k] != 0.0f)) return Reason::PolygonOffset;
   if ((fl & kPolygonModeNotFill) || (*d.polygon_mode)[k] != kGlFill) return Reason::PolygonMode;
@@ -129,6 +130,30 @@ AppsReplay::Target& AppsReplay::target(std::uint32_t fb, int width, int height, 
   // buffer has none to know.
   t.stale = has_depth;  // its content before the first clear is GL's, not known to the model
   return t;
+}
+
+raster::DrawCounters AppsReplay::replay(Target& t, const scene::DrawRecord& draw, bool has_depth) {
+  raster::DrawState s = raster::draw_state(draw.state);
+  if (!draw.state.test) s.depth.write = false;  // GL writes depth only with the test on
+  if (!has_depth) s.depth.test = false, s.depth.write = false;  // no depth buffer: every fragment passes
+  s.stencil = raster::stencil_state(draw.stencil);
+  if (t.flipped) s.geometry.face.front_ccw = !s.geometry.face.front_ccw;  // the winding mirrors with the rows
+  return t.path->draw(draw.clip_positions, s);
+}
+
+bool AppsReplay::same_change(const Target& t, const std::vector<float>& before, const scene::TechniqueRecord& change, std::uint64_t frame,
+                             std::size_t k) const {
+  const auto& pixel = scene::record_field<std::uint32_t>(change, "pixel", kChangeLabel, frame);
+  const auto& depth = scene::record_field<float>(change, "depth", kChangeLabel, frame);
+  if (pixel.size() != depth.size()) throw InputError(fmt::format("frame {}: the {} record of draw {} has {} pixels and {} depths", frame, kChangeLabel, k, pixel.size(), depth.size()));
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < t.depth.texels.size(); ++i) {
+    const std::size_t at = t.stored(i);  // i: GL's read-back index
+    if (std::memcmp(&t.depth.texels[at], &before[at], sizeof(float)) == 0) continue;
+    if (changed >= pixel.size() || pixel[changed] != i || std::memcmp(&depth[changed], &t.depth.texels[at], sizeof(float)) != 0) return false;
+    ++changed;
+  }
+  return changed == pixel.size();
 }
 
 AppFrameCounts AppsReplay::run_frame(const scene::Frame& f) {
@@ -225,21 +250,44 @@ AppFrameCounts AppsReplay::run_frame(const scene::Frame& f) {
     const bool may_write_stencil = (fl & kStencilTest) && !(fl & kRasterizerDiscard) &&
                                    ((draw.stencil.front.write_mask & 0xFFu) != 0 || (draw.stencil.back.write_mask & 0xFFu) != 0);
     const int w = static_cast<int>((*d.width)[k]), h = static_cast<int>((*d.height)[k]);
-    if (c.reason == Reason::Replayed) {
+    // A draw whose fragment shader may discard, and that nothing else keeps the model from, is
+    // replayed as if it discarded nothing and checked against GL: its samples passed, and the depth
+    // it changed against the change GL recorded (the interposer records one for every such draw
+    // that may write depth). Equal: compared and matched like any replayed draw; else GL's change
+    // stands and it is flagged (replay.h).
+    if (c.reason == Reason::Discard) {  // flagged for the next reason when it has one: discard may not even happen
+      const Reason other = reason_of(d, k, draw, format, true);
+      if (other != Reason::Replayed) c.reason = other;
+    }
+    const bool try_discard = c.reason == Reason::Discard && !may_write_stencil && (!may_write_depth || change[k] != nullptr);
+    if (try_discard) {
+      Target& t = target(c.framebuffer, w, h, *format, (*d.bits)[k] != 0);
+      if (!t.stale) {
+        std::vector<float>& before = scratch_;
+        before = t.depth.texels;
+        const raster::DrawCounters r = replay(t, draw, (*d.bits)[k] != 0);
+        bool equal = r.depth.passed == c.gl_samples;
+        if (equal && may_write_depth) equal = same_change(t, before, *change[k], frame, k);
+        c.may_discard = true;
+        if (equal) {
+          c.reason = Reason::Replayed;
+          c.triangles = draw.clip_positions.size() / 3;
+          c.fragments = r.depth.fragments, c.depth_tests = r.depth.depth_tests, c.samples = r.depth.passed, c.written = r.depth.written;
+        } else {
+          t.depth.texels.swap(before);  // the depth as before the draw: GL's change is applied below
+        }
+      }
+    }
+    if (c.reason == Reason::Replayed && !c.may_discard) {
       Target& t = target(c.framebuffer, w, h, *format, (*d.bits)[k] != 0);
       c.stale = t.stale;
-      raster::DrawState s = raster::draw_state(draw.state);
-      if (!draw.state.test) s.depth.write = false;  // GL writes depth only with the test on
-      if ((*d.bits)[k] == 0) s.depth.test = false, s.depth.write = false;  // no depth buffer: every fragment passes
-      s.stencil = raster::stencil_state(draw.stencil);
-      if (t.flipped) s.geometry.face.front_ccw = !s.geometry.face.front_ccw;  // the winding mirrors with the rows
-      const raster::DrawCounters r = t.path->draw(draw.clip_positions, s);
+      const raster::DrawCounters r = replay(t, draw, (*d.bits)[k] != 0);
       c.triangles = draw.clip_positions.size() / 3;
       c.fragments = r.depth.fragments;
       c.depth_tests = r.depth.depth_tests;
       c.samples = r.depth.passed;
       c.written = r.depth.written;
-    } else if (w > 0 && h > 0 && (may_write_depth || may_write_stencil)) {
+    } else if (c.reason != Reason::Replayed && w > 0 && h > 0 && (may_write_depth || may_write_stencil)) {
       Target& t = target(c.framebuffer, w, h, format.value_or(raster::DepthFormat::Float32), (*d.bits)[k] != 0);
       if (change[k] && !may_write_stencil) {
         const scene::TechniqueRecord& r = *change[k];

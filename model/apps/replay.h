@@ -9,11 +9,15 @@
 //    viewport), with its depth, cull, clip-control, depth-clamp and stencil state, and its samples
 //    passed compared with GL's; or
 //  - flagged, by the first reason the model cannot redo it exactly (Reason: not captured, points or
-//    lines, discard or alpha test, a written fragment depth, polygon offset or mode, multisampling,
+//    lines, discard or alpha test (named only when nothing else applies), a written fragment depth, polygon offset or mode, multisampling,
 //    a viewport, depth range or scissor smaller than the target, a depth format the model does not
 //    store, a non-finite position). A flagged draw is never compared; when the recording holds the
 //    depth it changed (AppDepthChange), that change is applied to the target, so the draws after it
-//    still compare exactly; when it may have written depth or stencil and the recording has no
+//    still compare exactly. A draw flagged only because its shader may discard (the flag comes
+//    from the source, not from what the draw did) is first replayed as if nothing was discarded
+//    and checked against GL: equal samples passed and, when it may write depth, a depth change
+//    equal to GL's recorded one, pixel for pixel: then it counts as replayed and matched (its
+//    may_discard set); else GL's change stands and it stays flagged; when it may have written depth or stencil and the recording has no
 //    change, the target is marked stale: the draws after it, until a clear of the whole target, are
 //    replayed and counted apart (after_stale), never among the compared ones.
 // At the frame's end the depth of the frame's main target (AppFrame) is compared with GL's "final"
@@ -70,6 +74,7 @@ struct AppDrawCounts {
   std::uint32_t frame = 0, draw = 0;
   Reason reason = Reason::Replayed;
   bool stale = false;         // replayed after a stale change of its target (not compared)
+  bool may_discard = false;   // its shader may discard: replayed as if nothing was, and checked (reason Replayed when equal)
   bool depth_change = false;  // flagged, and GL's depth change applied
   std::uint32_t framebuffer = 0;
   std::uint64_t triangles = 0;  // captured triangles
@@ -115,7 +120,15 @@ class AppsReplay {
   // stale until a whole clear when it has a depth buffer).
   Target& target(std::uint32_t fb, int width, int height, raster::DepthFormat format, bool has_depth);
 
+  // One draw through the target's raster path with its recorded state.
+  raster::DrawCounters replay(Target& t, const scene::DrawRecord& draw, bool has_depth);
+  // Whether the depth the model's draw changed (`before` -> the target now) is GL's recorded change,
+  // pixel for pixel and bit for bit.
+  bool same_change(const Target& t, const std::vector<float>& before, const scene::TechniqueRecord& change, std::uint64_t frame,
+                   std::size_t k) const;
+
   std::map<std::uint32_t, Target> targets_;
+  std::vector<float> scratch_;  // a target's depth before a draw that may discard
 };
 
 }  // namespace nbsim::apps

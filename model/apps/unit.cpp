@@ -59,11 +59,16 @@ AppsUnit::AppsUnit(const sc_core::sc_module_name& name, stats::Registry& registr
       depth_pixels_(stats().counter("depth_pixels", "pixels", "pixels of the final depth compared")),
       depth_mismatches_(stats().counter("depth_mismatches", "pixels", "of those, pixels whose depth differs from GL's (expected 0)")),
       unhandled_frames_(stats().counter("unhandled_frames", "frames", "frames in which the program used a GL feature not captured")),
+      may_discard_replayed_(stats().counter("may_discard_replayed", "draws",
+                                            "draws whose shader may discard, replayed as if nothing was and checked against GL")),
+      may_discard_equal_(stats().counter("may_discard_equal", "draws",
+                                         "of those, the draws equal to GL's (samples, and the depth change when it writes depth): "
+                                         "counted among the compared and matched")),
       cycles_(stats().counter("cycles", "cycles", "cycles of every draw")) {
   for (int r = 1; r < kReasons; ++r)
     flagged_[static_cast<std::size_t>(r)] = &stats().counter(fmt::format("flagged_{}", to_string(static_cast<Reason>(r))), "draws",
                                                               fmt::format("draws flagged: {}", to_string(static_cast<Reason>(r))));
-  if (log_) *log_ << "frame,draw,framebuffer,reason,stale,depth_change,triangles,fragments,depth_tests,samples,gl_samples,match\n";
+  if (log_) *log_ << "frame,draw,framebuffer,reason,stale,depth_change,may_discard,triangles,fragments,depth_tests,samples,gl_samples,match\n";
 }
 
 void AppsUnit::depth_cleared(float) {
@@ -82,6 +87,7 @@ void AppsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Comma
   for (const AppDrawCounts& d : k.draws) {
     ++draws_;
     gl_samples_ += d.gl_samples;
+    if (d.may_discard) ++may_discard_replayed_, may_discard_equal_ += d.reason == Reason::Replayed ? 1 : 0;
     std::uint64_t spent = static_cast<std::uint64_t>(config_.draw_overhead_cycles);
     if (d.reason == Reason::Replayed) {
       ++replayed_;
@@ -104,8 +110,8 @@ void AppsUnit::run_frame(const std::shared_ptr<const scene::Frame>& f, cp::Comma
     work(spent);
     cycles_ += spent;
     if (log_)
-      *log_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", d.frame, d.draw, d.framebuffer, to_string(d.reason), d.stale ? 1 : 0,
-                           d.depth_change ? 1 : 0, d.triangles, d.fragments, d.depth_tests, d.samples, d.gl_samples,
+      *log_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", d.frame, d.draw, d.framebuffer, to_string(d.reason), d.stale ? 1 : 0,
+                           d.depth_change ? 1 : 0, d.may_discard ? 1 : 0, d.triangles, d.fragments, d.depth_tests, d.samples, d.gl_samples,
                            d.reason != Reason::Replayed || d.stale ? "" : d.samples == d.gl_samples ? "1" : "0");
   }
 }

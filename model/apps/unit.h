@@ -49,7 +49,7 @@ class AppsUnit : public sim::Unit, public cp::FrameProgram, public depth::DepthL
   AppsReplay replay_;
   stats::Counter &frames_, &draws_, &replayed_, &compared_, &matched_, &mismatched_, &after_stale_, &depth_changes_, &clears_, &triangles_,
       &fragments_, &depth_tests_, &samples_, &gl_samples_, &gl_samples_compared_, &frames_depth_compared_, &depth_pixels_, &depth_mismatches_,
-      &unhandled_frames_, &cycles_;
+      &unhandled_frames_, &may_discard_replayed_, &may_discard_equal_, &cycles_;
   std::array<stats::Counter*, kReasons> flagged_{};
 };
 

@@ -40,6 +40,7 @@
 #include <string_view>
 #include <vector>
 
+#include "traces/apitrace/glsl_active.h"
 #include "traces/apitrace/raw.h"
 
 // The compatibility profile's alpha test (not in the core profile's header).
@@ -261,24 +262,6 @@ std::map<GLuint, ProgramInfo> g_programs;
 std::set<GLuint> g_own_varyings;                 // programs given varyings by the program itself
 std::map<void*, ContextObjects> g_contexts;
 std::map<GLuint, std::uint64_t> g_frame_samples;  // samples passed per framebuffer this frame
-
-// Comments removed, for the token search below.
-std::string without_comments(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (std::size_t i = 0; i < s.size();) {
-    if (s.compare(i, 2, "//") == 0) {
-      while (i < s.size() && s[i] != '\n') ++i;
-    } else if (s.compare(i, 2, "/*") == 0) {
-      const std::size_t end = s.find("*/", i + 2);
-      i = end == std::string::npos ? s.size() : end + 2;
-      out += ' ';
-    } else {
-      out += s[i++];
-    }
-  }
-  return out;
-}
 
 bool has_token(const std::string& s, std::string_view token) {
   const auto word = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_'; };
@@ -719,7 +702,7 @@ void hook_glLinkProgram(GLuint program) {
     if (type != GL_FRAGMENT_SHADER) continue;
     const auto it = g_shader_source.find(shaders[i]);
     if (it == g_shader_source.end()) continue;
-    const std::string code = without_comments(it->second);
+    const std::string code = glsl_active_text(it->second);  // the branches the compiler keeps
     info.discards = info.discards || has_token(code, "discard");
     info.writes_depth = info.writes_depth || has_token(code, "gl_FragDepth");
   }

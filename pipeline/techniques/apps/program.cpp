@@ -48,7 +48,7 @@ nlohmann::ordered_json summary(const SummaryInputs& in) {
   nlohmann::ordered_json j;
   for (const char* name : {"frames", "draws", "replayed", "compared", "matched", "mismatched", "after_stale", "depth_changes", "clears",
                            "triangles", "fragments", "depth_tests", "samples", "gl_samples", "gl_samples_compared", "frames_depth_compared",
-                           "depth_pixels", "depth_mismatches", "unhandled_frames", "cycles"})
+                           "depth_pixels", "depth_mismatches", "unhandled_frames", "may_discard_replayed", "may_discard_equal", "cycles"})
     j[name] = stat(g, name);
   const double draws = static_cast<double>(stat(g, "draws"));
   nlohmann::ordered_json flagged = nlohmann::ordered_json::object();
@@ -75,11 +75,12 @@ bool exact(const nlohmann::ordered_json& s) { return s.value("mismatched", 0) ==
 std::string describe(const nlohmann::ordered_json& s) {
   std::string reasons;
   for (const auto& [name, v] : s["flagged_by_reason"].items()) reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", name, v.get<std::uint64_t>());
-  return fmt::format("  apps draws {}: replayed {} (compared {}: matched {}, differing {}; after a stale change {}), flagged {}{}\n"
+  return fmt::format("  apps draws {}: replayed {} (compared {}: matched {}, differing {}; after a stale change {}; may discard, "
+                     "checked and equal {} of {}), flagged {}{}\n"
                      "  apps final depth: {} frames compared, {} pixels differing\n",
                      s["draws"].get<std::uint64_t>(), s["replayed"].get<std::uint64_t>(), s["compared"].get<std::uint64_t>(),
                      s["matched"].get<std::uint64_t>(), s["mismatched"].get<std::uint64_t>(), s["after_stale"].get<std::uint64_t>(),
-                     s["flagged"].get<std::uint64_t>(), reasons.empty() ? "" : " (" + reasons + ")",
+                     s["may_discard_equal"].get<std::uint64_t>(), s["may_discard_replayed"].get<std::uint64_t>(), s["flagged"].get<std::uint64_t>(), reasons.empty() ? "" : " (" + reasons + ")",
                      s["frames_depth_compared"].get<std::uint64_t>(), s["depth_mismatches"].get<std::uint64_t>());
 }
 

@@ -237,6 +237,40 @@ TEST(AppsReplayTest, AFlaggedDrawsDepthChangeKeepsTheNextDrawsCompared) {
   EXPECT_TRUE(fresh.run_frame(frame_of({behind}, {})).draws[0].stale);
 }
 
+TEST(AppsReplayTest, ADrawThatMayDiscardIsCheckedAgainstGlsDepthChange) {
+  // A full-target rectangle at window depth 0.25 whose shader may discard: GL's recorded change says
+  // it wrote every pixel (it discarded nothing), so it counts as replayed and equal; a change that
+  // leaves out one pixel (GL discarded it) keeps it flagged, and GL's change stands.
+  Draw maybe;
+  maybe.flags |= kDiscards, maybe.z = -0.5f, maybe.gl_samples = kArea;
+  Change all{0, {}, {}};
+  for (std::uint32_t i = 0; i < kArea; ++i) all.pixel.push_back(i), all.depth.push_back(0.25f);
+  Draw behind;  // at 0.5: hidden wherever the first drew
+  behind.gl_samples = 0;
+  AppsReplay replay;
+  const AppFrameCounts k = replay.run_frame(frame_of({maybe, behind}, {Clear{}}, {all}));
+  EXPECT_EQ(k.draws[0].reason, Reason::Replayed);
+  EXPECT_TRUE(k.draws[0].may_discard);
+  EXPECT_FALSE(k.draws[0].mismatch());
+  EXPECT_EQ(k.draws[1].samples, 0u);
+  Change holed = all;
+  holed.pixel.erase(holed.pixel.begin() + 5), holed.depth.pop_back();
+  Draw discarded = maybe;
+  discarded.gl_samples = kArea - 1;
+  behind.gl_samples = 1;  // the hole
+  AppsReplay other;
+  const AppFrameCounts h = other.run_frame(frame_of({discarded, behind}, {Clear{}}, {holed}));
+  EXPECT_EQ(h.draws[0].reason, Reason::Discard);
+  EXPECT_TRUE(h.draws[0].may_discard);
+  EXPECT_TRUE(h.draws[0].depth_change);
+  EXPECT_EQ(h.draws[1].samples, 1u) << "GL's change applied: the next draw passes in the hole only";
+  EXPECT_FALSE(h.draws[1].mismatch());
+  // Equal samples but another depth change: still flagged.
+  discarded.gl_samples = kArea;
+  AppsReplay third;
+  EXPECT_EQ(third.run_frame(frame_of({discarded}, {Clear{}}, {holed})).draws[0].reason, Reason::Discard);
+}
+
 TEST(AppsReplayTest, ClearsKeepTheirScissorAndWriteMask) {
   Clear left;  // depth 0.25 in the left half only
   left.flags |= kScissor, left.scissor = {0, 0, kW / 2, kH}, left.depth = 0.25f;
