@@ -30,10 +30,16 @@ bool side_ok(std::int32_t v) { return v >= 0 && v <= kMaxSide; }
 RawReader::RawReader(const std::filesystem::path& file) : name_(file.string()) {
   file_ = std::fopen(name_.c_str(), "rb");
   if (!file_) throw InputError(fmt::format("cannot read the recording '{}'", name_));
-  if (!read_bytes(&head_, sizeof head_) || std::memcmp(head_.magic, kRawMagic, sizeof head_.magic) != 0)
-    fail("not an nbsim interposer recording (no NBSIMIP1 head)");
-  if (head_.version != kRawVersion) fail(fmt::format("recording version {}, this nbsim reads version {}", head_.version, kRawVersion));
-  if (head_.first_frame > head_.last_frame) fail(fmt::format("frame range {}:{} is empty", head_.first_frame, head_.last_frame));
+  try {  // a constructor that throws runs no destructor: the file is closed here
+    if (!read_bytes(&head_, sizeof head_) || std::memcmp(head_.magic, kRawMagic, sizeof head_.magic) != 0)
+      fail("not an nbsim interposer recording (no NBSIMIP1 head)");
+    if (head_.version != kRawVersion) fail(fmt::format("recording version {}, this nbsim reads version {}", head_.version, kRawVersion));
+    if (head_.first_frame > head_.last_frame) fail(fmt::format("frame range {}:{} is empty", head_.first_frame, head_.last_frame));
+  } catch (...) {
+    std::fclose(file_);
+    file_ = nullptr;
+    throw;
+  }
 }
 
 RawReader::~RawReader() {

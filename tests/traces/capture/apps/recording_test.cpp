@@ -232,6 +232,20 @@ TEST(AppsRecordingTest, DamageIsRefusedWithWhatIsWrong) {
   EXPECT_EQ(read_error(good), "");
 }
 
+// A refused head closes the file (found by fuzz_apitrace_recording: the constructor threw with the
+// file open, and after a thousand refusals every open failed).
+TEST(AppsRecordingTest, ARefusedRecordingLeavesNoFileOpen) {
+  Bytes b = whole();
+  b[0] = 'X';
+  const auto file = write(b, "bad_head.raw");
+  const auto open_files = [] {
+    return std::distance(std::filesystem::directory_iterator("/proc/self/fd"), std::filesystem::directory_iterator{});
+  };
+  const auto before = open_files();
+  for (int i = 0; i < 100; ++i) EXPECT_THROW(RawReader r(file), InputError);
+  EXPECT_EQ(open_files(), before);
+}
+
 TEST(AppsRecordingTest, ConvertedIntoATraceOfTechniqueApps) {
   const auto out = nbsim::testing::scratch_path("nbsim_apps_recording", "whole.nbt");
   const ConvertSummary s = convert_recording(write(whole(), "whole.raw"), out, {"prog.trace", "nbsim capture apitrace prog.trace -o whole.nbt"});
