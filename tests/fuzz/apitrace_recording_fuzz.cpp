@@ -13,6 +13,8 @@
 
 #include "model/common/error.h"
 #include "traces/capture/apps/recording.h"
+// The reader's source, compiled into this target (the capture library it belongs to needs GL).
+#include "traces/capture/apps/recording.cpp"
 
 namespace {
 
