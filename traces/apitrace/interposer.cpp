@@ -10,7 +10,7 @@
 // - every program is linked with transform feedback of gl_Position (glTransformFeedbackVaryings
 //   before each glLinkProgram; when that link fails, the program is linked again without it and its
 //   draws are recorded as Skip::NoPosition); a program that declares varyings of its own is left as
-//   it is (Skip::OwnFeedback);
+//   it is (Skip::OwnFeedback), unless gl_Position is its only one, which is what the library records;
 // - around the draw: the library's own transform feedback object and buffer bound, queries of
 //   samples passed, primitives generated and primitives written begun, transform feedback begun with
 //   the primitive the last vertex stage emits, and everything restored after it;
@@ -20,7 +20,9 @@
 // its own open, and recorded with the reason (raw.h Skip). Features it does not handle (immediate
 // mode, display lists, depth blits) are recorded by name once a frame (RawType::Unhandled).
 //
-// Environment: NBSIM_IP_OUT (the recording's path, required), NBSIM_IP_FRAMES ("A:B", the swaps
+// Frames end at eglSwapBuffers, or at the frame marker of a program without a window
+// (raw.h kFrameMarker, a glDebugMessageInsert).
+// Environment: NBSIM_IP_OUT (the recording's path, required), NBSIM_IP_FRAMES ("A:B", the frames
 // recorded, inclusive; after B the library ends the recording and exits the process with status 0).
 // One GL context at a time is assumed current per thread; the library's GL objects are made per
 // context.
@@ -596,7 +598,9 @@ void record_draw(DrawCall call, GLenum mode, std::size_t vertices, bool indirect
 
 // A clear of `buffers` (ClearBuffer bits) with the given values; glClear obeys the depth and stencil
 // write masks and the scissor, glClearBuffer the same.
-void record_clear(std::uint32_t buffers, double depth, GLint stencil) {
+// `framebuffer`: a named framebuffer's clear (glClearNamedFramebuffer*), or -1 for the one bound
+// for drawing.
+void record_clear(std::uint32_t buffers, double depth, GLint stencil, GLint framebuffer = -1) {
   Recording& rec = recording();
   if (!rec.recording() || !gl().complete) return;
   std::lock_guard lock(g_mutex);
@@ -604,7 +608,7 @@ void record_clear(std::uint32_t buffers, double depth, GLint stencil) {
   ClearHead c{};
   c.frame = rec.frame();
   c.index = rec.draws();
-  c.framebuffer = static_cast<std::uint32_t>(get_int(GL_DRAW_FRAMEBUFFER_BINDING));
+  c.framebuffer = static_cast<std::uint32_t>(framebuffer >= 0 ? framebuffer : get_int(GL_DRAW_FRAMEBUFFER_BINDING));
   c.buffers = buffers;
   if (g.glIsEnabled(GL_SCISSOR_TEST)) c.flags |= kScissor;
   GLboolean mask = GL_TRUE;
@@ -673,7 +677,9 @@ void hook_glShaderSource(GLuint shader, GLsizei count, const GLchar* const* stri
 void hook_glTransformFeedbackVaryings(GLuint program, GLsizei count, const GLchar* const* varyings, GLenum mode) {
   {
     std::lock_guard lock(g_mutex);
-    if (count > 0) g_own_varyings.insert(program);
+    // gl_Position alone is what the library records itself: such a program is captured as is.
+    const bool position_only = count == 1 && varyings && varyings[0] && std::strcmp(varyings[0], "gl_Position") == 0;
+    if (count > 0 && !position_only) g_own_varyings.insert(program);
     else g_own_varyings.erase(program);
   }
   real_glTransformFeedbackVaryings.fn(program, count, varyings, mode);
@@ -844,12 +850,34 @@ void APIENTRY hook_glClearBufferfi(GLenum buffer, GLint drawbuffer, GLfloat dept
   if (buffer == GL_DEPTH_STENCIL) record_clear(kClearDepth | kClearStencil, depth, stencil);
   real_glClearBufferfi.fn(buffer, drawbuffer, depth, stencil);
 }
+// The direct-state-access clears of a named framebuffer (0: the window's).
+Real<PFNGLCLEARNAMEDFRAMEBUFFERFVPROC> real_glClearNamedFramebufferfv;
+void APIENTRY hook_glClearNamedFramebufferfv(GLuint fb, GLenum buffer, GLint drawbuffer, const GLfloat* value) {
+  if (buffer == GL_DEPTH && value) record_clear(kClearDepth, value[0], 0, static_cast<GLint>(fb));
+  real_glClearNamedFramebufferfv.fn(fb, buffer, drawbuffer, value);
+}
+Real<PFNGLCLEARNAMEDFRAMEBUFFERIVPROC> real_glClearNamedFramebufferiv;
+void APIENTRY hook_glClearNamedFramebufferiv(GLuint fb, GLenum buffer, GLint drawbuffer, const GLint* value) {
+  if (buffer == GL_STENCIL && value) record_clear(kClearStencil, 0.0, value[0], static_cast<GLint>(fb));
+  real_glClearNamedFramebufferiv.fn(fb, buffer, drawbuffer, value);
+}
+Real<PFNGLCLEARNAMEDFRAMEBUFFERFIPROC> real_glClearNamedFramebufferfi;
+void APIENTRY hook_glClearNamedFramebufferfi(GLuint fb, GLenum buffer, GLint drawbuffer, GLfloat depth, GLint stencil) {
+  if (buffer == GL_DEPTH_STENCIL) record_clear(kClearDepth | kClearStencil, depth, stencil, static_cast<GLint>(fb));
+  real_glClearNamedFramebufferfi.fn(fb, buffer, drawbuffer, depth, stencil);
+}
 
 // Features not handled: recorded by name.
 Real<PFNGLBLITFRAMEBUFFERPROC> real_glBlitFramebuffer;
 void APIENTRY hook_glBlitFramebuffer(GLint a, GLint b, GLint c, GLint d, GLint e, GLint f, GLint g, GLint h, GLbitfield mask, GLenum filter) {
   if (mask & GL_DEPTH_BUFFER_BIT) recording().unhandled("glBlitFramebuffer of depth");
   real_glBlitFramebuffer.fn(a, b, c, d, e, f, g, h, mask, filter);
+}
+Real<PFNGLBLITNAMEDFRAMEBUFFERPROC> real_glBlitNamedFramebuffer;
+void APIENTRY hook_glBlitNamedFramebuffer(GLuint from, GLuint to, GLint a, GLint b, GLint c, GLint d, GLint e, GLint f, GLint g, GLint h,
+                                          GLbitfield mask, GLenum filter) {
+  if (mask & GL_DEPTH_BUFFER_BIT) recording().unhandled("glBlitNamedFramebuffer of depth");
+  real_glBlitNamedFramebuffer.fn(from, to, a, b, c, d, e, f, g, h, mask, filter);
 }
 using BeginFn = void(APIENTRY*)(GLenum);
 Real<BeginFn> real_glBegin;
@@ -876,6 +904,17 @@ Real<SwapFn> real_eglSwapBuffers;
 EGLBoolean hook_eglSwapBuffers(EGLDisplay display, EGLSurface surface) {
   record_frame_end();
   return real_eglSwapBuffers.fn(display, surface);
+}
+
+// A frame marker (kFrameMarker) from a program without a window: a swap.
+using DebugMessageInsertFn = void(APIENTRY*)(GLenum, GLenum, GLuint, GLenum, GLsizei, const GLchar*);
+Real<DebugMessageInsertFn> real_glDebugMessageInsert;
+void APIENTRY hook_glDebugMessageInsert(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei length, const GLchar* text) {
+  if (type == GL_DEBUG_TYPE_MARKER && text) {
+    const std::size_t n = length < 0 ? std::strlen(text) : static_cast<std::size_t>(length);
+    if (std::string_view(text, n) == kFrameMarker) record_frame_end();
+  }
+  real_glDebugMessageInsert.fn(source, type, id, severity, length, text);
 }
 
 void* hook_eglGetProcAddress(const char* name);
@@ -928,12 +967,19 @@ const std::vector<Hook>& hooks() {
       NBSIM_HOOK(glClearBufferfv),
       NBSIM_HOOK(glClearBufferiv),
       NBSIM_HOOK(glClearBufferfi),
+      NBSIM_HOOK(glClearNamedFramebufferfv),
+      NBSIM_HOOK(glClearNamedFramebufferiv),
+      NBSIM_HOOK(glClearNamedFramebufferfi),
+      NBSIM_HOOK(glBlitNamedFramebuffer),
       NBSIM_HOOK(glBlitFramebuffer),
       NBSIM_HOOK_AS(glBlitFramebufferEXT, glBlitFramebuffer),
       NBSIM_HOOK(glBegin),
       NBSIM_HOOK(glCallList),
       NBSIM_HOOK(glCallLists),
       NBSIM_HOOK(eglSwapBuffers),
+      NBSIM_HOOK(glDebugMessageInsert),
+      NBSIM_HOOK_AS(glDebugMessageInsertKHR, glDebugMessageInsert),
+      NBSIM_HOOK_AS(glDebugMessageInsertARB, glDebugMessageInsert),
   };
   return table;
 }

@@ -24,6 +24,11 @@ using namespace nbsim::apps::flags;  // Skip, DrawFlag, ClearBuffer: model/apps/
 inline constexpr char kRawMagic[8] = {'N', 'B', 'S', 'I', 'M', 'I', 'P', '1'};
 inline constexpr std::uint32_t kRawVersion = 1;
 
+// A frame's end marked by a program that has no window to swap (e.g. `nbsim capture apps
+// --as-program`, drawing into FBOs on a surfaceless context): glDebugMessageInsert with
+// GL_DEBUG_TYPE_MARKER and this text, which the library takes as a swap.
+inline constexpr char kFrameMarker[] = "nbsim: frame end";
+
 enum class RawType : std::uint32_t {
   Draw = 1,       // DrawHead, then vertices * 4 floats (clip x, y, z, w)
   Frame = 2,      // FrameHead, then width * height floats of depth (y up) when has_depth

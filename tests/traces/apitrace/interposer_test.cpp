@@ -5,11 +5,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
+#include "model/scene/frame.h"
 #include "tests/common/run_nbsim.h"
+#include "traces/format/reader.h"
 
 namespace {
 
@@ -19,6 +23,68 @@ using nbsim::testing::shell_output;
 const std::filesystem::path kSamples = NBSIM_APITRACE_SAMPLES;
 
 bool have_eglretrace() { return std::system("command -v eglretrace > /dev/null 2>&1") == 0; }
+bool have_apitrace() { return std::system("command -v apitrace > /dev/null 2>&1") == 0; }
+
+std::vector<nbsim::scene::Frame> frames_of(const std::filesystem::path& trace) {
+  nbsim::trace::FrameReader r(trace);
+  std::vector<nbsim::scene::Frame> out;
+  while (auto f = r.next()) out.push_back(std::move(*f));
+  return out;
+}
+
+bool same_floats(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
+// The self-check that needs no program: the project's own capture, recorded by apitrace while it
+// draws its frames as a program would (`--as-program`: no feedback, queries or ground truth, a
+// frame marker at each frame's end), then captured through the interposer, gives the native
+// capture's draws: the same clip positions bit for bit, depth state, GL samples passed and final
+// depth, frame by frame; and both replay alike in the model.
+TEST(InterposerTest, NativeCaptureRecordedThroughApitraceIsTheSame) {
+  if (!have_eglretrace() || !have_apitrace()) GTEST_SKIP() << "apitrace not installed (apt install apitrace)";
+  const auto dir = nbsim::testing::scratch_dir("nbsim_interposer_self");
+  const std::string scene = " --scene boxes --path fly --size 96x64 --frames 4 --seed 5";
+  const auto native = run_nbsim("capture apps" + scene + " -o " + (dir / "native.nbt").string());
+  ASSERT_EQ(native.status, 0) << native.err;
+  const std::string record = "cd " + dir.string() + " && apitrace trace --api egl -o program.trace " + std::string(NBSIM_EXE) +
+                             " capture apps" + scene + " --as-program yes -o plain.nbt > apitrace.log 2>&1";
+  ASSERT_EQ(std::system(record.c_str()), 0) << shell_output("cat " + (dir / "apitrace.log").string());
+  const auto interposed = run_nbsim("capture apitrace " + (dir / "program.trace").string() + " -o " + (dir / "interposed.nbt").string());
+  ASSERT_EQ(interposed.status, 0) << interposed.out << interposed.err;
+
+  const auto a = frames_of(dir / "native.nbt"), b = frames_of(dir / "interposed.nbt");
+  ASSERT_EQ(a.size(), 4u);
+  ASSERT_EQ(b.size(), a.size());
+  std::size_t draws = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    SCOPED_TRACE("frame " + std::to_string(i));
+    ASSERT_EQ(b[i].draws.size(), a[i].draws.size());
+    for (std::size_t k = 0; k < a[i].draws.size(); ++k, ++draws) {
+      const auto &x = a[i].draws[k], &y = b[i].draws[k];
+      EXPECT_EQ(x.clip_positions.size(), y.clip_positions.size()) << "draw " << k;
+      EXPECT_TRUE(x.clip_positions.size() == y.clip_positions.size() &&
+                  std::memcmp(x.clip_positions.data(), y.clip_positions.data(), x.clip_positions.size() * sizeof(x.clip_positions[0])) == 0)
+          << "draw " << k << ": clip positions differ";
+      EXPECT_EQ(x.gl.samples_passed, y.gl.samples_passed) << "draw " << k;
+      EXPECT_EQ(x.state.func, y.state.func) << "draw " << k;
+      EXPECT_EQ(x.state.write, y.state.write) << "draw " << k;
+      EXPECT_EQ(x.state.cull, y.state.cull) << "draw " << k;
+    }
+    const auto *da = a[i].depth("final"), *db = b[i].depth("final");
+    ASSERT_TRUE(da && db);
+    EXPECT_TRUE(same_floats(da->texels, db->texels)) << "final depth differs";
+  }
+  EXPECT_GT(draws, 20u);
+  for (const char* t : {"native", "interposed"}) {
+    const auto r = run_nbsim("compare " + (dir / (std::string(t) + ".nbt")).string() + " --json");
+    ASSERT_EQ(r.status, 0) << t << ": " << r.err;
+    const auto s = nlohmann::json::parse(r.out)["apps"];
+    EXPECT_EQ(s["compared"].get<std::size_t>(), draws) << t;
+    EXPECT_EQ(s["mismatched"], 0) << t;
+    EXPECT_EQ(s["depth_mismatches"], 0) << t;
+  }
+}
 
 TEST(InterposerTest, ReplayImagesUnchangedByTheRecording) {
   if (!have_eglretrace()) GTEST_SKIP() << "eglretrace not installed (apt install apitrace)";

@@ -22,10 +22,22 @@ namespace nbsim::capture {
 
 namespace {
 
+// --as-program: draw the frames as a program that records nothing would (for apitrace to record).
+const OptionSpec& as_program_option() {
+  static const OptionSpec spec = choice_option(
+      "as-program",
+      "yes: draw each frame's draw calls as a program that records nothing would (no feedback, queries or ground truth) and "
+      "mark each frame's end for apitrace (glDebugMessageInsert); the trace then holds no draws. For the check that "
+      "`nbsim capture apitrace` of such a run gives the draws of a native capture",
+      "no", {"no", "yes"});
+  return spec;
+}
+
 class Apps final : public Technique {
  public:
   explicit Apps(const TechniqueSetup& s)
-      : scene_(s.scene), width_(s.width), height_(s.height), projection_(s.projection), pass_(s.scene, false), target_(s.width, s.height) {
+      : scene_(s.scene), width_(s.width), height_(s.height), projection_(s.projection), pass_(s.scene, false), target_(s.width, s.height),
+        as_program_(s.options.text(as_program_option()) == "yes") {
     if (s.projection.reversed_z) throw InputError("the apps capture draws with depth func LESS; --reversed-z is not for it");
   }
 
@@ -49,6 +61,7 @@ class Apps final : public Technique {
     const auto t0 = std::chrono::steady_clock::now();
     glBindFramebuffer(GL_FRAMEBUFFER, target_.framebuffer());
     target_.clear_depth(false);
+    if (as_program_) return render_as_program(index, begin, view_proj, objects, t0);
     recorder_.begin_frame(objects.size() + 16);
     pass_.begin(target_, view_proj, false, recorder_);
     for (const std::uint32_t o : objects) {
@@ -122,18 +135,40 @@ class Apps final : public Technique {
   }
 
  private:
+  // The same draws with nothing recorded, and the frame's end marked for apitrace.
+  CapturedFrame render_as_program(std::uint32_t index, const scene::FrameBegin& begin, const glm::mat4& view_proj,
+                                  const std::vector<std::uint32_t>& objects, std::chrono::steady_clock::time_point t0) {
+    recorder_.begin_frame(0);
+    pass_.begin(target_, view_proj, false, recorder_);
+    glDepthMask(GL_TRUE);
+    pass_.draw_ids(objects, recorder_.scratch_slot());
+    glDebugMessageInsert(GL_DEBUG_SOURCE_APPLICATION, GL_DEBUG_TYPE_MARKER, 0, GL_DEBUG_SEVERITY_NOTIFICATION, -1, apitrace::kFrameMarker);
+    glFinish();
+    CapturedFrame out;
+    apitrace::RawFrame raw;
+    raw.frame = index;
+    raw.end.frame = index;
+    raw.end.framebuffer = target_.framebuffer();
+    raw.end.width = width_, raw.end.height = height_;
+    out.frame = apitrace::to_frame(std::move(raw));
+    out.frame.begin = begin;
+    out.frame.end.gl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+  }
+
   const CaptureScene& scene_;
   int width_, height_;
   Projection projection_;
   ScenePass pass_;
   RenderTarget target_;
   DrawRecorder recorder_;
+  bool as_program_;
 };
 
 }  // namespace
 
 const std::vector<OptionSpec>& apps_options() {
-  static const std::vector<OptionSpec> options = {};
+  static const std::vector<OptionSpec> options = {as_program_option()};
   return options;
 }
 

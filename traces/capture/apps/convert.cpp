@@ -92,6 +92,7 @@ scene::TechniqueRecord empty_record(const trace::ChunkSpec& spec) {
       case trace::FieldKind::U32:
       case trace::FieldKind::U64: field.value = std::uint64_t{0}; break;
       case trace::FieldKind::I32: field.value = std::int64_t{0}; break;
+      case trace::FieldKind::F32:
       case trace::FieldKind::F64: field.value = 0.0; break;
       case trace::FieldKind::String: field.value = std::string(); break;
       case trace::FieldKind::VecF32: field.value = std::vector<float>(); break;
