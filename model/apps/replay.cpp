@@ -10,6 +10,7 @@
 
 #include "model/apps/draw_flags.h"
 #include "model/common/error.h"
+#include "model/cull/primitive.h"
 #include "model/scene/technique_record.h"
 
 namespace nbsim::apps {
@@ -106,7 +107,107 @@ float cleared_depth(raster::DepthFormat format, float z) {
   return raster::from_unorm24(static_cast<std::uint32_t>(static_cast<double>(z) * 16777215.0));
 }
 
+constexpr std::array<std::string_view, kUntested> kUntestedNames = {"tested", "flagged", "other_target", "stale", "depth_func",
+                                                                   "stencil_writes", "no_triangles"};
+
+// Whether a draw's depth func fails wherever the buffer holds a nearer-or-equal depth under `op`,
+// so that a rectangle found hidden holds no fragment that passes.
+bool fails_behind(scene::DepthFunc f, FarOp op) {
+  if (op == FarOp::Max) return f == scene::DepthFunc::Less || f == scene::DepthFunc::Lequal;
+  return f == scene::DepthFunc::Greater || f == scene::DepthFunc::Gequal;
+}
+
 }  // namespace
+
+std::string_view to_string(Untested u) noexcept {
+  const auto i = static_cast<std::size_t>(u);
+  return i < kUntestedNames.size() ? kUntestedNames[i] : "?";
+}
+
+query::Answer full_depth_query(const DepthImage& depth, const Rect& r, float nearest, FarOp op) noexcept {
+  query::Answer a;
+  a.lookups = static_cast<std::uint64_t>(r.area());
+  a.hidden = true;
+  for (int y = r.y; y < r.y1() && a.hidden; ++y) {
+    const float* row = depth.texels.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(depth.width);
+    for (int x = r.x; x < r.x1(); ++x)
+      if (op == FarOp::Max ? !(nearest > row[x]) : !(nearest < row[x])) {
+        a.hidden = false;
+        break;
+      }
+  }
+  return a;
+}
+
+void AppsReplay::touched(Target& t, const Rect& r) {
+  if (!cull_.tester || mirrored_ != &t || r.empty()) return;
+  cull_.tester->changed(t.depth, r);
+  t.tester_dirty = true;
+}
+
+bool AppsReplay::cull_test(Target& t, const scene::DrawRecord& draw, AppDrawCounts& c, std::vector<char>& skip) {
+  DrawTester& tester = *cull_.tester;
+  if (mirrored_ != &t) {
+    tester.rebuild(t.depth);
+    mirrored_ = &t;
+    t.tester_dirty = true;
+  }
+  // The draw's bounds and its triangles' (per-primitive), from setup, as the path will draw them.
+  raster::DrawState s = raster::draw_state(draw.state);
+  if (t.flipped) s.geometry.face.front_ccw = !s.geometry.face.front_ccw;
+  rects_.clear(), nearest_.clear();
+  Rect box{};
+  float nearest = cull_.op == FarOp::Max ? 1.0f : 0.0f;
+  bool bounded = true;
+  int x0 = t.width, y0 = t.height, x1 = 0, y1 = 0;
+  t.path->setup_only(draw.clip_positions, s, [&](const geometry::WindowTriangle& w, const raster::SetupTriangle& st) {
+    const cull::PrimitiveQuery q = cull::primitive_query(w, st, cull_.op, cull_.fused_interpolation);
+    if (!q.testable) {  // no depth bound: the draw cannot be culled, nor this triangle
+      if (!q.rect.empty()) x0 = 0, y0 = 0, x1 = t.width, y1 = t.height;
+      bounded = false;
+      rects_.push_back(Rect{}), nearest_.push_back(0.0f);
+      return;
+    }
+    const float z = raster::stored_depth(t.format, q.nearest);  // monotone: still no fragment nearer
+    x0 = std::min(x0, q.rect.x), y0 = std::min(y0, q.rect.y), x1 = std::max(x1, q.rect.x1()), y1 = std::max(y1, q.rect.y1());
+    nearest = cull_.op == FarOp::Max ? std::min(nearest, z) : std::max(nearest, z);
+    rects_.push_back(q.rect), nearest_.push_back(z);
+  });
+  if (rects_.empty()) {
+    c.untested = Untested::NoTriangles;
+    return false;
+  }
+  c.untested = Untested::Tested;
+  if (x1 > x0 && y1 > y0) box = Rect{x0, y0, x1 - x0, y1 - y0};
+  if (t.tester_dirty) {
+    tester.prepare(t.depth);
+    t.tester_dirty = false;
+  }
+  if (bounded && !box.empty()) {
+    tester.query(t.depth, std::span<const Rect>(&box, 1), std::span<const float>(&nearest, 1), answers_);
+    c.query_lookups = answers_.front().lookups;
+    if (answers_.front().hidden) {
+      c.culled = true;
+      return true;
+    }
+  }
+  if (!cull_.primitives) return false;
+  // Each triangle with a bound: one batch.
+  std::vector<Rect> rects;
+  std::vector<float> near;
+  std::vector<std::size_t> index;
+  for (std::size_t i = 0; i < rects_.size(); ++i)
+    if (!rects_[i].empty()) rects.push_back(rects_[i]), near.push_back(nearest_[i]), index.push_back(i);
+  skip.assign(rects_.size(), 0);
+  if (rects.empty()) return false;
+  tester.query(t.depth, rects, near, answers_);
+  c.primitive_tests = rects.size();
+  for (std::size_t j = 0; j < answers_.size(); ++j) {
+    c.primitive_lookups += answers_[j].lookups;
+    if (answers_[j].hidden) skip[index[j]] = 1, ++c.primitives_culled;
+  }
+  return false;
+}
 
 std::string_view to_string(Reason r) noexcept {
   const auto i = static_cast<std::size_t>(r);
@@ -116,6 +217,7 @@ std::string_view to_string(Reason r) noexcept {
 AppsReplay::Target& AppsReplay::target(std::uint32_t fb, int width, int height, raster::DepthFormat format, bool has_depth) {
   Target& t = targets_[fb];
   if (t.path && t.width == width && t.height == height && t.format == format) return t;
+  if (mirrored_ == &t) mirrored_ = nullptr;  // remade: the tester rebuilds from it before its next query
   t.width = width, t.height = height, t.format = format;
   t.depth = DepthImage(width, height, 1.0f);
   t.stencil = raster::StencilImage(width, height, 0);
@@ -132,13 +234,19 @@ AppsReplay::Target& AppsReplay::target(std::uint32_t fb, int width, int height, 
   return t;
 }
 
-raster::DrawCounters AppsReplay::replay(Target& t, const scene::DrawRecord& draw, bool has_depth) {
+raster::DrawCounters AppsReplay::replay(Target& t, const scene::DrawRecord& draw, bool has_depth, std::span<const char> skip) {
+  const raster::DrawCounters k = replay_untold(t, draw, has_depth, skip);
+  touched(t, t.path->written_box());
+  return k;
+}
+
+raster::DrawCounters AppsReplay::replay_untold(Target& t, const scene::DrawRecord& draw, bool has_depth, std::span<const char> skip) {
   raster::DrawState s = raster::draw_state(draw.state);
   if (!draw.state.test) s.depth.write = false;  // GL writes depth only with the test on
   if (!has_depth) s.depth.test = false, s.depth.write = false;  // no depth buffer: every fragment passes
   s.stencil = raster::stencil_state(draw.stencil);
   if (t.flipped) s.geometry.face.front_ccw = !s.geometry.face.front_ccw;  // the winding mirrors with the rows
-  return t.path->draw(draw.clip_positions, s);
+  return t.path->draw(draw.clip_positions, s, skip);
 }
 
 bool AppsReplay::same_change(const Target& t, const std::vector<float>& before, const scene::TechniqueRecord& change, std::uint64_t frame,
@@ -202,6 +310,17 @@ AppFrameCounts AppsReplay::run_frame(const scene::Frame& f) {
     if (const auto fmt = format_of((*d.bits)[k], (*d.is_float)[k] != 0); fmt && (*d.width)[k] > 0 && (*d.height)[k] > 0)
       known.emplace((*d.framebuffer)[k], Known{static_cast<int>((*d.width)[k]), static_cast<int>((*d.height)[k]), *fmt, (*d.bits)[k] != 0});
 
+  const auto main_fb = static_cast<std::uint32_t>(scene::record_scalar<std::uint64_t>(frame_rec, "framebuffer", kFrameLabel, frame));
+  // Whether draw k into `t` is tested for culling, and why not (c.untested; Tested then set by cull_test).
+  const auto untested = [&](std::size_t k, const scene::DrawRecord& draw, const Target& t, bool may_write_stencil) {
+    const std::uint32_t fl = (*d.flags)[k];
+    if ((*d.framebuffer)[k] != main_fb || t.width != cull_.width || t.height != cull_.height) return Untested::OtherTarget;
+    if (t.stale) return Untested::Stale;
+    if (!(fl & kDepthTest) || (*d.bits)[k] == 0 || !fails_behind(draw.state.func, cull_.op)) return Untested::DepthFunc;
+    if (may_write_stencil || (fl & kRasterizerDiscard)) return Untested::StencilWrites;
+    return Untested::Tested;
+  };
+
   std::size_t next_clear = 0;
   const auto apply_clears = [&](std::size_t upto) {
     for (; next_clear < clears && before[next_clear] <= upto; ++next_clear) {
@@ -229,6 +348,12 @@ AppFrameCounts AppsReplay::run_frame(const scene::Frame& f) {
           if (depth) t->depth.texels[at] = z;
           if (stencil) t->stencil.texels[at] = static_cast<std::uint8_t>((t->stencil.texels[at] & ~sm) | (sv & sm));
         }
+      if (depth && whole && cull_.tester && mirrored_ == t) {
+        cull_.tester->cleared(t->depth, z);
+        t->tester_dirty = true;
+      } else if (depth) {
+        touched(*t, Rect{x0, y0, x1 - x0, y1 - y0});
+      }
       // A whole clear of both buffers makes the target known again (a target with no stencil writes
       // counts as cleared by its depth clear: the model keeps stencil 0 there as GL does).
       if (whole && depth && (stencil || !(buffers[c] & kClearStencil))) t->stale = false;
@@ -260,28 +385,41 @@ AppFrameCounts AppsReplay::run_frame(const scene::Frame& f) {
       if (other != Reason::Replayed) c.reason = other;
     }
     const bool try_discard = c.reason == Reason::Discard && !may_write_stencil && (!may_write_depth || change[k] != nullptr);
+    // The cull test, for a draw the model replays (a may-discard one too: discard only removes fragments).
+    skip_.clear();
+    if (cull_.tester && (c.reason == Reason::Replayed || try_discard)) {
+      Target& t = target(c.framebuffer, w, h, *format, (*d.bits)[k] != 0);
+      c.untested = untested(k, draw, t, may_write_stencil);
+      if (c.untested == Untested::Tested && cull_test(t, draw, c, skip_)) {
+        c.reason = Reason::Replayed;  // not drawn: culled (its GL samples say whether wrongly)
+        c.triangles = draw.clip_positions.size() / 3;
+        out.draws.push_back(c);
+        continue;
+      }
+    }
     if (try_discard) {
       Target& t = target(c.framebuffer, w, h, *format, (*d.bits)[k] != 0);
       if (!t.stale) {
-        std::vector<float>& before = scratch_;
-        before = t.depth.texels;
-        const raster::DrawCounters r = replay(t, draw, (*d.bits)[k] != 0);
+        std::vector<float>& prior = scratch_;
+        prior = t.depth.texels;
+        const raster::DrawCounters r = replay_untold(t, draw, (*d.bits)[k] != 0, skip_);
         bool equal = r.depth.passed == c.gl_samples;
-        if (equal && may_write_depth) equal = same_change(t, before, *change[k], frame, k);
+        if (equal && may_write_depth) equal = same_change(t, prior, *change[k], frame, k);
         c.may_discard = true;
         if (equal) {
+          touched(t, t.path->written_box());
           c.reason = Reason::Replayed;
           c.triangles = draw.clip_positions.size() / 3;
           c.fragments = r.depth.fragments, c.depth_tests = r.depth.depth_tests, c.samples = r.depth.passed, c.written = r.depth.written;
         } else {
-          t.depth.texels.swap(before);  // the depth as before the draw: GL's change is applied below
+          t.depth.texels.swap(prior);  // the depth as before the draw: GL's change is applied below
         }
       }
     }
     if (c.reason == Reason::Replayed && !c.may_discard) {
       Target& t = target(c.framebuffer, w, h, *format, (*d.bits)[k] != 0);
       c.stale = t.stale;
-      const raster::DrawCounters r = replay(t, draw, (*d.bits)[k] != 0);
+      const raster::DrawCounters r = replay(t, draw, (*d.bits)[k] != 0, skip_);
       c.triangles = draw.clip_positions.size() / 3;
       c.fragments = r.depth.fragments;
       c.depth_tests = r.depth.depth_tests;
@@ -296,10 +434,15 @@ AppFrameCounts AppsReplay::run_frame(const scene::Frame& f) {
         if (pixel.size() != depth.size() || scene::record_scalar<std::uint64_t>(r, "width", kChangeLabel, frame) != static_cast<std::uint64_t>(w) ||
             scene::record_scalar<std::uint64_t>(r, "height", kChangeLabel, frame) != static_cast<std::uint64_t>(h))
           throw InputError(fmt::format("frame {}: the {} record of draw {} does not fit its {}x{} target", frame, kChangeLabel, k, w, h));
+        int x0 = t.width, y0 = t.height, x1 = 0, y1 = 0;
         for (std::size_t i = 0; i < pixel.size(); ++i) {
           if (pixel[i] >= t.depth.texels.size()) throw InputError(fmt::format("frame {}: the {} record of draw {} names pixel {}", frame, kChangeLabel, k, pixel[i]));
-          t.depth.texels[t.stored(pixel[i])] = depth[i];
+          const std::size_t at = t.stored(pixel[i]);
+          t.depth.texels[at] = depth[i];
+          const int x = static_cast<int>(at % static_cast<std::size_t>(t.width)), y = static_cast<int>(at / static_cast<std::size_t>(t.width));
+          x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x + 1), y1 = std::max(y1, y + 1);
         }
+        if (x1 > x0) touched(t, Rect{x0, y0, x1 - x0, y1 - y0});
         c.depth_change = true;
       } else {
         t.stale = true;
@@ -310,7 +453,6 @@ AppFrameCounts AppsReplay::run_frame(const scene::Frame& f) {
   apply_clears(n);
 
   // The final depth of the main target against GL's.
-  const auto main_fb = static_cast<std::uint32_t>(scene::record_scalar<std::uint64_t>(frame_rec, "framebuffer", kFrameLabel, frame));
   out.unhandled = scene::record_scalar<std::string>(frame_rec, "unhandled", kFrameLabel, frame);
   const scene::DepthSnapshot* gl = f.depth("final");
   if (const auto it = targets_.find(main_fb); gl && it != targets_.end() && !it->second.stale && gl->width == it->second.width &&

@@ -23,6 +23,25 @@
 // At the frame's end the depth of the frame's main target (AppFrame) is compared with GL's "final"
 // image pixel by pixel (when the target is not stale).
 //
+// Culling a program's draw calls (set_culling): the program never asked for it, so each draw call
+// is an object, tested in submission order against the depth its target holds at that moment, as a
+// unit beside the depth buffer would test it. A draw is tested when
+//  - it is one the model replays (not flagged; a may-discard draw too: discard only removes
+//    fragments) into the frame's main target, at the size of the tester's structure, not stale;
+//  - its depth test is on with a func that fails behind (LESS or LEQUAL; GREATER or GEQUAL under a
+//    reversed structure), and it writes no stencil (a stencil op on a failed test would change the
+//    target even when nothing passes).
+// Its bounds are those of the triangles setup accepts (cull/primitive.h: a rectangle that holds
+// every pixel the rasterizer may cover, and a depth no fragment is nearer than, bit for bit; for a
+// 24-bit target that depth as the buffer stores it, which keeps the bound since storing is
+// monotone). The tester (DrawTester) says whether the rectangle is hidden; a hidden draw is not
+// drawn. Ground truth is GL's samples passed: a culled draw with GL samples is a false cull. With
+// per-primitive granularity the triangles of a draw found visible are each tested too, and the
+// hidden ones skipped before the tile walk (the draw's samples are still compared with GL's, which
+// catches a wrong drop). Every change of the main target (clears, replayed draws' written blocks,
+// GL's applied changes) reaches the tester, which is brought up to date before a query when it
+// changed since the last one.
+//
 // The window's framebuffer (0) is drawn as Mesa draws it: upside down, relative to an FBO. The
 // state tracker keeps a window-system buffer with its first row at the top, so llvmpipe rasterizes
 // it with the rows the other way round and reads it back right side up; the model negates the
@@ -37,11 +56,14 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <span>
 #include <memory>
 #include <string_view>
 #include <vector>
 
 #include "model/common/depth.h"
+#include "model/common/rect.h"
+#include "model/query/structure.h"
 #include "model/raster/raster_path.h"
 #include "model/raster/stencil_test.h"
 #include "model/scene/frame.h"
@@ -69,6 +91,50 @@ enum class Reason : std::uint8_t {
 inline constexpr int kReasons = 15;
 std::string_view to_string(Reason r) noexcept;
 
+// What tests draws for culling (model/apps/unit.h makes one over a query structure, or the
+// occlusion query's full-resolution test): told of every change of the target it mirrors.
+class DrawTester {
+ public:
+  virtual ~DrawTester() = default;
+  // The mirrored target is now `depth` (another target, or the same one remade): the structure is
+  // made from it whole.
+  virtual void rebuild(const DepthImage& depth) = 0;
+  virtual void cleared(const DepthImage& depth, float value) = 0;        // a whole clear to `value`
+  virtual void changed(const DepthImage& depth, const Rect& dirty) = 0;  // the pixels in `dirty` changed
+  // Queries come next and something changed since the last ones.
+  virtual void prepare(const DepthImage& depth) = 0;
+  // One query per rectangle (rects[i] with nearest[i], non-empty, inside the target), answers in order.
+  virtual void query(const DepthImage& depth, std::span<const Rect> rects, std::span<const float> nearest,
+                     std::vector<query::Answer>& answers) = 0;
+};
+
+// The occlusion query's answer at full resolution: a box at `nearest` over `r`, drawn with a test
+// that passes where the buffer holds a farther depth (under `op`); hidden when no pixel passes. Its
+// lookups are the box's fragments (the rectangle's pixels).
+query::Answer full_depth_query(const DepthImage& depth, const Rect& r, float nearest, FarOp op) noexcept;
+
+// Which draws are tested, and how.
+struct CullSettings {
+  DrawTester* tester = nullptr;  // null: no culling
+  int width = 0, height = 0;     // the tester's target size: draws into a main target of another size are not tested
+  FarOp op = FarOp::Max;
+  bool primitives = false;       // also test each triangle of a draw found visible
+  bool fused_interpolation = true;
+};
+
+// Why a draw is not tested in a cull mode. Fixed values.
+enum class Untested : std::uint8_t {
+  Tested = 0,
+  Flagged,       // a draw the model does not replay
+  OtherTarget,   // not the frame's main target, or not at the tester's size
+  Stale,         // its target's depth is not known to the model
+  DepthFunc,     // the depth test off, or a func that does not fail behind
+  StencilWrites, // it may write stencil
+  NoTriangles,   // setup accepts none of its triangles: nothing to draw
+};
+inline constexpr int kUntested = 7;
+std::string_view to_string(Untested u) noexcept;
+
 // One draw's counts.
 struct AppDrawCounts {
   std::uint32_t frame = 0, draw = 0;
@@ -80,6 +146,13 @@ struct AppDrawCounts {
   std::uint64_t triangles = 0;  // captured triangles
   std::uint64_t fragments = 0, depth_tests = 0, samples = 0, written = 0;  // the model's (replayed draws)
   std::uint64_t gl_samples = 0;
+  // Culling (set_culling): whether it was tested and why not, culled, the query's lookups; its
+  // triangles tested and dropped (per-primitive) and their lookups.
+  Untested untested = Untested::Flagged;
+  bool culled = false;
+  std::uint64_t query_lookups = 0;
+  std::uint64_t primitive_tests = 0, primitives_culled = 0, primitive_lookups = 0;
+  bool false_cull() const noexcept { return culled && gl_samples > 0; }
   bool mismatch() const noexcept { return reason == Reason::Replayed && !stale && samples != gl_samples; }
 };
 
@@ -95,6 +168,13 @@ struct AppFrameCounts {
 class AppsReplay {
  public:
   AppsReplay() = default;
+  // Culls the draws in every frame from now on (settings.tester must outlive the replay).
+  void set_culling(const CullSettings& settings) { cull_ = settings; }
+  // The depth the model holds for framebuffer `fb` (rows as stored), or null when it has none.
+  const DepthImage* depth_of(std::uint32_t fb) const {
+    const auto it = targets_.find(fb);
+    return it == targets_.end() ? nullptr : &it->second.depth;
+  }
   // Replays one frame. InputError when its records are missing or do not fit its draws.
   AppFrameCounts run_frame(const scene::Frame& f);
 
@@ -106,6 +186,7 @@ class AppsReplay {
     raster::StencilImage stencil;
     std::unique_ptr<raster::RasterPath> path;
     bool stale = false;
+    bool tester_dirty = false;  // changed since the tester's last prepare (the tester mirrors it)
     // The window's framebuffer (0): Mesa renders it upside down (rows from the top, the winding
     // mirrored), so the model does too and stores its rows flipped; GL reads it back bottom up.
     bool flipped = false;
@@ -120,14 +201,29 @@ class AppsReplay {
   // stale until a whole clear when it has a depth buffer).
   Target& target(std::uint32_t fb, int width, int height, raster::DepthFormat format, bool has_depth);
 
-  // One draw through the target's raster path with its recorded state.
-  raster::DrawCounters replay(Target& t, const scene::DrawRecord& draw, bool has_depth);
+  // One draw through the target's raster path with its recorded state (skip: per-primitive culls,
+  // RasterPath::draw), its written blocks told to the tester; replay_untold tells nothing (the
+  // may-discard check tells them only when the draw is found equal to GL's).
+  raster::DrawCounters replay(Target& t, const scene::DrawRecord& draw, bool has_depth, std::span<const char> skip = {});
+  raster::DrawCounters replay_untold(Target& t, const scene::DrawRecord& draw, bool has_depth, std::span<const char> skip = {});
   // Whether the depth the model's draw changed (`before` -> the target now) is GL's recorded change,
   // pixel for pixel and bit for bit.
   bool same_change(const Target& t, const std::vector<float>& before, const scene::TechniqueRecord& change, std::uint64_t frame,
                    std::size_t k) const;
 
+  // Tells the tester of a change of `t` when it mirrors it.
+  void touched(Target& t, const Rect& stored_rect);
+  // The cull test of draw `draw` into `t` (tested: c.untested is Tested); fills c's cull counts and
+  // `skip` (per-primitive). Returns whether the draw is culled.
+  bool cull_test(Target& t, const scene::DrawRecord& draw, AppDrawCounts& c, std::vector<char>& skip);
+
   std::map<std::uint32_t, Target> targets_;
+  CullSettings cull_;
+  const Target* mirrored_ = nullptr;  // the target the tester holds
+  std::vector<Rect> rects_;
+  std::vector<float> nearest_;
+  std::vector<query::Answer> answers_;
+  std::vector<char> skip_;
   std::vector<float> scratch_;  // a target's depth before a draw that may discard
 };
 

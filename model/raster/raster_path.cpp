@@ -1,6 +1,7 @@
 // RasterPath: geometry -> setup -> rasterizer -> stencil and early depth test for one draw; see raster_path.h.
 #include "model/raster/raster_path.h"
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 
@@ -85,36 +86,64 @@ DrawState draw_state(const scene::DepthState& t) {
 }
 
 DrawCounters RasterPath::draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state) {
+  return draw(clip_positions, state, {});
+}
+
+DrawCounters RasterPath::draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state, std::span<const char> skip) {
   DrawCounters k;
-  if (reuse_ && cached_ && same_state(state.geometry, cached_state_) && same_positions(clip_positions, cached_positions_)) {
+  int x0 = config_.width_px, y0 = config_.height_px, x1 = 0, y1 = 0;
+  const auto test = [&](const DepthPlane& plane, bool front, int x, int y, std::uint16_t mask) {
+    const std::uint64_t before = k.depth.written;
+    test_.test_block(plane, front, x, y, mask, state.depth, state.stencil, k.depth, k.stencil);
+    if (k.depth.written != before) x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x + 4), y1 = std::max(y1, y + 4);
+  };
+  const auto finish = [&] {
+    x1 = std::min(x1, config_.width_px), y1 = std::min(y1, config_.height_px);
+    written_box_ = x1 > x0 && y1 > y0 ? Rect{x0, y0, x1 - x0, y1 - y0} : Rect{};
+  };
+  const bool reusable = reuse_ && skip.empty();
+  if (reusable && cached_ && same_state(state.geometry, cached_state_) && same_positions(clip_positions, cached_positions_)) {
     k.geometry = cached_geometry_, k.setup = cached_setup_, k.tiles = cached_tiles_;
-    for (const CachedBlock& b : cached_blocks_)
-      test_.test_block(cached_planes_[b.triangle], cached_front_[b.triangle] != 0, b.x, b.y, b.mask, state.depth, state.stencil,
-                       k.depth, k.stencil);
+    for (const CachedBlock& b : cached_blocks_) test(cached_planes_[b.triangle], cached_front_[b.triangle] != 0, b.x, b.y, b.mask);
+    finish();
     return k;
   }
+  cached_ = false;
   triangles_.clear();
   geometry_.process(clip_positions, state.geometry, triangles_, k.geometry);
-  if (reuse_) {
+  if (reusable) {
     cached_planes_.clear(), cached_front_.clear(), cached_blocks_.clear();
   }
   SetupTriangle t;
+  std::size_t accepted = 0;
   for (const geometry::WindowTriangle& w : triangles_) {
     if (setup_.setup(w, state.geometry.face, t, k.setup) != SetupResult::Accepted) continue;
+    if (const std::size_t i = accepted++; i < skip.size() && skip[i]) continue;
     const auto triangle = static_cast<std::uint32_t>(cached_planes_.size());
-    if (reuse_) cached_planes_.push_back(t.depth), cached_front_.push_back(t.front_facing ? 1 : 0);
+    if (reusable) cached_planes_.push_back(t.depth), cached_front_.push_back(t.front_facing ? 1 : 0);
     rasterizer_.rasterize(t, k.tiles, [&](int x, int y, std::uint16_t mask) {
-      if (reuse_) cached_blocks_.push_back({x, y, mask, triangle});
-      test_.test_block(t.depth, t.front_facing, x, y, mask, state.depth, state.stencil, k.depth, k.stencil);
+      if (reusable) cached_blocks_.push_back({x, y, mask, triangle});
+      test(t.depth, t.front_facing, x, y, mask);
     });
   }
-  if (reuse_) {
+  if (reusable) {
     cached_ = true;
     cached_positions_.assign(clip_positions.begin(), clip_positions.end());
     cached_state_ = state.geometry;
     cached_geometry_ = k.geometry, cached_setup_ = k.setup, cached_tiles_ = k.tiles;
   }
+  finish();
   return k;
+}
+
+void RasterPath::setup_only(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state,
+                            const std::function<void(const geometry::WindowTriangle&, const SetupTriangle&)>& each) {
+  DrawCounters k;  // not reported: draw() counts the same work when the draw runs
+  triangles_.clear();
+  geometry_.process(clip_positions, state.geometry, triangles_, k.geometry);
+  SetupTriangle t;
+  for (const geometry::WindowTriangle& w : triangles_)
+    if (setup_.setup(w, state.geometry.face, t, k.setup) == SetupResult::Accepted) each(w, t);
 }
 
 DrawCounters RasterPath::draw_points(std::span<const geometry::ClipPosition> clip_positions,

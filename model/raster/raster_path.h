@@ -4,11 +4,13 @@
 // the SystemC units wrap one stage at a time, and what the counter comparison replays against GL.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
 
 #include "model/common/depth.h"
+#include "model/common/rect.h"
 #include "model/geometry/geometry.h"
 #include "model/raster/depth_test.h"
 #include "model/raster/point_setup.h"
@@ -63,6 +65,18 @@ class RasterPath {
 
   // Runs one draw (three clip positions a triangle) and returns its counters.
   DrawCounters draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state);
+  // The same, leaving out the triangles that setup accepts whose index among the accepted ones (in
+  // the order setup_only() gives them) has skip[i] != 0: a per-primitive cull before the tile walk.
+  // Indices past skip's end are drawn. The skipped triangles count in geometry and setup, not after.
+  DrawCounters draw(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state, std::span<const char> skip);
+  // Geometry and setup only (no tile walk, no test, nothing written): calls `each` with every
+  // triangle setup accepts, in the order draw() rasterizes them, and its window triangle. What a
+  // depth query of a draw, or of each of its triangles, is built from before it is drawn.
+  void setup_only(std::span<const geometry::ClipPosition> clip_positions, const DrawState& state,
+                  const std::function<void(const geometry::WindowTriangle&, const SetupTriangle&)>& each);
+  // The 4x4 blocks the last triangle draw wrote depth in, as one rectangle clipped to the target
+  // (empty: it wrote none): what the depth unit reports as the draw's dirty rectangle.
+  const Rect& written_box() const noexcept { return written_box_; }
   // A point draw's rasterization kept to be tested again into another path of the same
   // configuration (two render targets drawn with the same points): its inputs, counters, each
   // accepted point's depth plane and its blocks in rasterization order. Filled by draw_points.
@@ -118,6 +132,7 @@ class RasterPath {
   std::unique_ptr<StencilImage> own_stencil_;  // when the caller gave none
   DepthStencilTest test_;
   std::vector<geometry::WindowTriangle> triangles_;  // reused from draw to draw
+  Rect written_box_;
   std::vector<geometry::WindowPoint> points_;        // likewise
   // The previous triangle draw's rasterization (set_reuse_rasterization): its inputs, counters,
   // each accepted triangle's depth plane and facing, and its blocks in rasterization order.

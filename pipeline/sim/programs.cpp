@@ -31,11 +31,15 @@ std::string technique_list() {
   return s;
 }
 
-// The program a cull.mode other than trace runs, as messages name it.
+// The programs a cull.mode other than trace runs, as messages name them.
 std::string cull_mode_owner() {
+  std::vector<std::string> names;
   for (const ProgramRow& r : programs())
-    if (r.runs_cull_mode) return fmt::format("the {} program", r.technique);
-  return "no program";
+    if (r.runs_cull_mode) names.emplace_back(r.technique);
+  if (names.empty()) return "no program";
+  std::string s = names.size() == 1 ? "the " + names.front() + " program" : "the programs ";
+  for (std::size_t i = 0; names.size() > 1 && i < names.size(); ++i) s += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+  return s;
 }
 
 }  // namespace

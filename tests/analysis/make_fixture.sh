@@ -2,7 +2,8 @@
 # Regenerates tests/analysis/fixture/, the input folder of analysis/report.py's tests, from real nbsim
 # outputs on the small samples (city_small_oq.nbt, and city_small_nb_reversed.nbt for a second trace
 # in two sweeps) on four tiny particles captures, nine tiny shadows captures, a small `nbsim ldi table1` and ten tiny
-# relief captures (five heightfields at two sizes). Big files are trimmed to what the report reads.
+# relief captures (five heightfields at two sizes) and the apps table of the OpenArena sample. Big files are
+# trimmed to what the report reads.
 # About a minute on 2 cores.
 # Usage: tests/analysis/make_fixture.sh [NBSIM]   (default: build/pipeline/nbsim; run from anywhere)
 set -eu
@@ -104,6 +105,11 @@ mkdir -p "$out/relief" "$tmp/relief_traces"
  done &&
  "$nbsim" relief *.nbt --out "$tmp/relief" >/dev/null)
 cp "$tmp/relief/relief.json" "$out/relief/"
+
+# A real program's draw calls culled in every mode: the table of the OpenArena sample (table2.json alone).
+mkdir -p "$out/apps"
+"$nbsim" table2 traces/samples/apps_openarena_320.nbt --jobs 2 --out "$tmp/apps" >/dev/null
+cp "$tmp/apps/table2.json" "$out/apps/"
 
 du -sh "$out"
 echo "wrote $out"

@@ -220,10 +220,39 @@ class FixtureReport(unittest.TestCase):
             self.assertEqual(len(list(csv.DictReader(f))), len(doc["rows"]), "every row in relief_rows.csv")
         text = (self.dir / "report" / "headline.md").read_text()
         block = text.split("Relief textures (")[1]
-        lines = [line for line in block.splitlines() if line.startswith("| ") and not line.startswith("| method")]
+        lines = []  # the block's first table (the blocks after it have theirs)
+        for line in block.splitlines():
+            if line.startswith("|"):
+                lines.append(line)
+            elif lines:
+                break
+        lines = [line for line in lines if line.startswith("| ") and not line.startswith("| method")]
         self.assertEqual(len(lines), len(doc["ranking"]), block)
         front = [r["method"] for r in doc["ranking"] if r["pareto"]]
         self.assertIn(f"Pareto front of cycles per box draw against hit error: {front[0]} (", block)
+
+    def test_apps_section_beside_the_walkthrough(self):
+        # apps/table2.json: the real program's rows beside the walkthrough's (table2/table2.json), its CSV copy,
+        # and a reading whose numbers are the fixture's own
+        apps = json.loads((FIXTURE / "apps" / "table2.json").read_text())
+        city = json.loads((FIXTURE / "table2" / "table2.json").read_text())
+        self.assertIn("A real program: its draw calls culled in every mode", self.html)
+        self.assertIn("apps/table2.json", self.html, "the page names its input")
+        with open(self.dir / "report" / "apps.csv") as f:
+            table = list(csv.DictReader(f))
+        self.assertEqual(len(table), len(apps["rows"]) + len(city["rows"]), "both programs' rows")
+        self.assertEqual([r["mode"] for r in table[:len(apps["rows"])]], [r["mode"] for r in apps["rows"]])
+        for got, r in zip(table, apps["rows"] + city["rows"]):
+            self.assertEqual(float(got["total_depth_tests_per_frame"]), float(r["total_depth_tests_per_frame"]))
+            self.assertEqual(int(float(got["false_culls"])), int(r["false_culls"]))
+        rows = {r["mode"]: r for r in apps["rows"]}
+        best = min((r for r in apps["rows"] if r["mode"] != "none"), key=lambda r: r["total_depth_tests_per_frame"])
+        self.assertIn(f"with {best['mode']} ({best['total_depth_tests_per_frame']:,.0f} a frame)", self.html)
+        ratio = rows["oq"]["query_depth_tests_per_frame"] / rows["nb"]["query_depth_tests_per_frame"]
+        self.assertIn(f"occlusion queries read {ratio:,.0f} times", self.html)
+        self.assertTrue((self.dir / "report" / "apps.png").exists())
+        headline = (self.dir / "report" / "headline.md").read_text()
+        self.assertIn("Culling a real program's draw calls", headline)
 
     def test_particles_section_per_mode_beside_the_paper(self):
         # particles/particles.json: one row per mode beside the paper's 256 N and N, its CSV copy, and a
@@ -828,7 +857,7 @@ class MissingAndBroken(unittest.TestCase):
         html = (self.dir / "report" / "index.html").read_text()
         self.assertIn("Table 1: N-buffer build cost", html)
         for missing in ["figure4_map.csv", "table2/table2.json", "sweeps/NAME/results.csv", "particles/particles.json",
-                        "shadows/shadows.json", "ldi/ldi.json", "relief/relief.json"]:
+                        "shadows/shadows.json", "ldi/ldi.json", "relief/relief.json", "apps/table2.json"]:
             self.assertIn(missing, html, f"the page does not say {missing} is missing")
         self.assertIn("missing inputs", out)
 

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -303,6 +304,161 @@ TEST(AppsReplayTest, TheWindowFramebufferIsDrawnUpsideDown) {
   std::vector<float> flipped(gl.rbegin(), gl.rend());
   AppsReplay other;
   EXPECT_EQ(other.run_frame(frame_of({bottom}, {clear}, {}, 0, &flipped)).depth_mismatches, kArea);
+}
+
+// A tester that keeps its own copy of the target, made only from what the core tells it (rebuild,
+// clears, changes), answers at full resolution from that copy, and checks at every query that the
+// copy is the target: every change reached it.
+class MirrorTester : public DrawTester {
+ public:
+  void rebuild(const DepthImage& depth) override { mirror = depth, ++rebuilds; }
+  void cleared(const DepthImage&, float value) override { std::fill(mirror.texels.begin(), mirror.texels.end(), value); }
+  void changed(const DepthImage& depth, const Rect& dirty) override {
+    ASSERT_GE(dirty.x, 0);
+    ASSERT_LE(dirty.x1(), depth.width);
+    for (int y = dirty.y; y < dirty.y1(); ++y)
+      for (int x = dirty.x; x < dirty.x1(); ++x) mirror.at(x, y) = depth.at(x, y);
+  }
+  void prepare(const DepthImage&) override { ++prepares; }
+  void query(const DepthImage& depth, std::span<const Rect> rects, std::span<const float> nearest,
+             std::vector<query::Answer>& answers) override {
+    EXPECT_EQ(std::memcmp(mirror.texels.data(), depth.texels.data(), depth.texels.size() * sizeof(float)), 0)
+        << "a change of the target did not reach the tester";
+    answers.clear();
+    for (std::size_t i = 0; i < rects.size(); ++i) answers.push_back(full_depth_query(mirror, rects[i], nearest[i], FarOp::Max));
+    queries += rects.size();
+  }
+  DepthImage mirror;
+  int rebuilds = 0, prepares = 0;
+  std::size_t queries = 0;
+};
+
+CullSettings settings(DrawTester& t, bool primitives = false) {
+  CullSettings s;
+  s.tester = &t;
+  s.width = kW, s.height = kH;
+  s.primitives = primitives;
+  return s;
+}
+
+TEST(AppsCullTest, AHiddenDrawIsCulledAndAVisibleOneDrawn) {
+  MirrorTester tester;
+  AppsReplay replay;
+  replay.set_culling(settings(tester));
+  Draw near, far, half;
+  near.z = -0.5f, near.gl_samples = kArea;
+  far.z = 0.5f;  // behind `near` everywhere: GL passed none
+  half.z = -0.75f, half.rect = {-1.0f, -1.0f, 0.0f, 1.0f}, half.gl_samples = kArea / 2;  // nearer, on the left half
+  std::vector<float> final_depth(kArea, 0.25f);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW / 2; ++x) final_depth[static_cast<std::size_t>(y * kW + x)] = 0.125f;
+  const AppFrameCounts k = replay.run_frame(frame_of({near, far, half}, {Clear{}}, {}, 7, &final_depth));
+  ASSERT_EQ(k.draws.size(), 3u);
+  EXPECT_EQ(k.draws[0].untested, Untested::Tested);
+  EXPECT_FALSE(k.draws[0].culled) << "nothing in front of it yet";
+  EXPECT_TRUE(k.draws[1].culled);
+  EXPECT_FALSE(k.draws[1].false_cull());
+  EXPECT_EQ(k.draws[1].samples, 0u);
+  EXPECT_FALSE(k.draws[2].culled);
+  EXPECT_EQ(k.draws[2].samples, kArea / 2);
+  EXPECT_FALSE(k.draws[2].mismatch());
+  EXPECT_EQ(k.draws[1].query_lookups, kArea) << "the full-resolution test reads the rectangle's pixels";
+  EXPECT_EQ(tester.queries, 3u);
+  EXPECT_EQ(tester.rebuilds, 1);
+  EXPECT_EQ(k.depth_mismatches, 0u);
+  // A culled draw GL drew samples of is a false cull.
+  Draw wrong = far;
+  wrong.gl_samples = 1;
+  AppsReplay again;
+  MirrorTester t2;
+  again.set_culling(settings(t2));
+  EXPECT_TRUE(again.run_frame(frame_of({near, wrong}, {Clear{}})).draws[1].false_cull());
+}
+
+TEST(AppsCullTest, DrawsThatCannotBeCulledSafelyAreNotTested) {
+  MirrorTester tester;
+  AppsReplay replay;
+  replay.set_culling(settings(tester));
+  Draw near, other_target, no_test, always, stencil, offscreen, flagged, after;
+  near.z = -0.5f, near.gl_samples = kArea;
+  other_target.fb = 9, other_target.z = 0.5f;
+  no_test.z = 0.5f, no_test.flags = kDepthMask | kFrontCcw;
+  stencil.z = 0.5f, stencil.flags |= kStencilTest;
+  flagged.z = 0.5f, flagged.primitive = 1;  // lines
+  offscreen.z = 0.5f, offscreen.rect = {2.0f, 2.0f, 3.0f, 3.0f};
+  after.z = 0.5f;  // after the flagged draw, which may have written depth GL did not record: stale
+  scene::Frame f = frame_of({near, other_target, no_test, always, stencil, offscreen, flagged, after}, {Clear{}});
+  f.draws[3].state.func = scene::DepthFunc::Always;
+  f.draws[3].clip_positions[0][2] = 0.5f;
+  f.draws[4].stencil.test = true;
+  f.draws[4].stencil.front.write_mask = 0xFF;
+  const AppFrameCounts k = replay.run_frame(f);
+  ASSERT_EQ(k.draws.size(), 8u);
+  EXPECT_EQ(k.draws[1].untested, Untested::OtherTarget);
+  EXPECT_EQ(k.draws[2].untested, Untested::DepthFunc);
+  EXPECT_EQ(k.draws[3].untested, Untested::DepthFunc);
+  EXPECT_EQ(k.draws[4].untested, Untested::StencilWrites);
+  EXPECT_EQ(k.draws[5].untested, Untested::NoTriangles);
+  EXPECT_EQ(k.draws[6].untested, Untested::Flagged);
+  EXPECT_EQ(k.draws[7].untested, Untested::Stale);
+  for (std::size_t i = 1; i < k.draws.size(); ++i) EXPECT_FALSE(k.draws[i].culled) << i;
+}
+
+TEST(AppsCullTest, PerPrimitiveCullingSkipsTheHiddenTriangleOfAVisibleDraw) {
+  MirrorTester tester;
+  AppsReplay replay;
+  replay.set_culling(settings(tester, true));
+  Draw left, both;
+  left.z = -0.5f, left.rect = {-1.0f, -1.0f, 0.0f, 1.0f}, left.gl_samples = kArea / 2;
+  both.z = 0.0f;
+  scene::Frame f = frame_of({left, both}, {Clear{}});
+  // The second draw: one triangle behind the left half's depth, one on the right (nothing in front).
+  f.draws[1].clip_positions = {{-1.0f, -1.0f, 0.0f, 1.0f}, {-0.25f, -1.0f, 0.0f, 1.0f}, {-1.0f, 1.0f, 0.0f, 1.0f},
+                               {0.25f, -1.0f, 0.0f, 1.0f}, {1.0f, -1.0f, 0.0f, 1.0f}, {1.0f, 1.0f, 0.0f, 1.0f}};
+  // GL's samples: the right triangle's, which the model counts when it draws it alone.
+  AppsReplay plain;
+  const AppFrameCounts truth = plain.run_frame(f);
+  f.draws[1].gl.samples_passed = truth.draws[1].samples;
+  const AppFrameCounts k = replay.run_frame(f);
+  EXPECT_FALSE(k.draws[1].culled);
+  EXPECT_EQ(k.draws[1].primitive_tests, 2u);
+  EXPECT_EQ(k.draws[1].primitives_culled, 1u);
+  EXPECT_GT(k.draws[1].samples, 0u);
+  EXPECT_FALSE(k.draws[1].mismatch());
+  EXPECT_LT(k.draws[1].fragments, truth.draws[1].fragments) << "the hidden triangle's fragments are not rasterized";
+}
+
+TEST(AppsCullTest, RandomFramesCullOnlyHiddenDrawsAndKeepTheDepth) {
+  // Quads of random size and depth, some behind others; GL's samples are the model's without
+  // culling (its own replay is exact against GL on such draws). Culling must never remove a draw
+  // with samples and must leave the final depth as it was.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::size_t culled = 0;
+  for (int round = 0; round < 40; ++round) {
+    std::vector<Draw> draws(12);
+    for (Draw& d : draws) {
+      float a = u(rng), b = u(rng), c = u(rng), e = u(rng);
+      d.rect = {std::min(a, b), std::min(c, e), std::max(a, b) + 0.1f, std::max(c, e) + 0.1f};
+      d.z = u(rng);
+    }
+    scene::Frame f = frame_of(draws, {Clear{}});
+    AppsReplay plain;
+    const AppFrameCounts truth = plain.run_frame(f);
+    for (std::size_t k = 0; k < draws.size(); ++k) f.draws[k].gl.samples_passed = truth.draws[k].samples;
+    MirrorTester tester;
+    AppsReplay culling;
+    culling.set_culling(settings(tester, round % 2 == 1));
+    const AppFrameCounts k = culling.run_frame(f);
+    for (const AppDrawCounts& d : k.draws) {
+      EXPECT_FALSE(d.false_cull()) << "round " << round << " draw " << d.draw;
+      EXPECT_FALSE(d.mismatch()) << "round " << round << " draw " << d.draw;
+      culled += d.culled ? 1 : 0;
+    }
+    ASSERT_TRUE(plain.depth_of(7) && culling.depth_of(7));
+    EXPECT_EQ(plain.depth_of(7)->texels, culling.depth_of(7)->texels) << "round " << round;
+  }
+  EXPECT_GT(culled, 20u) << "the frames hide draws behind others";
 }
 
 TEST(AppsReplayTest, DamagedRecordsAreRefusedByName) {

@@ -33,7 +33,8 @@ TEST(AppsCliTest, NativeCaptureReplaysEveryDrawExactly) {
     std::ifstream log(dir / "out" / "app_draws.csv");
     std::string header;
     std::getline(log, header);
-    EXPECT_EQ(header, "frame,draw,framebuffer,reason,stale,depth_change,may_discard,triangles,fragments,depth_tests,samples,gl_samples,match");
+    EXPECT_EQ(header, "frame,draw,framebuffer,reason,stale,depth_change,may_discard,triangles,fragments,depth_tests,samples,gl_samples,match,"
+                      "query_depth_tests");
   }
 }
 
