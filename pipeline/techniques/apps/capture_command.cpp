@@ -26,6 +26,7 @@ struct ApitraceArgs {
   std::string trace, out, frames, eglretrace = "eglretrace", interposer, keep;
   double timeout_s = 3600.0;
   bool overhead = false;
+  bool allow_unhandled = false;
 };
 
 // The interposer library: --interposer, else NBSIM_INTERPOSER, else the build's.
@@ -83,11 +84,15 @@ void add_apps_commands(CLI::App& app, Action& action) {
   cmd->add_option("--interposer", a->interposer, "The interposer library (default: NBSIM_INTERPOSER, else the build's)");
   cmd->add_option("--keep-recording", a->keep, "Also keep the interposer's raw recording in this file");
   cmd->add_option("--timeout", a->timeout_s, "Seconds the replay may take")->check(CLI::Range(1.0, 1e6))->capture_default_str();
+  cmd->add_flag("--allow-unhandled", a->allow_unhandled,
+                "Keep the trace when the program uses a GL feature the interposer does not handle (immediate mode, display "
+                "lists, depth blits): its frames are marked, and the model counts them apart");
   cmd->add_flag("--overhead", a->overhead,
                 "Also replay the same frames without recording and print the recording's overhead (interposed / plain replay time)");
   cmd->footer("Needs apitrace's eglretrace (Debian: apt install apitrace). Exit 2 with a message for a trace eglretrace cannot "
-              "replay, an OpenGL ES trace (ES has no samples-passed query), or a frame above the trace format's limits; no trace "
-              "is written then.");
+              "replay, an OpenGL ES trace (ES has no samples-passed query), a program that uses a GL feature the interposer does not "
+              "handle (named; --allow-unhandled keeps the trace), or a frame above the trace format's limits; no trace is written "
+              "then.");
   cmd->callback([&action, a] {
     action = [a] {
       if (!a->frames.empty()) parse_frames(a->frames);
@@ -127,6 +132,16 @@ void add_apps_commands(CLI::App& app, Action& action) {
                  s.frames, s.draws, s.captured, s.draws - s.captured, s.skipped[1], s.skipped[2], s.skipped[3], s.skipped[4], s.skipped[5],
                  s.skipped[6], s.clears, s.depth_changes, a->out, static_cast<double>(s.bytes) / 1e6, recorded_s);
       for (const auto& [name, count] : s.unhandled) fmt::print("  not captured: {} ({} times)\n", name, count);
+      if (!s.unhandled.empty() && !a->allow_unhandled) {
+        std::error_code ec;
+        std::filesystem::remove(a->out, ec);
+        std::string names;
+        for (const auto& [name, count] : s.unhandled) names += fmt::format("{}{} ({} times)", names.empty() ? "" : ", ", name, count);
+        throw InputError(fmt::format("the program uses GL features the interposer does not handle: {}; what they draw is not recorded, "
+                                     "so the model's depth would not be GL's (no trace written; --allow-unhandled keeps it, those "
+                                     "frames marked)",
+                                     names));
+      }
       if (a->overhead) {
         const double plain_s = run_retrace(*a, lib, "");
         fmt::print("recording overhead: interposed {:.2f} s, plain {:.2f} s, ratio {:.2f}\n", recorded_s, plain_s, recorded_s / plain_s);

@@ -45,6 +45,9 @@ TEST(ApitraceCliTest, BadInputIsRefusedWithNothingLeftBehind) {
       {"capture apitrace " + sample + " --frames 5000:5001 -o " + out, "holds no frame", true},
       // Cut traces replay up to the cut (apitrace reads what is there): the frames past it are refused.
       {"capture apitrace " + cut.string() + " --frames 900:901 -o " + out, "holds no frame", true},
+      // A fixed-function program (glxgears): immediate mode in display lists, named.
+      {"capture apitrace " + (kSamples / "glxgears_160x120.trace").string() + " -o " + out,
+       "GL features the interposer does not handle: glBegin (immediate mode) (18 times), glCallList (display lists) (18 times)", true},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);
@@ -56,6 +59,19 @@ TEST(ApitraceCliTest, BadInputIsRefusedWithNothingLeftBehind) {
     EXPECT_FALSE(std::filesystem::exists(out + ".partial"));
     EXPECT_FALSE(std::filesystem::exists(out + ".recording"));
   }
+}
+
+// --allow-unhandled keeps the trace of such a program, its frames marked, and the model counts them.
+TEST(ApitraceCliTest, UnhandledFeaturesAreKeptWhenAllowed) {
+  if (!have_eglretrace()) GTEST_SKIP() << "eglretrace not installed (apt install apitrace)";
+  const auto dir = nbsim::testing::scratch_dir("nbsim_apitrace_unhandled");
+  const std::string out = (dir / "gears.nbt").string();
+  const auto c = run_nbsim("capture apitrace " + (kSamples / "glxgears_160x120.trace").string() + " --allow-unhandled -o " + out);
+  ASSERT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("not captured: glBegin (immediate mode)"), std::string::npos) << c.out;
+  const auto r = run_nbsim("compare " + out + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("\"unhandled_frames\":6"), std::string::npos) << r.out.substr(0, 2000);
 }
 
 TEST(ApitraceCliTest, HelpNamesWhatItNeeds) {
