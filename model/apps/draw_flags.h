@@ -38,6 +38,7 @@ enum DrawFlag : std::uint32_t {
   kOverflow = 1u << 14,        // fewer primitives written than generated: positions incomplete
   kMultisample = 1u << 15,     // the render target has samples > 1
   kColorWrite = 1u << 16,      // any colour channel writes
+  kClipDistance = 1u << 17,    // a clip distance (or a fixed-function user clip plane) is enabled
 };
 
 

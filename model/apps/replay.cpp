@@ -31,7 +31,8 @@ constexpr std::uint32_t kGlPoints = 0x0000, kGlLines = 0x0001, kGlTriangles = 0x
 
 constexpr std::array<std::string_view, kReasons> kReasonNames = {
     "replayed", "not_captured", "points",   "lines",    "discard",      "frag_depth", "polygon_offset", "polygon_mode",
-    "multisample", "viewport",  "depth_range", "scissor", "depth_format", "non_finite", "no_target"};
+    "multisample", "viewport",  "depth_range", "scissor", "depth_format", "non_finite", "no_target",
+    "clip_distance"};
 
 // The frame's AppDraws fields, each checked to have one value per draw.
 struct DrawFields {
@@ -81,6 +82,7 @@ Reason reason_of(const DrawFields& d, std::size_t k, const scene::DrawRecord& dr
   if ((fl & kPolygonOffsetFill) && ((*d.factor)[k] != 0.0f || (*d.units)[k] != 0.0f)) return Reason::PolygonOffset;
   if ((fl & kPolygonModeNotFill) || (*d.polygon_mode)[k] != kGlFill) return Reason::PolygonMode;
   if (fl & kMultisample) return Reason::Multisample;
+  if (fl & kClipDistance) return Reason::ClipDistance;
   if ((*d.vx)[k] != 0 || (*d.vy)[k] != 0 || (*d.vw)[k] != w || (*d.vh)[k] != h) return Reason::Viewport;
   if ((*d.near)[k] != 0.0f || (*d.far)[k] != 1.0f) return Reason::DepthRange;
   if ((fl & kScissor) && ((*d.sx)[k] > 0 || (*d.sy)[k] > 0 || (*d.sx)[k] + (*d.sw)[k] < w || (*d.sy)[k] + (*d.sh)[k] < h))

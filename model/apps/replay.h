@@ -11,7 +11,7 @@
 //  - flagged, by the first reason the model cannot redo it exactly (Reason: not captured, points or
 //    lines, discard or alpha test (named only when nothing else applies), a written fragment depth, polygon offset or mode, multisampling,
 //    a viewport, depth range or scissor smaller than the target, a depth format the model does not
-//    store, a non-finite position). A flagged draw is never compared; when the recording holds the
+//    store, a non-finite position, a user clip plane). A flagged draw is never compared; when the recording holds the
 //    depth it changed (AppDepthChange), that change is applied to the target, so the draws after it
 //    still compare exactly. A draw flagged only because its shader may discard (the flag comes
 //    from the source, not from what the draw did) is first replayed as if nothing was discarded
@@ -87,8 +87,9 @@ enum class Reason : std::uint8_t {
   DepthFormat,    // a depth buffer the model does not store (16 bits, 32-bit integer)
   NonFinite,      // a NaN or infinite clip position
   NoTarget,       // a render target of size 0
+  ClipDistance,   // a user clip plane or clip distance is enabled (the model clips at the view volume only)
 };
-inline constexpr int kReasons = 15;
+inline constexpr int kReasons = 16;
 std::string_view to_string(Reason r) noexcept;
 
 // What tests draws for culling (model/apps/unit.h makes one over a query structure, or the

@@ -192,7 +192,17 @@ Recording& recording() {
   X(PFNGLGETTEXTURELEVELPARAMETERIVPROC, glGetTextureLevelParameteriv)                                 \
   X(PFNGLGETNAMEDRENDERBUFFERPARAMETERIVPROC, glGetNamedRenderbufferParameteriv)                       \
   X(PFNGLREADPIXELSPROC, glReadPixels)                                                                 \
-  X(PFNGLPIXELSTOREIPROC, glPixelStorei)
+  X(PFNGLPIXELSTOREIPROC, glPixelStorei)                                                               \
+  X(PFNGLCREATESHADERPROC, glCreateShader)                                                             \
+  X(PFNGLSHADERSOURCEPROC, glShaderSource)                                                             \
+  X(PFNGLCOMPILESHADERPROC, glCompileShader)                                                           \
+  X(PFNGLCREATEPROGRAMPROC, glCreateProgram)                                                           \
+  X(PFNGLATTACHSHADERPROC, glAttachShader)                                                             \
+  X(PFNGLDELETESHADERPROC, glDeleteShader)                                                             \
+  X(PFNGLLINKPROGRAMPROC, glLinkProgram)                                                               \
+  X(PFNGLUSEPROGRAMPROC, glUseProgram)                                                                 \
+  X(PFNGLENABLEPROC, glEnable)                                                                         \
+  X(PFNGLDISABLEPROC, glDisable)
 
 struct Gl {
 #define NBSIM_GL_MEMBER(type, name) type name = nullptr;
@@ -256,6 +266,10 @@ struct ProgramInfo {
 struct ContextObjects {
   GLuint feedback = 0, buffer = 0, samples = 0, generated = 0, written = 0;
   std::size_t capacity = 0;
+  // The fixed-function capture pass's program (gl_Position = ftransform(), its only varying), made
+  // once per context when it is a compatibility one; tried: made or found impossible.
+  GLuint ftransform = 0;
+  bool ftransform_tried = false;
 };
 
 std::mutex g_mutex;
@@ -300,6 +314,35 @@ bool compatibility_profile() {
   GLint mask = 0;
   gl().glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &mask);
   return (mask & GL_CONTEXT_COMPATIBILITY_PROFILE_BIT) != 0 || (mask & GL_CONTEXT_CORE_PROFILE_BIT) == 0;
+}
+
+// The fixed-function capture pass's program of the current context, or 0 (a core context, or a
+// compile or link that failed). ftransform() is invariant with the fixed-function transform, so the
+// positions it feeds back are the ones the fixed-function draw rasterizes.
+GLuint ftransform_program(ContextObjects& o) {
+  if (o.ftransform_tried) return o.ftransform;
+  o.ftransform_tried = true;
+  if (!compatibility_profile()) return 0;
+  Gl& g = gl();
+  static const char* kSource = "#version 120\nvoid main() { gl_Position = ftransform(); }\n";
+  const GLuint vs = g.glCreateShader(GL_VERTEX_SHADER);
+  g.glShaderSource(vs, 1, &kSource, nullptr);
+  g.glCompileShader(vs);
+  GLint ok = 0;
+  g.glGetShaderiv(vs, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    g.glDeleteShader(vs);
+    return 0;
+  }
+  const GLuint program = g.glCreateProgram();
+  g.glAttachShader(program, vs);
+  const GLchar* position = "gl_Position";
+  g.glTransformFeedbackVaryings(program, 1, &position, GL_INTERLEAVED_ATTRIBS);
+  g.glLinkProgram(program);
+  g.glDeleteShader(vs);
+  g.glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (ok) o.ftransform = program;
+  return o.ftransform;
 }
 
 // A render target as the library reads it: its size (the depth attachment's, else the first colour
@@ -435,6 +478,12 @@ void read_state(DrawHead& d) {
   d.depth_bits = t.depth_bits;
   d.depth_float = t.depth_float ? 1 : 0;
   if (get_int(GL_SAMPLES) > 1) d.flags |= kMultisample;
+  static const GLint clip_distances = std::min(get_int(GL_MAX_CLIP_DISTANCES), 32);
+  for (GLint i = 0; i < clip_distances; ++i)
+    if (g.glIsEnabled(static_cast<GLenum>(GL_CLIP_DISTANCE0 + i))) {
+      d.flags |= kClipDistance;
+      break;
+    }
 }
 
 // The primitive transform feedback records for a draw of `mode` by the program.
@@ -466,7 +515,7 @@ std::size_t vertices_bound(GLenum primitive, std::size_t vertices, const Program
 // its depth change recorded (RawType::Delta), so that the draws after it can still be compared.
 bool plain_draw(const DrawHead& d, Skip skip, GLenum primitive) {
   if (skip != Skip::None || primitive != GL_TRIANGLES) return false;
-  if (d.flags & (kDiscards | kWritesDepth | kAlphaTest | kPolygonModeNotFill | kMultisample)) return false;
+  if (d.flags & (kDiscards | kWritesDepth | kAlphaTest | kPolygonModeNotFill | kMultisample | kClipDistance)) return false;
   if ((d.flags & kPolygonOffsetFill) && (d.offset_factor != 0.0f || d.offset_units != 0.0f)) return false;
   if (d.viewport[0] != 0 || d.viewport[1] != 0 || d.viewport[2] != d.target_width || d.viewport[3] != d.target_height) return false;
   if (d.depth_range[0] != 0.0 || d.depth_range[1] != 1.0) return false;
@@ -521,8 +570,15 @@ void record_draw(DrawCall call, GLenum mode, std::size_t vertices, bool indirect
   else if (!p->position) skip = Skip::NoPosition;
   if (skip == Skip::None && query_open) skip = Skip::OwnQuery;
   if (skip == Skip::None && indirect) skip = Skip::Indirect;
-  d.skipped = static_cast<std::uint32_t>(skip);
   ContextObjects& o = context_objects();
+  // A fixed-function draw is captured by a pass of its own before it: the same draw with the
+  // ftransform program, its rasterization discarded, under transform feedback.
+  GLuint fixed_function = 0;
+  if (skip == Skip::FixedFunction && !query_open && !feedback_active && !indirect) {
+    fixed_function = ftransform_program(o);
+    if (fixed_function != 0) skip = Skip::None;
+  }
+  d.skipped = static_cast<std::uint32_t>(skip);
   std::vector<float> positions;
   // GL writes depth only with the depth test on.
   const bool may_write = (d.flags & kDepthTest) && (d.flags & kDepthMask) && !(d.flags & kRasterizerDiscard) && d.depth_bits > 0;
@@ -555,17 +611,37 @@ void record_draw(DrawCall call, GLenum mode, std::size_t vertices, bool indirect
     const GLint app_buffer = get_int(GL_TRANSFORM_FEEDBACK_BUFFER_BINDING);
     g.glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, o.feedback);
     g.glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, o.buffer);
-    g.glBeginQuery(GL_SAMPLES_PASSED, o.samples);
-    g.glBeginQuery(GL_PRIMITIVES_GENERATED, o.generated);
-    g.glBeginQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, o.written);
-    g.glBeginTransformFeedback(primitive);
-    run();
-    g.glEndTransformFeedback();
-    g.glEndQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN);
-    g.glEndQuery(GL_PRIMITIVES_GENERATED);
-    g.glEndQuery(GL_SAMPLES_PASSED);
-    g.glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, static_cast<GLuint>(app_feedback));
-    g.glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, static_cast<GLuint>(app_buffer));
+    if (fixed_function != 0) {  // the capture pass, then the draw itself with its samples query
+      const bool discarding = g.glIsEnabled(GL_RASTERIZER_DISCARD) != GL_FALSE;
+      g.glUseProgram(fixed_function);
+      g.glEnable(GL_RASTERIZER_DISCARD);
+      g.glBeginQuery(GL_PRIMITIVES_GENERATED, o.generated);
+      g.glBeginQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, o.written);
+      g.glBeginTransformFeedback(primitive);
+      run();
+      g.glEndTransformFeedback();
+      g.glEndQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN);
+      g.glEndQuery(GL_PRIMITIVES_GENERATED);
+      if (!discarding) g.glDisable(GL_RASTERIZER_DISCARD);
+      g.glUseProgram(0);
+      g.glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, static_cast<GLuint>(app_feedback));
+      g.glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, static_cast<GLuint>(app_buffer));
+      g.glBeginQuery(GL_SAMPLES_PASSED, o.samples);
+      run();
+      g.glEndQuery(GL_SAMPLES_PASSED);
+    } else {
+      g.glBeginQuery(GL_SAMPLES_PASSED, o.samples);
+      g.glBeginQuery(GL_PRIMITIVES_GENERATED, o.generated);
+      g.glBeginQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, o.written);
+      g.glBeginTransformFeedback(primitive);
+      run();
+      g.glEndTransformFeedback();
+      g.glEndQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN);
+      g.glEndQuery(GL_PRIMITIVES_GENERATED);
+      g.glEndQuery(GL_SAMPLES_PASSED);
+      g.glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, static_cast<GLuint>(app_feedback));
+      g.glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, static_cast<GLuint>(app_buffer));
+    }
     GLuint64 samples = 0, generated = 0, written = 0;
     g.glGetQueryObjectui64v(o.samples, GL_QUERY_RESULT, &samples);
     g.glGetQueryObjectui64v(o.generated, GL_QUERY_RESULT, &generated);

@@ -174,6 +174,7 @@ TEST(AppsReplayTest, EveryReasonFlagsItsDraw) {
       {Reason::PolygonOffset, [](Draw& d) { d.flags |= kPolygonOffsetFill, d.units = 1.0f; }},
       {Reason::PolygonMode, [](Draw& d) { d.polygon_mode = 0x1B01; }},
       {Reason::Multisample, [](Draw& d) { d.flags |= kMultisample; }},
+      {Reason::ClipDistance, [](Draw& d) { d.flags |= kClipDistance; }},
       {Reason::Viewport, [](Draw& d) { d.viewport[2] = kW / 2; }},
       {Reason::DepthRange, [](Draw& d) { d.far = 0.5f; }},
       {Reason::Scissor, [](Draw& d) { d.flags |= kScissor, d.scissor[1] = 2; }},

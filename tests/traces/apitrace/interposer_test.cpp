@@ -99,6 +99,26 @@ TEST(InterposerTest, ReplayImagesUnchangedByTheRecording) {
   EXPECT_GT(std::filesystem::file_size(dir / "r.raw"), 1000u) << "the library recorded";
 }
 
+// A fixed-function program (neverball: no GLSL program, VBOs and client arrays, user clip planes for
+// its reflections) is captured by the interposer's pass of its own before each draw (the same draw
+// with gl_Position = ftransform() under transform feedback, rasterization discarded): every draw is
+// captured, and every draw the model replays passes GL's samples exactly; clip planes are flagged.
+TEST(InterposerTest, FixedFunctionDrawsCapturedByTheirFtransformPass) {
+  if (!have_eglretrace()) GTEST_SKIP() << "eglretrace not installed (apt install apitrace)";
+  const auto dir = nbsim::testing::scratch_dir("nbsim_interposer_ff");
+  const std::string out = (dir / "neverball.nbt").string();
+  const auto c = run_nbsim("capture apitrace " + (kSamples / "neverball_800x600.trace").string() + " --frames 10:12 -o " + out);
+  ASSERT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("not: fixed function 0,"), std::string::npos) << c.out;
+  const auto r = run_nbsim("compare " + out + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto s = nlohmann::json::parse(r.out)["apps"];
+  EXPECT_EQ(s["flagged_by_reason"].value("not_captured", 0), 0);
+  EXPECT_GT(s["compared"].get<int>(), 500);
+  EXPECT_EQ(s["mismatched"], 0);
+  EXPECT_GT(s["flagged_by_reason"].value("clip_distance", 0), 0) << "the reflections' clip planes";
+}
+
 TEST(InterposerTest, GlmarkScenesReplayDrawByDraw) {
   if (!have_eglretrace()) GTEST_SKIP() << "eglretrace not installed (apt install apitrace)";
   struct Sample {
