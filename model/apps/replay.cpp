@@ -155,8 +155,7 @@ bool AppsReplay::cull_test(Target& t, const scene::DrawRecord& draw, AppDrawCoun
     t.tester_dirty = true;
   }
   // The draw's bounds and its triangles' (per-primitive), from setup, as the path will draw them.
-  raster::DrawState s = raster::draw_state(draw.state);
-  if (t.flipped) s.geometry.face.front_ccw = !s.geometry.face.front_ccw;
+  const raster::DrawState s = draw_state_of(t, draw, true);
   rects_.clear(), nearest_.clear();
   Rect box{};
   float nearest = cull_.op == FarOp::Max ? 1.0f : 0.0f;
@@ -194,19 +193,19 @@ bool AppsReplay::cull_test(Target& t, const scene::DrawRecord& draw, AppDrawCoun
     }
   }
   if (!cull_.primitives) return false;
-  // Each triangle with a bound: one batch.
-  std::vector<Rect> rects;
-  std::vector<float> near;
-  std::vector<std::size_t> index;
-  for (std::size_t i = 0; i < rects_.size(); ++i)
-    if (!rects_[i].empty()) rects.push_back(rects_[i]), near.push_back(nearest_[i]), index.push_back(i);
+  // Each triangle with a bound, as one batch: rects_ and nearest_ compacted to those, index_ the
+  // triangle each came from.
   skip.assign(rects_.size(), 0);
-  if (rects.empty()) return false;
-  tester.query(t.depth, rects, near, answers_);
-  c.primitive_tests = rects.size();
+  index_.clear();
+  for (std::size_t i = 0; i < rects_.size(); ++i)
+    if (!rects_[i].empty()) rects_[index_.size()] = rects_[i], nearest_[index_.size()] = nearest_[i], index_.push_back(i);
+  if (index_.empty()) return false;
+  rects_.resize(index_.size()), nearest_.resize(index_.size());
+  tester.query(t.depth, rects_, nearest_, answers_);
+  c.primitive_tests = index_.size();
   for (std::size_t j = 0; j < answers_.size(); ++j) {
     c.primitive_lookups += answers_[j].lookups;
-    if (answers_[j].hidden) skip[index[j]] = 1, ++c.primitives_culled;
+    if (answers_[j].hidden) skip[index_[j]] = 1, ++c.primitives_culled;
   }
   return false;
 }
@@ -242,13 +241,17 @@ raster::DrawCounters AppsReplay::replay(Target& t, const scene::DrawRecord& draw
   return k;
 }
 
-raster::DrawCounters AppsReplay::replay_untold(Target& t, const scene::DrawRecord& draw, bool has_depth, std::span<const char> skip) {
+raster::DrawState AppsReplay::draw_state_of(const Target& t, const scene::DrawRecord& draw, bool has_depth) {
   raster::DrawState s = raster::draw_state(draw.state);
   if (!draw.state.test) s.depth.write = false;  // GL writes depth only with the test on
   if (!has_depth) s.depth.test = false, s.depth.write = false;  // no depth buffer: every fragment passes
   s.stencil = raster::stencil_state(draw.stencil);
   if (t.flipped) s.geometry.face.front_ccw = !s.geometry.face.front_ccw;  // the winding mirrors with the rows
-  return t.path->draw(draw.clip_positions, s, skip);
+  return s;
+}
+
+raster::DrawCounters AppsReplay::replay_untold(Target& t, const scene::DrawRecord& draw, bool has_depth, std::span<const char> skip) {
+  return t.path->draw(draw.clip_positions, draw_state_of(t, draw, has_depth), skip);
 }
 
 bool AppsReplay::same_change(const Target& t, const std::vector<float>& before, const scene::TechniqueRecord& change, std::uint64_t frame,
@@ -319,7 +322,8 @@ AppFrameCounts AppsReplay::run_frame(const scene::Frame& f) {
     if ((*d.framebuffer)[k] != main_fb || t.width != cull_.width || t.height != cull_.height) return Untested::OtherTarget;
     if (t.stale) return Untested::Stale;
     if (!(fl & kDepthTest) || (*d.bits)[k] == 0 || !fails_behind(draw.state.func, cull_.op)) return Untested::DepthFunc;
-    if (may_write_stencil || (fl & kRasterizerDiscard)) return Untested::StencilWrites;
+    if (fl & kRasterizerDiscard) return Untested::NoTriangles;
+    if (may_write_stencil) return Untested::StencilWrites;
     return Untested::Tested;
   };
 

@@ -131,7 +131,7 @@ enum class Untested : std::uint8_t {
   Stale,         // its target's depth is not known to the model
   DepthFunc,     // the depth test off, or a func that does not fail behind
   StencilWrites, // it may write stencil
-  NoTriangles,   // setup accepts none of its triangles: nothing to draw
+  NoTriangles,   // setup accepts none of its triangles, or rasterization is discarded: nothing to draw
 };
 inline constexpr int kUntested = 7;
 std::string_view to_string(Untested u) noexcept;
@@ -207,6 +207,9 @@ class AppsReplay {
   // may-discard check tells them only when the draw is found equal to GL's).
   raster::DrawCounters replay(Target& t, const scene::DrawRecord& draw, bool has_depth, std::span<const char> skip = {});
   raster::DrawCounters replay_untold(Target& t, const scene::DrawRecord& draw, bool has_depth, std::span<const char> skip = {});
+  // The path's state for a recorded draw into `t` (its depth, cull, winding mirrored in the window,
+  // stencil).
+  static raster::DrawState draw_state_of(const Target& t, const scene::DrawRecord& draw, bool has_depth);
   // Whether the depth the model's draw changed (`before` -> the target now) is GL's recorded change,
   // pixel for pixel and bit for bit.
   bool same_change(const Target& t, const std::vector<float>& before, const scene::TechniqueRecord& change, std::uint64_t frame,
@@ -221,8 +224,9 @@ class AppsReplay {
   std::map<std::uint32_t, Target> targets_;
   CullSettings cull_;
   const Target* mirrored_ = nullptr;  // the target the tester holds
-  std::vector<Rect> rects_;
+  std::vector<Rect> rects_;  // cull_test's scratch: each accepted triangle's query, then the batch
   std::vector<float> nearest_;
+  std::vector<std::size_t> index_;
   std::vector<query::Answer> answers_;
   std::vector<char> skip_;
   std::vector<float> scratch_;  // a target's depth before a draw that may discard

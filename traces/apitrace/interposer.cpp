@@ -611,36 +611,35 @@ void record_draw(DrawCall call, GLenum mode, std::size_t vertices, bool indirect
     const GLint app_buffer = get_int(GL_TRANSFORM_FEEDBACK_BUFFER_BINDING);
     g.glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, o.feedback);
     g.glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, o.buffer);
-    if (fixed_function != 0) {  // the capture pass, then the draw itself with its samples query
-      const bool discarding = g.glIsEnabled(GL_RASTERIZER_DISCARD) != GL_FALSE;
+    // A fixed-function draw: the capture pass (the ftransform program, rasterization discarded),
+    // then the draw itself alone in the samples query; any other: one run inside all three queries.
+    const bool capture_pass = fixed_function != 0;
+    const bool discarding = capture_pass && g.glIsEnabled(GL_RASTERIZER_DISCARD) != GL_FALSE;
+    if (capture_pass) {
       g.glUseProgram(fixed_function);
       g.glEnable(GL_RASTERIZER_DISCARD);
-      g.glBeginQuery(GL_PRIMITIVES_GENERATED, o.generated);
-      g.glBeginQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, o.written);
-      g.glBeginTransformFeedback(primitive);
-      run();
-      g.glEndTransformFeedback();
-      g.glEndQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN);
-      g.glEndQuery(GL_PRIMITIVES_GENERATED);
-      if (!discarding) g.glDisable(GL_RASTERIZER_DISCARD);
-      g.glUseProgram(0);
-      g.glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, static_cast<GLuint>(app_feedback));
-      g.glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, static_cast<GLuint>(app_buffer));
-      g.glBeginQuery(GL_SAMPLES_PASSED, o.samples);
-      run();
-      g.glEndQuery(GL_SAMPLES_PASSED);
     } else {
       g.glBeginQuery(GL_SAMPLES_PASSED, o.samples);
-      g.glBeginQuery(GL_PRIMITIVES_GENERATED, o.generated);
-      g.glBeginQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, o.written);
-      g.glBeginTransformFeedback(primitive);
-      run();
-      g.glEndTransformFeedback();
-      g.glEndQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN);
-      g.glEndQuery(GL_PRIMITIVES_GENERATED);
+    }
+    g.glBeginQuery(GL_PRIMITIVES_GENERATED, o.generated);
+    g.glBeginQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, o.written);
+    g.glBeginTransformFeedback(primitive);
+    run();
+    g.glEndTransformFeedback();
+    g.glEndQuery(GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN);
+    g.glEndQuery(GL_PRIMITIVES_GENERATED);
+    if (capture_pass) {
+      if (!discarding) g.glDisable(GL_RASTERIZER_DISCARD);
+      g.glUseProgram(0);
+    } else {
       g.glEndQuery(GL_SAMPLES_PASSED);
-      g.glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, static_cast<GLuint>(app_feedback));
-      g.glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, static_cast<GLuint>(app_buffer));
+    }
+    g.glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, static_cast<GLuint>(app_feedback));
+    g.glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, static_cast<GLuint>(app_buffer));
+    if (capture_pass) {
+      g.glBeginQuery(GL_SAMPLES_PASSED, o.samples);
+      run();
+      g.glEndQuery(GL_SAMPLES_PASSED);
     }
     GLuint64 samples = 0, generated = 0, written = 0;
     g.glGetQueryObjectui64v(o.samples, GL_QUERY_RESULT, &samples);
