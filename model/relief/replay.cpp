@@ -104,11 +104,13 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   const std::uint64_t pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
   const std::vector<GlReliefFragments> records = read_relief_fragments(f, pixels);
   const FieldView view = gl.view();
-  const ReferenceBlocks blocks(gl.field);
+  std::optional<ReferenceBlocks> blocks;
+  if (scoring_) blocks.emplace(gl.field);
   WalkParams params = gl.params;  // the record's tunables with the capture's covering
   params.covering = covering_;
   reference_.resize(pixels);
-  referenced_.assign(pixels, 0);
+  rays_.resize(pixels);
+  pixel_state_.assign(pixels, kPixelUnknown);
   ReliefFrameCounts out;
   out.size = gl.field.size;
   for (const float r : gl.radius.radius) out.radius_sum += static_cast<std::uint64_t>(r), out.radius_zero += r == 0.0f ? 1 : 0;
@@ -165,6 +167,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
 
     BoxDrawCounts c;
     c.method = r.method;
+    c.scored = scoring_;
     c.storage_bytes = storage_bytes(r.method, gl.field.size, gl.levels);
     c.triangles = k.geometry.prims_out;
     c.blocks = k.depth.blocks;
@@ -176,8 +179,18 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     // The fragments' walks and scores (every pixel's reference computed at most once a frame), in
     // parallel runs of consecutive fragments; each run's lookups go to `lookups` in pixel order.
     fragment_pixels_.clear();
-    for (std::uint32_t px = 0; px < pixels; ++px)
-      if (passed_[px] != 0) fragment_pixels_.push_back(px);
+    {
+      std::uint32_t at = 0;
+      for (; at + 8 <= pixels; at += 8) {  // eight pixels at a time: most of the viewport has no fragment
+        std::uint64_t word;
+        std::memcpy(&word, passed_.data() + at, sizeof word);
+        if (word == 0) continue;
+        for (std::uint32_t b = at; b < at + 8; ++b)
+          if (passed_[b] != 0) fragment_pixels_.push_back(b);
+      }
+      for (; at < pixels; ++at)
+        if (passed_[at] != 0) fragment_pixels_.push_back(at);
+    }
     walks_.resize(fragment_pixels_.size());
     const std::size_t run_count = (fragment_pixels_.size() + kRunFragments - 1) / kRunFragments;
     if (runs_.size() < run_count) runs_.resize(run_count);
@@ -188,61 +201,69 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       const std::size_t end = std::min(fragment_pixels_.size(), (run + 1) * kRunFragments);
       for (std::size_t at = run * kRunFragments; at < end; ++at) {
         const std::uint32_t px = fragment_pixels_[at];
-        const float fx = static_cast<float>(px % static_cast<std::uint32_t>(width_)) + 0.5f;
-        const float fy = static_cast<float>(px / static_cast<std::uint32_t>(width_)) + 0.5f;
-        const std::optional<FragmentRay> ray = fragment_ray(gl.ray, gl.field.size, fx, fy);
+        std::uint8_t& state = pixel_state_[px];
+        if (state == kPixelUnknown) {  // the pixel's first walk this frame: its ray (and, below, its reference)
+          const float fx = static_cast<float>(px % static_cast<std::uint32_t>(width_)) + 0.5f;
+          const float fy = static_cast<float>(px / static_cast<std::uint32_t>(width_)) + 0.5f;
+          const std::optional<FragmentRay> ray = fragment_ray(gl.ray, gl.field.size, fx, fy);
+          state = ray ? kPixelRay : kPixelNoRay;
+          if (ray) rays_[px] = *ray;
+        }
         FragmentWalk& fw = walks_[at];
         fw = FragmentWalk{};
-        if (!ray) continue;
+        if (state == kPixelNoRay) continue;
+        const FragmentRay& ray = rays_[px];
         fw.ray = true;
-        fw.walk = lookups ? walk(r.method, view, params, *ray, lines) : walk(r.method, view, params, *ray);
-        if (!referenced_[px]) reference_[px] = reference_of(gl.field, *ray, &blocks), referenced_[px] = 1;
-        fw.score = score_against(reference_[px], *ray, gl.field.size, fw.walk.hit && !fw.walk.capped, fw.walk.t, box_height, tolerance);
-        if (box_depth_ == BoxDepth::Exact && fw.walk.hit && !fw.walk.capped) fw.depth = hit_depth(gl_depth->texel_to_clip, *ray, fw.walk.t);
+        fw.walk = lookups ? walk(r.method, view, params, ray, lines) : walk(r.method, view, params, ray);
+        if (scoring_) {
+          if (state == kPixelRay) reference_[px] = reference_of(gl.field, ray, &*blocks), state = kPixelReference;
+          fw.score = score_against(reference_[px], ray, gl.field.size, fw.walk.hit && !fw.walk.capped, fw.walk.t, box_height, tolerance);
+        }
+        if (box_depth_ == BoxDepth::Exact && fw.walk.hit && !fw.walk.capped) fw.depth = hit_depth(gl_depth->texel_to_clip, ray, fw.walk.t);
+      }
+    };
+    // The model's fragments (pixel order) against GL's, merged as two sorted pixel lists, run by run
+    // in order on this thread while the workers walk the runs after it.
+    std::size_t g = 0;
+    const auto merge_run = [&](std::size_t run) {
+      const std::size_t end = std::min(fragment_pixels_.size(), (run + 1) * kRunFragments);
+      for (std::size_t at = run * kRunFragments; at < end; ++at) {
+        const std::uint32_t px = fragment_pixels_[at];
+        while (g < r.pixel.size() && r.pixel[g] < px) ++c.pixel_mismatches, ++g;  // GL's alone
+        const bool in_gl = g < r.pixel.size() && r.pixel[g] == px;
+        const FragmentWalk& fw = walks_[at];
+        const WalkResult& w = fw.walk;
+        const std::uint32_t code = w.capped ? 2u : w.hit ? 1u : 0u;
+        if (writes) {
+          hit_[px] = code == 1u ? 1 : 0;
+          if (box_depth_ == BoxDepth::Exact && code == 1u) hit_depth_[px] = fw.depth;
+        }
+        c.lookups += w.lookups, c.steps += w.steps, c.bisections += w.bisections;
+        c.longest_walk = std::max<std::uint64_t>(c.longest_walk, w.lookups);
+        c.hits += code == 1u, c.capped += code == 2u, c.samples += code == 1u;
+        if (fw.ray) {
+          const HitScore& score = fw.score;
+          c.reference_hits += score.reference_hit;
+          c.wrong_hit += score.error == HitError::WrongHit;
+          c.wrong_miss += score.error == HitError::WrongMiss;
+          c.far_hit += score.error == HitError::FarHit;
+          if (code == 1u && score.reference_hit) c.distance_sum += score.distance;
+        }
+        if (!in_gl) {  // the model's alone
+          ++c.pixel_mismatches;
+          continue;
+        }
+        c.gl_lookups += r.lookups[g];
+        const bool same = code == r.hit[g] && std::memcmp(&w.t, &r.t[g], sizeof(float)) == 0 && w.lookups == r.lookups[g] &&
+                          w.steps == r.steps[g] && w.bisections == r.bisections[g];
+        c.walk_mismatches += same ? 0 : 1;
+        ++g;
       }
     };
     pool_.run(run_count, walk_run, [&](std::size_t run) {
       if (lookups) lookups->take(runs_[run]);
+      merge_run(run);
     });
-
-    // The model's fragments (pixel order) against GL's, merged.
-    std::size_t g = 0, fragment = 0;
-    for (std::uint32_t px = 0; px < pixels; ++px) {
-      const bool model = passed_[px] != 0;
-      while (g < r.pixel.size() && r.pixel[g] < px) ++c.pixel_mismatches, ++g;
-      const bool in_gl = g < r.pixel.size() && r.pixel[g] == px;
-      if (!model) {
-        if (in_gl) ++c.pixel_mismatches, ++g;
-        continue;
-      }
-      const FragmentWalk& fw = walks_[fragment++];
-      const WalkResult& w = fw.walk;
-      const std::uint32_t code = w.capped ? 2u : w.hit ? 1u : 0u;
-      if (writes) {
-        hit_[px] = code == 1u ? 1 : 0;
-        if (box_depth_ == BoxDepth::Exact && code == 1u) hit_depth_[px] = fw.depth;
-      }
-      c.lookups += w.lookups, c.steps += w.steps, c.bisections += w.bisections;
-      c.longest_walk = std::max<std::uint64_t>(c.longest_walk, w.lookups);
-      c.hits += code == 1u, c.capped += code == 2u, c.samples += code == 1u;
-      if (fw.ray) {
-        const HitScore& score = fw.score;
-        c.reference_hits += score.reference_hit;
-        c.wrong_hit += score.error == HitError::WrongHit;
-        c.wrong_miss += score.error == HitError::WrongMiss;
-        c.far_hit += score.error == HitError::FarHit;
-        if (code == 1u && score.reference_hit) c.distance_sum += score.distance;
-      }
-      if (!in_gl) {
-        ++c.pixel_mismatches;
-        continue;
-      }
-      c.gl_lookups += r.lookups[g];
-      const bool same = code == r.hit[g] && std::memcmp(&w.t, &r.t[g], sizeof(float)) == 0 && w.lookups == r.lookups[g] &&
-                        w.steps == r.steps[g] && w.bisections == r.bisections[g];
-      c.walk_mismatches += same ? 0 : 1;
-      ++g;
-    }
     c.pixel_mismatches += r.pixel.size() - g;
     if (writes) {  // the write: the hits at the box's depth (early test, late write) or at their own
       raster::DrawState keep = raster::draw_state(d.state);

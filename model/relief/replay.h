@@ -50,6 +50,7 @@ struct BoxDrawCounts {
   std::uint64_t lookups = 0, steps = 0, bisections = 0, hits = 0, capped = 0;
   std::uint64_t gl_lookups = 0;
   std::uint64_t longest_walk = 0;  // most lookups of one fragment
+  bool scored = true;  // the walks were scored against the reference (ReliefReplay::set_scoring); else the five below are 0
   std::uint64_t reference_hits = 0, wrong_hit = 0, wrong_miss = 0, far_hit = 0;
   std::uint64_t errors() const noexcept { return wrong_hit + wrong_miss + far_hit; }
   double distance_sum = 0.0;  // texels between the hit and the reference's, summed over fragments where both hit
@@ -118,6 +119,11 @@ class ReliefReplay {
   ReliefReplay(const ReliefReplay&) = delete;
   ReliefReplay& operator=(const ReliefReplay&) = delete;
 
+  // Whether walks are scored against the exact reference (default yes). Off, no reference is
+  // computed and every BoxDrawCounts score field (reference_hits, wrong_hit, wrong_miss, far_hit,
+  // distance_sum) stays 0, with `scored` false.
+  void set_scoring(bool on) noexcept { scoring_ = on; }
+
   // Runs the frame. `tolerance`: score.h's, texels; `box_height`: the box's height over its width
   // (the trace header's relief_box_height). `lookups` (may be null) sees every lookup of every walk;
   // `draw_done` (may be null) is called after each box draw's walks with its counts.
@@ -130,16 +136,19 @@ class ReliefReplay {
   int width_, height_;
   CoveringSpec covering_;
   BoxDepth box_depth_;
+  bool scoring_ = true;
   DepthImage depth_;
   std::vector<float> before_boxes_;  // the depth before the frame's first box draw
   DepthImage without_box_;           // the scene after a box drawn without it (box_depth_ not none)
   std::vector<std::uint8_t> hit_;     // per pixel: the current box draw's walk hit there
   std::vector<float> hit_depth_;      // and its exact depth (box_depth_ exact)
   std::vector<std::uint8_t> passed_;
-  // The frame's references by pixel (the methods' draws share the frame's rays): computed at the
-  // first draw that walks the pixel.
+  // The frame's rays and references by pixel (the methods' draws share the frame's ray frame):
+  // computed at the first draw that walks the pixel, which pixel_state_ records.
+  static constexpr std::uint8_t kPixelUnknown = 0, kPixelNoRay = 1, kPixelRay = 2, kPixelReference = 3;
+  std::vector<FragmentRay> rays_;
   std::vector<ReferenceHit> reference_;
-  std::vector<std::uint8_t> referenced_;
+  std::vector<std::uint8_t> pixel_state_;
   raster::RasterPath path_;
   raster::RasterPath without_box_path_;
   // A draw's fragments (pixels in order), their walks and scores, and their lookups by run of

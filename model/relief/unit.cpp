@@ -50,6 +50,9 @@ void ReliefUnitConfig::describe(config::Schema& s, ReliefUnitConfig& c) {
   s.add("relief.cache_ways", c.cache_ways, "ways", "texel cache associativity", 1, 64);
   s.add("relief.hit_tolerance_texels", c.hit_tolerance_texels, "texels",
         "a hit farther than this from the exact reference's is a hit error (the height axis in texel units)", 0.0, 1e6);
+  s.add("relief.score", c.score,
+        "score every walk against the exact reference (hit errors); false skips the reference, as the capture's timing leaves out "
+        "GL's own reference pass: the hit-error counts are then null (unscored_draws counts the draws)");
 }
 
 void ReliefUnitConfig::validate() const {
@@ -88,6 +91,7 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
       scene_depth_tests_(stats().counter("scene_depth_tests", "tests", "depth tests of the scene draws (charged at relief.tests_per_cycle)")),
       scene_mismatches_(stats().counter("scene_mismatches", "draws", "scene draws whose samples passed differ from GL's (expected 0)")),
       box_draws_(stats().counter("box_draws", "draws", "relief_box draws replayed")),
+      unscored_draws_(stats().counter("unscored_draws", "draws", "box draws whose walks were not scored (relief.score false)")),
       cache_hits_(stats().counter("cache_hits", "lookups", "lookups the texel cache served")),
       cache_misses_(stats().counter("cache_misses", "lookups", "lookups that missed the texel cache (a line read each)")),
       memory_bytes_(stats().counter("memory_bytes", "bytes", "texel cache line reads on the channel (client relief)")),
@@ -98,6 +102,7 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
       radius_zero_(stats().counter("radius_zero", "texels", "of those, texels with radius 0")) {
   if (!(box_height > 0.0 && std::isfinite(box_height)))
     throw InputError(fmt::format("the relief trace's box height is {}; it must be a positive number", box_height));
+  replay_.set_scoring(config_.score);
   for (Method m : kAllMethods) {
     const std::string p = std::string(to_string(m)) + "_";
     const std::string of = std::string(" (") + std::string(to_string(m)) + ")";
@@ -166,6 +171,7 @@ void ReliefUnit::account(const BoxDrawCounts& d) {
   cache_hits_ += cache_.draw_hits;
   cache_misses_ += cache_.draw_misses;
   ++box_draws_;
+  if (!d.scored) ++unscored_draws_;
   *c.draws += 1, *c.rasterized += d.rasterized, *c.fragments += d.fragments, *c.gl_fragments += d.gl_fragments, *c.samples += d.samples, *c.gl_samples += d.gl_samples;
   *c.pixel_mismatches += d.pixel_mismatches, *c.walk_mismatches += d.walk_mismatches;
   *c.lookups += d.lookups, *c.gl_lookups += d.gl_lookups, *c.steps += d.steps, *c.bisections += d.bisections;

@@ -34,6 +34,7 @@ struct ReliefUnitConfig {
   int cache_line_bytes = 64;               // tunable
   int cache_ways = 4;                      // tunable
   double hit_tolerance_texels = kDefaultHitTolerance;  // score.h's tolerance; tunable
+  bool score = true;  // score every walk against the exact reference (false: no hit errors, as GL's timed passes)
 
   // Declares "relief.<field>".
   static void describe(config::Schema& s, ReliefUnitConfig& c);
@@ -71,7 +72,7 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
   double box_height_;
   ReliefReplay replay_;
   TexelCache cache_;
-  stats::Counter &frames_, &scene_draws_, &scene_depth_tests_, &scene_mismatches_, &box_draws_, &cache_hits_, &cache_misses_, &memory_bytes_, &memory_stall_cycles_, &cycles_,
+  stats::Counter &frames_, &scene_draws_, &scene_depth_tests_, &scene_mismatches_, &box_draws_, &unscored_draws_, &cache_hits_, &cache_misses_, &memory_bytes_, &memory_stall_cycles_, &cycles_,
       &radius_texels_, &radius_sum_, &radius_zero_;
   std::array<PerMethod, kMethods> per_method_{};
 };

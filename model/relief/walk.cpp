@@ -101,7 +101,7 @@ float bilerp(float h00, float h10, float h01, float h11, float fx, float fy) noe
 
 // The height above the surface at t (negative or zero: below), 4 lookups.
 template <class Sink>
-float above(Reader<Sink>& r, const FragmentRay& ray, float t) {
+[[gnu::always_inline]] inline float above(Reader<Sink>& r, const FragmentRay& ray, float t) {
   const float u = along(ray.o[0], t, ray.d[0]) - 0.5f, v = along(ray.o[1], t, ray.d[1]) - 0.5f;
   const int i = floor_int(u), j = floor_int(v);
   const float fx = u - static_cast<float>(i), fy = v - static_cast<float>(j);

@@ -39,13 +39,20 @@ constexpr std::array<const char*, 13> kReliefFrameCounts = {"fragments", "gl_fra
                                                              "lookups", "steps", "errors", "reference_hits", "cycles", "rasterized",
                                                              "depth_written", "depth_mismatches", "scene_hidden"};
 
+// The counts a replay with relief.score false leaves at 0: null in its results, not a perfect score.
+constexpr std::array<const char*, 5> kScoreCounts = {"reference_hits", "wrong_hit", "wrong_miss", "far_hit", "errors"};
+
 void frame_values(const nlohmann::ordered_json& now, const nlohmann::ordered_json& last, nlohmann::ordered_json& pf) {
+  const bool unscored = stat(now, "unscored_draws") != stat(last, "unscored_draws");
   nlohmann::ordered_json methods = nlohmann::ordered_json::object();
   for (relief::Method m : relief::kAllMethods) {
     const std::string prefix = std::string(relief::to_string(m)) + "_";
     if (stat(now, (prefix + "draws").c_str()) == stat(last, (prefix + "draws").c_str())) continue;
     nlohmann::ordered_json v;
     for (const char* name : kReliefFrameCounts) v[name] = stat(now, (prefix + name).c_str()) - stat(last, (prefix + name).c_str());
+    if (unscored)
+      for (const char* name : kScoreCounts)
+        if (v.contains(name)) v[name] = nullptr;
     v["storage_bytes"] = stat(now, (prefix + "storage_bytes").c_str());  // the largest field's so far, not a difference
     methods[std::string(relief::to_string(m))] = v;
   }
@@ -66,6 +73,7 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
   j["radius_zero_fraction"] =
       radius_texels > 0 ? nlohmann::ordered_json(static_cast<double>(stat(p, "radius_zero")) / radius_texels) : nlohmann::ordered_json(nullptr);
   j["channel_bytes"] = stat(memory, "bytes_relief");
+  const bool unscored = stat(p, "unscored_draws") > 0;  // relief.score false: no hit errors
   nlohmann::ordered_json methods = nlohmann::ordered_json::object();
   for (relief::Method m : relief::kAllMethods) {
     const std::string prefix = std::string(relief::to_string(m)) + "_";
@@ -87,6 +95,11 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
     const std::uint64_t both = v("hits") - std::min(v("hits"), v("wrong_hit"));
     e["mean_hit_distance"] = both ? nlohmann::ordered_json(static_cast<double>(v("distance_microtexels")) * 1e-6 / static_cast<double>(both))
                                   : nlohmann::ordered_json(nullptr);
+    if (unscored) {
+      for (const char* name : kScoreCounts) e[name] = nullptr;
+      e["error_rate"] = nullptr;
+      e["mean_hit_distance"] = nullptr;
+    }
     e["cycles_per_frame"] = stat(p, "frames") ? nlohmann::ordered_json(static_cast<double>(v("cycles")) / static_cast<double>(stat(p, "frames")))
                                               : nlohmann::ordered_json(nullptr);
     methods[std::string(relief::to_string(m))] = e;
@@ -96,14 +109,14 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
   std::uint64_t fragments = 0, lookups = 0, errors = 0, walk_mismatches = 0, pixel_mismatches = 0, depth_mismatches = 0;
   for (const auto& [name, e] : methods.items()) {
     fragments += e["fragments"].get<std::uint64_t>(), lookups += e["lookups"].get<std::uint64_t>();
-    errors += e["errors"].get<std::uint64_t>(), walk_mismatches += e["walk_mismatches"].get<std::uint64_t>();
+    errors += e["errors"].is_number() ? e["errors"].get<std::uint64_t>() : 0, walk_mismatches += e["walk_mismatches"].get<std::uint64_t>();
     pixel_mismatches += e["pixel_mismatches"].get<std::uint64_t>(), depth_mismatches += e["depth_mismatches"].get<std::uint64_t>();
   }
   j["fragments"] = fragments;
   j["lookups"] = lookups;
   j["lookups_per_fragment"] = fragments ? nlohmann::ordered_json(static_cast<double>(lookups) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
-  j["errors"] = errors;
-  j["error_rate"] = fragments ? nlohmann::ordered_json(static_cast<double>(errors) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
+  j["errors"] = unscored ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(errors);
+  j["error_rate"] = unscored ? nlohmann::ordered_json(nullptr) : fragments ? nlohmann::ordered_json(static_cast<double>(errors) / static_cast<double>(fragments)) : nlohmann::ordered_json(nullptr);
   j["walk_mismatches"] = walk_mismatches;
   j["pixel_mismatches"] = pixel_mismatches;
   j["depth_mismatches"] = depth_mismatches;
@@ -141,7 +154,7 @@ std::string describe(const nlohmann::ordered_json& s) {
                        name, m["fragments"].get<std::uint64_t>(), m["gl_fragments"].get<std::uint64_t>(), m["samples"].get<std::uint64_t>(),
                        m["gl_samples"].get<std::uint64_t>(), m["walk_mismatches"].get<std::uint64_t>(),
                        m["pixel_mismatches"].get<std::uint64_t>(), m["lookups_per_fragment"].is_number() ? m["lookups_per_fragment"].get<double>() : 0.0,
-                       m["errors"].get<std::uint64_t>());
+                       m["errors"].is_number() ? fmt::format("{}", m["errors"].get<std::uint64_t>()) : std::string("not scored"));
   return out;
 }
 

@@ -56,6 +56,8 @@ nlohmann::ordered_json relief_rows(const std::vector<nlohmann::json>& runs, cons
       if (!f.contains("relief")) continue;
       const std::uint64_t frame = u(f, "frame");
       for (const auto& [method, v] : f["relief"].items()) {
+        if (v.contains("errors") && v["errors"].is_null())
+          throw InputError("'" + traces[i] + "' was replayed with relief.score=false: the table needs the walks' hit errors");
         nlohmann::ordered_json r;
         r["trace"] = traces[i];
         r["field"] = props.value("relief_field", "");

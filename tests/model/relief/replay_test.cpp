@@ -263,5 +263,40 @@ TEST(ReliefReplayThreadsTest, CountsDoNotDependOnThreads) {
   }
 }
 
+// Unscored walks (set_scoring(false), the bench's replay): every count but the five scores is the
+// scored replay's, with the same cache outcomes, and the scores are 0 with `scored` false.
+TEST(ReliefReplayScoringTest, UnscoredWalksCountAsScoredOnes) {
+  constexpr int kWidth = 64, kHeight = 48;
+  const Field f;
+  const scene::Frame frame = box_frame(f, kWidth);
+  const auto replay = [&](bool scoring) {
+    ReliefReplay r(kWidth, kHeight, true, {}, BoxDepth::None, 2);
+    r.set_scoring(scoring);
+    TexelCache cache(memory::CacheConfig{16 * 1024, 64, 4});
+    DrawCache draws{&cache, {}};
+    cache.invalidate();
+    const ReliefFrameCounts counts = r.run_frame(frame, 0.25, 0.25, &cache, &draws, &DrawCache::done);
+    return std::pair{counts, draws.per_draw};
+  };
+  const auto [scored, scored_cache] = replay(true);
+  const auto [unscored, unscored_cache] = replay(false);
+  EXPECT_EQ(unscored_cache, scored_cache);
+  ASSERT_EQ(unscored.draws.size(), scored.draws.size());
+  std::uint64_t reference_hits = 0;
+  for (std::size_t k = 0; k < scored.draws.size(); ++k) {
+    const BoxDrawCounts &a = scored.draws[k], &b = unscored.draws[k];
+    EXPECT_TRUE(a.scored);
+    EXPECT_FALSE(b.scored);
+    EXPECT_TRUE(a.fragments == b.fragments && a.samples == b.samples && a.pixel_mismatches == b.pixel_mismatches &&
+                a.walk_mismatches == b.walk_mismatches && a.lookups == b.lookups && a.steps == b.steps && a.bisections == b.bisections &&
+                a.hits == b.hits && a.capped == b.capped && a.longest_walk == b.longest_walk)
+        << to_string(a.method);
+    EXPECT_EQ(b.reference_hits + b.wrong_hit + b.wrong_miss + b.far_hit, 0u) << to_string(b.method);
+    EXPECT_EQ(b.distance_sum, 0.0);
+    reference_hits += a.reference_hits;
+  }
+  EXPECT_GT(reference_hits, 0u) << "the scored replay computed references";
+}
+
 }  // namespace
 }  // namespace nbsim::relief

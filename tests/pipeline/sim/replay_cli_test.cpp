@@ -258,6 +258,35 @@ TEST(ReplayCliTest, ProgramOffReplaysTheRecordedDraws) {
   EXPECT_EQ(bad.status, 2) << bad.err;
   EXPECT_TRUE(has(bad.err, "gpu.program")) << bad.err;
 }
+// relief.score=false (the bench's replay) leaves out the exact reference: the hit-error counts are
+// null, not 0, every other count is the scored replay's, and the relief table refuses the run.
+TEST(ReplayCliTest, ReliefUnscoredReplayNullsTheHitErrors) {
+  const CliResult scored = run_nbsim("compare " + sample("relief_fbm_64.nbt") + " --json");
+  ASSERT_EQ(scored.status, 0) << scored.err;
+  const CliResult unscored = run_nbsim("compare " + sample("relief_fbm_64.nbt") + " --json --set relief.score=false");
+  ASSERT_EQ(unscored.status, 0) << unscored.err;
+  const nlohmann::json a = nlohmann::json::parse(scored.out)["relief"], b = nlohmann::json::parse(unscored.out)["relief"];
+  EXPECT_TRUE(a["errors"].is_number());
+  EXPECT_TRUE(b["errors"].is_null());
+  EXPECT_TRUE(b["error_rate"].is_null());
+  EXPECT_EQ(a["cycles"], b["cycles"]);
+  EXPECT_EQ(a["cache_misses"], b["cache_misses"]);
+  for (const auto& [method, m] : a["methods"].items()) {
+    const nlohmann::json& u = b["methods"][method];
+    for (const char* k : {"reference_hits", "wrong_hit", "wrong_miss", "far_hit", "errors", "error_rate", "mean_hit_distance"})
+      EXPECT_TRUE(u[k].is_null()) << method << " " << k;
+    for (const char* k : {"fragments", "samples", "lookups", "steps", "bisections", "hits", "cycles", "walk_mismatches", "pixel_mismatches"})
+      EXPECT_EQ(u[k], m[k]) << method << " " << k;
+  }
+  const fs::path out = scratch("relief_unscored");
+  ASSERT_EQ(run_nbsim("replay " + sample("relief_fbm_64.nbt") + " --out " + out.string() + " --set relief.score=false").status, 0);
+  const nlohmann::json run = read_json(out / "run.json");
+  for (const auto& [method, v] : run["frames"][0]["relief"].items()) {
+    EXPECT_TRUE(v["errors"].is_null()) << method;
+    EXPECT_TRUE(v["fragments"].is_number()) << method;
+  }
+}
+
 // A damaged trace is refused by replay with exit 2 and the chunk named.
 TEST(ReplayCliTest, RefusesDamagedTrace) {
   const fs::path t = scratch("damaged.nbt");

@@ -570,7 +570,8 @@ const std::vector<OptionSpec>& relief_options() {
 
 BenchPreset relief_bench_preset() {
   // The box is seen from its own camera: no scene is built (relief_technique's no_scene); --size is the viewport.
-  return {"boxes", "fly", "512x512", {{"field", "fbm"}, {"field-size", "128"}}, "field", {}};
+  // The replay leaves out the exact reference, as the capture's timing leaves out GL's reference pass.
+  return {"boxes", "fly", "512x512", {{"field", "fbm"}, {"field-size", "128"}}, "field", {"relief.score=false"}};
 }
 
 std::unique_ptr<Technique> make_relief(const TechniqueSetup& setup) { return std::make_unique<Relief>(setup); }

@@ -81,6 +81,18 @@ TEST(ReliefTableTest, RunOfAnotherTechniqueRefused) {
   EXPECT_THROW(relief_rows({no_frames}, {"q.nbt"}), nbsim::InputError);
 }
 
+// A replay with relief.score=false has null hit errors: the table refuses it rather than read 0.
+TEST(ReliefTableTest, UnscoredRunRefused) {
+  json methods = {{"exact", method_values(100, 800, 0, 5000)}};
+  methods["exact"]["errors"] = nullptr;
+  try {
+    relief_rows({relief_run("fbm", 64, methods, 1)}, {"u.nbt"});
+    FAIL() << "an unscored run gave rows";
+  } catch (const nbsim::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("relief.score=false"), std::string::npos) << e.what();
+  }
+}
+
 // Ranking: mean cycles a frame, error rate over all fragments; a method is on the front unless
 // another is at most as costly and as wrong and better in one.
 TEST(ReliefTableTest, RankingOrdersByCyclesAndMarksTheParetoFront) {
