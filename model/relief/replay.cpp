@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstring>
 #include <optional>
 #include <span>
@@ -119,6 +120,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   const bool writes = box_depth_ != BoxDepth::None;
   const std::optional<GlReliefDepth> gl_depth = read_relief_depth(f, writes);
   std::size_t next_record = 0, box_draw = 0;
+  on_demand_.reset();  // the frame's heights are its own
   std::fill(depth_.texels.begin(), depth_.texels.end(), 1.0f);  // the frame's depth buffer: the scene's, then tested by the boxes
   // A box draw's counts are handed on once the scene draws after it are counted too.
   std::optional<BoxDrawCounts> open;
@@ -260,10 +262,37 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
         ++g;
       }
     };
+    // The N-buffer walk's level reads, computed on demand (in the walks' order, on this thread).
+    const bool levels = r.method == Method::NBuffer && lookups;
+    UpdateStats demand;
+    if (levels && !on_demand_) {
+      const int n = gl.field.size;
+      on_demand_.emplace(n, n, NBufferConfig{FarOp::Max, StorageFormat::F32, -1});
+      on_demand_->set_on_demand(true);
+      DepthImage heights;
+      heights.width = heights.height = n;
+      heights.texels = gl.field.heights;
+      on_demand_->update(heights, Rect{0, 0, n, n});
+      c.levels_eager_texels = static_cast<std::uint64_t>(gl.levels - 1) * static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(n);
+    }
+    if (levels) demand = on_demand_->new_stats();
+    const auto demand_run = [&](std::size_t run) {
+      const std::uint64_t plane = static_cast<std::uint64_t>(gl.field.size) * static_cast<std::uint64_t>(gl.field.size);
+      for (const std::uint32_t index : runs_[run].level_texels()) {
+        const int level = static_cast<int>(index / plane);
+        const std::uint64_t at = index % plane;
+        const int x = static_cast<int>(at % static_cast<std::uint64_t>(gl.field.size)), y = static_cast<int>(at / static_cast<std::uint64_t>(gl.field.size));
+        on_demand_->ensure(level, x, y, demand);
+        c.levels_on_demand_mismatches += std::bit_cast<std::uint32_t>(on_demand_->texel(level, x, y)) != std::bit_cast<std::uint32_t>(gl.nbuffer[index]);
+      }
+    };
     pool_.run(run_count, walk_run, [&](std::size_t run) {
       if (lookups) lookups->take(runs_[run]);
+      if (levels) demand_run(run);
       merge_run(run);
     });
+    if (levels)
+      for (std::size_t l = 1; l < demand.texels_recomputed.size(); ++l) c.levels_on_demand_texels += static_cast<std::uint64_t>(demand.texels_recomputed[l]);
     c.pixel_mismatches += r.pixel.size() - g;
     if (writes) {  // the write: the hits at the box's depth (early test, late write) or at their own
       raster::DrawState keep = raster::draw_state(d.state);

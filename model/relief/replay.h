@@ -24,10 +24,12 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "model/common/depth.h"
 #include "model/memory/memory.h"
+#include "model/nbuffer/nbuffer.h"
 #include "model/raster/raster_path.h"
 #include "model/relief/box_depth.h"
 #include "model/relief/records.h"
@@ -61,6 +63,12 @@ struct BoxDrawCounts {
   // differs from GL's (its RLFD CRC), else 0; the scene draws after it (placement city), the samples
   // they passed and the fragments of theirs the box's depth hid.
   std::uint64_t depth_written = 0, depth_mismatches = 0;
+  // The N-buffer walk (method nbuffer) against an on-demand N-buffer of the heightfield: the level
+  // texels above 0 a full build computes (eager: (levels - 1) N^2, charged to the frame's first
+  // nbuffer draw), those an on-demand build computes for the texels the walks read (each from the
+  // level below, recursively, kept for the frame's later draws; from a cleared N-buffer), and read
+  // texels whose on-demand value differs from the full build's the walks read (expected 0).
+  std::uint64_t levels_eager_texels = 0, levels_on_demand_texels = 0, levels_on_demand_mismatches = 0;
   std::uint64_t scene_after_draws = 0, scene_after_samples = 0, scene_hidden = 0;
 };
 
@@ -164,6 +172,8 @@ class ReliefReplay {
   std::vector<FragmentWalk> walks_;
   std::vector<LookupLines> runs_;
   WorkerPool pool_;
+  // The frame's on-demand N-buffer of the heights (made at its first nbuffer draw).
+  std::optional<NBuffer> on_demand_;
 };
 
 }  // namespace nbsim::relief

@@ -141,6 +141,11 @@ ReliefUnit::ReliefUnit(const sc_core::sc_module_name& name, stats::Registry& reg
     c.scene_after_draws = counter("scene_after_draws", "draws", "scene draws after the box draws (placement city)");
     c.scene_after_samples = counter("scene_after_samples", "samples", "samples those scene draws passed");
     c.scene_hidden = counter("scene_hidden", "fragments", "fragments of those scene draws the box's depth hid");
+    c.levels_eager_texels = counter("levels_eager_texels", "texels", "N-buffer level texels above 0 a full build per frame computes (nbuffer)");
+    c.levels_on_demand_texels = counter("levels_on_demand_texels", "texels",
+                                        "level texels above 0 an on-demand build computes for the texels the walks read (nbuffer)");
+    c.levels_on_demand_mismatches = counter("levels_on_demand_mismatches", "texels",
+                                            "read level texels whose on-demand value differs from the full build's (expected 0)");
   }
 }
 
@@ -182,6 +187,8 @@ void ReliefUnit::account(const BoxDrawCounts& d) {
   *c.cache_misses += cache_.draw_misses;
   c.storage_bytes->raise_to(d.storage_bytes);
   *c.depth_written += d.depth_written, *c.depth_mismatches += d.depth_mismatches;
+  *c.levels_eager_texels += d.levels_eager_texels, *c.levels_on_demand_texels += d.levels_on_demand_texels;
+  *c.levels_on_demand_mismatches += d.levels_on_demand_mismatches;
   *c.scene_after_draws += d.scene_after_draws, *c.scene_after_samples += d.scene_after_samples, *c.scene_hidden += d.scene_hidden;
   cache_.draw_misses = cache_.draw_hits = 0;
 }

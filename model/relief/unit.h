@@ -63,7 +63,7 @@ class ReliefUnit : public sim::Unit, public cp::FrameProgram {
     stats::Counter *draws, *rasterized, *fragments, *gl_fragments, *samples, *gl_samples, *pixel_mismatches, *walk_mismatches, *lookups,
         *gl_lookups, *steps, *bisections, *hits, *capped, *reference_hits, *wrong_hit, *wrong_miss, *far_hit, *errors,
         *distance_microtexels, *cycles, *cache_misses, *storage_bytes, *depth_written, *depth_mismatches, *scene_after_draws,
-        *scene_after_samples, *scene_hidden;
+        *scene_after_samples, *scene_hidden, *levels_eager_texels, *levels_on_demand_texels, *levels_on_demand_mismatches;
   };
 
   ReliefUnitConfig config_;

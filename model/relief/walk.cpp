@@ -82,7 +82,10 @@ struct ObserverSink {
 // The recording sink: virtual border texels need no memory and are left out.
 struct LinesSink {
   LookupLines& lines;
-  void operator()(Texture t, std::int64_t index) const { lines.add(texel_address(t, index)); }
+  void operator()(Texture t, std::int64_t index) const {
+    lines.add(texel_address(t, index));
+    if (t == Texture::NBuffer) lines.add_level_texel(index);
+  }
   void pair(Texture t, std::int64_t index) const { lines.add_pair(texel_address(t, index), texel_address(t, index + 1)); }
   void border(Texture) const noexcept {}
 };

@@ -147,6 +147,7 @@ class alignas(64) LookupLines {
     last_.assign(set_mask_ + 1, kNone);
     size_ = 0;
     repeats_ = 0;
+    level_texels_.clear();
   }
   void add(std::uint64_t address) {
     const std::uint64_t line = address >> line_shift_;
@@ -175,6 +176,10 @@ class alignas(64) LookupLines {
   }
   std::span<const std::uint64_t> lines() const noexcept { return {storage_.data(), size_}; }
   std::uint64_t repeats() const noexcept { return repeats_; }
+  // The N-buffer level texels the walks read (their indices in FieldView::nbuffer, repeats kept),
+  // for the replay's on-demand N-buffer: which texels a build on demand would have had to compute.
+  void add_level_texel(std::int64_t index) { level_texels_.push_back(static_cast<std::uint32_t>(index)); }
+  std::span<const std::uint32_t> level_texels() const noexcept { return level_texels_; }
 
  private:
   static constexpr std::uint64_t kNone = ~std::uint64_t{0};  // no line (addresses are multiples of 4)
@@ -186,6 +191,7 @@ class alignas(64) LookupLines {
   std::vector<std::uint64_t> storage_;
   std::size_t size_ = 0;
   std::uint64_t repeats_ = 0;
+  std::vector<std::uint32_t> level_texels_;
 };
 
 // The ray of pixel centre (px, py) clipped to the box: false when it misses the box.

@@ -95,6 +95,12 @@ nlohmann::ordered_json totals(const nlohmann::ordered_json& p, const nlohmann::o
     const std::uint64_t both = v("hits") - std::min(v("hits"), v("wrong_hit"));
     e["mean_hit_distance"] = both ? nlohmann::ordered_json(static_cast<double>(v("distance_microtexels")) * 1e-6 / static_cast<double>(both))
                                   : nlohmann::ordered_json(nullptr);
+    if (m == relief::Method::NBuffer) {  // the levels the walks read, on demand, against a full build a frame
+      for (const char* name : {"levels_eager_texels", "levels_on_demand_texels", "levels_on_demand_mismatches"}) e[name] = v(name);
+      e["levels_on_demand_share"] = v("levels_eager_texels") ? nlohmann::ordered_json(static_cast<double>(v("levels_on_demand_texels")) /
+                                                                                        static_cast<double>(v("levels_eager_texels")))
+                                                             : nlohmann::ordered_json(nullptr);
+    }
     if (unscored) {
       for (const char* name : kScoreCounts) e[name] = nullptr;
       e["error_rate"] = nullptr;
@@ -140,7 +146,7 @@ nlohmann::ordered_json summary(const SummaryInputs& in) {
 bool exact(const nlohmann::ordered_json& s) {
   if (s.value("scene_mismatches", 0) != 0) return false;
   for (const auto& [name, m] : s["methods"].items())
-    if (m.value("pixel_mismatches", 0) != 0 || m.value("walk_mismatches", 0) != 0 || m.value("fragments", 0) != m.value("gl_fragments", 0) ||
+    if (m.value("pixel_mismatches", 0) != 0 || m.value("walk_mismatches", 0) != 0 || m.value("levels_on_demand_mismatches", 0) != 0 || m.value("fragments", 0) != m.value("gl_fragments", 0) ||
         m.value("samples", 0) != m.value("gl_samples", 0) || m.value("depth_mismatches", 0) != 0)
       return false;
   return true;

@@ -2,7 +2,8 @@
 // (occlusion culling's `nbuffer`, particles' `nbuffer`, shadows' `litmap_min` and `litmap_max`),
 // replayed eager and on demand through `nbsim compare`: every decision is the same (culled objects,
 // sprites and casters, false culls, popping, GL mismatches), and the upkeep (texels computed for
-// the levels) is smaller on these samples.
+// the levels) is smaller on these samples; relief's N-buffer walk reads what an on-demand build of
+// the heightfield's levels computes.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -53,6 +54,17 @@ TEST(OnDemandReplayTest, SamplesDecideAsEager) {
     for (const char* k : s.decisions) EXPECT_EQ(e[k], o[k]) << k;
     EXPECT_LT(o[s.upkeep].get<double>(), e[s.upkeep].get<double>()) << "the upkeep follows the queries";
   }
+}
+
+// Relief's N-buffer walk reads the heightfield's levels as GL built them in full; the replay
+// computes every texel it read on demand as well (from a cleared N-buffer, each from the level
+// below, recursively, kept for the frame) and compares: the same values, for part of the texels.
+TEST(OnDemandReplayTest, ReliefWalksReadWhatAnOnDemandBuildComputes) {
+  const nlohmann::json m = summary(std::string(NBSIM_SAMPLES) + "/relief_fbm_64.nbt", "relief")["methods"]["nbuffer"];
+  EXPECT_EQ(m["levels_on_demand_mismatches"].get<long>(), 0);
+  EXPECT_GT(m["levels_on_demand_texels"].get<long>(), 0);
+  EXPECT_LT(m["levels_on_demand_texels"].get<long>(), m["levels_eager_texels"].get<long>()) << "the walks read part of the levels";
+  EXPECT_EQ(m["levels_eager_texels"].get<long>(), 4 * 5 * 64 * 64) << "four frames of five levels above 0 at 64x64";
 }
 
 }  // namespace

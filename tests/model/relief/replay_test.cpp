@@ -298,5 +298,33 @@ TEST(ReliefReplayScoringTest, UnscoredWalksCountAsScoredOnes) {
   EXPECT_GT(reference_hits, 0u) << "the scored replay computed references";
 }
 
+// The N-buffer walk's level reads computed on demand: the same values as the full build it read,
+// part of the texels, the same counts for any thread count, and nothing for the other methods.
+TEST(ReliefReplayLevelsTest, OnDemandLevelsEqualTheFullBuild) {
+  constexpr int kWidth = 64, kHeight = 48;
+  const Field f;
+  const scene::Frame frame = box_frame(f, kWidth);
+  const auto replay = [&](int threads) {
+    ReliefReplay r(kWidth, kHeight, true, {}, BoxDepth::None, threads);
+    TexelCache cache(memory::CacheConfig{16 * 1024, 64, 4});
+    cache.invalidate();
+    return r.run_frame(frame, 0.25, 0.25, &cache);
+  };
+  const ReliefFrameCounts one = replay(1), two = replay(2);
+  const int levels = nbuffer_level_count(kN, kN);
+  for (std::size_t k = 0; k < one.draws.size(); ++k) {
+    const BoxDrawCounts& d = one.draws[k];
+    EXPECT_EQ(d.levels_on_demand_mismatches, 0u) << to_string(d.method);
+    EXPECT_EQ(d.levels_on_demand_texels, two.draws[k].levels_on_demand_texels) << to_string(d.method);
+    if (d.method != Method::NBuffer) {
+      EXPECT_EQ(d.levels_eager_texels + d.levels_on_demand_texels, 0u) << to_string(d.method);
+      continue;
+    }
+    EXPECT_EQ(d.levels_eager_texels, static_cast<std::uint64_t>(levels - 1) * kN * kN);
+    EXPECT_GT(d.levels_on_demand_texels, 0u);
+    EXPECT_LT(d.levels_on_demand_texels, d.levels_eager_texels);
+  }
+}
+
 }  // namespace
 }  // namespace nbsim::relief
