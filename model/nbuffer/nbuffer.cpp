@@ -396,6 +396,13 @@ long long NBuffer::current_texels(int level) const noexcept {
   return std::count(begin, begin + static_cast<std::ptrdiff_t>(pixels()), std::uint8_t{1});
 }
 
+void NBuffer::replace_on_demand(const DepthImage& depth) {
+  NBSIM_CHECK(on_demand_, "replace_on_demand needs an on-demand N-buffer");
+  NBSIM_CHECK(depth.width == width_ && depth.height == height_, "depth image size differs from the N-buffer's");
+  std::copy(depth.texels.begin(), depth.texels.end(), level_ptr(0));
+  std::fill(current_.begin() + static_cast<std::ptrdiff_t>(offset(1)), current_.end(), std::uint8_t{0});
+}
+
 void NBuffer::ensure(int level, int x, int y, UpdateStats& stats) {
   NBSIM_CHECK(level >= 0 && level < levels_ && x >= 0 && y >= 0 && x < width_ && y < height_, "N-buffer texel out of range");
   if (!on_demand_ || level == 0) return;

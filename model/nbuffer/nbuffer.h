@@ -124,6 +124,9 @@ class NBuffer {
   void ensure(int level, int x, int y, UpdateStats& stats);
   // Makes every texel current (before the levels are read out whole).
   void ensure_all(UpdateStats& stats);
+  // On demand: level 0 replaced by `depth` (same size) and every texel above it stale, as after a
+  // clear and a new level 0 (no texel above level 0 computed, none invalidated one by one).
+  void replace_on_demand(const DepthImage& depth);
   // Texels of `level` that are current (every one when not on demand).
   long long current_texels(int level) const noexcept;
   UpdateStats new_stats() const;

@@ -99,6 +99,35 @@ ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, Cove
   }
 }
 
+// The level texels the walks read (level_marks_), computed by the frame's on-demand N-buffer of the
+// heights (made at its first nbuffer draw, where a full build's texels are charged) and compared
+// with the full build's. Which texels an on-demand build computes does not depend on the order.
+void ReliefReplay::on_demand_levels(const GlReliefField& gl, BoxDrawCounts& c) {
+  const int n = gl.field.size;
+  if (!on_demand_fresh_) {  // the frame's first nbuffer draw
+    if (!on_demand_ || on_demand_->width() != n) {
+      on_demand_.emplace(n, n, NBufferConfig{FarOp::Max, StorageFormat::F32, -1});
+      on_demand_->set_on_demand(true);
+    }
+    DepthImage heights;
+    heights.width = heights.height = n;
+    heights.texels = gl.field.heights;
+    on_demand_->replace_on_demand(heights);
+    on_demand_fresh_ = true;
+    c.levels_eager_texels = static_cast<std::uint64_t>(gl.levels - 1) * static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(n);
+  }
+  UpdateStats demand = on_demand_->new_stats();
+  const std::size_t plane = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  for (std::size_t index = 0; index < level_marks_.size(); ++index) {
+    if (!level_marks_[index]) continue;
+    const int level = static_cast<int>(index / plane);
+    const int x = static_cast<int>(index % plane % static_cast<std::size_t>(n)), y = static_cast<int>(index % plane / static_cast<std::size_t>(n));
+    on_demand_->ensure(level, x, y, demand);
+    c.levels_on_demand_mismatches += std::bit_cast<std::uint32_t>(on_demand_->texel(level, x, y)) != std::bit_cast<std::uint32_t>(gl.nbuffer[index]);
+  }
+  for (std::size_t l = 1; l < demand.texels_recomputed.size(); ++l) c.levels_on_demand_texels += static_cast<std::uint64_t>(demand.texels_recomputed[l]);
+}
+
 ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double tolerance, double box_height, LookupSink* lookups,
                                           void* context, void (*draw_done)(void* context, const BoxDrawCounts& draw)) {
   const GlReliefField gl = read_relief_field(f);
@@ -120,7 +149,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   const bool writes = box_depth_ != BoxDepth::None;
   const std::optional<GlReliefDepth> gl_depth = read_relief_depth(f, writes);
   std::size_t next_record = 0, box_draw = 0;
-  on_demand_.reset();  // the frame's heights are its own
+  on_demand_fresh_ = false;  // the frame's heights are its own
   std::fill(depth_.texels.begin(), depth_.texels.end(), 1.0f);  // the frame's depth buffer: the scene's, then tested by the boxes
   // A box draw's counts are handed on once the scene draws after it are counted too.
   std::optional<BoxDrawCounts> open;
@@ -262,37 +291,15 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
         ++g;
       }
     };
-    // The N-buffer walk's level reads, computed on demand (in the walks' order, on this thread).
+    // The N-buffer walk's level reads, marked by the walks, then computed on demand.
     const bool levels = r.method == Method::NBuffer && lookups;
-    UpdateStats demand;
-    if (levels && !on_demand_) {
-      const int n = gl.field.size;
-      on_demand_.emplace(n, n, NBufferConfig{FarOp::Max, StorageFormat::F32, -1});
-      on_demand_->set_on_demand(true);
-      DepthImage heights;
-      heights.width = heights.height = n;
-      heights.texels = gl.field.heights;
-      on_demand_->update(heights, Rect{0, 0, n, n});
-      c.levels_eager_texels = static_cast<std::uint64_t>(gl.levels - 1) * static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(n);
-    }
-    if (levels) demand = on_demand_->new_stats();
-    const auto demand_run = [&](std::size_t run) {
-      const std::uint64_t plane = static_cast<std::uint64_t>(gl.field.size) * static_cast<std::uint64_t>(gl.field.size);
-      for (const std::uint32_t index : runs_[run].level_texels()) {
-        const int level = static_cast<int>(index / plane);
-        const std::uint64_t at = index % plane;
-        const int x = static_cast<int>(at % static_cast<std::uint64_t>(gl.field.size)), y = static_cast<int>(at / static_cast<std::uint64_t>(gl.field.size));
-        on_demand_->ensure(level, x, y, demand);
-        c.levels_on_demand_mismatches += std::bit_cast<std::uint32_t>(on_demand_->texel(level, x, y)) != std::bit_cast<std::uint32_t>(gl.nbuffer[index]);
-      }
-    };
+    if (levels) level_marks_.assign(gl.nbuffer.size(), 0);
+    for (std::size_t run = 0; run < run_count; ++run) runs_[run].mark_levels(levels ? level_marks_.data() : nullptr);
     pool_.run(run_count, walk_run, [&](std::size_t run) {
       if (lookups) lookups->take(runs_[run]);
-      if (levels) demand_run(run);
       merge_run(run);
     });
-    if (levels)
-      for (std::size_t l = 1; l < demand.texels_recomputed.size(); ++l) c.levels_on_demand_texels += static_cast<std::uint64_t>(demand.texels_recomputed[l]);
+    if (levels) on_demand_levels(gl, c);
     c.pixel_mismatches += r.pixel.size() - g;
     if (writes) {  // the write: the hits at the box's depth (early test, late write) or at their own
       raster::DrawState keep = raster::draw_state(d.state);

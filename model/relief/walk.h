@@ -37,6 +37,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -147,7 +148,6 @@ class alignas(64) LookupLines {
     last_.assign(set_mask_ + 1, kNone);
     size_ = 0;
     repeats_ = 0;
-    level_texels_.clear();
   }
   void add(std::uint64_t address) {
     const std::uint64_t line = address >> line_shift_;
@@ -176,10 +176,17 @@ class alignas(64) LookupLines {
   }
   std::span<const std::uint64_t> lines() const noexcept { return {storage_.data(), size_}; }
   std::uint64_t repeats() const noexcept { return repeats_; }
-  // The N-buffer level texels the walks read (their indices in FieldView::nbuffer, repeats kept),
-  // for the replay's on-demand N-buffer: which texels a build on demand would have had to compute.
-  void add_level_texel(std::int64_t index) { level_texels_.push_back(static_cast<std::uint32_t>(index)); }
-  std::span<const std::uint32_t> level_texels() const noexcept { return level_texels_; }
+  // Marks the N-buffer level texels the walks read, one byte a texel of FieldView::nbuffer (null:
+  // none marked), for the replay's on-demand N-buffer: which texels a build on demand computes.
+  // Records walked at once on several threads may share the marks (relaxed: a mark is only ever set
+  // to 1, and set once, so that threads reading the same texels do not keep taking the line from
+  // each other).
+  void mark_levels(std::uint8_t* marks) noexcept { level_marks_ = marks; }
+  void add_level_texel(std::int64_t index) const noexcept {
+    if (!level_marks_) return;
+    std::atomic_ref<std::uint8_t> mark(level_marks_[index]);
+    if (mark.load(std::memory_order_relaxed) == 0) mark.store(1, std::memory_order_relaxed);
+  }
 
  private:
   static constexpr std::uint64_t kNone = ~std::uint64_t{0};  // no line (addresses are multiples of 4)
@@ -191,7 +198,7 @@ class alignas(64) LookupLines {
   std::vector<std::uint64_t> storage_;
   std::size_t size_ = 0;
   std::uint64_t repeats_ = 0;
-  std::vector<std::uint32_t> level_texels_;
+  std::uint8_t* level_marks_ = nullptr;
 };
 
 // The ray of pixel centre (px, py) clipped to the box: false when it misses the box.

@@ -130,6 +130,31 @@ TEST(OnDemandTest, UpkeepFollowsTheQueries) {
   EXPECT_EQ(nb.texel(top, 0, 0), full.texel(top, 0, 0));
 }
 
+// replace_on_demand: a new level 0 with every texel above it stale, as a cleared N-buffer given a
+// new image; each texel then made current equals a full build of that image, and computing one
+// texel of level L computes the 4^L - 1 texels above level 0 under it, once.
+TEST(OnDemandTest, ReplacedLevelZeroLeavesEveryLevelStale) {
+  std::mt19937 rng(11);
+  NBuffer nb(random_image(rng, 33, 20), NBufferConfig{FarOp::Max, StorageFormat::F32, -1});
+  nb.set_on_demand(true);
+  const DepthImage next = random_image(rng, 33, 20);
+  nb.replace_on_demand(next);
+  for (int l = 1; l < nb.level_count(); ++l) EXPECT_EQ(nb.current_texels(l), 0) << "level " << l;
+  UpdateStats s = nb.new_stats();
+  nb.ensure(3, 4, 2, s);
+  EXPECT_EQ(computed_above_level_0(s), 1 + 4 + 16) << "the texel and the 4 + 16 below it";
+  nb.ensure(3, 4, 2, s);
+  EXPECT_EQ(computed_above_level_0(s), 21) << "kept";
+  const NBuffer full(next, NBufferConfig{FarOp::Max, StorageFormat::F32, -1});
+  for (int l = 0; l < nb.level_count(); ++l)
+    for (int y = 0; y < 20; ++y)
+      for (int x = 0; x < 33; ++x) {
+        nb.ensure(l, x, y, s);
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(nb.texel(l, x, y)), std::bit_cast<std::uint32_t>(full.texel(l, x, y)))
+            << "level " << l << " (" << x << ", " << y << ")";
+      }
+}
+
 TEST(OnDemandTest, RectangleLevelsRefused) {
   NBuffer nb(16, 16, NBufferConfig{FarOp::Max, StorageFormat::F32, -1, LevelShape::Rect});
   try {
