@@ -91,7 +91,8 @@ ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, Cove
       passed_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0),
       path_(path_config(width, height, fused_interpolation), depth_),
       without_box_path_(path_config(width, height, fused_interpolation), without_box_),
-      pool_(threads) {
+      pool_(threads),
+      level_marks_(static_cast<std::size_t>(pool_.threads())) {
   path_.set_reuse_rasterization(true);  // every method draws the same box
   if (box_depth_ != BoxDepth::None) {
     hit_.assign(passed_.size(), 0);
@@ -118,8 +119,9 @@ void ReliefReplay::on_demand_levels(const GlReliefField& gl, BoxDrawCounts& c) {
   }
   UpdateStats demand = on_demand_->new_stats();
   const std::size_t plane = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
-  for (std::size_t index = 0; index < level_marks_.size(); ++index) {
-    if (!level_marks_[index]) continue;
+  for (std::size_t index = 0; index < gl.nbuffer.size(); ++index) {
+    if (std::none_of(level_marks_.begin(), level_marks_.end(), [index](const std::vector<std::uint8_t>& m) { return m[index] != 0; }))
+      continue;
     const int level = static_cast<int>(index / plane);
     const int x = static_cast<int>(index % plane % static_cast<std::size_t>(n)), y = static_cast<int>(index % plane / static_cast<std::size_t>(n));
     on_demand_->ensure(level, x, y, demand);
@@ -226,9 +228,14 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     const std::size_t run_count = (fragment_pixels_.size() + kRunFragments - 1) / kRunFragments;
     if (runs_.size() < run_count) runs_.resize(run_count);
     const LineGeometry geometry = lookups ? lookups->geometry() : LineGeometry{};
+    // The N-buffer walk's level reads, marked by the walks, then computed on demand.
+    const bool levels = r.method == Method::NBuffer && lookups;
+    if (levels)
+      for (std::vector<std::uint8_t>& marks : level_marks_) marks.assign(gl.nbuffer.size(), 0);
     const auto walk_run = [&](std::size_t run) {
       LookupLines& lines = runs_[run];
       if (lookups) lines.reset(geometry);
+      lines.mark_levels(levels ? level_marks_[static_cast<std::size_t>(WorkerPool::slot())].data() : nullptr);
       const std::size_t end = std::min(fragment_pixels_.size(), (run + 1) * kRunFragments);
       for (std::size_t at = run * kRunFragments; at < end; ++at) {
         const std::uint32_t px = fragment_pixels_[at];
@@ -291,10 +298,6 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
         ++g;
       }
     };
-    // The N-buffer walk's level reads, marked by the walks, then computed on demand.
-    const bool levels = r.method == Method::NBuffer && lookups;
-    if (levels) level_marks_.assign(gl.nbuffer.size(), 0);
-    for (std::size_t run = 0; run < run_count; ++run) runs_[run].mark_levels(levels ? level_marks_.data() : nullptr);
     pool_.run(run_count, walk_run, [&](std::size_t run) {
       if (lookups) lookups->take(runs_[run]);
       merge_run(run);

@@ -173,10 +173,10 @@ class ReliefReplay {
   std::vector<LookupLines> runs_;
   WorkerPool pool_;
   // The frame's on-demand N-buffer of the heights (made at its first nbuffer draw), and the level
-  // texels the current draw's walks read (a byte each).
+  // texels the current draw's walks read (a byte each), per thread of the pool.
   std::optional<NBuffer> on_demand_;
   bool on_demand_fresh_ = false;  // on_demand_ holds this frame's heights
-  std::vector<std::uint8_t> level_marks_;
+  std::vector<std::vector<std::uint8_t>> level_marks_;
   void on_demand_levels(const GlReliefField& gl, BoxDrawCounts& c);
 };
 

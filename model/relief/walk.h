@@ -37,7 +37,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -178,14 +177,11 @@ class alignas(64) LookupLines {
   std::uint64_t repeats() const noexcept { return repeats_; }
   // Marks the N-buffer level texels the walks read, one byte a texel of FieldView::nbuffer (null:
   // none marked), for the replay's on-demand N-buffer: which texels a build on demand computes.
-  // Records walked at once on several threads may share the marks (relaxed: a mark is only ever set
-  // to 1, and set once, so that threads reading the same texels do not keep taking the line from
-  // each other).
+  // The marks are the walking thread's own (threads sharing them would take their lines from each
+  // other at every first read).
   void mark_levels(std::uint8_t* marks) noexcept { level_marks_ = marks; }
   void add_level_texel(std::int64_t index) const noexcept {
-    if (!level_marks_) return;
-    std::atomic_ref<std::uint8_t> mark(level_marks_[index]);
-    if (mark.load(std::memory_order_relaxed) == 0) mark.store(1, std::memory_order_relaxed);
+    if (level_marks_) level_marks_[index] = 1;
   }
 
  private:

@@ -18,8 +18,18 @@ int relief_threads() {
   return std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 8);
 }
 
+namespace {
+thread_local int t_slot = 0;
+}  // namespace
+
+int WorkerPool::slot() noexcept { return t_slot; }
+
 WorkerPool::WorkerPool(int threads) {
-  for (int k = 1; k < threads; ++k) helpers_.emplace_back([this](const std::stop_token& stop) { helper(stop); });
+  for (int k = 1; k < threads; ++k)
+    helpers_.emplace_back([this, k](const std::stop_token& stop) {
+      t_slot = k;
+      helper(stop);
+    });
 }
 
 // The jthreads ask their helpers to stop (waking them) and join them.

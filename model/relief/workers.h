@@ -32,6 +32,9 @@ class WorkerPool {
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   int threads() const noexcept { return static_cast<int>(helpers_.size()) + 1; }
+  // The calling thread's place in its pool, for state a work keeps per thread: 0 for the thread that
+  // calls run() (and any thread outside a pool), 1 to threads() - 1 for the helpers.
+  static int slot() noexcept;
 
   // Runs work(k) for every k in [0, count) on the helpers and the calling thread, and then(k) on
   // the calling thread in order k = 0, 1, ..., count - 1, each once work(k) has finished (the

@@ -123,11 +123,17 @@ TEST(ReliefWorkerPoolTest, EveryWorkOnceThenInOrder) {
     for (const std::size_t count : {std::size_t{0}, std::size_t{1}, std::size_t{500}}) {  // the pool is reused
       std::vector<std::atomic<int>> runs(count);
       std::vector<std::size_t> order;
-      std::vector<int> seen(count, 0);
+      std::vector<int> seen(count, 0), slot(count, -1);
       pool.run(
-          count, [&](std::size_t k) { runs[k].fetch_add(1), seen[k] = static_cast<int>(k) * 3; },
+          count,
+          [&](std::size_t k) {
+            runs[k].fetch_add(1), seen[k] = static_cast<int>(k) * 3;
+            slot[k] = WorkerPool::slot();
+          },
           [&](std::size_t k) {
             EXPECT_EQ(seen[k], static_cast<int>(k) * 3) << "then(k) sees what work(k) wrote";
+            EXPECT_EQ(WorkerPool::slot(), 0) << "then runs on the calling thread";
+            EXPECT_TRUE(slot[k] >= 0 && slot[k] < threads) << "work " << k << " on slot " << slot[k];
             order.push_back(k);
           });
       ASSERT_EQ(order.size(), count) << threads << " threads";
