@@ -13,17 +13,17 @@
 
 #include "model/scene/frame.h"
 #include "tests/common/run_nbsim.h"
+#include "tests/common/tools.h"
 #include "traces/format/reader.h"
 
 namespace {
 
+using nbsim::testing::have_apitrace;
+using nbsim::testing::have_eglretrace;
 using nbsim::testing::run_nbsim;
 using nbsim::testing::shell_output;
 
 const std::filesystem::path kSamples = NBSIM_APITRACE_SAMPLES;
-
-bool have_eglretrace() { return std::system("command -v eglretrace > /dev/null 2>&1") == 0; }
-bool have_apitrace() { return std::system("command -v apitrace > /dev/null 2>&1") == 0; }
 
 std::vector<nbsim::scene::Frame> frames_of(const std::filesystem::path& trace) {
   nbsim::trace::FrameReader r(trace);

@@ -9,14 +9,14 @@
 #include <string>
 
 #include "tests/common/run_nbsim.h"
+#include "tests/common/tools.h"
 
 namespace {
 
+using nbsim::testing::have_eglretrace;
 using nbsim::testing::run_nbsim;
 
 const std::filesystem::path kSamples = NBSIM_APITRACE_SAMPLES;
-
-bool have_eglretrace() { return std::system("command -v eglretrace > /dev/null 2>&1") == 0; }
 
 TEST(ApitraceCliTest, BadInputIsRefusedWithNothingLeftBehind) {
   const auto dir = nbsim::testing::scratch_dir("nbsim_apitrace_cli");
