@@ -226,6 +226,33 @@ struct DrawCache {
   }
 };
 
+// `frames` replays of a box frame at width x height with a 16 KiB texel cache emptied at each:
+// every frame's counts and the cache's hits and misses per draw.
+struct BoxReplay {
+  std::vector<ReliefFrameCounts> frames;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> cache;
+};
+BoxReplay replay_box(const scene::Frame& frame, int width, int height, int threads, bool scoring = true, int frames = 1) {
+  ReliefReplay r(width, height, true, {}, BoxDepth::None, threads);
+  r.set_scoring(scoring);
+  TexelCache cache(memory::CacheConfig{16 * 1024, 64, 4});
+  DrawCache draws{&cache, {}};
+  BoxReplay out;
+  for (int k = 0; k < frames; ++k) {
+    cache.invalidate();
+    out.frames.push_back(r.run_frame(frame, 0.25, 0.25, &cache, &draws, &DrawCache::done));
+  }
+  out.cache = draws.per_draw;
+  return out;
+}
+
+// The counts of two replays of a draw alike, the scores aside.
+bool same_walks(const BoxDrawCounts& a, const BoxDrawCounts& b) {
+  return a.fragments == b.fragments && a.samples == b.samples && a.pixel_mismatches == b.pixel_mismatches &&
+         a.walk_mismatches == b.walk_mismatches && a.lookups == b.lookups && a.steps == b.steps && a.bisections == b.bisections &&
+         a.hits == b.hits && a.capped == b.capped && a.longest_walk == b.longest_walk;
+}
+
 // Every count of every draw, and the texel cache's hits and misses per draw, with 1, 2 and 3
 // threads (the runs of fragments then finish out of order), over two frames (the cache and the
 // frame's references carried from draw to draw).
@@ -234,15 +261,8 @@ TEST(ReliefReplayThreadsTest, CountsDoNotDependOnThreads) {
   const Field f;
   const scene::Frame frame = box_frame(f, kWidth);
   const auto replay = [&](int threads) {
-    ReliefReplay r(kWidth, kHeight, true, {}, BoxDepth::None, threads);
-    TexelCache cache(memory::CacheConfig{16 * 1024, 64, 4});
-    DrawCache draws{&cache, {}};
-    std::vector<ReliefFrameCounts> frames;
-    for (int k = 0; k < 2; ++k) {
-      cache.invalidate();
-      frames.push_back(r.run_frame(frame, 0.25, 0.25, &cache, &draws, &DrawCache::done));
-    }
-    return std::pair{frames, draws.per_draw};
+    BoxReplay b = replay_box(frame, kWidth, kHeight, threads, true, 2);
+    return std::pair{b.frames, b.cache};
   };
   const auto [one, one_cache] = replay(1);
   ASSERT_EQ(one.size(), 2u);
@@ -259,10 +279,7 @@ TEST(ReliefReplayThreadsTest, CountsDoNotDependOnThreads) {
     for (std::size_t fr = 0; fr < one.size(); ++fr)
       for (std::size_t k = 0; k < one[fr].draws.size(); ++k) {
         const BoxDrawCounts &a = one[fr].draws[k], &b = many[fr].draws[k];
-        EXPECT_TRUE(a.fragments == b.fragments && a.samples == b.samples && a.pixel_mismatches == b.pixel_mismatches &&
-                    a.walk_mismatches == b.walk_mismatches && a.lookups == b.lookups && a.steps == b.steps &&
-                    a.bisections == b.bisections && a.hits == b.hits && a.capped == b.capped && a.longest_walk == b.longest_walk &&
-                    a.reference_hits == b.reference_hits && a.wrong_hit == b.wrong_hit && a.wrong_miss == b.wrong_miss &&
+        EXPECT_TRUE(same_walks(a, b) && a.reference_hits == b.reference_hits && a.wrong_hit == b.wrong_hit && a.wrong_miss == b.wrong_miss &&
                     a.far_hit == b.far_hit && a.distance_sum == b.distance_sum)
             << "frame " << fr << ", " << to_string(a.method) << ", " << threads << " threads";
       }
@@ -276,13 +293,8 @@ TEST(ReliefReplayScoringTest, UnscoredWalksCountAsScoredOnes) {
   const Field f;
   const scene::Frame frame = box_frame(f, kWidth);
   const auto replay = [&](bool scoring) {
-    ReliefReplay r(kWidth, kHeight, true, {}, BoxDepth::None, 2);
-    r.set_scoring(scoring);
-    TexelCache cache(memory::CacheConfig{16 * 1024, 64, 4});
-    DrawCache draws{&cache, {}};
-    cache.invalidate();
-    const ReliefFrameCounts counts = r.run_frame(frame, 0.25, 0.25, &cache, &draws, &DrawCache::done);
-    return std::pair{counts, draws.per_draw};
+    BoxReplay b = replay_box(frame, kWidth, kHeight, 2, scoring);
+    return std::pair{b.frames[0], b.cache};
   };
   const auto [scored, scored_cache] = replay(true);
   const auto [unscored, unscored_cache] = replay(false);
@@ -293,10 +305,7 @@ TEST(ReliefReplayScoringTest, UnscoredWalksCountAsScoredOnes) {
     const BoxDrawCounts &a = scored.draws[k], &b = unscored.draws[k];
     EXPECT_TRUE(a.scored);
     EXPECT_FALSE(b.scored);
-    EXPECT_TRUE(a.fragments == b.fragments && a.samples == b.samples && a.pixel_mismatches == b.pixel_mismatches &&
-                a.walk_mismatches == b.walk_mismatches && a.lookups == b.lookups && a.steps == b.steps && a.bisections == b.bisections &&
-                a.hits == b.hits && a.capped == b.capped && a.longest_walk == b.longest_walk)
-        << to_string(a.method);
+    EXPECT_TRUE(same_walks(a, b)) << to_string(a.method);
     EXPECT_EQ(b.reference_hits + b.wrong_hit + b.wrong_miss + b.far_hit, 0u) << to_string(b.method);
     EXPECT_EQ(b.distance_sum, 0.0);
     reference_hits += a.reference_hits;
@@ -310,13 +319,7 @@ TEST(ReliefReplayLevelsTest, OnDemandLevelsEqualTheFullBuild) {
   constexpr int kWidth = 64, kHeight = 48;
   const Field f;
   const scene::Frame frame = box_frame(f, kWidth);
-  const auto replay = [&](int threads) {
-    ReliefReplay r(kWidth, kHeight, true, {}, BoxDepth::None, threads);
-    TexelCache cache(memory::CacheConfig{16 * 1024, 64, 4});
-    cache.invalidate();
-    return r.run_frame(frame, 0.25, 0.25, &cache);
-  };
-  const ReliefFrameCounts one = replay(1), two = replay(2);
+  const ReliefFrameCounts one = replay_box(frame, kWidth, kHeight, 1).frames[0], two = replay_box(frame, kWidth, kHeight, 2).frames[0];
   const int levels = nbuffer_level_count(kN, kN);
   for (std::size_t k = 0; k < one.draws.size(); ++k) {
     const BoxDrawCounts& d = one.draws[k];
