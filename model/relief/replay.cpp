@@ -92,7 +92,8 @@ ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, Cove
       path_(path_config(width, height, fused_interpolation), depth_),
       without_box_path_(path_config(width, height, fused_interpolation), without_box_),
       pool_(threads),
-      level_marks_(static_cast<std::size_t>(pool_.threads())) {
+      level_marks_(static_cast<std::size_t>(pool_.threads())),
+      scratch_(static_cast<std::size_t>(pool_.threads())) {
   path_.set_reuse_rasterization(true);  // every method draws the same box
   if (box_depth_ != BoxDepth::None) {
     hit_.assign(passed_.size(), 0);
@@ -237,6 +238,9 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       if (lookups) lines.reset(geometry);
       lines.mark_levels(levels ? level_marks_[static_cast<std::size_t>(WorkerPool::slot())].data() : nullptr);
       const std::size_t end = std::min(fragment_pixels_.size(), (run + 1) * kRunFragments);
+      RunScratch& scratch = scratch_[static_cast<std::size_t>(WorkerPool::slot())];
+      scratch.rays.clear();
+      scratch.fragments.clear();
       for (std::size_t at = run * kRunFragments; at < end; ++at) {
         const std::uint32_t px = fragment_pixels_[at];
         std::uint8_t& state = pixel_state_[px];
@@ -247,12 +251,21 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
           state = ray ? kPixelRay : kPixelNoRay;
           if (ray) rays_[px] = *ray;
         }
-        FragmentWalk& fw = walks_[at];
-        fw = FragmentWalk{};
+        walks_[at] = FragmentWalk{};
         if (state == kPixelNoRay) continue;
+        scratch.rays.push_back(&rays_[px]);
+        scratch.fragments.push_back(at);
+      }
+      scratch.results.resize(scratch.rays.size());
+      walk_each(r.method, view, params, scratch.rays, scratch.results, lookups ? &lines : nullptr);
+      for (std::size_t q = 0; q < scratch.fragments.size(); ++q) {
+        const std::size_t at = scratch.fragments[q];
+        const std::uint32_t px = fragment_pixels_[at];
+        std::uint8_t& state = pixel_state_[px];
         const FragmentRay& ray = rays_[px];
+        FragmentWalk& fw = walks_[at];
         fw.ray = true;
-        fw.walk = lookups ? walk(r.method, view, params, ray, lines) : walk(r.method, view, params, ray);
+        fw.walk = scratch.results[q];
         if (scoring_) {
           if (state == kPixelRay) reference_[px] = reference_of(gl.field, ray, &*blocks), state = kPixelReference;
           fw.score = score_against(reference_[px], ray, gl.field.size, fw.walk.hit && !fw.walk.capped, fw.walk.t, box_height, tolerance);

@@ -177,6 +177,13 @@ class ReliefReplay {
   std::optional<NBuffer> on_demand_;
   bool on_demand_fresh_ = false;  // on_demand_ holds this frame's heights
   std::vector<std::vector<std::uint8_t>> level_marks_;
+  // Per thread of the pool: a run's rays to walk (walk_each), their fragments and their walks.
+  struct RunScratch {
+    std::vector<const FragmentRay*> rays;
+    std::vector<std::size_t> fragments;
+    std::vector<WalkResult> results;
+  };
+  std::vector<RunScratch> scratch_;
   void on_demand_levels(const GlReliefField& gl, BoxDrawCounts& c);
 };
 

@@ -6,6 +6,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include "model/nbuffer/covering.h"
 
 namespace nbsim::relief {
@@ -18,11 +22,14 @@ constexpr float kFar = 3.0e38f;  // the shader's "no boundary" (a finite constan
 // A lookup source: the field's textures, every read reported to `sink` (sink(texture, index) for a
 // texel in memory, sink.border() for a virtual border texel). The walks are templates on the sink
 // so that a recording sink (LookupLines) costs no indirect call per lookup.
+struct Deferred;
+
 template <class Sink>
 struct Reader {
   const FieldView f;  // a copy: its size and spans one load away, not two
   Sink& sink;
   std::uint32_t lookups = 0;
+  Deferred* defer = nullptr;  // not null: a hit's refinement in its cell is left for later (see Deferred)
 
   float height(int i, int j) {
     ++lookups;
@@ -172,18 +179,35 @@ float refine_in_cell(const Cell& cell, const FragmentRay& ray, float a, float b,
   return b;
 }
 
+// A hit's refinement in its cell, left for later: it reads no texel and is the walk's last work, so
+// walk_each runs the refinements of a run's walks together, eight at a time (refine_lanes).
+struct Deferred {
+  bool pending = false;
+  Cell cell;
+  float a = 0.0f, b = 0.0f;
+};
+
+// refine_in_cell, or its deferral: then b stands for the hit's t until the refinement is run (b >= 0,
+// a hit for every caller), and the bisections are counted now.
+float refine(const Cell& cell, const FragmentRay& ray, float a, float b, int steps, WalkResult& w, Deferred* defer) {
+  if (!defer) return refine_in_cell(cell, ray, a, b, steps, w);
+  *defer = Deferred{true, cell, a, b};
+  w.bisections += static_cast<std::uint32_t>(steps);
+  return b;
+}
+
 // The cell test on [ta, tb]: the hit's t, or a negative value when none. `full` adds the dip.
-float cell_test(const Cell& cell, const FragmentRay& ray, float ta, float tb, bool full, int root_steps, WalkResult& w) {
+float cell_test(const Cell& cell, const FragmentRay& ray, float ta, float tb, bool full, int root_steps, WalkResult& w, Deferred* defer) {
   const float fa = cell.above(ray, ta);
   if (fa <= 0.0f) return ta;
   const float fb = cell.above(ray, tb);
-  if (fb <= 0.0f) return refine_in_cell(cell, ray, ta, tb, root_steps, w);
+  if (fb <= 0.0f) return refine(cell, ray, ta, tb, root_steps, w, defer);
   if (!full) return -1.0f;
   // f along the ray in this cell is a quadratic; through s = 0, 1/2, 1 of [ta, tb]:
   // f(s) = fa + q1 s + q2 s^2 with q2 = 2 (fa - 2 fm + fb), q1 = (fb - fa) - q2.
   const float tm = (ta + tb) * 0.5f;
   const float fm = cell.above(ray, tm);
-  if (fm <= 0.0f) return refine_in_cell(cell, ray, ta, tm, root_steps, w);
+  if (fm <= 0.0f) return refine(cell, ray, ta, tm, root_steps, w, defer);
   const float q2 = 2.0f * ((fa - 2.0f * fm) + fb);
   if (!(q2 > 0.0f)) return -1.0f;  // not convex: no dip below both ends
   const float q1 = (fb - fa) - q2;
@@ -191,7 +215,7 @@ float cell_test(const Cell& cell, const FragmentRay& ray, float ta, float tb, bo
   if (!(s > 0.0f && s < 1.0f)) return -1.0f;
   const float tv = ta + s * (tb - ta);
   if (cell.above(ray, tv) > 0.0f) return -1.0f;
-  return refine_in_cell(cell, ray, ta, tv, root_steps, w);
+  return refine(cell, ray, ta, tv, root_steps, w, defer);
 }
 
 // A cell walker (Amanatides-Woo over cells) from t.
@@ -219,7 +243,7 @@ struct CellWalk {
     const float tb = std::max(t, std::min(std::min(tx, ty), ray.t_out));
     cell.read(r);
     ++w.steps;
-    const float hit = cell_test(cell, ray, t, tb, full, root_steps, w);
+    const float hit = cell_test(cell, ray, t, tb, full, root_steps, w, r.defer);
     if (hit >= 0.0f) return hit;
     if (tx < ty) cell.ci += ray.d[0] > 0.0f ? 1 : -1;
     else if (ty < tx) cell.cj += ray.d[1] > 0.0f ? 1 : -1;
@@ -446,8 +470,10 @@ std::optional<FragmentRay> fragment_ray(const RayFrame& frame, int size, float p
 namespace {
 
 template <class Sink>
-WalkResult walk_with(Method method, const FieldView& field, const WalkParams& params, const FragmentRay& ray, Sink& sink) {
+WalkResult walk_with(Method method, const FieldView& field, const WalkParams& params, const FragmentRay& ray, Sink& sink,
+                     Deferred* defer = nullptr) {
   Reader<Sink> r{field, sink};
+  r.defer = defer;
   WalkResult w;
   const int cap = walk_iteration_cap(field.size);
   if (above(r, ray, ray.t_in) <= 0.0f) {
@@ -478,6 +504,328 @@ WalkResult walk(Method method, const FieldView& field, const WalkParams& params,
 WalkResult walk(Method method, const FieldView& field, const WalkParams& params, const FragmentRay& ray, LookupLines& lines) {
   LinesSink sink{lines};
   return walk_with(method, field, params, ray, sink);
+}
+
+}  // namespace nbsim::relief
+
+// ---- Runs of walks: the exact method in AVX2 lanes ----
+
+namespace nbsim::relief {
+
+namespace {
+
+// The texel reads of a run's walks kept for the record: the cells whose corners each walk read
+// (its first height at t_in, then one cell a step), replayed into the record after the run in the
+// walks' order through the same Reader::corners the one-by-one walks use.
+struct CellLog {
+  // Per ray: the cell of its first height, the lane that walked it (-1: none, its first height
+  // ended it) and its steps' rows in `rows` (the lane's column).
+  struct Ray {
+    int first_i = 0, first_j = 0, lane = -1;
+    std::uint32_t row0 = 0, row1 = 0;
+  };
+  std::vector<Ray> rays;
+  std::vector<std::int32_t> rows;  // per step of the lanes: the eight lanes' ci, then their cj
+
+  void replay(const FieldView& field, LookupLines& lines) const {
+    LinesSink sink{lines};
+    Reader<LinesSink> r{field, sink};
+    float h00, h10, h01, h11;
+    for (const Ray& ray : rays) {
+      r.corners(ray.first_i, ray.first_j, h00, h10, h01, h11);
+      if (ray.lane < 0) continue;
+      for (std::uint32_t row = ray.row0; row < ray.row1; ++row) {
+        const std::int32_t* p = rows.data() + 16 * static_cast<std::size_t>(row);
+        r.corners(p[ray.lane], p[8 + ray.lane], h00, h10, h01, h11);
+      }
+    }
+  }
+};
+
+void walk_one_by_one(Method method, const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
+                     std::span<WalkResult> out, LookupLines* lines) {
+  for (std::size_t k = 0; k < rays.size(); ++k) out[k] = lines ? walk(method, field, params, *rays[k], *lines) : walk(method, field, params, *rays[k]);
+}
+
+#if defined(__x86_64__)
+
+// One lane's ray and walk state, eight lanes side by side (structure of arrays, loaded as vectors).
+struct alignas(32) Lanes {
+  float o0[8], o1[8], o2[8], d0[8], d1[8], d2[8], t_out[8], t[8], tb[8];
+  std::int32_t ci[8], cj[8], sx[8], sy[8], iter[8];
+  std::int32_t ray[8];  // the ray's index in the run, -1: the lane is idle
+};
+
+// How a lane's walk ended.
+enum class LaneEnd { HitEntry, HitInside, Miss, Capped };
+
+[[gnu::target("avx2")]] inline __m256 select(__m256 mask, __m256 yes, __m256 no) { return _mm256_blendv_ps(no, yes, mask); }
+
+// std::min(a, b) and std::max(a, b) to the bit (the first argument on ties, +0 and -0 included).
+[[gnu::target("avx2")]] inline __m256 std_min(__m256 a, __m256 b) { return select(_mm256_cmp_ps(b, a, _CMP_LT_OQ), b, a); }
+[[gnu::target("avx2")]] inline __m256 std_max(__m256 a, __m256 b) { return select(_mm256_cmp_ps(a, b, _CMP_LT_OQ), b, a); }
+
+// cell_exit(o, d, c) in eight lanes.
+[[gnu::target("avx2")]] inline __m256 cell_exits(__m256 o, __m256 d, __m256i c) {
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 forward = _mm256_cmp_ps(d, zero, _CMP_GT_OQ), backward = _mm256_cmp_ps(d, zero, _CMP_LT_OQ);
+  const __m256 edge = select(forward, _mm256_set1_ps(1.5f), _mm256_set1_ps(0.5f));
+  const __m256 exit = _mm256_div_ps(_mm256_sub_ps(_mm256_add_ps(_mm256_cvtepi32_ps(c), edge), o), d);
+  return select(_mm256_or_ps(forward, backward), exit, _mm256_set1_ps(kFar));
+}
+
+// The height at one corner of each lane's cell: 0 outside the field (the virtual border) or in an
+// idle lane.
+[[gnu::target("avx2")]] inline __m256 corner(const float* heights, __m256i i, __m256i j, __m256i n, __m256i live) {
+  const __m256i minus1 = _mm256_set1_epi32(-1);
+  const __m256i in = _mm256_and_si256(_mm256_and_si256(_mm256_cmpgt_epi32(i, minus1), _mm256_cmpgt_epi32(j, minus1)),
+                                      _mm256_and_si256(_mm256_cmpgt_epi32(n, i), _mm256_cmpgt_epi32(n, j)));
+  const __m256i index = _mm256_add_epi32(_mm256_mullo_epi32(j, n), i);
+  return _mm256_mask_i32gather_ps(_mm256_setzero_ps(), heights, index, _mm256_castsi256_ps(_mm256_and_si256(in, live)), 4);
+}
+
+// Cell::above in eight lanes.
+[[gnu::target("avx2")]] inline __m256 cell_above(__m256 o0, __m256 o1, __m256 o2, __m256 d0, __m256 d1, __m256 d2, __m256 t, __m256 fci,
+                                                 __m256 fcj, __m256 h00, __m256 h10, __m256 h01, __m256 h11) {
+  const __m256 half = _mm256_set1_ps(0.5f);
+  const __m256 fx = _mm256_sub_ps(_mm256_sub_ps(_mm256_add_ps(o0, _mm256_mul_ps(t, d0)), half), fci);
+  const __m256 fy = _mm256_sub_ps(_mm256_sub_ps(_mm256_add_ps(o1, _mm256_mul_ps(t, d1)), half), fcj);
+  const __m256 a = _mm256_add_ps(h00, _mm256_mul_ps(fx, _mm256_sub_ps(h10, h00)));
+  const __m256 b = _mm256_add_ps(h01, _mm256_mul_ps(fx, _mm256_sub_ps(h11, h01)));
+  const __m256 bilinear = _mm256_add_ps(a, _mm256_mul_ps(fy, _mm256_sub_ps(b, a)));
+  return _mm256_sub_ps(_mm256_add_ps(o2, _mm256_mul_ps(t, d2)), bilinear);
+}
+
+// A hit's refinement in its cell for out[out].
+struct Refinement {
+  const FragmentRay* ray;
+  Cell cell;
+  float a, b;
+  std::size_t out;
+};
+
+// refine_in_cell for every job, eight at a time: the one-by-one bisection, each lane the same
+// operations in the same order (refine_in_cell's two-at-a-time rounds take the same values). Sets
+// each job's hit t (its bisections are counted).
+[[gnu::target("avx2")]] void refine_lanes(std::span<const Refinement> jobs, int steps, std::span<WalkResult> out) {
+  for (std::size_t first = 0; first < jobs.size(); first += 8) {
+    alignas(32) float v[15][8];  // o0, o1, o2, d0, d1, d2, ci, cj, h00, h10, h01, h11, a, b, spare
+    for (std::size_t l = 0; l < 8; ++l) {
+      const Refinement& j = jobs[std::min(first + l, jobs.size() - 1)];  // the last job again in spare lanes
+      const float row[14] = {j.ray->o[0], j.ray->o[1], j.ray->o[2], j.ray->d[0], j.ray->d[1], j.ray->d[2], static_cast<float>(j.cell.ci),
+                             static_cast<float>(j.cell.cj), j.cell.h00, j.cell.h10, j.cell.h01, j.cell.h11, j.a, j.b};
+      for (std::size_t q = 0; q < 14; ++q) v[q][l] = row[q];
+    }
+    const __m256 o0 = _mm256_load_ps(v[0]), o1 = _mm256_load_ps(v[1]), o2 = _mm256_load_ps(v[2]);
+    const __m256 d0 = _mm256_load_ps(v[3]), d1 = _mm256_load_ps(v[4]), d2 = _mm256_load_ps(v[5]);
+    const __m256 fci = _mm256_load_ps(v[6]), fcj = _mm256_load_ps(v[7]);
+    const __m256 h00 = _mm256_load_ps(v[8]), h10 = _mm256_load_ps(v[9]), h01 = _mm256_load_ps(v[10]), h11 = _mm256_load_ps(v[11]);
+    __m256 a = _mm256_load_ps(v[12]), b = _mm256_load_ps(v[13]);
+    const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps();
+    for (int k = 0; k < steps; ++k) {
+      const __m256 m = _mm256_mul_ps(_mm256_add_ps(a, b), half);
+      const __m256 below = _mm256_cmp_ps(cell_above(o0, o1, o2, d0, d1, d2, m, fci, fcj, h00, h10, h01, h11), zero, _CMP_LE_OQ);
+      b = select(below, m, b);
+      a = select(below, a, m);
+    }
+    _mm256_store_ps(v[14], b);
+    for (std::size_t l = 0; l < 8 && first + l < jobs.size(); ++l) out[jobs[first + l].out].t = v[14][l];
+  }
+}
+
+// The exact walks of a run, eight at a time: walk_exact's steps, lane by lane the same operations in
+// the same order (and walk_with's first height and end, done per ray in scalar code).
+[[gnu::target("avx2")]] void exact_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
+                                         std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
+  const int n = field.size, cap = walk_iteration_cap(n);
+  log.rays.assign(rays.size(), CellLog::Ray{});
+  log.rows.clear();
+  std::uint32_t row = 0;
+  Lanes L;
+  std::size_t next = 0;
+  ObserverSink none{nullptr, nullptr};
+  Reader<ObserverSink> reader{field, none};
+
+  // Ends ray k's walk (lanes: its steps, how it ended) as walk_with does.
+  const auto finish = [&](std::size_t k, WalkResult& w) {
+    const FragmentRay& ray = *rays[k];
+    if (!w.hit && !w.capped && ray.floor_exit) set_hit(w, ray.t_out);
+    if (w.capped) w.hit = false, w.t = 0.0f;
+  };
+  // Gives lane `l` the run's next ray that needs a walk (the rays whose first height ends them, or
+  // whose walk ends before its first step, are done here); false when none is left.
+  const auto load = [&](int l) {
+    while (next < rays.size()) {
+      const std::size_t k = next++;
+      const FragmentRay& ray = *rays[k];
+      WalkResult& w = out[k];
+      w = WalkResult{};
+      CellLog::Ray& logged = log.rays[k];
+      const float u = along(ray.o[0], ray.t_in, ray.d[0]) - 0.5f, v = along(ray.o[1], ray.t_in, ray.d[1]) - 0.5f;
+      logged.first_i = floor_int(u), logged.first_j = floor_int(v);
+      reader.lookups = 0;
+      if (above(reader, ray, ray.t_in) <= 0.0f) {
+        set_hit(w, ray.t_in);
+        w.lookups = 4;
+        finish(k, w);
+        continue;
+      }
+      CellWalk cw;
+      cw.start(ray, ray.t_in, n);
+      if (cap <= 0 || !cw.inside(n) || cw.t >= ray.t_out) {  // walk_exact's loop: capped before its first step, or done
+        w.capped = cap <= 0;
+        w.lookups = 4;
+        finish(k, w);
+        continue;
+      }
+      logged.lane = l;
+      logged.row0 = logged.row1 = row;
+      L.o0[l] = ray.o[0], L.o1[l] = ray.o[1], L.o2[l] = ray.o[2];
+      L.d0[l] = ray.d[0], L.d1[l] = ray.d[1], L.d2[l] = ray.d[2];
+      L.t_out[l] = ray.t_out, L.t[l] = cw.t, L.tb[l] = 0.0f;
+      L.ci[l] = cw.cell.ci, L.cj[l] = cw.cell.cj;
+      L.sx[l] = ray.d[0] > 0.0f ? 1 : -1, L.sy[l] = ray.d[1] > 0.0f ? 1 : -1;
+      L.iter[l] = 0;
+      L.ray[l] = static_cast<std::int32_t>(k);
+      return;
+    }
+    L.ray[l] = -1;
+    L.o0[l] = L.o1[l] = L.o2[l] = L.d0[l] = L.d1[l] = L.d2[l] = L.t_out[l] = L.t[l] = L.tb[l] = 0.0f;
+    L.ci[l] = L.cj[l] = L.sx[l] = L.sy[l] = L.iter[l] = 0;
+  };
+  // Ends lane l's walk and loads the next ray into it.
+  const auto end_lane = [&](int l, LaneEnd how) {
+    const auto k = static_cast<std::size_t>(L.ray[l]);
+    const FragmentRay& ray = *rays[k];
+    WalkResult& w = out[k];
+    CellLog::Ray& logged = log.rays[k];
+    w.steps = logged.row1 - logged.row0;
+    w.lookups = 4 * (1 + w.steps);
+    switch (how) {
+      case LaneEnd::HitEntry: set_hit(w, L.t[l]); break;
+      case LaneEnd::HitInside: {  // refined with the run's other hits (refine_lanes)
+        Refinement job{&ray, Cell{}, L.t[l], L.tb[l], k};
+        job.cell.ci = L.ci[l], job.cell.cj = L.cj[l];
+        job.cell.read(reader);
+        refinements.push_back(job);
+        w.bisections += static_cast<std::uint32_t>(params.root_steps);
+        set_hit(w, L.tb[l]);
+        break;
+      }
+      case LaneEnd::Miss: break;
+      case LaneEnd::Capped: w.capped = true; break;
+    }
+    finish(k, w);
+    load(l);
+  };
+
+  for (int l = 0; l < 8; ++l) load(l);
+  const __m256i nv = _mm256_set1_epi32(n), one = _mm256_set1_epi32(1), minus1 = _mm256_set1_epi32(-1);
+  const __m256 zero = _mm256_setzero_ps();
+  for (;;) {
+    const __m256i ray_index = _mm256_load_si256(reinterpret_cast<const __m256i*>(L.ray));
+    const __m256i live = _mm256_cmpgt_epi32(ray_index, minus1);
+    if (_mm256_testz_si256(live, live)) break;
+    const __m256 o0 = _mm256_load_ps(L.o0), o1 = _mm256_load_ps(L.o1), o2 = _mm256_load_ps(L.o2);
+    const __m256 d0 = _mm256_load_ps(L.d0), d1 = _mm256_load_ps(L.d1), d2 = _mm256_load_ps(L.d2);
+    const __m256 t = _mm256_load_ps(L.t), t_out = _mm256_load_ps(L.t_out);
+    const __m256i ci = _mm256_load_si256(reinterpret_cast<const __m256i*>(L.ci)), cj = _mm256_load_si256(reinterpret_cast<const __m256i*>(L.cj));
+    // The step's cells, for the record.
+    log.rows.resize(log.rows.size() + 16);
+    std::int32_t* logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), ci);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), cj);
+    // CellWalk::step: the cell's exits, its end tb, its corners, the cell test.
+    const __m256 tx = cell_exits(o0, d0, ci), ty = cell_exits(o1, d1, cj);
+    const __m256 tb = std_max(t, std_min(std_min(tx, ty), t_out));
+    const __m256i ci1 = _mm256_add_epi32(ci, one), cj1 = _mm256_add_epi32(cj, one);
+    const __m256 h00 = corner(field.heights.data(), ci, cj, nv, live), h10 = corner(field.heights.data(), ci1, cj, nv, live);
+    const __m256 h01 = corner(field.heights.data(), ci, cj1, nv, live), h11 = corner(field.heights.data(), ci1, cj1, nv, live);
+    const __m256 fci = _mm256_cvtepi32_ps(ci), fcj = _mm256_cvtepi32_ps(cj);
+    const __m256 fa = cell_above(o0, o1, o2, d0, d1, d2, t, fci, fcj, h00, h10, h01, h11);
+    const __m256 fb = cell_above(o0, o1, o2, d0, d1, d2, tb, fci, fcj, h00, h10, h01, h11);
+    const __m256 livef = _mm256_castsi256_ps(live);
+    const __m256 hit_entry = _mm256_and_ps(livef, _mm256_cmp_ps(fa, zero, _CMP_LE_OQ));
+    const __m256 hit_inside = _mm256_andnot_ps(hit_entry, _mm256_and_ps(livef, _mm256_cmp_ps(fb, zero, _CMP_LE_OQ)));
+    // The move to the next cell (lanes without a hit).
+    const __m256i x_first = _mm256_castps_si256(_mm256_cmp_ps(tx, ty, _CMP_LT_OQ));
+    const __m256i y_first = _mm256_castps_si256(_mm256_cmp_ps(ty, tx, _CMP_LT_OQ));
+    const __m256i step_x = _mm256_andnot_si256(y_first, minus1);  // tx < ty, or neither first (a corner)
+    const __m256i step_y = _mm256_andnot_si256(x_first, minus1);
+    const __m256i next_ci = _mm256_add_epi32(ci, _mm256_and_si256(step_x, _mm256_load_si256(reinterpret_cast<const __m256i*>(L.sx))));
+    const __m256i next_cj = _mm256_add_epi32(cj, _mm256_and_si256(step_y, _mm256_load_si256(reinterpret_cast<const __m256i*>(L.sy))));
+    const __m256i iter = _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(L.iter)), one);
+    // walk_exact's loop head for the next step: inside the field, t before t_out, under the cap.
+    const __m256i inside = _mm256_and_si256(_mm256_and_si256(_mm256_cmpgt_epi32(next_ci, _mm256_set1_epi32(-2)), _mm256_cmpgt_epi32(next_cj, _mm256_set1_epi32(-2))),
+                                            _mm256_and_si256(_mm256_cmpgt_epi32(nv, next_ci), _mm256_cmpgt_epi32(nv, next_cj)));
+    const __m256 before_end = _mm256_cmp_ps(tb, t_out, _CMP_LT_OQ);
+    const __m256 goes_on = _mm256_and_ps(before_end, _mm256_castsi256_ps(inside));
+    const __m256i under_cap = _mm256_cmpgt_epi32(_mm256_set1_epi32(cap), iter);
+    // Hit lanes keep their cell and t (the refinement and the record need them).
+    const __m256 hit = _mm256_or_ps(hit_entry, hit_inside);
+    const __m256i hiti = _mm256_castps_si256(hit);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(L.ci), _mm256_blendv_epi8(next_ci, ci, hiti));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(L.cj), _mm256_blendv_epi8(next_cj, cj, hiti));
+    _mm256_store_ps(L.t, select(hit, t, tb));
+    _mm256_store_ps(L.tb, tb);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(L.iter), iter);
+    ++row;
+    const int live_bits = _mm256_movemask_ps(livef);
+    const int entry_bits = _mm256_movemask_ps(hit_entry), inside_bits = _mm256_movemask_ps(hit_inside);
+    // walk_exact's loop ends after its cap-th step whatever the next step would find.
+    const int walked = live_bits & ~(entry_bits | inside_bits);
+    const int capped_bits = walked & ~_mm256_movemask_ps(_mm256_castsi256_ps(under_cap));
+    const int on_bits = walked & ~capped_bits & _mm256_movemask_ps(goes_on);
+    const int ended = live_bits & ~on_bits;
+    if (ended == 0) continue;
+    for (int l = 0; l < 8; ++l) {
+      if (!(ended >> l & 1)) continue;
+      log.rays[static_cast<std::size_t>(L.ray[l])].row1 = row;
+      end_lane(l, entry_bits >> l & 1 ? LaneEnd::HitEntry : inside_bits >> l & 1 ? LaneEnd::HitInside : capped_bits >> l & 1 ? LaneEnd::Capped : LaneEnd::Miss);
+    }
+  }
+}
+
+#endif
+
+}  // namespace
+
+bool vector_walks_available() noexcept {
+#if defined(__x86_64__)
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+void walk_each(Method method, const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
+               std::span<WalkResult> out, LookupLines* lines, bool vector) {
+#if defined(__x86_64__)
+  if (vector && (method == Method::Exact || method == Method::NBuffer) && vector_walks_available()) {
+    thread_local std::vector<Refinement> refinements;
+    refinements.clear();
+    if (method == Method::Exact) {
+      thread_local CellLog log;
+      exact_lanes(field, params, rays, out, log, refinements);
+      if (lines) log.replay(field, *lines);
+    } else {  // one by one, the hits' refinements left for refine_lanes
+      for (std::size_t k = 0; k < rays.size(); ++k) {
+        Deferred deferred;
+        if (lines) {
+          LinesSink sink{*lines};
+          out[k] = walk_with(method, field, params, *rays[k], sink, &deferred);
+        } else {
+          ObserverSink sink{nullptr, nullptr};
+          out[k] = walk_with(method, field, params, *rays[k], sink, &deferred);
+        }
+        if (deferred.pending) refinements.push_back(Refinement{rays[k], deferred.cell, deferred.a, deferred.b, k});
+      }
+    }
+    refine_lanes(refinements, params.root_steps, out);
+    return;
+  }
+#endif
+  walk_one_by_one(method, field, params, rays, out, lines);
 }
 
 }  // namespace nbsim::relief

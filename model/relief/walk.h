@@ -214,6 +214,17 @@ WalkResult walk(Method method, const FieldView& field, const WalkParams& params,
 // The same walk (the same result, bit for bit), its lookups appended to `lines`.
 WalkResult walk(Method method, const FieldView& field, const WalkParams& params, const FragmentRay& ray, LookupLines& lines);
 
+// The walks of a run of fragments with one method, one after another: out[k] is walk(method, field,
+// params, *rays[k], ...) and `lines` (may be null) receives every walk's lookups in the order of k,
+// the same records bit for bit. The exact method walks eight rays at once in AVX2 lanes when the CPU
+// has AVX2 and `vector` is true (each lane takes the run's next ray when its walk ends, and the
+// lookups are recorded after the run, ray by ray); every other method, and the exact one without
+// AVX2, walks the rays one by one.
+void walk_each(Method method, const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
+               std::span<WalkResult> out, LookupLines* lines, bool vector = true);
+// Whether walk_each's lanes run here (the CPU has AVX2).
+bool vector_walks_available() noexcept;
+
 // The iteration cap of every walk's main loop (a walk that reaches it is a capped miss).
 int walk_iteration_cap(int size) noexcept;
 

@@ -5,6 +5,8 @@
 // and rays entering through the box's sides. The GL twin of every walk is ReliefGlWalkTest's.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <random>
 
@@ -174,6 +176,64 @@ TEST(ReliefWalkTest, ExactMethodsAgreeWithTheReferenceOnRandomRays) {
   EXPECT_EQ(nbuffer_errors, 0);
   EXPECT_EQ(robust_errors, 0);
   RecordProperty("exact_saddle_misses", exact_misses);
+}
+
+// walk_each's lanes (the exact method in AVX2, the hits' refinements of the exact and N-buffer walks)
+// against the one-by-one walks: every result and the
+// record of lookups the same bit for bit, on fields of every kind and size 2 to 64 and on rays from
+// above, through the sides, grazing, vertical, axis-aligned and along cell diagonals.
+TEST(ReliefWalkTest, LanesWalkAsOneByOne) {
+  if (!vector_walks_available()) GTEST_SKIP() << "no AVX2 here: walk_each walks one by one";
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int hits = 0, refined = 0, walked = 0;
+  for (const std::string_view kind : heightfield_kinds())
+    for (const int n : {2, 5, 16, 64}) {
+      const Fixture s(make_heightfield(kind, n, 0, 7));
+      const float size = static_cast<float>(n);
+      std::vector<FragmentRay> rays;
+      for (int k = 0; k < 600; ++k) {
+        std::array<float, 3> o = {size * (1.4f * u(rng) - 0.2f), size * (1.4f * u(rng) - 0.2f), 1.5f * u(rng)};
+        std::array<float, 3> d = {u(rng) - 0.5f, u(rng) - 0.5f, -u(rng)};
+        switch (k % 6) {
+          case 1: d[2] = 0.02f * (u(rng) - 0.7f); break;  // grazing
+          case 2: d[0] = d[1] = 0.0f; break;                // vertical
+          case 3: d[k % 4 == 3 ? 1 : 0] = 0.0f; break;      // along an axis
+          case 4: d[1] = d[0]; o[1] = o[0] = std::floor(o[0]) + 0.5f; break;  // through cell corners
+          default: break;
+        }
+        if (d[2] == 0.0f && d[0] == 0.0f && d[1] == 0.0f) continue;
+        const FragmentRay r = clipped(s, o, d);
+        if (r.t_in <= r.t_out) rays.push_back(r);
+      }
+      std::vector<const FragmentRay*> pointers;
+      for (const FragmentRay& r : rays) pointers.push_back(&r);
+      for (const Method m : {Method::Exact, Method::NBuffer})
+      for (const LineGeometry g : {LineGeometry{6, 64, true}, LineGeometry{6, 0, false}, LineGeometry{7, 3, true}}) {
+        const WalkParams p{16, 8, 16 - (n % 3) * 5, {}};
+        LookupLines want, got;
+        want.reset(g), got.reset(g);
+        std::vector<WalkResult> a(rays.size()), b(rays.size()), c(rays.size());
+        walk_each(m, s.view(), p, pointers, a, &want, false);
+        walk_each(m, s.view(), p, pointers, b, &got, true);
+        walk_each(m, s.view(), p, pointers, c, nullptr, true);
+        for (std::size_t k = 0; k < rays.size(); ++k) {
+          ASSERT_TRUE(a[k].hit == b[k].hit && std::bit_cast<std::uint32_t>(a[k].t) == std::bit_cast<std::uint32_t>(b[k].t) &&
+                      a[k].lookups == b[k].lookups && a[k].steps == b[k].steps && a[k].bisections == b[k].bisections &&
+                      a[k].capped == b[k].capped)
+              << to_string(m) << " " << kind << " " << n << ": ray " << k << " hit " << a[k].hit << "/" << b[k].hit << " t " << a[k].t << "/" << b[k].t << " steps "
+              << a[k].steps << "/" << b[k].steps;
+          ASSERT_TRUE(b[k].hit == c[k].hit && b[k].t == c[k].t && b[k].lookups == c[k].lookups) << kind << " " << n << ": ray " << k;
+          hits += a[k].hit, refined += a[k].bisections > 0, walked += a[k].steps > 0;
+        }
+        ASSERT_TRUE(std::ranges::equal(want.lines(), got.lines())) << kind << " " << n;
+        EXPECT_EQ(want.repeats(), got.repeats()) << kind << " " << n;
+      }
+    }
+  // The rays take every way out of a walk.
+  EXPECT_GT(hits, 1000);
+  EXPECT_GT(refined, 500);
+  EXPECT_GT(walked, 5000);
 }
 
 }  // namespace
