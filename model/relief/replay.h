@@ -151,6 +151,15 @@ class ReliefReplay {
   std::vector<std::uint8_t> hit_;     // per pixel: the current box draw's walk hit there
   std::vector<float> hit_depth_;      // and its exact depth (box_depth_ exact)
   std::vector<std::uint8_t> passed_;
+  // The early depth test of the frame's last box draw that ran it: its draw (clip positions and
+  // state) and counts; passed_ and fragment_pixels_ hold its fragments.
+  struct EarlyTest {
+    bool valid = false;
+    scene::DepthState state;
+    std::vector<std::array<float, 4>> positions;
+    raster::DrawCounters counts;
+  };
+  EarlyTest early_;
   // The frame's rays and references by pixel (the methods' draws share the frame's ray frame):
   // computed at the first draw that walks the pixel, which pixel_state_ records.
   static constexpr std::uint8_t kPixelUnknown = 0, kPixelNoRay = 1, kPixelRay = 2, kPixelReference = 3;

@@ -96,6 +96,7 @@ struct DepthState {
   bool front_ccw = true;
   ClipControl clip = ClipControl::NegativeOneToOne;
   bool depth_clamp = false;
+  bool operator==(const DepthState&) const = default;
 };
 
 // GL's own counters for one draw (what each counts on llvmpipe: docs/architecture.md, "Platform
