@@ -163,10 +163,45 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     out.draws.push_back(*open);
     open.reset();
   };
+  // A box draw's write (its hits into the depth buffer, checked against GL's), left pending after
+  // its walks so that it can run beside the next box draw's walks when nothing between them needs
+  // it (the next draw is a box draw whose early test is this one's); then the draw is open.
+  struct PendingWrite {
+    const scene::DrawRecord* draw;
+    BoxDrawCounts counts;
+    std::size_t box;  // the box draw's index in the frame
+  };
+  std::optional<PendingWrite> pending;
+  const auto write_pending = [&] {
+    if (!pending) return;
+    BoxDrawCounts& c = pending->counts;
+    if (writes) {  // the write: the hits at the box's depth (early test, late write) or at their own
+      raster::DrawState keep = raster::draw_state(pending->draw->state);
+      const KeepHits shader(hit_, box_depth_ == BoxDepth::Exact ? &hit_depth_ : nullptr, width_);
+      keep.depth.shader = &shader;
+      const raster::DrawCounters w = path_.draw(pending->draw->clip_positions, keep);
+      c.samples = w.depth.passed;
+      c.depth_written = w.depth.written;
+      if (box_depth_ == BoxDepth::Exact) c.depth_tests = w.depth.depth_tests;
+      for (const std::uint32_t px : fragment_pixels_) hit_[px] = 0;  // only walked pixels were set (the next draw walks the same)
+      const std::uint32_t crc = static_cast<std::uint32_t>(
+          crc32(0L, reinterpret_cast<const Bytef*>(depth_.texels.data()), static_cast<uInt>(depth_.texels.size() * sizeof(float))));
+      c.depth_mismatches = crc != gl_depth->depth_crc[pending->box] ? 1 : 0;
+    }
+    open = c;
+    pending.reset();
+  };
+  // Every box draw starts from the depth before the frame's first (box_depth.h).
+  const auto restore = [&](std::size_t box) {
+    if (box == 0) before_boxes_ = depth_.texels;
+    else std::copy(before_boxes_.begin(), before_boxes_.end(), depth_.texels.begin());
+    if (writes) std::copy(before_boxes_.begin(), before_boxes_.end(), without_box_.texels.begin());
+  };
   for (const scene::DrawRecord& d : f.draws) {
     if (d.role == scene::DrawRole::Scene) {  // boxes in a scene: its depth, drawn before and after the boxes
       if (d.topology != scene::Topology::Triangles || d.clip_positions.size() % 3 != 0)
         throw InputError(fmt::format("frame {}: scene draw {} is not a list of triangles", f.begin.frame, d.index));
+      write_pending();
       const raster::DrawState s = raster::draw_state(d.state);
       const raster::DrawCounters k = path_.draw(d.clip_positions, s);
       out.scene_depth_tests += k.depth.depth_tests;
@@ -185,11 +220,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     if (next_record >= records.size() || records[next_record].draw != d.index)
       throw InputError(fmt::format("frame {}: relief_box draw {} has no ReliefFragments (RLFF) record in draw order", f.begin.frame, d.index));
     const GlReliefFragments& r = records[next_record++];
-    close();
-    // Every box draw starts from the depth before the frame's first (box_depth.h).
-    if (box_draw++ == 0) before_boxes_ = depth_.texels;
-    else std::copy(before_boxes_.begin(), before_boxes_.end(), depth_.texels.begin());
-    if (writes) std::copy(before_boxes_.begin(), before_boxes_.end(), without_box_.texels.begin());
+    const std::size_t box = box_draw++;
 
     // The walk's fragments: after the early test (none, box), or every rasterized one (exact: the
     // test waits for the shader's depth). No write here: a box draw writes after its walks. Every box
@@ -198,6 +229,14 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     const bool same_as_before = early_.valid && early_.state == d.state && early_.positions.size() == d.clip_positions.size() &&
                                 std::memcmp(early_.positions.data(), d.clip_positions.data(),
                                             d.clip_positions.size() * sizeof(d.clip_positions[0])) == 0;
+    // The box draw before's write and hand-on, then this draw's depth: now, or beside the walks.
+    const bool beside = same_as_before && pending.has_value();
+    const auto before_walks = [&] {
+      write_pending();
+      close();
+      restore(box);
+    };
+    if (!beside) before_walks();
     if (!same_as_before) {
       std::fill(passed_.begin(), passed_.end(), std::uint8_t{0});
       raster::DrawState s = raster::draw_state(d.state);
@@ -321,27 +360,18 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
         ++g;
       }
     };
-    pool_.run(run_count, walk_run, [&](std::size_t run) {
-      if (lookups) lookups->take(runs_[run]);
-      merge_run(run);
-    });
+    pool_.run(
+        run_count, walk_run,
+        [&](std::size_t run) {
+          if (lookups) lookups->take(runs_[run]);
+          merge_run(run);
+        },
+        beside ? std::function<void()>(before_walks) : std::function<void()>());
     if (levels) on_demand_levels(gl, c);
     c.pixel_mismatches += r.pixel.size() - g;
-    if (writes) {  // the write: the hits at the box's depth (early test, late write) or at their own
-      raster::DrawState keep = raster::draw_state(d.state);
-      const KeepHits shader(hit_, box_depth_ == BoxDepth::Exact ? &hit_depth_ : nullptr, width_);
-      keep.depth.shader = &shader;
-      const raster::DrawCounters w = path_.draw(d.clip_positions, keep);
-      c.samples = w.depth.passed;
-      c.depth_written = w.depth.written;
-      if (box_depth_ == BoxDepth::Exact) c.depth_tests = w.depth.depth_tests;
-      for (const std::uint32_t px : fragment_pixels_) hit_[px] = 0;  // only walked pixels were set
-      const std::uint32_t crc = static_cast<std::uint32_t>(
-          crc32(0L, reinterpret_cast<const Bytef*>(depth_.texels.data()), static_cast<uInt>(depth_.texels.size() * sizeof(float))));
-      c.depth_mismatches = crc != gl_depth->depth_crc[box_draw - 1] ? 1 : 0;
-    }
-    open = c;
+    pending = PendingWrite{&d, c, box};
   }
+  write_pending();
   close();
   if (next_record != records.size())
     throw InputError(fmt::format("frame {}: {} ReliefFragments (RLFF) records, but {} relief_box draws", f.begin.frame, records.size(),

@@ -77,7 +77,8 @@ void WorkerPool::finish(std::size_t k, std::exception_ptr error) {
   done_[k].notify_one();
 }
 
-void WorkerPool::run(std::size_t count, const std::function<void(std::size_t)>& work, const std::function<void(std::size_t)>& then) {
+void WorkerPool::run(std::size_t count, const std::function<void(std::size_t)>& work, const std::function<void(std::size_t)>& then,
+                     const std::function<void()>& first) {
   {
     // A helper still inside the previous job (it found nothing left to claim) reads its fields:
     // they change only once every helper has left it.
@@ -96,6 +97,15 @@ void WorkerPool::run(std::size_t count, const std::function<void(std::size_t)>& 
   }
   if (!helpers_.empty()) wake_.notify_all();
   bool failed = false;
+  std::exception_ptr first_error;
+  if (first) {
+    try {
+      first();
+    } catch (...) {
+      first_error = std::current_exception();
+      failed = true;
+    }
+  }
   for (std::size_t k = 0; k < count; ++k) {
     for (;;) {
       const std::uint32_t state = done_[k].load(std::memory_order_acquire);
@@ -120,8 +130,8 @@ void WorkerPool::run(std::size_t count, const std::function<void(std::size_t)>& 
     if (!failed) then(k);
   }
   if (failed) {
-    std::exception_ptr error;
-    {
+    std::exception_ptr error = first_error;
+    if (!error) {
       std::lock_guard lock(mutex_);
       error = error_;
     }

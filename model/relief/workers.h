@@ -41,7 +41,11 @@ class WorkerPool {
   // calling thread takes on unstarted work while it waits). work(k) must touch nothing that
   // another work(j) or then(j) touches but what it owns for k. An exception from work(k) is
   // rethrown here, after every started work has finished (then(j) not called from k on).
-  void run(std::size_t count, const std::function<void(std::size_t)>& work, const std::function<void(std::size_t)>& then);
+  // `first` (may be empty) runs on the calling thread once the helpers have started, before any
+  // then(k): work the calling thread does beside the job's (it must touch nothing a work touches);
+  // an exception from it is rethrown likewise, no then(k) called.
+  void run(std::size_t count, const std::function<void(std::size_t)>& work, const std::function<void(std::size_t)>& then,
+           const std::function<void()>& first = {});
 
  private:
   void helper(const std::stop_token& stop);

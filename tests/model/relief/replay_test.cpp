@@ -160,6 +160,34 @@ TEST(ReliefWorkerPoolTest, WorkErrorIsRethrown) {
   }
 }
 
+// `first` runs once on the calling thread, beside the works and before every then(k); its exception
+// is rethrown once every started work has finished, with nothing handed on.
+TEST(ReliefWorkerPoolTest, FirstRunsOnTheCallingThreadBeforeThen) {
+  for (const int threads : {1, 2, 3}) {
+    WorkerPool pool(threads);
+    std::atomic<int> works{0};
+    int firsts = 0, first_slot = -1;
+    bool then_before_first = false;
+    pool.run(
+        64, [&](std::size_t) { ++works; }, [&](std::size_t) { then_before_first = then_before_first || firsts == 0; },
+        [&] { ++firsts, first_slot = WorkerPool::slot(); });
+    EXPECT_EQ(works.load(), 64);
+    EXPECT_EQ(firsts, 1);
+    EXPECT_EQ(first_slot, 0);
+    EXPECT_FALSE(then_before_first);
+    std::vector<std::size_t> handed;
+    works = 0;
+    EXPECT_THROW(pool.run(
+                     50, [&](std::size_t) { ++works; }, [&](std::size_t k) { handed.push_back(k); },
+                     [] { throw std::runtime_error("first"); }),
+                 std::runtime_error);
+    EXPECT_EQ(works.load(), 50) << "every work ran, as the pool cannot stop its helpers midway";
+    EXPECT_TRUE(handed.empty());
+    pool.run(3, [&](std::size_t) { ++works; }, [](std::size_t) {});
+    EXPECT_EQ(works.load(), 53) << "the pool still works";
+  }
+}
+
 // A frame: RLFH of the random field, seen from above the box's front edge, and one box draw a method
 // covering the whole viewport (two triangles at depth 0), each with an empty RLFF (the comparison
 // with GL is not what this checks: its pixel mismatches are the same for any thread count anyway).
