@@ -96,8 +96,9 @@ ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, Cove
       scratch_(static_cast<std::size_t>(pool_.threads())) {
   path_.set_reuse_rasterization(true);  // every method draws the same box
   if (box_depth_ != BoxDepth::None) {
-    hit_.assign(passed_.size(), 0);
-    if (box_depth_ == BoxDepth::Exact) hit_depth_.assign(passed_.size(), 0.0f);
+    for (std::vector<std::uint8_t>& h : hit_) h.assign(passed_.size(), 0);
+    if (box_depth_ == BoxDepth::Exact)
+      for (std::vector<float>& h : hit_depth_) h.assign(passed_.size(), 0.0f);
   }
 }
 
@@ -177,13 +178,14 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     BoxDrawCounts& c = pending->counts;
     if (writes) {  // the write: the hits at the box's depth (early test, late write) or at their own
       raster::DrawState keep = raster::draw_state(pending->draw->state);
-      const KeepHits shader(hit_, box_depth_ == BoxDepth::Exact ? &hit_depth_ : nullptr, width_);
+      std::vector<std::uint8_t>& hit = hit_[pending->box % 2];
+      const KeepHits shader(hit, box_depth_ == BoxDepth::Exact ? &hit_depth_[pending->box % 2] : nullptr, width_);
       keep.depth.shader = &shader;
       const raster::DrawCounters w = path_.draw(pending->draw->clip_positions, keep);
       c.samples = w.depth.passed;
       c.depth_written = w.depth.written;
       if (box_depth_ == BoxDepth::Exact) c.depth_tests = w.depth.depth_tests;
-      for (const std::uint32_t px : fragment_pixels_) hit_[px] = 0;  // only walked pixels were set (the next draw walks the same)
+      for (const std::uint32_t px : fragment_pixels_) hit[px] = 0;  // only walked pixels were set (the next draw walks the same)
       const std::uint32_t crc = static_cast<std::uint32_t>(
           crc32(0L, reinterpret_cast<const Bytef*>(depth_.texels.data()), static_cast<uInt>(depth_.texels.size() * sizeof(float))));
       c.depth_mismatches = crc != gl_depth->depth_crc[pending->box] ? 1 : 0;
@@ -272,25 +274,28 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     c.rasterized = k.depth.fragments;
     c.gl_fragments = d.gl.fragments;
     c.gl_samples = d.gl.samples_passed;
-    // The fragments' walks and scores (every pixel's reference computed at most once a frame), in
-    // parallel runs of consecutive fragments; each run's lookups go to `lookups` in pixel order.
-    walks_.resize(fragment_pixels_.size());
+    // The fragments' walks, scores and comparison with GL's (every pixel's reference computed at most
+    // once a frame), in parallel runs of consecutive fragments; each run's lookups go to `lookups` in
+    // pixel order, and its counts are added to the draw's in order.
     const std::size_t run_count = (fragment_pixels_.size() + kRunFragments - 1) / kRunFragments;
-    if (runs_.size() < run_count) runs_.resize(run_count);
+    if (runs_.size() < run_count) runs_.resize(run_count), tallies_.resize(run_count);
     const LineGeometry geometry = lookups ? lookups->geometry() : LineGeometry{};
     // The N-buffer walk's level reads, marked by the walks, then computed on demand.
     const bool levels = r.method == Method::NBuffer && lookups;
     if (levels)
       for (std::vector<std::uint8_t>& marks : level_marks_) marks.assign(gl.nbuffer.size(), 0);
+    // This draw's hits (the draw before may still be writing its own, beside these walks).
+    std::vector<std::uint8_t>& hit = hit_[box % 2];
+    std::vector<float>& hit_depths = hit_depth_[box % 2];
     const auto walk_run = [&](std::size_t run) {
       LookupLines& lines = runs_[run];
       if (lookups) lines.reset(geometry);
       lines.mark_levels(levels ? level_marks_[static_cast<std::size_t>(WorkerPool::slot())].data() : nullptr);
-      const std::size_t end = std::min(fragment_pixels_.size(), (run + 1) * kRunFragments);
+      const std::size_t begin = run * kRunFragments, end = std::min(fragment_pixels_.size(), begin + kRunFragments);
       RunScratch& scratch = scratch_[static_cast<std::size_t>(WorkerPool::slot())];
       scratch.rays.clear();
       scratch.fragments.clear();
-      for (std::size_t at = run * kRunFragments; at < end; ++at) {
+      for (std::size_t at = begin; at < end; ++at) {
         const std::uint32_t px = fragment_pixels_[at];
         std::uint8_t& state = pixel_state_[px];
         if (state == kPixelUnknown) {  // the pixel's first walk this frame: its ray (and, below, its reference)
@@ -300,75 +305,78 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
           state = ray ? kPixelRay : kPixelNoRay;
           if (ray) rays_[px] = *ray;
         }
-        walks_[at] = FragmentWalk{};
         if (state == kPixelNoRay) continue;
         scratch.rays.push_back(&rays_[px]);
         scratch.fragments.push_back(at);
       }
       scratch.results.resize(scratch.rays.size());
       walk_each(r.method, view, params, scratch.rays, scratch.results, lookups ? &lines : nullptr);
-      for (std::size_t q = 0; q < scratch.fragments.size(); ++q) {
-        const std::size_t at = scratch.fragments[q];
+      // The run's fragments against GL's: the two sorted pixel lists merged over the run's share of
+      // the viewport, from its first pixel (0 for the first run) to the next run's first (the end of
+      // the viewport for the last), so that the runs' counts add up to one merge of the whole lists.
+      Tally& tally = tallies_[run];
+      tally.counts = BoxDrawCounts{};
+      tally.distances.clear();
+      BoxDrawCounts& t = tally.counts;
+      const auto gl_at = [&](std::uint32_t px) {
+        return static_cast<std::size_t>(std::lower_bound(r.pixel.begin(), r.pixel.end(), px) - r.pixel.begin());
+      };
+      std::size_t g = run == 0 ? 0 : gl_at(fragment_pixels_[begin]);
+      const std::size_t g_end = end == fragment_pixels_.size() ? r.pixel.size() : gl_at(fragment_pixels_[end]);
+      std::size_t q = 0;  // the next walked fragment in scratch
+      for (std::size_t at = begin; at < end; ++at) {
         const std::uint32_t px = fragment_pixels_[at];
-        std::uint8_t& state = pixel_state_[px];
-        const FragmentRay& ray = rays_[px];
-        FragmentWalk& fw = walks_[at];
-        fw.ray = true;
-        fw.walk = scratch.results[q];
-        if (scoring_) {
-          if (state == kPixelRay) reference_[px] = reference_of(gl.field, ray, &*blocks), state = kPixelReference;
-          fw.score = score_against(reference_[px], ray, gl.field.size, fw.walk.hit && !fw.walk.capped, fw.walk.t, box_height, tolerance);
-        }
-        if (box_depth_ == BoxDepth::Exact && fw.walk.hit && !fw.walk.capped) fw.depth = hit_depth(gl_depth->texel_to_clip, ray, fw.walk.t);
-      }
-    };
-    // The model's fragments (pixel order) against GL's, merged as two sorted pixel lists, run by run
-    // in order on this thread while the workers walk the runs after it.
-    std::size_t g = 0;
-    const auto merge_run = [&](std::size_t run) {
-      const std::size_t end = std::min(fragment_pixels_.size(), (run + 1) * kRunFragments);
-      for (std::size_t at = run * kRunFragments; at < end; ++at) {
-        const std::uint32_t px = fragment_pixels_[at];
-        while (g < r.pixel.size() && r.pixel[g] < px) ++c.pixel_mismatches, ++g;  // GL's alone
-        const bool in_gl = g < r.pixel.size() && r.pixel[g] == px;
-        const FragmentWalk& fw = walks_[at];
-        const WalkResult& w = fw.walk;
+        while (g < g_end && r.pixel[g] < px) ++t.pixel_mismatches, ++g;  // GL's alone
+        const bool in_gl = g < g_end && r.pixel[g] == px;
+        const bool walked = q < scratch.fragments.size() && scratch.fragments[q] == at;
+        const WalkResult w = walked ? scratch.results[q++] : WalkResult{};
         const std::uint32_t code = w.capped ? 2u : w.hit ? 1u : 0u;
-        if (writes) {
-          hit_[px] = code == 1u ? 1 : 0;
-          if (box_depth_ == BoxDepth::Exact && code == 1u) hit_depth_[px] = fw.depth;
-        }
-        c.lookups += w.lookups, c.steps += w.steps, c.bisections += w.bisections;
-        c.longest_walk = std::max<std::uint64_t>(c.longest_walk, w.lookups);
-        c.hits += code == 1u, c.capped += code == 2u, c.samples += code == 1u;
-        if (fw.ray) {
-          const HitScore& score = fw.score;
-          c.reference_hits += score.reference_hit;
-          c.wrong_hit += score.error == HitError::WrongHit;
-          c.wrong_miss += score.error == HitError::WrongMiss;
-          c.far_hit += score.error == HitError::FarHit;
-          if (code == 1u && score.reference_hit) c.distance_sum += score.distance;
+        if (writes) hit[px] = code == 1u ? 1 : 0;
+        t.lookups += w.lookups, t.steps += w.steps, t.bisections += w.bisections;
+        t.longest_walk = std::max<std::uint64_t>(t.longest_walk, w.lookups);
+        t.hits += code == 1u, t.capped += code == 2u, t.samples += code == 1u;
+        if (walked) {
+          const FragmentRay& ray = rays_[px];
+          if (box_depth_ == BoxDepth::Exact && code == 1u) hit_depths[px] = hit_depth(gl_depth->texel_to_clip, ray, w.t);
+          if (scoring_) {
+            std::uint8_t& state = pixel_state_[px];
+            if (state == kPixelRay) reference_[px] = reference_of(gl.field, ray, &*blocks), state = kPixelReference;
+            const HitScore score = score_against(reference_[px], ray, gl.field.size, w.hit && !w.capped, w.t, box_height, tolerance);
+            t.reference_hits += score.reference_hit;
+            t.wrong_hit += score.error == HitError::WrongHit;
+            t.wrong_miss += score.error == HitError::WrongMiss;
+            t.far_hit += score.error == HitError::FarHit;
+            if (code == 1u && score.reference_hit) tally.distances.push_back(score.distance);  // summed in order by the draw
+          }
         }
         if (!in_gl) {  // the model's alone
-          ++c.pixel_mismatches;
+          ++t.pixel_mismatches;
           continue;
         }
-        c.gl_lookups += r.lookups[g];
+        t.gl_lookups += r.lookups[g];
         const bool same = code == r.hit[g] && std::memcmp(&w.t, &r.t[g], sizeof(float)) == 0 && w.lookups == r.lookups[g] &&
                           w.steps == r.steps[g] && w.bisections == r.bisections[g];
-        c.walk_mismatches += same ? 0 : 1;
+        t.walk_mismatches += same ? 0 : 1;
         ++g;
       }
+      t.pixel_mismatches += g_end - g;  // GL's alone up to the next run's share
     };
-    pool_.run(
-        run_count, walk_run,
-        [&](std::size_t run) {
-          if (lookups) lookups->take(runs_[run]);
-          merge_run(run);
-        },
-        beside ? std::function<void()>(before_walks) : std::function<void()>());
+    // The runs' lookups and counts handed on in order on this thread while the workers walk the runs
+    // after them.
+    const auto add_run = [&](std::size_t run) {
+      if (lookups) lookups->take(runs_[run]);
+      const Tally& tally = tallies_[run];
+      const BoxDrawCounts& t = tally.counts;
+      c.pixel_mismatches += t.pixel_mismatches, c.walk_mismatches += t.walk_mismatches;
+      c.lookups += t.lookups, c.steps += t.steps, c.bisections += t.bisections, c.gl_lookups += t.gl_lookups;
+      c.longest_walk = std::max(c.longest_walk, t.longest_walk);
+      c.hits += t.hits, c.capped += t.capped, c.samples += t.samples;
+      c.reference_hits += t.reference_hits, c.wrong_hit += t.wrong_hit, c.wrong_miss += t.wrong_miss, c.far_hit += t.far_hit;
+      for (const double distance : tally.distances) c.distance_sum += distance;
+    };
+    pool_.run(run_count, walk_run, add_run, beside ? std::function<void()>(before_walks) : std::function<void()>());
+    if (run_count == 0) c.pixel_mismatches += r.pixel.size();  // GL's alone
     if (levels) on_demand_levels(gl, c);
-    c.pixel_mismatches += r.pixel.size() - g;
     pending = PendingWrite{&d, c, box};
   }
   write_pending();

@@ -148,8 +148,10 @@ class ReliefReplay {
   DepthImage depth_;
   std::vector<float> before_boxes_;  // the depth before the frame's first box draw
   DepthImage without_box_;           // the scene after a box drawn without it (box_depth_ not none)
-  std::vector<std::uint8_t> hit_;     // per pixel: the current box draw's walk hit there
-  std::vector<float> hit_depth_;      // and its exact depth (box_depth_ exact)
+  // Per pixel: a box draw's walk hit there, and its exact depth (box_depth_ exact); two of each, for
+  // the frame's even and odd box draws (a draw's write runs beside the next draw's walks).
+  std::array<std::vector<std::uint8_t>, 2> hit_;
+  std::array<std::vector<float>, 2> hit_depth_;
   std::vector<std::uint8_t> passed_;
   // The early depth test of the frame's last box draw that ran it: its draw (clip positions and
   // state) and counts; passed_ and fragment_pixels_ hold its fragments.
@@ -168,18 +170,17 @@ class ReliefReplay {
   std::vector<std::uint8_t> pixel_state_;
   raster::RasterPath path_;
   raster::RasterPath without_box_path_;
-  // A draw's fragments (pixels in order), their walks and scores, and their lookups by run of
-  // kRunFragments fragments: filled by the workers, read in order by the calling thread.
-  struct FragmentWalk {
-    bool ray = false;  // the pixel's ray meets the box (else no walk)
-    WalkResult walk;
-    HitScore score;
-    float depth = 0.0f;  // a hit's exact depth (box depth exact), computed with the walk
+  // A draw's fragments (pixels in order), and by run of kRunFragments fragments their lookups and
+  // counts (with the distances of the scored hits, summed by the draw in fragment order): filled by
+  // the workers, read in order by the calling thread.
+  struct Tally {
+    BoxDrawCounts counts;
+    std::vector<double> distances;
   };
   static constexpr std::size_t kRunFragments = 256;
   std::vector<std::uint32_t> fragment_pixels_;
-  std::vector<FragmentWalk> walks_;
   std::vector<LookupLines> runs_;
+  std::vector<Tally> tallies_;
   WorkerPool pool_;
   // The frame's on-demand N-buffer of the heights (made at its first nbuffer draw), and the level
   // texels the current draw's walks read (a byte each), per thread of the pool.
