@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -41,13 +42,14 @@ struct GlReliefField {
 GlReliefField read_relief_field(const scene::Frame& f);
 
 // One RLFF, checked.
+// The fragment fields are views into the frame's RLFF record (no copies): valid while the frame is.
 struct GlReliefFragments {
   std::uint32_t draw = 0;
   Method method = Method::Binary;
-  std::vector<std::uint32_t> pixel;  // strictly increasing
-  std::vector<std::uint32_t> hit;    // 0 miss, 1 hit, 2 capped
-  std::vector<float> t;
-  std::vector<std::uint32_t> lookups, steps, bisections;
+  std::span<const std::uint32_t> pixel;  // strictly increasing
+  std::span<const std::uint32_t> hit;    // 0 miss, 1 hit, 2 capped
+  std::span<const float> t;
+  std::span<const std::uint32_t> lookups, steps, bisections;
 };
 // Every RLFF of the frame, in record order; `viewport_pixels` bounds `pixel`.
 std::vector<GlReliefFragments> read_relief_fragments(const scene::Frame& f, std::uint64_t viewport_pixels);

@@ -5,6 +5,8 @@
 // is an InputError naming the frame, the record and the problem.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <functional>
 #include <stdexcept>
@@ -155,12 +157,12 @@ TEST(ReliefRecordsTest, GoodRecordsReadBack) {
   EXPECT_EQ(k[0].method, Method::Binary);
   EXPECT_EQ(k[1].draw, 2u);
   EXPECT_EQ(k[1].method, Method::NBuffer);
-  EXPECT_EQ(k[0].pixel, (std::vector<std::uint32_t>{9, 10, 17}));
-  EXPECT_EQ(k[0].hit, (std::vector<std::uint32_t>{1, 0, 2}));
-  EXPECT_EQ(k[0].t, (std::vector<float>{0.75f, 0.0f, 0.0f}));
-  EXPECT_EQ(k[0].lookups, (std::vector<std::uint32_t>{12, 8, 400}));
-  EXPECT_EQ(k[0].steps, (std::vector<std::uint32_t>{3, 2, 100}));
-  EXPECT_EQ(k[0].bisections, (std::vector<std::uint32_t>{8, 0, 0}));
+  EXPECT_TRUE(std::ranges::equal(k[0].pixel, std::vector<std::uint32_t>{9, 10, 17}));
+  EXPECT_TRUE(std::ranges::equal(k[0].hit, std::vector<std::uint32_t>{1, 0, 2}));
+  EXPECT_TRUE(std::ranges::equal(k[0].t, std::vector<float>{0.75f, 0.0f, 0.0f}));
+  EXPECT_TRUE(std::ranges::equal(k[0].lookups, std::vector<std::uint32_t>{12, 8, 400}));
+  EXPECT_TRUE(std::ranges::equal(k[0].steps, std::vector<std::uint32_t>{3, 2, 100}));
+  EXPECT_TRUE(std::ranges::equal(k[0].bisections, std::vector<std::uint32_t>{8, 0, 0}));
 }
 
 // The view spans the record's own vectors.
