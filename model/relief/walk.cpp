@@ -19,11 +19,11 @@ namespace {
 constexpr std::array<std::string_view, kMethods> kMethodNames = {"binary", "exact", "robust", "robust_clamp", "nbuffer"};
 constexpr float kFar = 3.0e38f;  // the shader's "no boundary" (a finite constant: GLSL has no inf literal)
 
+struct Deferred;
+
 // A lookup source: the field's textures, every read reported to `sink` (sink(texture, index) for a
 // texel in memory, sink.border() for a virtual border texel). The walks are templates on the sink
 // so that a recording sink (LookupLines) costs no indirect call per lookup.
-struct Deferred;
-
 template <class Sink>
 struct Reader {
   const FieldView f;  // a copy: its size and spans one load away, not two
@@ -261,6 +261,13 @@ void set_hit(WalkResult& w, float t) {
   w.t = t;
 }
 
+// Every walk's end: a ray that leaves through the box's floor with no hit before hits there, and a
+// capped walk is a miss.
+void end_walk(WalkResult& w, const FragmentRay& ray) {
+  if (!w.hit && !w.capped && ray.floor_exit) set_hit(w, ray.t_out);
+  if (w.capped) w.hit = false, w.t = 0.0f;
+}
+
 // Bisection of [a, b] (above at a, below at b) anywhere: 4 lookups a step.
 template <class Sink>
 float bisect(Reader<Sink>& r, const FragmentRay& ray, float a, float b, int steps, WalkResult& w) {
@@ -487,8 +494,7 @@ WalkResult walk_with(Method method, const FieldView& field, const WalkParams& pa
       case Method::NBuffer: walk_nbuffer(r, params, ray, w, cap); break;
     }
   }
-  if (!w.hit && !w.capped && ray.floor_exit) set_hit(w, ray.t_out);
-  if (w.capped) w.hit = false, w.t = 0.0f;
+  end_walk(w, ray);
   w.lookups = r.lookups;
   return w;
 }
@@ -506,11 +512,7 @@ WalkResult walk(Method method, const FieldView& field, const WalkParams& params,
   return walk_with(method, field, params, ray, sink);
 }
 
-}  // namespace nbsim::relief
-
 // ---- Runs of walks: the exact method in AVX2 lanes ----
-
-namespace nbsim::relief {
 
 namespace {
 
@@ -646,12 +648,6 @@ struct Refinement {
   ObserverSink none{nullptr, nullptr};
   Reader<ObserverSink> reader{field, none};
 
-  // Ends ray k's walk (lanes: its steps, how it ended) as walk_with does.
-  const auto finish = [&](std::size_t k, WalkResult& w) {
-    const FragmentRay& ray = *rays[k];
-    if (!w.hit && !w.capped && ray.floor_exit) set_hit(w, ray.t_out);
-    if (w.capped) w.hit = false, w.t = 0.0f;
-  };
   // Gives lane `l` the run's next ray that needs a walk (the rays whose first height ends them, or
   // whose walk ends before its first step, are done here); false when none is left.
   const auto load = [&](int l) {
@@ -667,7 +663,7 @@ struct Refinement {
       if (above(reader, ray, ray.t_in) <= 0.0f) {
         set_hit(w, ray.t_in);
         w.lookups = 4;
-        finish(k, w);
+        end_walk(w, ray);
         continue;
       }
       CellWalk cw;
@@ -675,7 +671,7 @@ struct Refinement {
       if (cap <= 0 || !cw.inside(n) || cw.t >= ray.t_out) {  // walk_exact's loop: capped before its first step, or done
         w.capped = cap <= 0;
         w.lookups = 4;
-        finish(k, w);
+        end_walk(w, ray);
         continue;
       }
       logged.lane = l;
@@ -715,7 +711,7 @@ struct Refinement {
       case LaneEnd::Miss: break;
       case LaneEnd::Capped: w.capped = true; break;
     }
-    finish(k, w);
+    end_walk(w, ray);
     load(l);
   };
 
