@@ -102,10 +102,12 @@ ReliefReplay::ReliefReplay(int width, int height, bool fused_interpolation, Cove
   }
 }
 
-// The level texels the walks read (level_marks_), computed by the frame's on-demand N-buffer of the
-// heights (made at its first nbuffer draw, where a full build's texels are charged) and compared
-// with the full build's. Which texels an on-demand build computes does not depend on the order.
-void ReliefReplay::on_demand_levels(const GlReliefField& gl, BoxDrawCounts& c) {
+// The level texels the walks read, computed by the frame's on-demand N-buffer of the heights (made
+// at its first nbuffer draw, where a full build's texels are charged) and compared with the full
+// build's: begun before a draw's walks, fed each run's newly read texels in run order while later
+// runs are walked, and summed after them. Which texels an on-demand build computes, and so every
+// count here, does not depend on the order the texels are asked for.
+void ReliefReplay::begin_levels(const GlReliefField& gl, BoxDrawCounts& c) {
   const int n = gl.field.size;
   if (!on_demand_fresh_) {  // the frame's first nbuffer draw
     if (!on_demand_ || on_demand_->width() != n) {
@@ -119,17 +121,25 @@ void ReliefReplay::on_demand_levels(const GlReliefField& gl, BoxDrawCounts& c) {
     on_demand_fresh_ = true;
     c.levels_eager_texels = static_cast<std::uint64_t>(gl.levels - 1) * static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(n);
   }
-  UpdateStats demand = on_demand_->new_stats();
-  const std::size_t plane = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
-  for (std::size_t index = 0; index < gl.nbuffer.size(); ++index) {
-    if (std::none_of(level_marks_.begin(), level_marks_.end(), [index](const std::vector<std::uint8_t>& m) { return m[index] != 0; }))
-      continue;
+  demand_ = on_demand_->new_stats();
+  for (std::vector<std::uint8_t>& marks : level_marks_) marks.assign(gl.nbuffer.size(), 0);
+  levels_checked_.assign(gl.nbuffer.size(), 0);
+}
+
+void ReliefReplay::run_levels(const GlReliefField& gl, std::span<const std::uint32_t> texels, BoxDrawCounts& c) {
+  const std::size_t n = static_cast<std::size_t>(gl.field.size), plane = n * n;
+  for (const std::uint32_t index : texels) {
+    if (levels_checked_[index]) continue;  // read by another thread's runs too
+    levels_checked_[index] = 1;
     const int level = static_cast<int>(index / plane);
-    const int x = static_cast<int>(index % plane % static_cast<std::size_t>(n)), y = static_cast<int>(index % plane / static_cast<std::size_t>(n));
-    on_demand_->ensure(level, x, y, demand);
+    const int x = static_cast<int>(index % plane % n), y = static_cast<int>(index % plane / n);
+    on_demand_->ensure(level, x, y, demand_);
     c.levels_on_demand_mismatches += std::bit_cast<std::uint32_t>(on_demand_->texel(level, x, y)) != std::bit_cast<std::uint32_t>(gl.nbuffer[index]);
   }
-  for (std::size_t l = 1; l < demand.texels_recomputed.size(); ++l) c.levels_on_demand_texels += static_cast<std::uint64_t>(demand.texels_recomputed[l]);
+}
+
+void ReliefReplay::end_levels(BoxDrawCounts& c) const {
+  for (std::size_t l = 1; l < demand_.texels_recomputed.size(); ++l) c.levels_on_demand_texels += static_cast<std::uint64_t>(demand_.texels_recomputed[l]);
 }
 
 ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double tolerance, double box_height, LookupSink* lookups,
@@ -282,8 +292,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     const LineGeometry geometry = lookups ? lookups->geometry() : LineGeometry{};
     // The N-buffer walk's level reads, marked by the walks, then computed on demand.
     const bool levels = r.method == Method::NBuffer && lookups;
-    if (levels)
-      for (std::vector<std::uint8_t>& marks : level_marks_) marks.assign(gl.nbuffer.size(), 0);
+    if (levels) begin_levels(gl, c);
     // This draw's hits (the draw before may still be writing its own, beside these walks).
     std::vector<std::uint8_t>& hit = hit_[box % 2];
     std::vector<float>& hit_depths = hit_depth_[box % 2];
@@ -365,6 +374,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     // after them.
     const auto add_run = [&](std::size_t run) {
       if (lookups) lookups->take(runs_[run]);
+      if (levels) run_levels(gl, runs_[run].level_texels(), c);
       const Tally& tally = tallies_[run];
       const BoxDrawCounts& t = tally.counts;
       c.pixel_mismatches += t.pixel_mismatches, c.walk_mismatches += t.walk_mismatches;
@@ -376,7 +386,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     };
     pool_.run(run_count, walk_run, add_run, beside ? std::function<void()>(before_walks) : std::function<void()>());
     if (run_count == 0) c.pixel_mismatches += r.pixel.size();  // GL's alone
-    if (levels) on_demand_levels(gl, c);
+    if (levels) end_levels(c);
     pending = PendingWrite{&d, c, box};
   }
   write_pending();

@@ -182,11 +182,14 @@ class ReliefReplay {
   std::vector<LookupLines> runs_;
   std::vector<Tally> tallies_;
   WorkerPool pool_;
-  // The frame's on-demand N-buffer of the heights (made at its first nbuffer draw), and the level
-  // texels the current draw's walks read (a byte each), per thread of the pool.
+  // The frame's on-demand N-buffer of the heights (made at its first nbuffer draw); the level texels
+  // the current draw's walks read (a byte each), per thread of the pool; those computed and compared
+  // so far (a byte each), and the build's counts over the draw.
   std::optional<NBuffer> on_demand_;
   bool on_demand_fresh_ = false;  // on_demand_ holds this frame's heights
   std::vector<std::vector<std::uint8_t>> level_marks_;
+  std::vector<std::uint8_t> levels_checked_;
+  UpdateStats demand_;
   // Per thread of the pool: a run's rays to walk (walk_each), their fragments and their walks.
   struct RunScratch {
     std::vector<const FragmentRay*> rays;
@@ -194,7 +197,9 @@ class ReliefReplay {
     std::vector<WalkResult> results;
   };
   std::vector<RunScratch> scratch_;
-  void on_demand_levels(const GlReliefField& gl, BoxDrawCounts& c);
+  void begin_levels(const GlReliefField& gl, BoxDrawCounts& c);
+  void run_levels(const GlReliefField& gl, std::span<const std::uint32_t> texels, BoxDrawCounts& c);
+  void end_levels(BoxDrawCounts& c) const;
 };
 
 }  // namespace nbsim::relief

@@ -178,11 +178,20 @@ class alignas(64) LookupLines {
   // Marks the N-buffer level texels the walks read, one byte a texel of FieldView::nbuffer (null:
   // none marked), for the replay's on-demand N-buffer: which texels a build on demand computes.
   // The marks are the walking thread's own (threads sharing them would take their lines from each
-  // other at every first read).
-  void mark_levels(std::uint8_t* marks) noexcept { level_marks_ = marks; }
-  void add_level_texel(std::int64_t index) const noexcept {
-    if (level_marks_) level_marks_[index] = 1;
+  // other at every first read) and outlive the record; a texel first marked while this record was
+  // taken is also listed in level_texels() (emptied here), so that the record's reader can compute
+  // it on demand while later runs are walked.
+  void mark_levels(std::uint8_t* marks) noexcept {
+    level_marks_ = marks;
+    level_texels_.clear();
   }
+  void add_level_texel(std::int64_t index) {
+    if (level_marks_ && !level_marks_[index]) {
+      level_marks_[index] = 1;
+      level_texels_.push_back(static_cast<std::uint32_t>(index));
+    }
+  }
+  std::span<const std::uint32_t> level_texels() const noexcept { return level_texels_; }
 
  private:
   static constexpr std::uint64_t kNone = ~std::uint64_t{0};  // no line (addresses are multiples of 4)
@@ -195,6 +204,7 @@ class alignas(64) LookupLines {
   std::size_t size_ = 0;
   std::uint64_t repeats_ = 0;
   std::uint8_t* level_marks_ = nullptr;
+  std::vector<std::uint32_t> level_texels_;
 };
 
 // The ray of pixel centre (px, py) clipped to the box: false when it misses the box.
