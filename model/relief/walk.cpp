@@ -84,6 +84,7 @@ struct ObserverSink {
     (*this)(t, index);
     (*this)(t, index + 1);
   }
+  void walked(std::uint32_t) const noexcept {}
 };
 
 // The recording sink: virtual border texels need no memory and are left out.
@@ -94,7 +95,8 @@ struct LinesSink {
     if (t == Texture::NBuffer) lines.add_level_texel(index);
   }
   void pair(Texture t, std::int64_t index) const { lines.add_pair(texel_address(t, index), texel_address(t, index + 1)); }
-  void border(Texture) const noexcept {}
+  void border(Texture) const noexcept { lines.add_border(); }
+  void walked(std::uint32_t lookups) const noexcept { lines.add_lookups(lookups); }
 };
 
 int floor_int(float v) noexcept { return static_cast<int>(std::floor(v)); }
@@ -496,6 +498,7 @@ WalkResult walk_with(Method method, const FieldView& field, const WalkParams& pa
   }
   end_walk(w, ray);
   w.lookups = r.lookups;
+  sink.walked(r.lookups);
   return w;
 }
 
@@ -541,6 +544,7 @@ struct CellLog {
         r.corners(p[ray.lane], p[8 + ray.lane], h00, h10, h01, h11);
       }
     }
+    sink.walked(r.lookups);
   }
 };
 

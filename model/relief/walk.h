@@ -146,16 +146,17 @@ class alignas(64) LookupLines {
     set_mask_ = table ? g.sets - 1 : 0;
     last_.assign(set_mask_ + 1, kNone);
     size_ = 0;
-    repeats_ = 0;
+    lookups_ = 0;
+    borders_ = 0;
   }
+  // A lookup of a texel in memory. A merged one is not counted here (a counter in memory, bumped at
+  // nearly every lookup, would chain the walk's lookups one after another): repeats() is what the
+  // walks' lookups leave over.
   void add(std::uint64_t address) {
     const std::uint64_t line = address >> line_shift_;
     if (merge_) {
       std::uint64_t& last = last_[line & set_mask_];
-      if (line == last) {
-        ++repeats_;
-        return;
-      }
+      if (line == last) return;
       last = line;
     }
     // The storage is kept at its full size (size_ counts what is used), so a record reused for the
@@ -167,14 +168,16 @@ class alignas(64) LookupLines {
   // 64-byte lines), the second is the repeat add() would find, counted without the table.
   void add_pair(std::uint64_t a, std::uint64_t b) {
     add(a);
-    if (merge_ && (b >> line_shift_) == (a >> line_shift_)) {
-      ++repeats_;
-      return;
-    }
+    if (merge_ && (b >> line_shift_) == (a >> line_shift_)) return;
     add(b);
   }
+  // A lookup of a virtual border texel (no memory, nothing recorded).
+  void add_border() noexcept { ++borders_; }
+  // A walk's lookups (WalkResult::lookups: in memory or on the border), told once it has ended.
+  void add_lookups(std::uint64_t n) noexcept { lookups_ += n; }
   std::span<const std::uint64_t> lines() const noexcept { return {storage_.data(), size_}; }
-  std::uint64_t repeats() const noexcept { return repeats_; }
+  // The merged lookups: every lookup of a texel in memory but those recorded.
+  std::uint64_t repeats() const noexcept { return lookups_ - borders_ - size_; }
   // Marks the N-buffer level texels the walks read, one byte a texel of FieldView::nbuffer (null:
   // none marked), for the replay's on-demand N-buffer: which texels a build on demand computes.
   // The marks are the walking thread's own (threads sharing them would take their lines from each
@@ -202,7 +205,7 @@ class alignas(64) LookupLines {
   std::vector<std::uint64_t> last_ = {kNone};  // per set, the line it saw last
   std::vector<std::uint64_t> storage_;
   std::size_t size_ = 0;
-  std::uint64_t repeats_ = 0;
+  std::uint64_t lookups_ = 0, borders_ = 0;
   std::uint8_t* level_marks_ = nullptr;
   std::vector<std::uint32_t> level_texels_;
 };
