@@ -191,6 +191,8 @@ struct TechniqueField {
 };
 struct TechniqueRecord {
   std::uint32_t type = 0;
+  // The chunk's bytes, kept only for a type this build does not know (not decoded): a decoded
+  // record's bytes are its fields' encoding (traces/format technique_chunks.h encode()).
   std::vector<std::uint8_t> payload;
   bool decoded = false;  // `fields` holds the payload's fields (the type was registered)
   std::vector<TechniqueField> fields;

@@ -191,7 +191,14 @@ Chunk TraceReader::read_chunk() {
                         "{} bytes ({})",
                         frame_, frame_bytes_ + raw, raw, frame_limit_, header_.frame_byte_limit_rule()));
 
-  std::vector<std::uint8_t> data(static_cast<std::size_t>(stored));
+  // A compressed payload is read into this thread's buffer, kept from chunk to chunk (only its
+  // decompressed bytes are kept): no allocation and no clearing for every chunk.
+  const bool packed = (flags & kFlagZstd) != 0;
+  thread_local std::vector<std::uint8_t> packed_bytes;
+  std::vector<std::uint8_t> own;
+  if (packed && packed_bytes.size() < stored) packed_bytes.resize(static_cast<std::size_t>(stored));
+  if (!packed) own.resize(static_cast<std::size_t>(stored));
+  const std::span<std::uint8_t> data(packed ? packed_bytes.data() : own.data(), static_cast<std::size_t>(stored));
   if (read_bytes(data.data(), data.size()) != data.size() ||
       read_bytes(head.data() + kChunkHeaderBytes, kChunkCrcBytes) != kChunkCrcBytes)
     fail_at(c.index, c.offset, type_name, "the file ends inside the chunk (truncated while reading)");
@@ -222,7 +229,7 @@ Chunk TraceReader::read_chunk() {
   c.compressed = (flags & kFlagZstd) != 0;
   if (!c.compressed) {
     if (raw != stored) fail(c, fmt::format("raw length {} differs from stored length {} of an uncompressed payload", raw, stored));
-    c.payload = std::move(data);
+    c.payload = std::move(own);
   } else {
     const unsigned long long declared = ZSTD_getFrameContentSize(data.data(), data.size());
     if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN)

@@ -136,9 +136,11 @@ std::vector<std::uint8_t> encode(const TechniqueRecord& record) {
 TechniqueRecord decode_technique(std::uint32_t type, std::span<const std::uint8_t> payload) {
   TechniqueRecord r;
   r.type = type;
-  r.payload.assign(payload.begin(), payload.end());
   const ChunkSpec* spec = find_technique_chunk(type);
-  if (!spec) return r;
+  if (!spec) {  // kept raw
+    r.payload.assign(payload.begin(), payload.end());
+    return r;
+  }
   // A payload of another layout (a trace captured by a build whose description of this type had
   // other fields) is refused naming the type and where to see the fields this build reads.
   try {

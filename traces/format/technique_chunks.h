@@ -62,7 +62,7 @@ const std::vector<ChunkSpec>& technique_chunks();
 // was not decoded (an unregistered type read from a file is written back as it was).
 std::vector<std::uint8_t> encode(const TechniqueRecord& record);
 // A chunk's payload -> record: fields decoded when the type is registered (InputError when the
-// payload does not match the description), raw otherwise.
+// payload does not match the description; the payload itself is not kept), raw otherwise.
 TechniqueRecord decode_technique(std::uint32_t type, std::span<const std::uint8_t> payload);
 // The Markdown table of a registered type's fields (as FORMAT.md's core tables).
 std::string technique_table(const ChunkSpec& spec);

@@ -433,6 +433,7 @@ TEST(TraceCorruptionTest, TechniqueChunks) {
     ASSERT_TRUE(f);
     ASSERT_EQ(f->technique_records.size(), 2u);
     expect_same(good, f->technique_records[0]);
+    EXPECT_TRUE(f->technique_records[0].payload.empty()) << "a decoded record keeps its fields, not its bytes";
     EXPECT_FALSE(f->technique_records[1].decoded) << "an unregistered type stays raw";
     EXPECT_EQ(f->technique_records[1].payload, sample_raw_record().payload);
   }
@@ -440,11 +441,12 @@ TEST(TraceCorruptionTest, TechniqueChunks) {
   EXPECT_TRUE(has(e, "chunk 1 (TSTX)") && has(e, "outside a frame")) << e;
   TechniqueRecord shorter = good;
   shorter.decoded = false;  // written as its payload, one byte short
+  shorter.payload = encode(good);
   shorter.payload.pop_back();
   e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(shorter).add(FrameEnd{0, 0, 0}).end(1).b);
   EXPECT_TRUE(has(e, "chunk 2 (TSTX)") && has(e, "decodes short")) << e;
   TechniqueRecord longer = shorter;
-  longer.payload = good.payload;
+  longer.payload = encode(good);
   longer.payload.push_back(0);
   e = read_error(Builder().add(P).add(sample_frame_begin(0)).technique(longer).add(FrameEnd{0, 0, 0}).end(1).b);
   EXPECT_TRUE(has(e, "chunk 2 (TSTX)") && has(e, "decodes long")) << e;

@@ -20,6 +20,7 @@
 #include "traces/capture/scenes.h"
 #include "traces/format/particles/particles_chunk.h"
 #include "traces/format/reader.h"
+#include "traces/format/technique_chunks.h"
 #include "tests/common/scratch.h"
 #include "model/particles/roles.h"
 
@@ -329,7 +330,7 @@ TEST(ParticlesTest, Reproducible) {
     }
     ASSERT_EQ(fa->technique_records.size(), fb->technique_records.size());
     for (std::size_t i = 0; i < fa->technique_records.size(); ++i)
-      EXPECT_EQ(fa->technique_records[i].payload, fb->technique_records[i].payload);
+      EXPECT_EQ(trace::encode(fa->technique_records[i]), trace::encode(fb->technique_records[i]));
     ASSERT_EQ(fa->depths.size(), fb->depths.size());
     for (std::size_t i = 0; i < fa->depths.size(); ++i) EXPECT_EQ(fa->depths[i].texels, fb->depths[i].texels);
   }
