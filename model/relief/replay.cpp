@@ -144,9 +144,67 @@ void ReliefReplay::end_levels(BoxDrawCounts& c) const {
 
 ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double tolerance, double box_height, LookupSink* lookups,
                                           void* context, void (*draw_done)(void* context, const BoxDrawCounts& draw)) {
-  const GlReliefField gl = read_relief_field(f);
   const std::uint64_t pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
-  const std::vector<GlReliefFragments> records = read_relief_fragments(f, pixels);
+  const bool writes = box_depth_ != BoxDepth::None;
+  on_demand_fresh_ = false;  // the frame's heights are its own
+  early_.valid = false;      // and its depth before the boxes
+  std::fill(depth_.texels.begin(), depth_.texels.end(), 1.0f);  // the frame's depth buffer: the scene's, then tested by the boxes
+  // Every box draw starts from the depth before the frame's first (box_depth.h).
+  const auto restore = [&](std::size_t box) {
+    if (box == 0) before_boxes_ = depth_.texels;
+    else std::copy(before_boxes_.begin(), before_boxes_.end(), depth_.texels.begin());
+    if (writes) std::copy(before_boxes_.begin(), before_boxes_.end(), without_box_.texels.begin());
+  };
+  // A box draw's early test against the depth before the frame's boxes (restored): its fragments
+  // (after the test for none and box, every rasterized one for exact: the test waits for the
+  // shader's depth) in fragment_pixels_, its counts in early_. No write: a box draw writes after its
+  // walks.
+  const auto early_test = [&](const scene::DrawRecord& d) {
+    std::fill(passed_.begin(), passed_.end(), std::uint8_t{0});
+    raster::DrawState s = raster::draw_state(d.state);
+    s.depth.passed_mask = &passed_;
+    s.depth.write = false;
+    if (box_depth_ == BoxDepth::Exact) s.depth.test = false;
+    early_.counts = path_.draw(d.clip_positions, s);
+    fragment_pixels_.clear();
+    std::uint32_t at = 0;
+    for (; at + 8 <= pixels; at += 8) {  // eight pixels at a time: most of the viewport has no fragment
+      std::uint64_t word;
+      std::memcpy(&word, passed_.data() + at, sizeof word);
+      if (word == 0) continue;
+      for (std::uint32_t b = at; b < at + 8; ++b)
+        if (passed_[b] != 0) fragment_pixels_.push_back(b);
+    }
+    for (; at < pixels; ++at)
+      if (passed_[at] != 0) fragment_pixels_.push_back(at);
+    early_.valid = true;
+    early_.state = d.state;
+    early_.positions = d.clip_positions;
+  };
+  // The frame's records are read and checked on a helper while this thread tests the frame's first
+  // draw early, when that is a box draw (the usual frame: no scene under the boxes); the loop below
+  // then finds that draw's test done, as for the box draws after it.
+  GlReliefField gl;
+  std::vector<GlReliefFragments> records;
+  std::optional<GlReliefDepth> gl_depth;
+  const scene::DrawRecord* first_box = nullptr;
+  if (!f.draws.empty()) {
+    const scene::DrawRecord& d = f.draws.front();
+    if (d.role == kReliefBoxRole && d.topology == scene::Topology::Triangles && d.clip_positions.size() % 3 == 0) first_box = &d;
+  }
+  pool_.run(
+      1,
+      [&](std::size_t) {
+        gl = read_relief_field(f);
+        records = read_relief_fragments(f, pixels);
+        gl_depth = read_relief_depth(f, writes);
+      },
+      [](std::size_t) {},
+      first_box ? std::function<void()>([&] {
+        restore(0);
+        early_test(*first_box);
+      })
+                : std::function<void()>());
   const FieldView view = gl.view();
   std::optional<ReferenceBlocks> blocks;
   if (scoring_) blocks.emplace(gl.field);
@@ -160,12 +218,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
   for (const float r : gl.radius.radius) out.radius_sum += static_cast<std::uint64_t>(r), out.radius_zero += r == 0.0f ? 1 : 0;
   out.view_angle = gl.view_angle;
 
-  const bool writes = box_depth_ != BoxDepth::None;
-  const std::optional<GlReliefDepth> gl_depth = read_relief_depth(f, writes);
   std::size_t next_record = 0, box_draw = 0;
-  on_demand_fresh_ = false;  // the frame's heights are its own
-  early_.valid = false;      // and its depth before the boxes
-  std::fill(depth_.texels.begin(), depth_.texels.end(), 1.0f);  // the frame's depth buffer: the scene's, then tested by the boxes
   // A box draw's counts are handed on once the scene draws after it are counted too.
   std::optional<BoxDrawCounts> open;
   const auto close = [&] {
@@ -203,12 +256,6 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     open = c;
     pending.reset();
   };
-  // Every box draw starts from the depth before the frame's first (box_depth.h).
-  const auto restore = [&](std::size_t box) {
-    if (box == 0) before_boxes_ = depth_.texels;
-    else std::copy(before_boxes_.begin(), before_boxes_.end(), depth_.texels.begin());
-    if (writes) std::copy(before_boxes_.begin(), before_boxes_.end(), without_box_.texels.begin());
-  };
   for (const scene::DrawRecord& d : f.draws) {
     if (d.role == scene::DrawRole::Scene) {  // boxes in a scene: its depth, drawn before and after the boxes
       if (d.topology != scene::Topology::Triangles || d.clip_positions.size() % 3 != 0)
@@ -234,10 +281,9 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     const GlReliefFragments& r = records[next_record++];
     const std::size_t box = box_draw++;
 
-    // The walk's fragments: after the early test (none, box), or every rasterized one (exact: the
-    // test waits for the shader's depth). No write here: a box draw writes after its walks. Every box
-    // draw tests against the same depth (the frame's before its boxes), so a draw bit-identical to
-    // the frame's box draw before it (the methods draw the same box) has its fragments and counts.
+    // The walk's fragments (early_test). Every box draw tests against the same depth (the frame's
+    // before its boxes), so a draw bit-identical to the frame's box draw before it (the methods draw
+    // the same box) has its fragments and counts.
     const bool same_as_before = early_.valid && early_.state == d.state && early_.positions.size() == d.clip_positions.size() &&
                                 std::memcmp(early_.positions.data(), d.clip_positions.data(),
                                             d.clip_positions.size() * sizeof(d.clip_positions[0])) == 0;
@@ -249,28 +295,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
       restore(box);
     };
     if (!beside) before_walks();
-    if (!same_as_before) {
-      std::fill(passed_.begin(), passed_.end(), std::uint8_t{0});
-      raster::DrawState s = raster::draw_state(d.state);
-      s.depth.passed_mask = &passed_;
-      s.depth.write = false;
-      if (box_depth_ == BoxDepth::Exact) s.depth.test = false;
-      early_.counts = path_.draw(d.clip_positions, s);
-      fragment_pixels_.clear();
-      std::uint32_t at = 0;
-      for (; at + 8 <= pixels; at += 8) {  // eight pixels at a time: most of the viewport has no fragment
-        std::uint64_t word;
-        std::memcpy(&word, passed_.data() + at, sizeof word);
-        if (word == 0) continue;
-        for (std::uint32_t b = at; b < at + 8; ++b)
-          if (passed_[b] != 0) fragment_pixels_.push_back(b);
-      }
-      for (; at < pixels; ++at)
-        if (passed_[at] != 0) fragment_pixels_.push_back(at);
-      early_.valid = true;
-      early_.state = d.state;
-      early_.positions = d.clip_positions;
-    }
+    if (!same_as_before) early_test(d);
     const raster::DrawCounters& k = early_.counts;
 
     BoxDrawCounts c;
