@@ -43,7 +43,7 @@ struct Reader {
   }
   // The four corners of cell (i, j) in the shader's order (h00, h10, h01, h11): one bounds check
   // and one index for a cell inside the field, the usual case.
-  void corners(int i, int j, float& h00, float& h10, float& h01, float& h11) {
+  [[gnu::always_inline]] void corners(int i, int j, float& h00, float& h10, float& h01, float& h11) {
     const int n = f.size;
     if (i >= 0 && j >= 0 && i + 1 < n && j + 1 < n) {
       lookups += 4;
@@ -88,15 +88,18 @@ struct ObserverSink {
 };
 
 // The recording sink: virtual border texels need no memory and are left out.
+// A sink is made for a walk (or a replay of logged walks) and holds a writer open on the record.
 struct LinesSink {
+  explicit LinesSink(LookupLines& l) : lines(l), writer(l) {}
   LookupLines& lines;
-  void operator()(Texture t, std::int64_t index) const {
-    lines.add(texel_address(t, index));
+  LookupLines::Writer writer;
+  [[gnu::always_inline]] void operator()(Texture t, std::int64_t index) {
+    writer.add(texel_address(t, index));
     if (t == Texture::NBuffer) lines.add_level_texel(index);
   }
-  void pair(Texture t, std::int64_t index) const { lines.add_pair(texel_address(t, index), texel_address(t, index + 1)); }
-  void border(Texture) const noexcept { lines.add_border(); }
-  void walked(std::uint32_t lookups) const noexcept { lines.add_lookups(lookups); }
+  [[gnu::always_inline]] void pair(Texture t, std::int64_t index) { writer.add_pair(texel_address(t, index), texel_address(t, index + 1)); }
+  void border(Texture) noexcept { writer.add_border(); }
+  void walked(std::uint32_t lookups) noexcept { writer.add_lookups(lookups); }
 };
 
 int floor_int(float v) noexcept { return static_cast<int>(std::floor(v)); }

@@ -130,7 +130,7 @@ struct LineGeometry {
 // Most of a walk's lookups are such (the four corners of a cell are two lines, read again by the
 // next cell), so the cache, which must see the rest in order on one thread, has little left to do.
 // (With no sets, a set count that is not a power of two or a huge cache, only a repeat of the line
-// just before is merged, as it always hits.) Aligned to a
+// just before is merged, as it always hits.) Lookups are added through a Writer. Aligned to a
 // cache line of the host: the records of runs walked at once on different threads sit side by side
 // in the replay's vector, and sharing a line would bounce it between the cores at every lookup.
 class alignas(64) LookupLines {
@@ -143,38 +143,77 @@ class alignas(64) LookupLines {
     // that is not a power of two would cost a division a lookup: one entry then (the line just
     // before, always its set's most recently used).
     const bool table = g.sets > 0 && g.sets <= kMaxTable && (g.sets & (g.sets - 1)) == 0;
-    set_mask_ = table ? g.sets - 1 : 0;
+    set_mask_ = table ? static_cast<std::uint32_t>(g.sets - 1) : 0;
     last_.assign(set_mask_ + 1, kNone);
     size_ = 0;
     lookups_ = 0;
     borders_ = 0;
   }
-  // A lookup of a texel in memory. A merged one is not counted here (a counter in memory, bumped at
-  // nearly every lookup, would chain the walk's lookups one after another): repeats() is what the
-  // walks' lookups leave over.
-  void add(std::uint64_t address) {
-    const std::uint64_t line = address >> line_shift_;
-    if (merge_) {
-      std::uint64_t& last = last_[line & set_mask_];
-      if (line == last) return;
-      last = line;
+
+  // Adds lookups to a record. While a writer is open on a record, its state is the writer's (held
+  // in registers in a walk's loop rather than in the record's members, which every stored line
+  // might alias), and nothing else may add to the record; the record is whole again once the writer
+  // has gone.
+  class Writer {
+   public:
+    explicit Writer(LookupLines& lines) noexcept : lines_(lines) { open(); }
+    ~Writer() { close(); }
+    Writer(const Writer&) = delete;
+    Writer& operator=(const Writer&) = delete;
+
+    // A lookup of a texel in memory (by its address). A merged one is not counted (a counter
+    // bumped at nearly every lookup would chain the walk's lookups one after another): repeats() is
+    // what the walks' lookups leave over.
+    [[gnu::always_inline]] void add(std::uint64_t address) { put(address >> shift_); }
+    // add(a) then add(b), for two texels side by side: when they share a line (15 times in 16 for
+    // 64-byte lines), the second is the repeat add() would find, merged without the table.
+    [[gnu::always_inline]] void add_pair(std::uint64_t a, std::uint64_t b) {
+      const std::uint64_t la = a >> shift_, lb = b >> shift_;
+      put(la);
+      if (!merge_ || lb != la) put(lb);
+    }
+    // A lookup of a virtual border texel (no memory, nothing recorded).
+    void add_border() noexcept { ++lines_.borders_; }
+    // A walk's lookups (WalkResult::lookups: in memory or on the border), told once it has ended.
+    void add_lookups(std::uint64_t n) noexcept { lines_.lookups_ += n; }
+
+   private:
+    [[gnu::always_inline]] void put(std::uint64_t line) {
+      if (merge_) {
+        std::uint64_t& last = last_[line & mask_];
+        if (line == last) return;
+        last = line;
+      }
+      if (out_ == end_) grow();
+      *out_++ = line;
     }
     // The storage is kept at its full size (size_ counts what is used), so a record reused for the
     // next run neither frees nor clears it.
-    if (size_ == storage_.size()) storage_.resize(std::max<std::size_t>(4096, 2 * storage_.size()));
-    storage_[size_++] = line;
-  }
-  // add(a) then add(b), for two texels side by side: when they share a line (15 times in 16 for
-  // 64-byte lines), the second is the repeat add() would find, counted without the table.
-  void add_pair(std::uint64_t a, std::uint64_t b) {
-    add(a);
-    if (merge_ && (b >> line_shift_) == (a >> line_shift_)) return;
-    add(b);
-  }
-  // A lookup of a virtual border texel (no memory, nothing recorded).
-  void add_border() noexcept { ++borders_; }
-  // A walk's lookups (WalkResult::lookups: in memory or on the border), told once it has ended.
-  void add_lookups(std::uint64_t n) noexcept { lookups_ += n; }
+    [[gnu::noinline]] void grow() {
+      close();
+      lines_.storage_.resize(std::max<std::size_t>(4096, 2 * lines_.storage_.size()));
+      open();
+    }
+    void open() noexcept {
+      out_ = lines_.storage_.data() + lines_.size_;
+      end_ = lines_.storage_.data() + lines_.storage_.size();
+      last_ = lines_.last_.data();
+      mask_ = lines_.set_mask_;
+      shift_ = lines_.line_shift_;
+      merge_ = lines_.merge_;
+    }
+    void close() noexcept { lines_.size_ = static_cast<std::size_t>(out_ - lines_.storage_.data()); }
+
+    LookupLines& lines_;
+    // None of the types a stored line (std::uint64_t) could alias.
+    std::uint64_t* out_ = nullptr;
+    std::uint64_t* end_ = nullptr;
+    std::uint64_t* last_ = nullptr;
+    std::uint32_t mask_ = 0;
+    int shift_ = 0;
+    bool merge_ = true;
+  };
+
   std::span<const std::uint64_t> lines() const noexcept { return {storage_.data(), size_}; }
   // The merged lookups: every lookup of a texel in memory but those recorded.
   std::uint64_t repeats() const noexcept { return lookups_ - borders_ - size_; }
@@ -201,7 +240,7 @@ class alignas(64) LookupLines {
   static constexpr std::uint64_t kMaxTable = 4096;
   int line_shift_ = 6;
   bool merge_ = true;
-  std::uint64_t set_mask_ = 0;
+  std::uint32_t set_mask_ = 0;
   std::vector<std::uint64_t> last_ = {kNone};  // per set, the line it saw last
   std::vector<std::uint64_t> storage_;
   std::size_t size_ = 0;
