@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <random>
 
 #include "model/common/depth.h"
 #include "model/raster/setup.h"
@@ -147,6 +151,60 @@ TEST(DepthTestTest, DepthFormatNames) {
   EXPECT_EQ(parse_depth_format("DEPTH24_STENCIL8"), DepthFormat::Unorm24);
   EXPECT_EQ(parse_depth_format("DEPTH_COMPONENT24"), DepthFormat::Unorm24);
   EXPECT_FALSE(parse_depth_format("DEPTH_COMPONENT16").has_value());
+}
+
+// Whole 4x4 blocks test each pixel as the per-pixel definition does (plane.at, the stored format,
+// depth_passes, the write), bit for bit: every function, fused and unfused planes, both formats,
+// writes on and off, random masks, blocks inside the buffer and on its ragged right and top edges,
+// and depths that tie, fall outside [0, 1], are -0 or NaN (planes and stored values).
+TEST(DepthTestTest, BlocksTestEveryPixelAsOneByOne) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> unit(-0.25f, 1.25f), slope(-0.05f, 0.05f);
+  const auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
+  constexpr int kW = 14, kH = 10;  // not multiples of 4: the last column and row of blocks are ragged
+  for (int trial = 0; trial < 400; ++trial) {
+    DepthPlane plane{unit(random), slope(random), slope(random)};
+    if (trial % 17 == 0) plane = DepthPlane{NAN, 0.0f, 0.0f};
+    if (trial % 19 == 0) plane = DepthPlane{-0.0f, 0.0f, 0.0f};
+    if (trial % 23 == 0) plane = DepthPlane{0.5f, 0.0f, 0.0f};  // ties with the stored 0.5s below
+    for (const DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm24})
+      for (const bool fused : {true, false}) {
+        DepthImage start(kW, kH, 0.5f);
+        for (float& t : start.texels) {
+          const int pick = static_cast<int>(random() % 8);
+          t = pick == 0 ? NAN : pick == 1 ? 0.5f : pick == 2 ? 1.0f : stored_depth(format, std::clamp(unit(random), 0.0f, 1.0f));
+        }
+        for (const CompareRow& row : kCompareFuncs)
+          for (const bool write : {true, false}) {
+            DepthImage got = start, want = start;
+            EarlyDepthTest unit_under_test(got, fused, format);
+            DepthCounters k;
+            std::uint64_t passed = 0, written = 0, tests = 0;
+            for (int y = 0; y < kH; y += 4)
+              for (int x = 0; x < kW; x += 4) {
+                std::uint16_t mask = static_cast<std::uint16_t>(random());
+                for (int i = 0; i < 16; ++i)  // pixels outside the buffer are never covered
+                  if (x + (i & 3) >= kW || y + (i >> 2) >= kH) mask = static_cast<std::uint16_t>(mask & ~(1u << i));
+                unit_under_test.test_block(plane, x, y, mask, DepthState{row.f, true, write}, k);
+                for (int i = 0; i < 16; ++i) {
+                  if (!(mask & (1u << i))) continue;
+                  const int px = x + (i & 3), py = y + (i >> 2);
+                  ++tests;
+                  const float z = stored_depth(format, plane.at(px, py, fused));
+                  float& stored = want.texels[static_cast<std::size_t>(py * kW + px)];
+                  if (!depth_passes(row.f, z, stored)) continue;
+                  ++passed;
+                  if (write) stored = z, ++written;
+                }
+              }
+            EXPECT_EQ(k.depth_tests, tests);
+            EXPECT_EQ(k.passed, passed) << "func " << static_cast<int>(row.f) << " trial " << trial << (fused ? " fused" : " unfused");
+            EXPECT_EQ(k.written, written);
+            for (std::size_t t = 0; t < got.texels.size(); ++t)
+              ASSERT_EQ(bits(got.texels[t]), bits(want.texels[t])) << "texel " << t << ", func " << static_cast<int>(row.f) << ", trial " << trial;
+          }
+      }
+  }
 }
 
 }  // namespace
