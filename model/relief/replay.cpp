@@ -182,8 +182,9 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
     early_.positions = d.clip_positions;
   };
   // The frame's records are read and checked on a helper while this thread tests the frame's first
-  // draw early, when that is a box draw (the usual frame: no scene under the boxes); the loop below
-  // then finds that draw's test done, as for the box draws after it.
+  // draw early, when that is a box draw (the usual frame: no scene under the boxes; the depth is then
+  // the cleared one, the depth before the boxes, which the loop saves); the loop below then finds
+  // that draw's test done, as for the box draws after it.
   GlReliefField gl;
   std::vector<GlReliefFragments> records;
   std::optional<GlReliefDepth> gl_depth;
@@ -200,11 +201,7 @@ ReliefFrameCounts ReliefReplay::run_frame(const scene::Frame& f, double toleranc
         gl_depth = read_relief_depth(f, writes);
       },
       [](std::size_t) {},
-      first_box ? std::function<void()>([&] {
-        restore(0);
-        early_test(*first_box);
-      })
-                : std::function<void()>());
+      first_box ? std::function<void()>([&] { early_test(*first_box); }) : std::function<void()>());
   const FieldView view = gl.view();
   std::optional<ReferenceBlocks> blocks;
   if (scoring_) blocks.emplace(gl.field);

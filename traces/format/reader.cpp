@@ -226,7 +226,7 @@ Chunk TraceReader::read_chunk() {
   }
   c.type = static_cast<ChunkType>(type);
   c.stored_bytes = stored;
-  c.compressed = (flags & kFlagZstd) != 0;
+  c.compressed = packed;
   if (!c.compressed) {
     if (raw != stored) fail(c, fmt::format("raw length {} differs from stored length {} of an uncompressed payload", raw, stored));
     c.payload = std::move(own);
