@@ -2,7 +2,9 @@
 #include "model/nbuffer/nbuffer.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
+#include <fstream>
 #include <new>
 #include <numeric>
 #include <string>
@@ -11,6 +13,9 @@
 
 #if defined(__linux__)
 #include <sys/mman.h>
+#endif
+#if defined(__x86_64__)
+#include <immintrin.h>
 #endif
 
 // The hot row loops get an AVX2 clone next to the baseline one on x86-64 (GCC and Clang pick one
@@ -248,8 +253,9 @@ NBuffer::NBuffer(const DepthImage& depth, NBufferConfig config) : NBuffer(depth.
 
 namespace {
 
-// Full builds (NBuffer::build). A level pass costs about what copying its plane costs plus its
-// arithmetic, and the two overlap poorly. So the build (1) runs level 0 and the levels with steps
+// Banded builds (NBuffer::build_banded, for levels that fit in the last-level cache). A level pass
+// costs about what copying its plane costs plus its arithmetic, and the two overlap poorly. So the
+// build (1) runs level 0 and the levels with steps
 // up to build_band_max_step band by band, top down, so that the rows a level reads were written a
 // moment ago and are still in cache, (2) computes G rows y, y + s, ..., y + (G - 1) s of a level
 // together from the G + 1 rows below (G = 4; 2 or single rows where four do not fit), so that each
@@ -300,12 +306,219 @@ NBSIM_ROW_LOOP_CLONES void reduce_rows(FarOp op, const float* src, float* dst, i
   else reduce_rows<FarOp::Min>(src, dst, width, height, s, y0, y1);
 }
 
+
+// Row builds (NBuffer::build_rows, for levels larger than the last-level cache) go row by row, from the top row down, and compute every level of a
+// row before the next row. With s = 2^(i-1), level i's texel (x, y) is far(h_i(y)[x], h_i(y+s)[x])
+// (h_i(y)[x] alone past the top edge), where h_i(y)[x] = far(L_{i-1}(y)[x], L_{i-1}(y)[x+s])
+// (L_{i-1}(y)[x] past the right edge) is the horizontal pair level i reads in row y: the reduction
+// order of reduce_row, so the levels are bit-identical to the level-by-level definition (signed
+// zeros and NaNs included). A row of level i gives level i + 1's pairs of that row at once, and each
+// level keeps only its pairs' last s + 1 rows, in a ring (BuildRows): about half a plane in all,
+// where a level-by-level build rereads every plane it wrote. Where the CPU has AVX2, the planes are
+// written with non-temporal stores in the loop that computes them: the build never reads them back,
+// and keeping them out of the caches keeps the rings in. docs/results.md (Table 1) has the
+// measurements and the designs tried before.
+
+// The build's scratch rows: one row T (a level's row just computed) and, for each level i >= 1, a
+// ring of min(2^(i-1) + 1, height) rows of its pairs h_i. Rows are 16-float aligned and padded past
+// the width (the vector loops run to a multiple of 8 and read up to 15 texels beyond it), and one
+// cache line longer than a multiple of 4 KiB rows would be, so that the rows a loop reads do not
+// share cache sets.
+struct BuildRows {
+  std::size_t stride = 0;
+  float* t = nullptr;
+  std::vector<float*> ring;  // ring[i]: level i's first ring row (ring[0] unused)
+  std::vector<int> cap;      // rows in ring[i]
+  float* pairs(int i, int y) const noexcept {
+    return ring[static_cast<std::size_t>(i)] + static_cast<std::size_t>(y % cap[static_cast<std::size_t>(i)]) * stride;
+  }
+};
+
+// The size of the largest cache cpu0 has (Linux sysfs: one instance, as its cores see it; glibc's
+// sysconf may give the whole socket's sum), 16 MiB where the system does not say.
+std::size_t last_level_cache_bytes() noexcept {
+  static const std::size_t bytes = [] {
+    std::size_t best = 0;
+    for (int index = 0; index < 8; ++index) {
+      std::ifstream in("/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(index) + "/size");
+      std::size_t size = 0;
+      char unit = 0;
+      if (!(in >> size)) continue;
+      in >> unit;
+      best = std::max(best, unit == 'K' ? size << 10 : unit == 'M' ? size << 20 : size);
+    }
+    return best > 0 ? best : std::size_t{16} << 20;
+  }();
+  return bytes;
+}
+
+std::size_t build_row_stride(int width) noexcept { return (static_cast<std::size_t>(width) + 15) / 16 * 16 + 16; }
+
+std::size_t build_rows_floats(int width, int height, int levels) noexcept {
+  std::size_t rows = 1;
+  for (int i = 1; i < levels; ++i) rows += static_cast<std::size_t>(std::min((1LL << (i - 1)) + 1, static_cast<long long>(height)));
+  return rows * build_row_stride(width);
+}
+
+BuildRows make_build_rows(float* base, int width, int height, int levels) {
+  BuildRows r;
+  r.stride = build_row_stride(width);
+  r.t = base;
+  r.ring.assign(static_cast<std::size_t>(levels), nullptr);
+  r.cap.assign(static_cast<std::size_t>(levels), 1);
+  float* p = base + r.stride;
+  for (int i = 1; i < levels; ++i) {
+    r.cap[static_cast<std::size_t>(i)] = static_cast<int>(std::min((1LL << (i - 1)) + 1, static_cast<long long>(height)));
+    r.ring[static_cast<std::size_t>(i)] = p;
+    p += static_cast<std::size_t>(r.cap[static_cast<std::size_t>(i)]) * r.stride;
+  }
+  return r;
+}
+
+// h[x] = far(t[x], t[x + s]) for x < width - s, t[x] beyond.
+template <FarOp Op>
+[[gnu::always_inline]] inline void pair_row(const float* __restrict t, float* __restrict h, int width, int s) noexcept {
+  const int split = std::clamp(width - s, 0, width);
+  for (int x = 0; x < split; ++x) h[x] = far2<Op>(t[x], t[x + s]);
+  for (int x = split; x < width; ++x) h[x] = t[x];
+}
+
+NBSIM_ROW_LOOP_CLONES void pair_row(FarOp op, const float* __restrict t, float* __restrict h, int width, int s) noexcept {
+  if (op == FarOp::Max) pair_row<FarOp::Max>(t, h, width, s);
+  else pair_row<FarOp::Min>(t, h, width, s);
+}
+
+// t[x] = far(a[x], b[x]).
+template <FarOp Op>
+[[gnu::always_inline]] inline void far_row(const float* __restrict a, const float* __restrict b, float* __restrict t, int width) noexcept {
+  for (int x = 0; x < width; ++x) t[x] = far2<Op>(a[x], b[x]);
+}
+
+NBSIM_ROW_LOOP_CLONES void far_row(FarOp op, const float* __restrict a, const float* __restrict b, float* __restrict t, int width) noexcept {
+  if (op == FarOp::Max) far_row<FarOp::Max>(a, b, t, width);
+  else far_row<FarOp::Min>(a, b, t, width);
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(NBSIM_BASELINE_ONLY)
+#define NBSIM_STREAMING_BUILD 1
+
+bool has_avx2() noexcept {
+  static const bool yes = __builtin_cpu_supports("avx2");
+  return yes;
+}
+
+// out[0, width) = in[0, width) with non-temporal stores where `out` is 32-byte aligned.
+[[gnu::target("avx2")]] void stream_row(const float* in, float* out, int width) noexcept {
+  int x = 0;
+  for (; x < width && (reinterpret_cast<std::uintptr_t>(out + x) & 31) != 0; ++x) out[x] = in[x];
+  for (; x + 8 <= width; x += 8) _mm256_stream_ps(out + x, _mm256_loadu_ps(in + x));
+  for (; x < width; ++x) out[x] = in[x];
+}
+
+template <FarOp Op>
+[[gnu::target("avx2"), gnu::always_inline]] inline __m256 far8(__m256 u, __m256 v) noexcept {
+  if constexpr (Op == FarOp::Max) return _mm256_max_ps(u, v);  // u > v ? u : v per lane, as far2
+  else return _mm256_min_ps(u, v);
+}
+
+// One level row: t = far(a, b) (a where b is null), streamed to `plane` (null: the caller copies
+// t), and, when h is not null, the next level's pairs h[x] = far(t[x], t[x + step]) (t[x] for
+// x >= width - step), step a multiple of 8. a, b, t and h are BuildRows rows. x runs down, so that
+// t[x + step] is already computed.
+template <FarOp Op>
+[[gnu::target("avx2")]] void level_row_avx2(const float* a, const float* b, float* t, float* plane, float* h, int width,
+                                            int step) noexcept {
+  const int split = width - step;  // x < split pairs with x + step
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  for (int x = (width + 7) / 8 * 8 - 8; x >= 0; x -= 8) {
+    __m256 v = _mm256_load_ps(a + x);
+    if (b) v = far8<Op>(v, _mm256_load_ps(b + x));
+    _mm256_store_ps(t + x, v);
+    if (plane) _mm256_stream_ps(plane + x, v);
+    if (h) {
+      __m256 p = v;
+      if (x + 8 <= split) p = far8<Op>(v, _mm256_load_ps(t + x + step));
+      else if (x < split)
+        p = _mm256_blendv_ps(v, far8<Op>(v, _mm256_load_ps(t + x + step)),
+                             _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(split - x), lane)));
+      _mm256_store_ps(h + x, p);
+    }
+  }
+}
+#else
+#define NBSIM_STREAMING_BUILD 0
+#endif
+
 }  // namespace
 
-void NBuffer::build(const DepthImage& depth) {
+void NBuffer::build(const DepthImage& depth, BuildPath path) {
   NBSIM_CHECK(depth.width == width_ && depth.height == height_, "depth image size differs from the N-buffer's");
   if (has_rect_levels()) return build_rect(depth);
   if (on_demand_) std::fill(current_.begin(), current_.end(), std::uint8_t{1});
+  if (path == BuildPath::Auto)
+    path = static_cast<std::size_t>(levels_) * pixels() * sizeof(float) > last_level_cache_bytes() ? BuildPath::Rows : BuildPath::Banded;
+  if (path == BuildPath::Banded) build_banded(depth);
+  else build_rows(depth);
+}
+
+void NBuffer::build_rows(const DepthImage& depth) {
+  const std::size_t need = build_rows_floats(width_, height_, levels_);
+  if (build_rows_.size() < need) build_rows_.assign(need, 0.0f);
+  const BuildRows rows = make_build_rows(build_rows_.data(), width_, height_, levels_);
+  const FarOp op = config_.op;
+  const std::size_t w = static_cast<std::size_t>(width_);
+#if NBSIM_STREAMING_BUILD
+  const bool streaming = has_avx2();
+#else
+  [[maybe_unused]] const bool streaming = false;
+#endif
+  // Copies a computed row to its plane (streamed where it can).
+  const auto put = [&](const float* row, float* out) {
+#if NBSIM_STREAMING_BUILD
+    if (streaming) return stream_row(row, out, width_);
+#endif
+    std::copy(row, row + width_, out);
+  };
+  for (int y = height_ - 1; y >= 0; --y) {
+    const float* l0 = depth.texels.data() + y * w;
+    if (config_.format != StorageFormat::F32) {
+      for (int x = 0; x < width_; ++x) rows.t[x] = quantize_toward_far(l0[x], config_.format, op);
+      l0 = rows.t;
+    }
+    put(l0, level_ptr(0) + y * w);
+    if (levels_ > 1) pair_row(op, l0, rows.pairs(1, y), width_, 1);
+    for (int i = 1; i < levels_; ++i) {
+      const int s = 1 << (i - 1);
+      const float* a = rows.pairs(i, y);
+      const float* b = y + s < height_ ? rows.pairs(i, y + s) : nullptr;
+      float* h = i + 1 < levels_ ? rows.pairs(i + 1, y) : nullptr;
+      float* out = level_ptr(i) + y * w;
+#if NBSIM_STREAMING_BUILD
+      if (streaming) {
+        const bool aligned = width_ % 8 == 0 && (reinterpret_cast<std::uintptr_t>(out) & 31) == 0;
+        const bool pairs_here = 2 * s >= 8;
+        if (op == FarOp::Max) level_row_avx2<FarOp::Max>(a, b, rows.t, aligned ? out : nullptr, pairs_here ? h : nullptr, width_, 2 * s);
+        else level_row_avx2<FarOp::Min>(a, b, rows.t, aligned ? out : nullptr, pairs_here ? h : nullptr, width_, 2 * s);
+        if (!aligned) stream_row(rows.t, out, width_);
+        if (h && !pairs_here) pair_row(op, rows.t, h, width_, 2 * s);
+        continue;
+      }
+#endif
+      const float* row = a;
+      if (b) {
+        far_row(op, a, b, rows.t, width_);
+        row = rows.t;
+      }
+      std::copy(row, row + width_, out);
+      if (h) pair_row(op, row, h, width_, 2 * s);
+    }
+  }
+#if NBSIM_STREAMING_BUILD
+  if (streaming) _mm_sfence();  // the streamed stores are ordered before whatever reads the levels next
+#endif
+}
+
+void NBuffer::build_banded(const DepthImage& depth) {
   // Level i's rows [y0, y1) need level i - 1's rows [y0, y1 + s): bands go from the top down.
   int banded = 1;  // levels [1, banded) are built band by band
   while (banded < levels_ && (1 << (banded - 1)) <= build_band_max_step) ++banded;
@@ -321,7 +534,8 @@ void NBuffer::build(const DepthImage& depth) {
     for (int i = 1; i < banded; ++i)
       reduce_rows(config_.op, level_ptr(i - 1), level_ptr(i), width_, height_, 1 << (i - 1), y0, y1);
   }
-  for (int i = banded; i < levels_; ++i) build_level(i);
+  for (int i = banded; i < levels_; ++i)
+    reduce_rows(config_.op, level_ptr(i - 1), level_ptr(i), width_, height_, 1 << (i - 1), 0, height_);
 }
 
 void NBuffer::build_rect(const DepthImage& depth) {
@@ -343,9 +557,6 @@ void NBuffer::build_rect(const DepthImage& depth) {
   }
 }
 
-void NBuffer::build_level(int dst) {
-  reduce_rows(config_.op, level_ptr(dst - 1), level_ptr(dst), width_, height_, 1 << (dst - 1), 0, height_);
-}
 
 QueryResult NBuffer::query(const Rect& r, CoveringSpec covering) const {
   if (r.empty())

@@ -99,8 +99,14 @@ class NBuffer {
   // Builds from a depth image.
   explicit NBuffer(const DepthImage& depth, NBufferConfig config = {});
 
+  // How build() computes the levels; every path gives the same texels, bit for bit.
+  enum class BuildPath {
+    Auto,    // Banded where the levels fit in the last-level cache, Rows where they do not
+    Banded,  // levels 0-7 band by band, the others plane by plane
+    Rows,    // row by row, every level of a row at once, the planes streamed out (AVX2 CPUs)
+  };
   // Replaces level 0 with `depth` (same size) and rebuilds every level.
-  void build(const DepthImage& depth);
+  void build(const DepthImage& depth, BuildPath path = BuildPath::Auto);
 
   // Farthest depth of r (clipped to the image) with at most four lookups, placed by `covering`
   // (covering.h; rectangle levels read cover_rect's rectangles, with the covering's alignment).
@@ -163,7 +169,8 @@ class NBuffer {
   std::size_t pixels() const noexcept { return static_cast<std::size_t>(width_) * height_; }
   std::size_t offset(int level) const noexcept { return static_cast<std::size_t>(level) * pixels(); }
   float* level_ptr(int i) noexcept { return data_.data() + offset(i); }
-  void build_level(int dst);
+  void build_banded(const DepthImage& depth);
+  void build_rows(const DepthImage& depth);
   void build_rect(const DepthImage& depth);
   // On demand: marks stale the texels above level 0 that read the changed level-0 texels.
   void invalidate_from(std::vector<Texel>& changed, UpdateStats& stats);
@@ -176,6 +183,7 @@ class NBuffer {
   NBufferConfig config_;
   int full_levels_ = 1, levels_ = 1;
   std::vector<float, LevelAllocator<float>> data_;  // levels_ planes of width_ * height_ texels
+  std::vector<float, LevelAllocator<float>> build_rows_;  // build()'s scratch rows (nbuffer.cpp, BuildRows), kept between builds
   std::vector<std::uint32_t> stamp_;   // per-pixel visit marks for set updates (lazily sized)
   std::uint32_t epoch_ = 0;
   // Rectangle levels: each plane's exponents, the plane it is built from (-1 for level 0) and

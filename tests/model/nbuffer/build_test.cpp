@@ -1,5 +1,5 @@
-// NBufferBuildTest: the optimized NBuffer::build (bands of rows, row groups, SIMD clones; see
-// model/nbuffer/nbuffer.cpp) against a straightforward level-by-level build kept here as the
+// NBufferBuildTest: the optimized NBuffer::build, both paths (bands of rows with row groups, and row
+// by row with rings of pairs and streamed planes; SIMD clones; see model/nbuffer/nbuffer.cpp) against a straightforward level-by-level build kept here as the
 // reference, bit for bit: every format, both ops, partial builds, sizes from 1x1 to past a band,
 // and inputs with ties, signed zeros, NaNs and the far and neutral limits.
 #include "model/nbuffer/nbuffer.h"
@@ -73,17 +73,25 @@ long long bit_differences(std::span<const float> a, const std::vector<float>& b)
   return n;
 }
 
-// Builds `img` with config c (from the constructor and again with build() into the same buffer)
-// and compares every level with the reference; failures go to f.
+// Builds `img` with config c from the constructor (the path build() picks), then again into the
+// same buffer on each path (banded, then rows, then rows over rows), and compares every level with
+// the reference after each; failures go to f.
 void check_against_reference(const DepthImage& img, const NBufferConfig& c, const std::string& what, ref::Failures& f) {
   NBuffer nb(img, c);
   const auto want = reference_build(img, c, nb.level_count());
-  for (int pass = 0; pass < 2; ++pass) {
+  const struct {
+    NBuffer::BuildPath path;
+    const char* name;
+  } passes[] = {{NBuffer::BuildPath::Auto, "built"},
+                {NBuffer::BuildPath::Banded, "rebuilt banded"},
+                {NBuffer::BuildPath::Rows, "rebuilt by rows"},
+                {NBuffer::BuildPath::Rows, "rebuilt by rows again"}};
+  for (const auto& pass : passes) {
+    if (pass.path != NBuffer::BuildPath::Auto) nb.build(img, pass.path);  // over the previous pass's levels
     for (int i = 0; i < nb.level_count(); ++i)
       if (const long long d = bit_differences(nb.level(i), want[static_cast<std::size_t>(i)]))
-        f.add(what + (pass ? " (rebuilt)" : "") + ": level " + std::to_string(i) + ": " + std::to_string(d) +
+        f.add(what + " (" + pass.name + "): level " + std::to_string(i) + ": " + std::to_string(d) +
               " texels differ from the level-by-level build");
-    nb.build(img);  // a second build over old contents must give the same levels
   }
 }
 
