@@ -421,29 +421,56 @@ template <FarOp Op>
   else return _mm256_min_ps(u, v);
 }
 
-// One level row: t = far(a, b) (a where b is null), streamed to `plane` (null: the caller copies
-// t), and, when h is not null, the next level's pairs h[x] = far(t[x], t[x + step]) (t[x] for
-// x >= width - step), step a multiple of 8. a, b, t and h are BuildRows rows. x runs down, so that
-// t[x + step] is already computed.
-template <FarOp Op>
+// One level row: v = far(a, b) (a where b is null), stored to t (when not null) and streamed to
+// `plane` (when not null: 32-byte aligned, width a multiple of 8), and, when h is not null, the
+// next level's pairs h[x] = far(v[x], v[x + step]) (v[x] for x >= width - step). x runs down by
+// eights: for a step of 1, 2 or 4 (Shift = step) v[x + step] comes from this vector and the one
+// before, shifted in registers; for a step of 8 or more (Shift = 8) it is read back from t, already
+// written. b, t and h are BuildRows rows; a is one too, or a level-0 row whose width is a multiple
+// of 8.
+template <FarOp Op, int Shift>
 [[gnu::target("avx2")]] void level_row_avx2(const float* a, const float* b, float* t, float* plane, float* h, int width,
                                             int step) noexcept {
   const int split = width - step;  // x < split pairs with x + step
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  __m256 above = _mm256_setzero_ps();  // v at x + 8 (lanes past the width only meet lanes >= split)
   for (int x = (width + 7) / 8 * 8 - 8; x >= 0; x -= 8) {
-    __m256 v = _mm256_load_ps(a + x);
+    __m256 v = _mm256_loadu_ps(a + x);
     if (b) v = far8<Op>(v, _mm256_load_ps(b + x));
-    _mm256_store_ps(t + x, v);
+    if (t) _mm256_store_ps(t + x, v);
     if (plane) _mm256_stream_ps(plane + x, v);
     if (h) {
+      __m256 next;  // v at x + step
+      if constexpr (Shift == 8) {
+        next = _mm256_load_ps(t + x + step);
+      } else {
+        const __m256 mid = _mm256_permute2f128_ps(v, above, 0x21);  // v at x + 4
+        if constexpr (Shift == 4) next = mid;
+        else
+          next = _mm256_castsi256_ps(_mm256_alignr_epi8(_mm256_castps_si256(mid), _mm256_castps_si256(v), 4 * Shift));
+      }
       __m256 p = v;
-      if (x + 8 <= split) p = far8<Op>(v, _mm256_load_ps(t + x + step));
+      if (x + 8 <= split) p = far8<Op>(v, next);
       else if (x < split)
-        p = _mm256_blendv_ps(v, far8<Op>(v, _mm256_load_ps(t + x + step)),
-                             _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(split - x), lane)));
+        p = _mm256_blendv_ps(v, far8<Op>(v, next), _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(split - x), lane)));
       _mm256_store_ps(h + x, p);
     }
+    above = v;
   }
+}
+
+// level_row_avx2 with the shift of `step` and the far operation as template arguments.
+void level_row(FarOp op, const float* a, const float* b, float* t, float* plane, float* h, int width, int step) noexcept {
+  const auto run = [&]<FarOp Op>() {
+    switch (step) {
+      case 1: return level_row_avx2<Op, 1>(a, b, t, plane, h, width, step);
+      case 2: return level_row_avx2<Op, 2>(a, b, t, plane, h, width, step);
+      case 4: return level_row_avx2<Op, 4>(a, b, t, plane, h, width, step);
+      default: return level_row_avx2<Op, 8>(a, b, t, plane, h, width, step);
+    }
+  };
+  if (op == FarOp::Max) run.template operator()<FarOp::Max>();
+  else run.template operator()<FarOp::Min>();
 }
 #else
 #define NBSIM_STREAMING_BUILD 0
@@ -485,8 +512,17 @@ void NBuffer::build_rows(const DepthImage& depth) {
       for (int x = 0; x < width_; ++x) rows.t[x] = quantize_toward_far(l0[x], config_.format, op);
       l0 = rows.t;
     }
-    put(l0, level_ptr(0) + y * w);
-    if (levels_ > 1) pair_row(op, l0, rows.pairs(1, y), width_, 1);
+    float* out0 = level_ptr(0) + y * w;
+    float* h1 = levels_ > 1 ? rows.pairs(1, y) : nullptr;
+#if NBSIM_STREAMING_BUILD
+    if (streaming && width_ % 8 == 0 && (reinterpret_cast<std::uintptr_t>(out0) & 31) == 0) {
+      level_row(op, l0, nullptr, nullptr, out0, h1, width_, 1);
+    } else
+#endif
+    {
+      put(l0, out0);
+      if (h1) pair_row(op, l0, h1, width_, 1);
+    }
     for (int i = 1; i < levels_; ++i) {
       const int s = 1 << (i - 1);
       const float* a = rows.pairs(i, y);
@@ -496,11 +532,8 @@ void NBuffer::build_rows(const DepthImage& depth) {
 #if NBSIM_STREAMING_BUILD
       if (streaming) {
         const bool aligned = width_ % 8 == 0 && (reinterpret_cast<std::uintptr_t>(out) & 31) == 0;
-        const bool pairs_here = 2 * s >= 8;
-        if (op == FarOp::Max) level_row_avx2<FarOp::Max>(a, b, rows.t, aligned ? out : nullptr, pairs_here ? h : nullptr, width_, 2 * s);
-        else level_row_avx2<FarOp::Min>(a, b, rows.t, aligned ? out : nullptr, pairs_here ? h : nullptr, width_, 2 * s);
+        level_row(op, a, b, rows.t, aligned ? out : nullptr, h, width_, 2 * s);
         if (!aligned) stream_row(rows.t, out, width_);
-        if (h && !pairs_here) pair_row(op, rows.t, h, width_, 2 * s);
         continue;
       }
 #endif
