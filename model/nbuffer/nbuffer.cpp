@@ -255,16 +255,17 @@ namespace {
 
 // Banded builds (NBuffer::build_banded, for levels that fit in the last-level cache). A level pass
 // costs about what copying its plane costs plus its arithmetic, and the two overlap poorly. So the
-// build (1) runs level 0 and the levels with steps
-// up to build_band_max_step band by band, top down, so that the rows a level reads were written a
-// moment ago and are still in cache, (2) computes G rows y, y + s, ..., y + (G - 1) s of a level
-// together from the G + 1 rows below (G = 4; 2 or single rows where four do not fit), so that each
-// horizontal pair far(a[x], a[x + s]) is loaded and reduced once instead of twice, and (3) runs its
-// row loops in an AVX2 clone where the CPU has AVX2 (NBSIM_ROW_LOOP_CLONES). With the levels' huge pages (allocate_level_storage) that takes 1024x1024 from
-// about 1.2-1.5 to about 0.8 times the level-by-level copy (docs/results.md, Table 1, has the measurements).
-// The two constants are tunable: (64, 64) and the pairs (64, 16), (32, 32), (128, 64), (128, 128)
-// and (64, all) timed within the noise of one another with `nbsim bench nbuffer --only build` at
-// 1024x1024 on the project's shared 2-core machines (1 MiB L2 per core, 32 MiB L3).
+// build (1) runs level 0 and the levels with steps up to build_band_max_step band by band, top
+// down, so that the rows a level reads were written a moment ago and are still in cache, (2)
+// computes G rows y, y + s, ..., y + (G - 1) s of a level together from the G + 1 rows below (G = 4;
+// 2 or single rows where four do not fit), so that each horizontal pair far(a[x], a[x + s]) is
+// loaded and reduced once instead of twice, and (3) runs its row loops in an AVX2 clone where the
+// CPU has AVX2 (NBSIM_ROW_LOOP_CLONES), on levels in huge pages (allocate_level_storage). Where the
+// levels do not fit in the cache it costs more than the row build below (at 1024x1024 about 1.45
+// times the level-by-level copy on a 32 MiB-L3 host where the row build takes 0.85 to 0.93;
+// docs/results.md, Table 1). The two constants are tunable: (64, 64) and the pairs (64, 16),
+// (32, 32), (128, 64), (128, 128) and (64, all) timed within the noise of one another with
+// `nbsim bench nbuffer --only build` at 1024x1024 on the project's shared 2-core machines.
 constexpr int build_band_rows = 64;      // rows per band
 constexpr int build_band_max_step = 64;  // levels with s <= this are banded; the others go plane by plane
 
@@ -307,23 +308,23 @@ NBSIM_ROW_LOOP_CLONES void reduce_rows(FarOp op, const float* src, float* dst, i
 }
 
 
-// Row builds (NBuffer::build_rows, for levels larger than the last-level cache) go row by row, from the top row down, and compute every level of a
-// row before the next row. With s = 2^(i-1), level i's texel (x, y) is far(h_i(y)[x], h_i(y+s)[x])
-// (h_i(y)[x] alone past the top edge), where h_i(y)[x] = far(L_{i-1}(y)[x], L_{i-1}(y)[x+s])
-// (L_{i-1}(y)[x] past the right edge) is the horizontal pair level i reads in row y: the reduction
-// order of reduce_row, so the levels are bit-identical to the level-by-level definition (signed
-// zeros and NaNs included). A row of level i gives level i + 1's pairs of that row at once, and each
-// level keeps only its pairs' last s + 1 rows, in a ring (BuildRows): about half a plane in all,
-// where a level-by-level build rereads every plane it wrote. Where the CPU has AVX2, the planes are
-// written with non-temporal stores in the loop that computes them: the build never reads them back,
-// and keeping them out of the caches keeps the rings in. docs/results.md (Table 1) has the
-// measurements and the designs tried before.
+// Row builds (NBuffer::build_rows, for levels larger than the last-level cache) go row by row,
+// from the top row down, and compute every level of a row before the next row. With s = 2^(i-1),
+// level i's texel (x, y) is far(h_i(y)[x], h_i(y+s)[x]) (h_i(y)[x] alone past the top edge), where
+// h_i(y)[x] = far(L_{i-1}(y)[x], L_{i-1}(y)[x+s]) (L_{i-1}(y)[x] past the right edge) is the
+// horizontal pair level i reads in row y: the reduction order of reduce_row, so the levels are
+// bit-identical to the level-by-level definition (signed zeros and NaNs included). A row of level
+// i gives level i + 1's pairs of that row at once, and each level keeps only its pairs' last s + 1
+// rows, in a ring (BuildRows): about half a plane in all, where a level-by-level build rereads
+// every plane it wrote. Where the CPU has AVX2, the planes are written with non-temporal stores in
+// the loop that computes them: the build never reads them back, and keeping them out of the caches
+// keeps the rings in. docs/results.md (Table 1) has the measurements and the designs tried before.
 
 // The build's scratch rows: one row T (a level's row just computed) and, for each level i >= 1, a
 // ring of min(2^(i-1) + 1, height) rows of its pairs h_i. Rows are 16-float aligned and padded past
-// the width (the vector loops run to a multiple of 8 and read up to 15 texels beyond it), and one
-// cache line longer than a multiple of 4 KiB rows would be, so that the rows a loop reads do not
-// share cache sets.
+// the width (the vector loops run to a multiple of 8 and read a few texels beyond it), and one
+// cache line longer than a multiple of 64 bytes would make them, so that rows 4 KiB apart in a
+// plane are not 4 KiB apart here and the rows a loop reads do not share cache sets.
 struct BuildRows {
   std::size_t stride = 0;
   float* t = nullptr;
