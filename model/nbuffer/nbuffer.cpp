@@ -376,30 +376,6 @@ BuildRows make_build_rows(float* base, int width, int height, int levels) {
   return r;
 }
 
-// h[x] = far(t[x], t[x + s]) for x < width - s, t[x] beyond.
-template <FarOp Op>
-[[gnu::always_inline]] inline void pair_row(const float* __restrict t, float* __restrict h, int width, int s) noexcept {
-  const int split = std::clamp(width - s, 0, width);
-  for (int x = 0; x < split; ++x) h[x] = far2<Op>(t[x], t[x + s]);
-  for (int x = split; x < width; ++x) h[x] = t[x];
-}
-
-NBSIM_ROW_LOOP_CLONES void pair_row(FarOp op, const float* __restrict t, float* __restrict h, int width, int s) noexcept {
-  if (op == FarOp::Max) pair_row<FarOp::Max>(t, h, width, s);
-  else pair_row<FarOp::Min>(t, h, width, s);
-}
-
-// t[x] = far(a[x], b[x]).
-template <FarOp Op>
-[[gnu::always_inline]] inline void far_row(const float* __restrict a, const float* __restrict b, float* __restrict t, int width) noexcept {
-  for (int x = 0; x < width; ++x) t[x] = far2<Op>(a[x], b[x]);
-}
-
-NBSIM_ROW_LOOP_CLONES void far_row(FarOp op, const float* __restrict a, const float* __restrict b, float* __restrict t, int width) noexcept {
-  if (op == FarOp::Max) far_row<FarOp::Max>(a, b, t, width);
-  else far_row<FarOp::Min>(a, b, t, width);
-}
-
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(NBSIM_BASELINE_ONLY)
 #define NBSIM_STREAMING_BUILD 1
 
@@ -477,14 +453,25 @@ void level_row(FarOp op, const float* a, const float* b, float* t, float* plane,
 #define NBSIM_STREAMING_BUILD 0
 #endif
 
+// The row build streams its planes out (AVX2 on x86-64, and not the baseline-only test build).
+bool streaming_build() noexcept {
+#if NBSIM_STREAMING_BUILD
+  return has_avx2();
+#else
+  return false;
+#endif
+}
+
 }  // namespace
 
 void NBuffer::build(const DepthImage& depth, BuildPath path) {
   NBSIM_CHECK(depth.width == width_ && depth.height == height_, "depth image size differs from the N-buffer's");
   if (has_rect_levels()) return build_rect(depth);
   if (on_demand_) std::fill(current_.begin(), current_.end(), std::uint8_t{1});
-  if (path == BuildPath::Auto)
-    path = static_cast<std::size_t>(levels_) * pixels() * sizeof(float) > last_level_cache_bytes() ? BuildPath::Rows : BuildPath::Banded;
+  if (path == BuildPath::Auto)  // rows only where they stream: without it they cost about twice the bands
+    path = streaming_build() && static_cast<std::size_t>(levels_) * pixels() * sizeof(float) > last_level_cache_bytes()
+               ? BuildPath::Rows
+               : BuildPath::Banded;
   if (path == BuildPath::Banded) build_banded(depth);
   else build_rows(depth);
 }
@@ -495,11 +482,7 @@ void NBuffer::build_rows(const DepthImage& depth) {
   const BuildRows rows = make_build_rows(build_rows_.data(), width_, height_, levels_);
   const FarOp op = config_.op;
   const std::size_t w = static_cast<std::size_t>(width_);
-#if NBSIM_STREAMING_BUILD
-  const bool streaming = has_avx2();
-#else
-  [[maybe_unused]] const bool streaming = false;
-#endif
+  [[maybe_unused]] const bool streaming = streaming_build();  // read only where NBSIM_STREAMING_BUILD
   // Copies a computed row to its plane (streamed where it can).
   const auto put = [&](const float* row, float* out) {
 #if NBSIM_STREAMING_BUILD
@@ -522,7 +505,7 @@ void NBuffer::build_rows(const DepthImage& depth) {
 #endif
     {
       put(l0, out0);
-      if (h1) pair_row(op, l0, h1, width_, 1);
+      if (h1) reduce_rect_row(op, l0, nullptr, h1, 0, width_, width_, 1, true);  // the pairs: a horizontal step
     }
     for (int i = 1; i < levels_; ++i) {
       const int s = 1 << (i - 1);
@@ -540,11 +523,11 @@ void NBuffer::build_rows(const DepthImage& depth) {
 #endif
       const float* row = a;
       if (b) {
-        far_row(op, a, b, rows.t, width_);
+        reduce_rect_row(op, a, b, rows.t, 0, width_, width_, s, false);  // far(a[x], b[x]): a vertical step
         row = rows.t;
       }
       std::copy(row, row + width_, out);
-      if (h) pair_row(op, row, h, width_, 2 * s);
+      if (h) reduce_rect_row(op, row, nullptr, h, 0, width_, width_, 2 * s, true);
     }
   }
 #if NBSIM_STREAMING_BUILD

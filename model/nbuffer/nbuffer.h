@@ -101,7 +101,7 @@ class NBuffer {
 
   // How build() computes the levels; every path gives the same texels, bit for bit.
   enum class BuildPath {
-    Auto,    // Banded where the levels fit in the last-level cache, Rows where they do not
+    Auto,    // Rows where the levels do not fit in the last-level cache and the CPU has AVX2, else Banded
     Banded,  // levels 0-7 band by band, the others plane by plane
     Rows,    // row by row, every level of a row at once, the planes streamed out (AVX2 CPUs)
   };

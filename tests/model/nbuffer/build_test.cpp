@@ -1,7 +1,8 @@
 // NBufferBuildTest: the optimized NBuffer::build, both paths (bands of rows with row groups, and row
-// by row with rings of pairs and streamed planes; SIMD clones; see model/nbuffer/nbuffer.cpp) against a straightforward level-by-level build kept here as the
-// reference, bit for bit: every format, both ops, partial builds, sizes from 1x1 to past a band,
-// and inputs with ties, signed zeros, NaNs and the far and neutral limits.
+// by row with rings of pairs and streamed planes; SIMD clones; see model/nbuffer/nbuffer.cpp)
+// against a straightforward level-by-level build kept here as the reference, bit for bit: every
+// format, both ops, partial builds, sizes from 1x1 to past a band, and inputs with ties, signed
+// zeros, NaNs and the far and neutral limits.
 #include "model/nbuffer/nbuffer.h"
 
 #include <gtest/gtest.h>
