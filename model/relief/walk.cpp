@@ -31,30 +31,43 @@ struct Reader {
   std::uint32_t lookups = 0;
   Deferred* defer = nullptr;  // not null: a hit's refinement in its cell is left for later (see Deferred)
 
-  float height(int i, int j) {
-    ++lookups;
-    if (i >= 0 && j >= 0 && i < f.size && j < f.size) {
-      const std::int64_t index = static_cast<std::int64_t>(j) * f.size + i;
-      sink(Texture::Height, index);
-      return f.heights[static_cast<std::size_t>(index)];
-    }
-    sink.border(Texture::Height);
-    return 0.0f;
-  }
-  // The four corners of cell (i, j) in the shader's order (h00, h10, h01, h11): one bounds check
-  // and one index for a cell inside the field, the usual case.
+  // The four corners of cell (i, j) in the shader's order (h00, h10, h01, h11), their lookups
+  // recorded: note() then peek().
   [[gnu::always_inline]] void corners(int i, int j, float& h00, float& h10, float& h01, float& h11) {
+    note(i, j);
+    peek(i, j, h00, h10, h01, h11);
+  }
+  // corners() in two halves, for a walk that reads a cell before it knows whether the shader does:
+  // peek() the values (nothing recorded), then note() the four lookups (recorded and counted) once
+  // the walk takes them. One bounds check and one index each for a cell inside the field, the usual
+  // case; a texel outside the field is the virtual border (height 0, no memory).
+  [[gnu::always_inline]] void peek(int i, int j, float& h00, float& h10, float& h01, float& h11) const {
     const int n = f.size;
     if (i >= 0 && j >= 0 && i + 1 < n && j + 1 < n) {
-      lookups += 4;
-      const std::int64_t index = static_cast<std::int64_t>(j) * n + i;
-      sink.pair(Texture::Height, index);
-      sink.pair(Texture::Height, index + n);
-      const float* p = f.heights.data() + index;
+      const float* p = f.heights.data() + static_cast<std::int64_t>(j) * n + i;
       h00 = p[0], h10 = p[1], h01 = p[n], h11 = p[n + 1];
       return;
     }
-    h00 = height(i, j), h10 = height(i + 1, j), h01 = height(i, j + 1), h11 = height(i + 1, j + 1);
+    h00 = peek_height(i, j), h10 = peek_height(i + 1, j), h01 = peek_height(i, j + 1), h11 = peek_height(i + 1, j + 1);
+  }
+  [[gnu::always_inline]] void note(int i, int j) {
+    const int n = f.size;
+    lookups += 4;
+    if (i >= 0 && j >= 0 && i + 1 < n && j + 1 < n) {
+      const std::int64_t index = static_cast<std::int64_t>(j) * n + i;
+      sink.pair(Texture::Height, index);
+      sink.pair(Texture::Height, index + n);
+      return;
+    }
+    note_height(i, j), note_height(i + 1, j), note_height(i, j + 1), note_height(i + 1, j + 1);
+  }
+  float peek_height(int i, int j) const {
+    if (i >= 0 && j >= 0 && i < f.size && j < f.size) return f.heights[static_cast<std::size_t>(static_cast<std::int64_t>(j) * f.size + i)];
+    return 0.0f;
+  }
+  void note_height(int i, int j) {
+    if (i >= 0 && j >= 0 && i < f.size && j < f.size) sink(Texture::Height, static_cast<std::int64_t>(j) * f.size + i);
+    else sink.border(Texture::Height);
   }
   float radius(int i, int j) {
     ++lookups;
@@ -114,15 +127,28 @@ float bilerp(float h00, float h10, float h01, float h11, float fx, float fy) noe
   return a + fy * (b - a);
 }
 
-// The height above the surface at t (negative or zero: below), 4 lookups.
+// The height above the surface at t (negative or zero: below), its cell's four lookups not yet
+// recorded (Reader::note(i, j) records them).
+struct Probe {
+  float f;
+  int i, j;
+};
 template <class Sink>
-[[gnu::always_inline]] inline float above(Reader<Sink>& r, const FragmentRay& ray, float t) {
+[[gnu::always_inline]] inline Probe probe(const Reader<Sink>& r, const FragmentRay& ray, float t) {
   const float u = along(ray.o[0], t, ray.d[0]) - 0.5f, v = along(ray.o[1], t, ray.d[1]) - 0.5f;
   const int i = floor_int(u), j = floor_int(v);
   const float fx = u - static_cast<float>(i), fy = v - static_cast<float>(j);
   float h00, h10, h01, h11;
-  r.corners(i, j, h00, h10, h01, h11);
-  return along(ray.o[2], t, ray.d[2]) - bilerp(h00, h10, h01, h11, fx, fy);
+  r.peek(i, j, h00, h10, h01, h11);
+  return Probe{along(ray.o[2], t, ray.d[2]) - bilerp(h00, h10, h01, h11, fx, fy), i, j};
+}
+
+// The height above the surface at t, 4 lookups.
+template <class Sink>
+[[gnu::always_inline]] inline float above(Reader<Sink>& r, const FragmentRay& ray, float t) {
+  const Probe p = probe(r, ray, t);
+  r.note(p.i, p.j);
+  return p.f;
 }
 
 // The cell ahead of the ray at t along one axis: on a cell boundary, the cell the ray enters.
@@ -273,10 +299,29 @@ void end_walk(WalkResult& w, const FragmentRay& ray) {
   if (w.capped) w.hit = false, w.t = 0.0f;
 }
 
-// Bisection of [a, b] (above at a, below at b) anywhere: 4 lookups a step.
+// Bisection of [a, b] (above at a, below at b) anywhere: 4 lookups a step. Two bisections a round,
+// as refine_in_cell's: the midpoint and both midpoints the second bisection may take are evaluated
+// at once (three independent chains of a cell's reads and its bilinear height instead of two in a
+// row), and the lookups recorded are the shader's: the midpoint's cell, then the cell of the one
+// taken.
 template <class Sink>
 float bisect(Reader<Sink>& r, const FragmentRay& ray, float a, float b, int steps, WalkResult& w) {
-  for (int k = 0; k < steps; ++k) {
+  int k = 0;
+  for (; k + 1 < steps; k += 2) {
+    const float m = (a + b) * 0.5f;
+    const float left = (a + m) * 0.5f, right = (m + b) * 0.5f;
+    const Probe pm = probe(r, ray, m), pl = probe(r, ray, left), pr = probe(r, ray, right);
+    const bool below = pm.f <= 0.0f;
+    const Probe& second = below ? pl : pr;
+    r.note(pm.i, pm.j);
+    r.note(second.i, second.j);
+    const bool second_below = second.f <= 0.0f;
+    // [a, m] then [a, left] or [left, m]; [m, b] then [m, right] or [right, b].
+    const float lo = below ? a : m, mid = below ? left : right, hi = below ? m : b;
+    a = second_below ? lo : mid;
+    b = second_below ? mid : hi;
+  }
+  for (; k < steps; ++k) {
     const float m = (a + b) * 0.5f;
     if (above(r, ray, m) <= 0.0f) b = m;
     else a = m;

@@ -178,14 +178,19 @@ class alignas(64) LookupLines {
     void add_lookups(std::uint64_t n) noexcept { lines_.lookups_ += n; }
 
    private:
+    // Without a branch on the merge (whether a line repeats its set's last follows the walk's path
+    // across lines, which a branch predictor cannot guess): the line is always written to the next
+    // slot, and the slot kept only when the line is not a repeat.
     [[gnu::always_inline]] void put(std::uint64_t line) {
+      if (out_ == end_) grow();
+      *out_ = line;
       if (merge_) {
         std::uint64_t& last = last_[line & mask_];
-        if (line == last) return;
+        out_ += line != last ? 1 : 0;
         last = line;
+      } else {
+        ++out_;
       }
-      if (out_ == end_) grow();
-      *out_++ = line;
     }
     // The storage is kept at its full size (size_ counts what is used), so a record reused for the
     // next run neither frees nor clears it.

@@ -107,7 +107,9 @@ TEST_F(ReliefGlWalkTest, EveryMethodMatchesTheModelBitForBit) {
   const std::vector<float> levels = gl.levels();
   ASSERT_EQ(levels, brute_levels(field, gl.level_count()));
   relief::FieldView fv{n, field.heights, radius.radius, levels, gl.level_count()};
-  const relief::WalkParams params;
+  // The default tunables, and odd step counts (the model's bisections run two at a time, the last one
+  // alone when the count is odd).
+  for (const relief::WalkParams& params : {relief::WalkParams{}, relief::WalkParams{5, 7, 3, {}}})
   for (double angle : {0.0, 30.0, 60.0, 85.0, 89.0}) {
     const capture::ReliefCamera cam = capture::relief_camera(n, 0.4, angle, 25.0 + angle, width, height);
     for (Method m : relief::kAllMethods) {
