@@ -579,17 +579,22 @@ struct CellLog {
   };
   std::vector<Ray> rays;
   std::vector<std::int32_t> rows;  // per step of the lanes: the eight lanes' ci, then their cj
+  // Empty, or per step of the lanes: the radius texel each lane read before its cell (-1: none).
+  std::vector<std::int32_t> radii;
 
   void replay(const FieldView& field, LookupLines& lines) const {
     LinesSink sink{lines};
     Reader<LinesSink> r{field, sink};
-    float h00, h10, h01, h11;
     for (const Ray& ray : rays) {
-      r.corners(ray.first_i, ray.first_j, h00, h10, h01, h11);
+      r.note(ray.first_i, ray.first_j);
       if (ray.lane < 0) continue;
       for (std::uint32_t row = ray.row0; row < ray.row1; ++row) {
+        if (!radii.empty()) {
+          const std::int32_t index = radii[8 * static_cast<std::size_t>(row) + static_cast<std::size_t>(ray.lane)];
+          if (index >= 0) ++r.lookups, sink(Texture::Radius, index);
+        }
         const std::int32_t* p = rows.data() + 16 * static_cast<std::size_t>(row);
-        r.corners(p[ray.lane], p[8 + ray.lane], h00, h10, h01, h11);
+        r.note(p[ray.lane], p[8 + ray.lane]);
       }
     }
     sink.walked(r.lookups);
@@ -687,6 +692,19 @@ struct Refinement {
   }
 }
 
+// walk_with's first height for a ray of a lanes run, its cell logged: true when it ends the walk (a
+// hit at t_in, the result set), false when the ray needs a lane (the result cleared).
+bool first_height(Reader<ObserverSink>& reader, const FragmentRay& ray, CellLog::Ray& logged, WalkResult& w) {
+  w = WalkResult{};
+  const float u = along(ray.o[0], ray.t_in, ray.d[0]) - 0.5f, v = along(ray.o[1], ray.t_in, ray.d[1]) - 0.5f;
+  logged.first_i = floor_int(u), logged.first_j = floor_int(v);
+  if (above(reader, ray, ray.t_in) > 0.0f) return false;
+  set_hit(w, ray.t_in);
+  w.lookups = 4;
+  end_walk(w, ray);
+  return true;
+}
+
 // The exact walks of a run, eight at a time: walk_exact's steps, lane by lane the same operations in
 // the same order (and walk_with's first height and end, done per ray in scalar code).
 [[gnu::target("avx2")]] void exact_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
@@ -694,6 +712,7 @@ struct Refinement {
   const int n = field.size, cap = walk_iteration_cap(n);
   log.rays.assign(rays.size(), CellLog::Ray{});
   log.rows.clear();
+  log.radii.clear();
   std::uint32_t row = 0;
   Lanes L;
   std::size_t next = 0;
@@ -707,17 +726,8 @@ struct Refinement {
       const std::size_t k = next++;
       const FragmentRay& ray = *rays[k];
       WalkResult& w = out[k];
-      w = WalkResult{};
       CellLog::Ray& logged = log.rays[k];
-      const float u = along(ray.o[0], ray.t_in, ray.d[0]) - 0.5f, v = along(ray.o[1], ray.t_in, ray.d[1]) - 0.5f;
-      logged.first_i = floor_int(u), logged.first_j = floor_int(v);
-      reader.lookups = 0;
-      if (above(reader, ray, ray.t_in) <= 0.0f) {
-        set_hit(w, ray.t_in);
-        w.lookups = 4;
-        end_walk(w, ray);
-        continue;
-      }
+      if (first_height(reader, ray, logged, w)) continue;
       CellWalk cw;
       cw.start(ray, ray.t_in, n);
       if (cap <= 0 || !cw.inside(n) || cw.t >= ray.t_out) {  // walk_exact's loop: capped before its first step, or done
@@ -834,6 +844,162 @@ struct Refinement {
   }
 }
 
+// The binary searches (walk_binary) or the robust searches with a radius of 0 clamped to 1
+// (walk_robust, robust_clamp) of a run, eight at a time, each ending in bisect()'s bisections: lane
+// by lane the same operations in the same order as the one-by-one walks (walk_with's first height
+// and end per ray in scalar code). Each iteration tests one point a lane: its step's end (binary:
+// t_in + dt * k; robust: its texel's radius ahead of t) or its bracket's midpoint. The cells the
+// heights read, and the radius texels, are logged for the record as exact_lanes' cells are.
+template <bool Robust>
+[[gnu::target("avx2")]] void search_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
+                                          std::span<WalkResult> out, CellLog& log) {
+  const int n = field.size, linear = params.linear_steps, bisections = params.binary_steps, cap = walk_iteration_cap(n);
+  log.rays.assign(rays.size(), CellLog::Ray{});
+  log.rows.clear();
+  log.radii.clear();
+  std::uint32_t row = 0;
+  struct alignas(32) SearchLanes {
+    float o0[8], o1[8], o2[8], d0[8], d1[8], d2[8];
+    float start[8];  // binary: t_in; robust: t_out
+    float delta[8];  // binary: dt; robust: the inverse horizontal length (inverse_horizontal)
+    float lo[8];     // the last point tested above the surface (t_in at first)
+    float a[8], b[8];  // the bracket
+    std::int32_t k[8];       // steps taken (while stepping), or bisections done
+    std::int32_t bisect[8];  // -1: bisecting the bracket [a, b], else 0 (stepping)
+    std::int32_t ray[8];     // the ray's index in the run, -1: the lane is idle
+  } L;
+  std::size_t next = 0;
+  ObserverSink none{nullptr, nullptr};
+  Reader<ObserverSink> reader{field, none};
+
+  // Gives lane `l` the run's next ray whose first height does not end it (nor the robust walk's cap
+  // before its first step).
+  const auto load = [&](int l) {
+    while (next < rays.size()) {
+      const std::size_t k = next++;
+      const FragmentRay& ray = *rays[k];
+      WalkResult& w = out[k];
+      CellLog::Ray& logged = log.rays[k];
+      if (first_height(reader, ray, logged, w)) continue;
+      if (Robust && cap <= 0) {  // walk_robust capped before its first step
+        w.capped = true;
+        w.lookups = 4;
+        end_walk(w, ray);
+        continue;
+      }
+      logged.lane = l;
+      logged.row0 = logged.row1 = row;
+      L.o0[l] = ray.o[0], L.o1[l] = ray.o[1], L.o2[l] = ray.o[2];
+      L.d0[l] = ray.d[0], L.d1[l] = ray.d[1], L.d2[l] = ray.d[2];
+      L.start[l] = Robust ? ray.t_out : ray.t_in;
+      L.delta[l] = Robust ? inverse_horizontal(ray) : (ray.t_out - ray.t_in) / static_cast<float>(linear);
+      L.lo[l] = ray.t_in, L.a[l] = L.b[l] = 0.0f;
+      L.k[l] = 0, L.bisect[l] = 0;
+      L.ray[l] = static_cast<std::int32_t>(k);
+      return;
+    }
+    L.ray[l] = -1;
+    L.o0[l] = L.o1[l] = L.o2[l] = L.d0[l] = L.d1[l] = L.d2[l] = L.start[l] = L.delta[l] = L.lo[l] = L.a[l] = L.b[l] = 0.0f;
+    L.k[l] = L.bisect[l] = 0;
+  };
+
+  for (int l = 0; l < 8; ++l) load(l);
+  const __m256i nv = _mm256_set1_epi32(n), one = _mm256_set1_epi32(1), minus1 = _mm256_set1_epi32(-1), zeroi = _mm256_setzero_si256();
+  const __m256i last_texel = _mm256_set1_epi32(n - 1), last_bisection = _mm256_set1_epi32(bisections);
+  const __m256i last_step = _mm256_set1_epi32(Robust ? cap : linear);
+  const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps(), onef = _mm256_set1_ps(1.0f);
+  const float* heights = field.heights.data();
+  for (;;) {
+    const __m256i live = _mm256_cmpgt_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(L.ray)), minus1);
+    if (_mm256_testz_si256(live, live)) break;
+    const __m256 o0 = _mm256_load_ps(L.o0), o1 = _mm256_load_ps(L.o1), o2 = _mm256_load_ps(L.o2);
+    const __m256 d0 = _mm256_load_ps(L.d0), d1 = _mm256_load_ps(L.d1), d2 = _mm256_load_ps(L.d2);
+    const __m256 start = _mm256_load_ps(L.start), delta = _mm256_load_ps(L.delta);
+    const __m256 lo = _mm256_load_ps(L.lo), a = _mm256_load_ps(L.a), b = _mm256_load_ps(L.b);
+    const __m256i k = _mm256_load_si256(reinterpret_cast<const __m256i*>(L.k));
+    const __m256i bisecting = _mm256_load_si256(reinterpret_cast<const __m256i*>(L.bisect));
+    const __m256 bisectingf = _mm256_castsi256_ps(bisecting);
+    const __m256i stepping = _mm256_andnot_si256(bisecting, live);
+    __m256 step_end;
+    __m256i rindex = minus1;
+    if constexpr (Robust) {
+      // The radius of the texel under lo (clamped into the field), 1 where it is 0, and the step's
+      // end: t_out for a vertical ray, else min(lo + radius * inv, t_out).
+      const __m256i ri = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(_mm256_floor_ps(_mm256_add_ps(o0, _mm256_mul_ps(lo, d0)))), zeroi),
+                                          last_texel);
+      const __m256i rj = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(_mm256_floor_ps(_mm256_add_ps(o1, _mm256_mul_ps(lo, d1)))), zeroi),
+                                          last_texel);
+      rindex = _mm256_blendv_epi8(minus1, _mm256_add_epi32(_mm256_mullo_epi32(rj, nv), ri), stepping);
+      __m256 rad = _mm256_mask_i32gather_ps(zero, field.radius.data(), rindex, _mm256_castsi256_ps(stepping), 4);
+      rad = select(_mm256_cmp_ps(rad, zero, _CMP_EQ_OQ), onef, rad);
+      step_end = select(_mm256_cmp_ps(delta, zero, _CMP_EQ_OQ), start, std_min(_mm256_add_ps(lo, _mm256_mul_ps(rad, delta)), start));
+    } else {
+      step_end = _mm256_add_ps(start, _mm256_mul_ps(delta, _mm256_cvtepi32_ps(_mm256_add_epi32(k, one))));
+    }
+    // above(p) at the step's end or the bracket's midpoint: the cell under the point, its four
+    // corners (0 outside the field or in idle lanes).
+    const __m256 m = _mm256_mul_ps(_mm256_add_ps(a, b), half);
+    const __m256 p = select(bisectingf, m, step_end);
+    const __m256i i = _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_sub_ps(_mm256_add_ps(o0, _mm256_mul_ps(p, d0)), half)));
+    const __m256i j = _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_sub_ps(_mm256_add_ps(o1, _mm256_mul_ps(p, d1)), half)));
+    log.rows.resize(log.rows.size() + 16);
+    std::int32_t* logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), i);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), j);
+    if constexpr (Robust) {
+      log.radii.resize(log.radii.size() + 8);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(log.radii.data() + 8 * static_cast<std::size_t>(row)), rindex);
+    }
+    const __m256i i1 = _mm256_add_epi32(i, one), j1 = _mm256_add_epi32(j, one);
+    const __m256 h00 = corner(heights, i, j, nv, live), h10 = corner(heights, i1, j, nv, live);
+    const __m256 h01 = corner(heights, i, j1, nv, live), h11 = corner(heights, i1, j1, nv, live);
+    const __m256 f = cell_above(o0, o1, o2, d0, d1, d2, p, _mm256_cvtepi32_ps(i), _mm256_cvtepi32_ps(j), h00, h10, h01, h11);
+    const __m256 below = _mm256_cmp_ps(f, zero, _CMP_LE_OQ);
+    // Stepping lanes: below starts the bracket [lo, step_end] (bisections from 0), else lo moves to
+    // the step's end. Bisecting lanes: below takes [a, m], else [m, b].
+    const __m256 bracket = _mm256_andnot_ps(bisectingf, below);
+    _mm256_store_ps(L.a, select(bisectingf, select(below, a, m), select(bracket, lo, a)));
+    _mm256_store_ps(L.b, select(bisectingf, select(below, m, b), select(bracket, step_end, b)));
+    _mm256_store_ps(L.lo, select(bisectingf, lo, step_end));
+    const __m256i bracketi = _mm256_castps_si256(bracket);
+    const __m256i next_k = _mm256_blendv_epi8(_mm256_add_epi32(k, one), zeroi, bracketi);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(L.k), next_k);
+    const __m256i now_bisecting = _mm256_or_si256(bisecting, bracketi);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(L.bisect), now_bisecting);
+    ++row;
+    // Ends: a bracket with no bisection to run or after its last bisection; a step with neither
+    // (binary: the last linear step, a miss; robust: one that reached t_out, a miss, or else the
+    // cap-th, capped).
+    const __m256i bisected = _mm256_and_si256(now_bisecting, _mm256_cmpeq_epi32(next_k, last_bisection));
+    const __m256i still_stepping = _mm256_andnot_si256(now_bisecting, live);
+    const __m256i missed = Robust ? _mm256_castps_si256(_mm256_cmp_ps(step_end, start, _CMP_GE_OQ)) : _mm256_cmpeq_epi32(next_k, last_step);
+    const __m256i capped = Robust ? _mm256_andnot_si256(missed, _mm256_cmpeq_epi32(next_k, last_step)) : zeroi;
+    const __m256i ends = _mm256_or_si256(bisected, _mm256_and_si256(still_stepping, _mm256_or_si256(missed, capped)));
+    const int ended = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(live, ends)));
+    if (ended == 0) continue;
+    const int capped_bits = _mm256_movemask_ps(_mm256_castsi256_ps(capped));
+    for (int l = 0; l < 8; ++l) {
+      if (!(ended >> l & 1)) continue;
+      const auto r = static_cast<std::size_t>(L.ray[l]);
+      CellLog::Ray& ended_ray = log.rays[r];
+      ended_ray.row1 = row;
+      WalkResult& w = out[r];
+      const std::uint32_t tested = ended_ray.row1 - ended_ray.row0;
+      if (L.bisect[l]) {  // the bracket's bisections done: a hit at its below end
+        w.bisections = static_cast<std::uint32_t>(bisections);
+        w.steps = tested - w.bisections;
+        set_hit(w, L.b[l]);
+      } else {
+        w.steps = tested;
+        w.capped = capped_bits >> l & 1;
+      }
+      w.lookups = 4 * (1 + tested) + (Robust ? w.steps : 0);  // robust: a radius a step
+      end_walk(w, *rays[r]);
+      load(l);
+    }
+  }
+}
+
 #endif
 
 }  // namespace
@@ -870,6 +1036,13 @@ void walk_each(Method method, const FieldView& field, const WalkParams& params, 
       }
     }
     refine_lanes(refinements, params.root_steps, out);
+    return;
+  }
+  if (vector && (method == Method::Binary || method == Method::RobustClamp) && vector_walks_available()) {
+    thread_local CellLog log;
+    if (method == Method::Binary) search_lanes<false>(field, params, rays, out, log);
+    else search_lanes<true>(field, params, rays, out, log);
+    if (lines) log.replay(field, *lines);
     return;
   }
 #endif

@@ -178,10 +178,11 @@ TEST(ReliefWalkTest, ExactMethodsAgreeWithTheReferenceOnRandomRays) {
   RecordProperty("exact_saddle_misses", exact_misses);
 }
 
-// walk_each's lanes (the exact method in AVX2, the hits' refinements of the exact and N-buffer walks)
-// against the one-by-one walks: every result and the
-// record of lookups the same bit for bit, on fields of every kind and size 2 to 64 and on rays from
-// above, through the sides, grazing, vertical, axis-aligned and along cell diagonals.
+// walk_each's lanes (the exact, binary and robust_clamp methods in AVX2, the hits' refinements of the
+// exact and N-buffer walks) against the one-by-one walks: every result and the record of lookups the
+// same bit for bit, on fields of every kind and size 2 to 64 and on rays from above, through the
+// sides, grazing, vertical, axis-aligned and along cell diagonals, with step counts that vary with
+// the size (1 to 16 linear steps, 0 to 9 bisections).
 TEST(ReliefWalkTest, LanesWalkAsOneByOne) {
   if (!vector_walks_available()) GTEST_SKIP() << "no AVX2 here: walk_each walks one by one";
   std::mt19937 rng(23);
@@ -208,9 +209,11 @@ TEST(ReliefWalkTest, LanesWalkAsOneByOne) {
       }
       std::vector<const FragmentRay*> pointers;
       for (const FragmentRay& r : rays) pointers.push_back(&r);
-      for (const Method m : {Method::Exact, Method::NBuffer})
+      for (const Method m : kAllMethods)
       for (const LineGeometry g : {LineGeometry{6, 64, true}, LineGeometry{6, 0, false}, LineGeometry{7, 3, true}}) {
-        const WalkParams p{16, 8, 16 - (n % 3) * 5, {}};
+        const int linear[] = {16, 1, 5}, bisections[] = {8, 0, 9};
+        const auto variant = static_cast<std::size_t>(n % 3);
+        const WalkParams p{linear[variant], bisections[variant], 16 - (n % 3) * 5, {}};
         LookupLines want, got;
         want.reset(g), got.reset(g);
         std::vector<WalkResult> a(rays.size()), b(rays.size()), c(rays.size());
