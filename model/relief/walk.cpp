@@ -581,6 +581,10 @@ struct CellLog {
   std::vector<std::int32_t> rows;  // per step of the lanes: the eight lanes' ci, then their cj
   // Empty, or per step of the lanes: the radius texel each lane read before its cell (-1: none).
   std::vector<std::int32_t> radii;
+  // Empty, or per step of the lanes: the N-buffer level texels each lane's query read before its
+  // cell, four a lane (the k-th of lane l at 8 k + l; -1: none).
+  std::vector<std::int32_t> texels;
+  static constexpr std::int32_t kNoCell = CellWalk::kNoCell;  // in `rows`: the lane read no cell
 
   void replay(const FieldView& field, LookupLines& lines) const {
     LinesSink sink{lines};
@@ -593,8 +597,13 @@ struct CellLog {
           const std::int32_t index = radii[8 * static_cast<std::size_t>(row) + static_cast<std::size_t>(ray.lane)];
           if (index >= 0) ++r.lookups, sink(Texture::Radius, index);
         }
+        if (!texels.empty())
+          for (std::size_t q = 0; q < 4; ++q) {
+            const std::int32_t index = texels[32 * static_cast<std::size_t>(row) + 8 * q + static_cast<std::size_t>(ray.lane)];
+            if (index >= 0) ++r.lookups, sink(Texture::NBuffer, index);
+          }
         const std::int32_t* p = rows.data() + 16 * static_cast<std::size_t>(row);
-        r.note(p[ray.lane], p[8 + ray.lane]);
+        if (p[ray.lane] != kNoCell) r.note(p[ray.lane], p[8 + ray.lane]);
       }
     }
     sink.walked(r.lookups);
@@ -619,6 +628,9 @@ struct alignas(32) Lanes {
 enum class LaneEnd { HitEntry, HitInside, Miss, Capped };
 
 [[gnu::target("avx2")]] inline __m256 select(__m256 mask, __m256 yes, __m256 no) { return _mm256_blendv_ps(no, yes, mask); }
+[[gnu::target("avx2")]] inline __m256i select_i(__m256 mask, __m256i yes, __m256i no) {
+  return _mm256_blendv_epi8(no, yes, _mm256_castps_si256(mask));
+}
 
 // std::min(a, b) and std::max(a, b) to the bit (the first argument on ties, +0 and -0 included).
 [[gnu::target("avx2")]] inline __m256 std_min(__m256 a, __m256 b) { return select(_mm256_cmp_ps(b, a, _CMP_LT_OQ), b, a); }
@@ -705,39 +717,72 @@ bool first_height(Reader<ObserverSink>& reader, const FragmentRay& ray, CellLog:
   return true;
 }
 
-// The exact walks of a run, eight at a time: walk_exact's steps, lane by lane the same operations in
-// the same order (and walk_with's first height and end, done per ray in scalar code).
-[[gnu::target("avx2")]] void exact_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
-                                         std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
-  const int n = field.size, cap = walk_iteration_cap(n);
-  log.rays.assign(rays.size(), CellLog::Ray{});
-  log.rows.clear();
-  log.radii.clear();
-  std::uint32_t row = 0;
-  Lanes L;
-  std::size_t next = 0;
+// A lanes run's rays handed to its lanes in order. walk_with's first height, and a walk that ends
+// before its first iteration (`ends_at_once(ray, w)` true, w's capped flag set), are done here, so a
+// lane takes only rays that walk.
+struct LaneFeed {
+  std::span<const FragmentRay* const> rays;
+  std::span<WalkResult> out;
+  CellLog& log;
   ObserverSink none{nullptr, nullptr};
-  Reader<ObserverSink> reader{field, none};
+  Reader<ObserverSink> reader;  // reads without recording (the log records)
+  std::size_t next = 0;
 
-  // Gives lane `l` the run's next ray that needs a walk (the rays whose first height ends them, or
-  // whose walk ends before its first step, are done here); false when none is left.
-  const auto load = [&](int l) {
+  LaneFeed(const FieldView& field, std::span<const FragmentRay* const> r, std::span<WalkResult> o, CellLog& l)
+      : rays(r), out(o), log(l), reader{field, none} {
+    log.rays.assign(rays.size(), CellLog::Ray{});
+    log.rows.clear();
+    log.radii.clear();
+    log.texels.clear();
+  }
+  LaneFeed(const LaneFeed&) = delete;
+  LaneFeed& operator=(const LaneFeed&) = delete;
+
+  // The next ray for lane `l`, its steps logged from `row` on; -1 when none is left.
+  template <class EndsAtOnce>
+  std::ptrdiff_t take(int l, std::uint32_t row, EndsAtOnce&& ends_at_once) {
     while (next < rays.size()) {
       const std::size_t k = next++;
       const FragmentRay& ray = *rays[k];
       WalkResult& w = out[k];
       CellLog::Ray& logged = log.rays[k];
       if (first_height(reader, ray, logged, w)) continue;
-      CellWalk cw;
-      cw.start(ray, ray.t_in, n);
-      if (cap <= 0 || !cw.inside(n) || cw.t >= ray.t_out) {  // walk_exact's loop: capped before its first step, or done
-        w.capped = cap <= 0;
+      if (ends_at_once(ray, w)) {
         w.lookups = 4;
         end_walk(w, ray);
         continue;
       }
       logged.lane = l;
       logged.row0 = logged.row1 = row;
+      return static_cast<std::ptrdiff_t>(k);
+    }
+    return -1;
+  }
+};
+
+// The exact walks of a run, eight at a time: walk_exact's steps, lane by lane the same operations in
+// the same order (and walk_with's first height and end, done per ray in scalar code).
+[[gnu::target("avx2")]] void exact_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
+                                         std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
+  const int n = field.size, cap = walk_iteration_cap(n);
+  LaneFeed feed(field, rays, out, log);
+  Reader<ObserverSink>& reader = feed.reader;
+  std::uint32_t row = 0;
+  Lanes L;
+
+  // Gives lane `l` the run's next ray that needs a walk, or leaves it idle.
+  const auto load = [&](int l) {
+    const std::ptrdiff_t next = feed.take(l, row, [&](const FragmentRay& ray, WalkResult& w) {
+      CellWalk cw;
+      cw.start(ray, ray.t_in, n);
+      w.capped = cap <= 0;
+      return cap <= 0 || !cw.inside(n) || cw.t >= ray.t_out;  // walk_exact's loop: capped before its first step, or done
+    });
+    if (next >= 0) {
+      const auto k = static_cast<std::size_t>(next);
+      const FragmentRay& ray = *rays[k];
+      CellWalk cw;
+      cw.start(ray, ray.t_in, n);
       L.o0[l] = ray.o[0], L.o1[l] = ray.o[1], L.o2[l] = ray.o[2];
       L.d0[l] = ray.d[0], L.d1[l] = ray.d[1], L.d2[l] = ray.d[2];
       L.t_out[l] = ray.t_out, L.t[l] = cw.t, L.tb[l] = 0.0f;
@@ -854,9 +899,7 @@ template <bool Robust>
 [[gnu::target("avx2")]] void search_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
                                           std::span<WalkResult> out, CellLog& log) {
   const int n = field.size, linear = params.linear_steps, bisections = params.binary_steps, cap = walk_iteration_cap(n);
-  log.rays.assign(rays.size(), CellLog::Ray{});
-  log.rows.clear();
-  log.radii.clear();
+  LaneFeed feed(field, rays, out, log);
   std::uint32_t row = 0;
   struct alignas(32) SearchLanes {
     float o0[8], o1[8], o2[8], d0[8], d1[8], d2[8];
@@ -868,27 +911,16 @@ template <bool Robust>
     std::int32_t bisect[8];  // -1: bisecting the bracket [a, b], else 0 (stepping)
     std::int32_t ray[8];     // the ray's index in the run, -1: the lane is idle
   } L;
-  std::size_t next = 0;
-  ObserverSink none{nullptr, nullptr};
-  Reader<ObserverSink> reader{field, none};
 
-  // Gives lane `l` the run's next ray whose first height does not end it (nor the robust walk's cap
-  // before its first step).
+  // Gives lane `l` the run's next ray that needs a walk, or leaves it idle.
   const auto load = [&](int l) {
-    while (next < rays.size()) {
-      const std::size_t k = next++;
+    const std::ptrdiff_t next = feed.take(l, row, [&](const FragmentRay&, WalkResult& w) {
+      w.capped = Robust && cap <= 0;  // walk_robust capped before its first step
+      return w.capped;
+    });
+    if (next >= 0) {
+      const auto k = static_cast<std::size_t>(next);
       const FragmentRay& ray = *rays[k];
-      WalkResult& w = out[k];
-      CellLog::Ray& logged = log.rays[k];
-      if (first_height(reader, ray, logged, w)) continue;
-      if (Robust && cap <= 0) {  // walk_robust capped before its first step
-        w.capped = true;
-        w.lookups = 4;
-        end_walk(w, ray);
-        continue;
-      }
-      logged.lane = l;
-      logged.row0 = logged.row1 = row;
       L.o0[l] = ray.o[0], L.o1[l] = ray.o[1], L.o2[l] = ray.o[2];
       L.d0[l] = ray.d[0], L.d1[l] = ray.d[1], L.d2[l] = ray.d[2];
       L.start[l] = Robust ? ray.t_out : ray.t_in;
@@ -1000,6 +1032,261 @@ template <bool Robust>
   }
 }
 
+// Eight lanes' ints from and to an aligned array.
+[[gnu::target("avx2")]] inline __m256i load_i(const std::int32_t* p) { return _mm256_load_si256(reinterpret_cast<const __m256i*>(p)); }
+[[gnu::target("avx2")]] inline void store_i(std::int32_t* p, __m256i v) { _mm256_store_si256(reinterpret_cast<__m256i*>(p), v); }
+// std::clamp(v, lo, hi) of ints in eight lanes.
+[[gnu::target("avx2")]] inline __m256i clamp_lanes(__m256i v, __m256i lo, __m256i hi) { return _mm256_min_epi32(_mm256_max_epi32(v, lo), hi); }
+// floor_int in eight lanes.
+[[gnu::target("avx2")]] inline __m256i floor_lanes(__m256 v) { return _mm256_cvttps_epi32(_mm256_floor_ps(v)); }
+
+// The paper's covering with top alignment (cover(): paper(), grid(), anchors()) of the rectangles
+// [i0, i0 + w) x [j0, j0 + h) (w, h >= 1, i0, j0 >= 0) in eight lanes: the level, and square q's
+// lower-left corner (x[q], y[q]) for q below `count` (the squares row by row, as grid() lists them).
+struct CoverLanes {
+  __m256i level, count, x[4], y[4];
+};
+[[gnu::target("avx2")]] inline CoverLanes cover_paper_top(__m256i i0, __m256i j0, __m256i w, __m256i h) {
+  const __m256i one = _mm256_set1_epi32(1), zero = _mm256_setzero_si256();
+  // ceil_log2(max(w, h)): bit_width(m - 1), from the exponent of m - 1 as a float (exact below 2^24).
+  const __m256i m1 = _mm256_sub_epi32(_mm256_max_epi32(w, h), one);
+  const __m256i exponent = _mm256_sub_epi32(_mm256_srli_epi32(_mm256_castps_si256(_mm256_cvtepi32_ps(m1)), 23), _mm256_set1_epi32(126));
+  const __m256i s_log = _mm256_and_si256(_mm256_cmpgt_epi32(m1, zero), exponent);
+  const __m256i q = _mm256_srli_epi32(_mm256_sllv_epi32(one, s_log), 1);
+  const __m256i wide = _mm256_cmpgt_epi32(w, q), tall = _mm256_cmpgt_epi32(h, q);
+  const __m256i quadrants = _mm256_and_si256(wide, tall);
+  // Four in a row (wide, 2 h <= q) or a column (not wide, 2 w <= q): squares of q / 2.
+  const __m256i row4 = _mm256_andnot_si256(quadrants, _mm256_and_si256(wide, _mm256_cmpgt_epi32(_mm256_add_epi32(q, one), _mm256_add_epi32(h, h))));
+  const __m256i col4 = _mm256_andnot_si256(wide, _mm256_cmpgt_epi32(_mm256_add_epi32(q, one), _mm256_add_epi32(w, w)));
+  const __m256i fourth = _mm256_or_si256(row4, col4);
+  const __m256i level = _mm256_andnot_si256(_mm256_cmpeq_epi32(s_log, zero),
+                                            _mm256_sub_epi32(s_log, _mm256_blendv_epi8(one, _mm256_set1_epi32(2), fourth)));
+  const __m256i side = _mm256_sllv_epi32(one, level), side1 = _mm256_sub_epi32(side, one);
+  // anchors(): one square when the span fits in one (x flush with the start; y flush with the end,
+  // moved up to 0), else ceil(len / side), one every side from the start and the last flush with the end.
+  const __m256i x_one = _mm256_cmpgt_epi32(_mm256_add_epi32(side, one), w), y_one = _mm256_cmpgt_epi32(_mm256_add_epi32(side, one), h);
+  const __m256i nx = _mm256_blendv_epi8(_mm256_srlv_epi32(_mm256_add_epi32(w, side1), level), one, x_one);
+  const __m256i ny = _mm256_blendv_epi8(_mm256_srlv_epi32(_mm256_add_epi32(h, side1), level), one, y_one);
+  const __m256i x_last = _mm256_sub_epi32(_mm256_add_epi32(i0, w), side), y_last = _mm256_sub_epi32(_mm256_add_epi32(j0, h), side);
+  const __m256i y_single = _mm256_max_epi32(y_last, zero);
+  CoverLanes c;
+  c.level = level;
+  c.count = _mm256_mullo_epi32(nx, ny);
+  const __m256i nx_is1 = _mm256_cmpeq_epi32(nx, one), nx_is2 = _mm256_cmpeq_epi32(nx, _mm256_set1_epi32(2));
+  for (int k = 0; k < 4; ++k) {
+    const __m256i qk = _mm256_set1_epi32(k);
+    // Square k's column and row: nx 1: (0, k); nx 2: (k & 1, k >> 1); nx 3 or 4: (k, 0).
+    const __m256i jy = _mm256_blendv_epi8(_mm256_blendv_epi8(zero, _mm256_set1_epi32(k >> 1), nx_is2), qk, nx_is1);
+    const __m256i ix = _mm256_sub_epi32(qk, _mm256_mullo_epi32(jy, nx));
+    const __m256i x_inner = _mm256_cmpgt_epi32(_mm256_sub_epi32(nx, one), ix), y_inner = _mm256_cmpgt_epi32(_mm256_sub_epi32(ny, one), jy);
+    const __m256i xs = _mm256_blendv_epi8(x_last, _mm256_add_epi32(i0, _mm256_mullo_epi32(ix, side)), x_inner);
+    const __m256i ys = _mm256_blendv_epi8(y_last, _mm256_add_epi32(j0, _mm256_mullo_epi32(jy, side)), y_inner);
+    c.x[k] = _mm256_blendv_epi8(xs, i0, x_one);
+    c.y[k] = _mm256_blendv_epi8(ys, y_single, y_one);
+  }
+  return c;
+}
+
+// The N-buffer walks of a run with the paper's covering (top alignment, no direct squares), eight at
+// a time: walk_nbuffer's queries and cell steps, lane by lane the same operations in the same order
+// (walk_with's first height and end per ray in scalar code). Each iteration is one query a lane and,
+// where it fails at a span of one texel, one cell step with the full cell test; the hits found inside
+// a cell are refined with the run's others (refine_lanes). The level texels and cells read are
+// logged for the record.
+[[gnu::target("avx2")]] void nbuffer_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
+                                           std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
+  const int n = field.size, top = field.levels - 1, cap = walk_iteration_cap(n);
+  LaneFeed feed(field, rays, out, log);
+  Reader<ObserverSink>& reader = feed.reader;
+  std::uint32_t row = 0;
+  struct alignas(32) NBufferLanes {
+    float o0[8], o1[8], o2[8], d0[8], d1[8], d2[8], t_out[8], inv[8], t[8];
+    float end_a[8], end_b[8];  // a hit's refinement bracket (or its t in end_b), at the iteration that ends it
+    std::int32_t s[8];         // the span's exponent
+    std::int32_t walking[8];   // -1: ci, cj hold the cell at t (after a cell step)
+    std::int32_t ci[8], cj[8], sx[8], sy[8];
+    std::int32_t iter[8], steps[8], lookups[8];
+    std::int32_t ray[8];  // the ray's index in the run, -1: the lane is idle
+  } L;
+
+  // Gives lane `l` the run's next ray that needs a walk, or leaves it idle.
+  const auto load = [&](int l) {
+    const std::ptrdiff_t next = feed.take(l, row, [&](const FragmentRay&, WalkResult& w) {
+      w.capped = cap <= 0;  // walk_nbuffer capped before its first query
+      return w.capped;
+    });
+    if (next >= 0) {
+      const auto k = static_cast<std::size_t>(next);
+      const FragmentRay& ray = *rays[k];
+      L.o0[l] = ray.o[0], L.o1[l] = ray.o[1], L.o2[l] = ray.o[2];
+      L.d0[l] = ray.d[0], L.d1[l] = ray.d[1], L.d2[l] = ray.d[2];
+      L.t_out[l] = ray.t_out, L.inv[l] = inverse_horizontal(ray), L.t[l] = ray.t_in;
+      L.end_a[l] = L.end_b[l] = 0.0f;
+      L.s[l] = 0, L.walking[l] = 0, L.ci[l] = L.cj[l] = 0;
+      L.sx[l] = ray.d[0] > 0.0f ? 1 : -1, L.sy[l] = ray.d[1] > 0.0f ? 1 : -1;
+      L.iter[l] = 0, L.steps[l] = 0, L.lookups[l] = 4;
+      L.ray[l] = static_cast<std::int32_t>(k);
+      return;
+    }
+    L.ray[l] = -1;
+    L.o0[l] = L.o1[l] = L.o2[l] = L.d0[l] = L.d1[l] = L.d2[l] = L.t_out[l] = L.inv[l] = L.t[l] = L.end_a[l] = L.end_b[l] = 0.0f;
+    L.s[l] = L.walking[l] = L.ci[l] = L.cj[l] = L.sx[l] = L.sy[l] = L.iter[l] = L.steps[l] = L.lookups[l] = 0;
+  };
+
+  for (int l = 0; l < 8; ++l) load(l);
+  const __m256i nv = _mm256_set1_epi32(n), one = _mm256_set1_epi32(1), minus1 = _mm256_set1_epi32(-1), zeroi = _mm256_setzero_si256();
+  const __m256i last_texel = _mm256_set1_epi32(n - 1), topv = _mm256_set1_epi32(top), capv = _mm256_set1_epi32(cap);
+  const __m256i no_cell = _mm256_set1_epi32(CellLog::kNoCell);
+  const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps(), two = _mm256_set1_ps(2.0f), onef = _mm256_set1_ps(1.0f);
+  const float* heights = field.heights.data();
+  const float* levels = field.nbuffer.data();
+  for (;;) {
+    const __m256i live = _mm256_cmpgt_epi32(load_i(L.ray), minus1);
+    if (_mm256_testz_si256(live, live)) break;
+    const __m256 o0 = _mm256_load_ps(L.o0), o1 = _mm256_load_ps(L.o1), o2 = _mm256_load_ps(L.o2);
+    const __m256 d0 = _mm256_load_ps(L.d0), d1 = _mm256_load_ps(L.d1), d2 = _mm256_load_ps(L.d2);
+    const __m256 t_out = _mm256_load_ps(L.t_out), inv = _mm256_load_ps(L.inv), t = _mm256_load_ps(L.t);
+    const __m256i s = load_i(L.s);
+    // The query: the span of 2^s texels of horizontal travel from t, and the N-buffer's maximum
+    // over the texels its surface depends on (nbuffer_max).
+    const __m256 texels = _mm256_cvtepi32_ps(_mm256_sllv_epi32(one, s));
+    const __m256 te = select(_mm256_cmp_ps(inv, zero, _CMP_EQ_OQ), t_out, std_min(_mm256_add_ps(t, _mm256_mul_ps(texels, inv)), t_out));
+    const __m256 xa = _mm256_add_ps(o0, _mm256_mul_ps(t, d0)), xb = _mm256_add_ps(o0, _mm256_mul_ps(te, d0));
+    const __m256 ya = _mm256_add_ps(o1, _mm256_mul_ps(t, d1)), yb = _mm256_add_ps(o1, _mm256_mul_ps(te, d1));
+    const __m256 x0 = std_min(xa, xb), x1 = std_max(xa, xb), y0 = std_min(ya, yb), y1 = std_max(ya, yb);
+    const __m256i i0 = clamp_lanes(floor_lanes(_mm256_sub_ps(x0, half)), zeroi, last_texel);
+    const __m256i i1 = clamp_lanes(_mm256_add_epi32(floor_lanes(_mm256_sub_ps(x1, half)), one), zeroi, last_texel);
+    const __m256i j0 = clamp_lanes(floor_lanes(_mm256_sub_ps(y0, half)), zeroi, last_texel);
+    const __m256i j1 = clamp_lanes(_mm256_add_epi32(floor_lanes(_mm256_sub_ps(y1, half)), one), zeroi, last_texel);
+    const CoverLanes c = cover_paper_top(i0, j0, _mm256_add_epi32(_mm256_sub_epi32(i1, i0), one), _mm256_add_epi32(_mm256_sub_epi32(j1, j0), one));
+    if (!_mm256_testz_si256(live, _mm256_cmpgt_epi32(c.level, topv))) {  // cover()'s check, with its message
+      for (int l = 0; l < 8; ++l)
+        if (L.ray[l] >= 0) {
+          alignas(32) std::int32_t a[4][8];
+          store_i(a[0], i0), store_i(a[1], j0), store_i(a[2], i1), store_i(a[3], j1);
+          (void)cover(Rect{a[0][l], a[1][l], a[2][l] - a[0][l] + 1, a[3][l] - a[1][l] + 1}, params.covering, top);
+        }
+    }
+    const __m256i plane = _mm256_mullo_epi32(c.level, nv);
+    log.texels.resize(log.texels.size() + 32);
+    std::int32_t* logged_texels = log.texels.data() + 32 * static_cast<std::size_t>(row);
+    __m256 top_height = zero;
+    for (int k = 0; k < 4; ++k) {
+      const __m256i read = _mm256_and_si256(live, _mm256_cmpgt_epi32(c.count, _mm256_set1_epi32(k)));
+      const __m256i index = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(plane, c.y[k]), nv), c.x[k]);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged_texels + 8 * k), _mm256_blendv_epi8(minus1, index, read));
+      const __m256 v = _mm256_mask_i32gather_ps(zero, levels, index, _mm256_castsi256_ps(read), 4);
+      top_height = k == 0 ? v : select(_mm256_castsi256_ps(read), std_max(top_height, v), top_height);
+    }
+    const __m256 lowest = std_min(_mm256_add_ps(o2, _mm256_mul_ps(t, d2)), _mm256_add_ps(o2, _mm256_mul_ps(te, d2)));
+    const __m256i pass = _mm256_castps_si256(_mm256_cmp_ps(lowest, top_height, _CMP_GT_OQ));
+    const __m256i s0 = _mm256_cmpeq_epi32(s, zeroi);
+    // A failed query at s = 0: a cell step (the cell walk started at t when not walking).
+    const __m256i walking = load_i(L.walking);
+    const __m256i cell_try = _mm256_and_si256(live, _mm256_andnot_si256(pass, s0));
+    const __m256 u0 = _mm256_sub_ps(xa, half), u1 = _mm256_sub_ps(ya, half);
+    const __m256i start_ci = clamp_lanes(select_i(_mm256_cmp_ps(d0, zero, _CMP_LT_OQ), _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_ceil_ps(u0)), one),
+                                                  floor_lanes(u0)), minus1, last_texel);
+    const __m256i start_cj = clamp_lanes(select_i(_mm256_cmp_ps(d1, zero, _CMP_LT_OQ), _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_ceil_ps(u1)), one),
+                                                  floor_lanes(u1)), minus1, last_texel);
+    const __m256i ci = _mm256_blendv_epi8(start_ci, load_i(L.ci), walking), cj = _mm256_blendv_epi8(start_cj, load_i(L.cj), walking);
+    const __m256i inside = _mm256_and_si256(_mm256_and_si256(_mm256_cmpgt_epi32(ci, _mm256_set1_epi32(-2)), _mm256_cmpgt_epi32(cj, _mm256_set1_epi32(-2))),
+                                            _mm256_and_si256(_mm256_cmpgt_epi32(nv, ci), _mm256_cmpgt_epi32(nv, cj)));
+    const __m256i before_end = _mm256_castps_si256(_mm256_cmp_ps(t, t_out, _CMP_LT_OQ));
+    const __m256i stepped = _mm256_and_si256(cell_try, _mm256_and_si256(inside, before_end));  // the lanes that read a cell
+    const __m256i cell_miss = _mm256_andnot_si256(stepped, cell_try);                           // ended before it
+    const __m256 tx = cell_exits(o0, d0, ci), ty = cell_exits(o1, d1, cj);
+    const __m256 tb = std_max(t, std_min(std_min(tx, ty), t_out));
+    const __m256i ci1 = _mm256_add_epi32(ci, one), cj1 = _mm256_add_epi32(cj, one);
+    const __m256 h00 = corner(heights, ci, cj, nv, stepped), h10 = corner(heights, ci1, cj, nv, stepped);
+    const __m256 h01 = corner(heights, ci, cj1, nv, stepped), h11 = corner(heights, ci1, cj1, nv, stepped);
+    std::int32_t* logged = nullptr;
+    log.rows.resize(log.rows.size() + 16);
+    logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), _mm256_blendv_epi8(no_cell, ci, stepped));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), cj);
+    // cell_test(full): the entry, the exit, the middle, and the dip of the quadratic through them.
+    const __m256 fci = _mm256_cvtepi32_ps(ci), fcj = _mm256_cvtepi32_ps(cj);
+    const __m256 tm = _mm256_mul_ps(_mm256_add_ps(t, tb), half);
+    const __m256 fa = cell_above(o0, o1, o2, d0, d1, d2, t, fci, fcj, h00, h10, h01, h11);
+    const __m256 fb = cell_above(o0, o1, o2, d0, d1, d2, tb, fci, fcj, h00, h10, h01, h11);
+    const __m256 fm = cell_above(o0, o1, o2, d0, d1, d2, tm, fci, fcj, h00, h10, h01, h11);
+    const __m256 q2 = _mm256_mul_ps(two, _mm256_add_ps(_mm256_sub_ps(fa, _mm256_mul_ps(two, fm)), fb));
+    const __m256 q1 = _mm256_sub_ps(_mm256_sub_ps(fb, fa), q2);
+    const __m256 sv = _mm256_div_ps(_mm256_sub_ps(zero, q1), _mm256_mul_ps(two, q2));
+    const __m256 tv = _mm256_add_ps(t, _mm256_mul_ps(sv, _mm256_sub_ps(tb, t)));
+    const __m256 fv = cell_above(o0, o1, o2, d0, d1, d2, tv, fci, fcj, h00, h10, h01, h11);
+    const __m256 steppedf = _mm256_castsi256_ps(stepped);
+    const __m256 hit_entry = _mm256_and_ps(steppedf, _mm256_cmp_ps(fa, zero, _CMP_LE_OQ));
+    const __m256 hit_exit = _mm256_andnot_ps(hit_entry, _mm256_and_ps(steppedf, _mm256_cmp_ps(fb, zero, _CMP_LE_OQ)));
+    const __m256 not_yet = _mm256_andnot_ps(_mm256_or_ps(hit_entry, hit_exit), steppedf);
+    const __m256 hit_middle = _mm256_and_ps(not_yet, _mm256_cmp_ps(fm, zero, _CMP_LE_OQ));
+    const __m256 dip = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(q2, zero, _CMP_GT_OQ), _mm256_cmp_ps(sv, zero, _CMP_GT_OQ)),
+                                     _mm256_and_ps(_mm256_cmp_ps(sv, onef, _CMP_LT_OQ), _mm256_cmp_ps(fv, zero, _CMP_LE_OQ)));
+    const __m256 hit_dip = _mm256_andnot_ps(hit_middle, _mm256_and_ps(not_yet, dip));
+    const __m256 refined = _mm256_or_ps(_mm256_or_ps(hit_exit, hit_middle), hit_dip);
+    _mm256_store_ps(L.end_a, t);
+    _mm256_store_ps(L.end_b, select(hit_entry, t, select(hit_exit, tb, select(hit_middle, tm, tv))));
+    // The walk goes on: a passed query moves t to the span's end (not walking, s up to the top);
+    // a failed one at s > 0 halves the span; a cell step without a hit moves to the next cell.
+    const __m256i hit = _mm256_castps_si256(_mm256_or_ps(hit_entry, refined));
+    const __m256i x_first = _mm256_castps_si256(_mm256_cmp_ps(tx, ty, _CMP_LT_OQ)), y_first = _mm256_castps_si256(_mm256_cmp_ps(ty, tx, _CMP_LT_OQ));
+    const __m256i next_ci = _mm256_add_epi32(ci, _mm256_andnot_si256(y_first, load_i(L.sx)));
+    const __m256i next_cj = _mm256_add_epi32(cj, _mm256_andnot_si256(x_first, load_i(L.sy)));
+    const __m256i moved = _mm256_andnot_si256(hit, stepped);
+    const __m256i next_inside = _mm256_and_si256(_mm256_and_si256(_mm256_cmpgt_epi32(next_ci, _mm256_set1_epi32(-2)), _mm256_cmpgt_epi32(next_cj, _mm256_set1_epi32(-2))),
+                                                 _mm256_and_si256(_mm256_cmpgt_epi32(nv, next_ci), _mm256_cmpgt_epi32(nv, next_cj)));
+    const __m256i moved_out = _mm256_andnot_si256(_mm256_and_si256(next_inside, _mm256_castps_si256(_mm256_cmp_ps(tb, t_out, _CMP_LT_OQ))), moved);
+    const __m256i passed = _mm256_and_si256(live, pass);
+    const __m256i passed_out = _mm256_and_si256(passed, _mm256_castps_si256(_mm256_cmp_ps(te, t_out, _CMP_GE_OQ)));
+    const __m256i halved = _mm256_andnot_si256(_mm256_or_si256(pass, s0), live);
+    _mm256_store_ps(L.t, select(_mm256_castsi256_ps(passed), te, select(_mm256_castsi256_ps(moved), tb, t)));
+    store_i(L.s, _mm256_blendv_epi8(_mm256_blendv_epi8(s, _mm256_sub_epi32(s, one), halved), _mm256_min_epi32(_mm256_add_epi32(s, one), topv), passed));
+    store_i(L.walking, _mm256_blendv_epi8(_mm256_andnot_si256(passed, walking), minus1, moved));
+    store_i(L.ci, _mm256_blendv_epi8(load_i(L.ci), next_ci, moved));
+    store_i(L.cj, _mm256_blendv_epi8(load_i(L.cj), next_cj, moved));
+    const __m256i hit_cells = _mm256_and_si256(hit, stepped);  // a hit keeps its cell (for the refinement)
+    store_i(L.ci, _mm256_blendv_epi8(load_i(L.ci), ci, hit_cells));
+    store_i(L.cj, _mm256_blendv_epi8(load_i(L.cj), cj, hit_cells));
+    // Counts: a step a query and a cell step; the query's texels and a cell's four corners.
+    store_i(L.steps, _mm256_add_epi32(load_i(L.steps), _mm256_sub_epi32(one, stepped)));
+    store_i(L.lookups, _mm256_add_epi32(load_i(L.lookups), _mm256_add_epi32(_mm256_and_si256(live, c.count), _mm256_and_si256(stepped, _mm256_set1_epi32(4)))));
+    const __m256i iter = _mm256_add_epi32(load_i(L.iter), one);
+    store_i(L.iter, iter);
+    ++row;
+    const __m256i missed = _mm256_or_si256(_mm256_or_si256(passed_out, cell_miss), moved_out);
+    const __m256i going = _mm256_andnot_si256(_mm256_or_si256(missed, hit), live);
+    const __m256i capped = _mm256_and_si256(going, _mm256_cmpeq_epi32(iter, capv));
+    const int ended = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(live, _mm256_or_si256(_mm256_or_si256(missed, hit), capped))));
+    if (ended == 0) continue;
+    const int entry_bits = _mm256_movemask_ps(hit_entry), refined_bits = _mm256_movemask_ps(refined);
+    const int capped_bits = _mm256_movemask_ps(_mm256_castsi256_ps(capped));
+    for (int l = 0; l < 8; ++l) {
+      if (!(ended >> l & 1)) continue;
+      const auto r = static_cast<std::size_t>(L.ray[l]);
+      log.rays[r].row1 = row;
+      WalkResult& w = out[r];
+      const FragmentRay& ray = *rays[r];
+      w.steps = static_cast<std::uint32_t>(L.steps[l]);
+      w.lookups = static_cast<std::uint32_t>(L.lookups[l]);
+      if (entry_bits >> l & 1) {
+        set_hit(w, L.end_b[l]);
+      } else if (refined_bits >> l & 1) {  // refined with the run's other hits (refine_lanes)
+        Refinement job{&ray, Cell{}, L.end_a[l], L.end_b[l], r};
+        job.cell.ci = L.ci[l], job.cell.cj = L.cj[l];
+        job.cell.read(reader);
+        refinements.push_back(job);
+        w.bisections += static_cast<std::uint32_t>(params.root_steps);
+        set_hit(w, L.end_b[l]);
+      } else if (capped_bits >> l & 1) {
+        w.capped = true;
+      }
+      end_walk(w, ray);
+      load(l);
+    }
+  }
+}
+
 #endif
 
 }  // namespace
@@ -1021,6 +1308,10 @@ void walk_each(Method method, const FieldView& field, const WalkParams& params, 
     if (method == Method::Exact) {
       thread_local CellLog log;
       exact_lanes(field, params, rays, out, log, refinements);
+      if (lines) log.replay(field, *lines);
+    } else if (params.covering == CoveringSpec{}) {  // the paper's covering: in lanes
+      thread_local CellLog log;
+      nbuffer_lanes(field, params, rays, out, log, refinements);
       if (lines) log.replay(field, *lines);
     } else {  // one by one, the hits' refinements left for refine_lanes
       for (std::size_t k = 0; k < rays.size(); ++k) {
