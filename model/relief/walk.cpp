@@ -585,6 +585,7 @@ struct CellLog {
   // cell, four a lane (the k-th of lane l at 8 k + l; -1: none).
   std::vector<std::int32_t> texels;
   static constexpr std::int32_t kNoCell = CellWalk::kNoCell;  // in `rows`: the lane read no cell
+  std::vector<std::uint8_t> first_ends;  // scratch of the lanes' runs (LaneFeed)
 
   void replay(const FieldView& field, LookupLines& lines) const {
     LinesSink sink{lines};
@@ -704,17 +705,37 @@ struct Refinement {
   }
 }
 
-// walk_with's first height for a ray of a lanes run, its cell logged: true when it ends the walk (a
-// hit at t_in, the result set), false when the ray needs a lane (the result cleared).
-bool first_height(Reader<ObserverSink>& reader, const FragmentRay& ray, CellLog::Ray& logged, WalkResult& w) {
-  w = WalkResult{};
-  const float u = along(ray.o[0], ray.t_in, ray.d[0]) - 0.5f, v = along(ray.o[1], ray.t_in, ray.d[1]) - 0.5f;
-  logged.first_i = floor_int(u), logged.first_j = floor_int(v);
-  if (above(reader, ray, ray.t_in) > 0.0f) return false;
-  set_hit(w, ray.t_in);
-  w.lookups = 4;
-  end_walk(w, ray);
-  return true;
+// walk_with's first height (above() at t_in) for every ray of a lanes run, eight at a time: each
+// ray's cell logged, and whether the height ends its walk (a hit at t_in) in `ends`.
+[[gnu::target("avx2")]] void first_heights(const FieldView& field, std::span<const FragmentRay* const> rays, CellLog& log,
+                                           std::vector<std::uint8_t>& ends) {
+  ends.resize(rays.size());
+  const __m256i nv = _mm256_set1_epi32(field.size), live = _mm256_set1_epi32(-1), one = _mm256_set1_epi32(1);
+  const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps();
+  for (std::size_t first = 0; first < rays.size(); first += 8) {
+    alignas(32) float v[7][8];  // o0, o1, o2, d0, d1, d2, t_in
+    for (std::size_t l = 0; l < 8; ++l) {
+      const FragmentRay& ray = *rays[std::min(first + l, rays.size() - 1)];  // the last ray again in spare lanes
+      const float row[7] = {ray.o[0], ray.o[1], ray.o[2], ray.d[0], ray.d[1], ray.d[2], ray.t_in};
+      for (std::size_t q = 0; q < 7; ++q) v[q][l] = row[q];
+    }
+    const __m256 o0 = _mm256_load_ps(v[0]), o1 = _mm256_load_ps(v[1]), o2 = _mm256_load_ps(v[2]);
+    const __m256 d0 = _mm256_load_ps(v[3]), d1 = _mm256_load_ps(v[4]), d2 = _mm256_load_ps(v[5]), t = _mm256_load_ps(v[6]);
+    const __m256i i = _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_sub_ps(_mm256_add_ps(o0, _mm256_mul_ps(t, d0)), half)));
+    const __m256i j = _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_sub_ps(_mm256_add_ps(o1, _mm256_mul_ps(t, d1)), half)));
+    const __m256i i1 = _mm256_add_epi32(i, one), j1 = _mm256_add_epi32(j, one);
+    const float* h = field.heights.data();
+    const __m256 f = cell_above(o0, o1, o2, d0, d1, d2, t, _mm256_cvtepi32_ps(i), _mm256_cvtepi32_ps(j), corner(h, i, j, nv, live),
+                                corner(h, i1, j, nv, live), corner(h, i, j1, nv, live), corner(h, i1, j1, nv, live));
+    const int below = _mm256_movemask_ps(_mm256_cmp_ps(f, zero, _CMP_LE_OQ));
+    alignas(32) std::int32_t cells[2][8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(cells[0]), i);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(cells[1]), j);
+    for (std::size_t l = 0; l < 8 && first + l < rays.size(); ++l) {
+      log.rays[first + l].first_i = cells[0][l], log.rays[first + l].first_j = cells[1][l];
+      ends[first + l] = static_cast<std::uint8_t>(below >> l & 1);
+    }
+  }
 }
 
 // A lanes run's rays handed to its lanes in order. walk_with's first height, and a walk that ends
@@ -728,12 +749,15 @@ struct LaneFeed {
   Reader<ObserverSink> reader;  // reads without recording (the log records)
   std::size_t next = 0;
 
+  std::vector<std::uint8_t>& first_ends;  // per ray: its first height ends its walk
+
   LaneFeed(const FieldView& field, std::span<const FragmentRay* const> r, std::span<WalkResult> o, CellLog& l)
-      : rays(r), out(o), log(l), reader{field, none} {
+      : rays(r), out(o), log(l), reader{field, none}, first_ends(l.first_ends) {
     log.rays.assign(rays.size(), CellLog::Ray{});
     log.rows.clear();
     log.radii.clear();
     log.texels.clear();
+    first_heights(field, rays, log, first_ends);
   }
   LaneFeed(const LaneFeed&) = delete;
   LaneFeed& operator=(const LaneFeed&) = delete;
@@ -746,8 +770,9 @@ struct LaneFeed {
       const FragmentRay& ray = *rays[k];
       WalkResult& w = out[k];
       CellLog::Ray& logged = log.rays[k];
-      if (first_height(reader, ray, logged, w)) continue;
-      if (ends_at_once(ray, w)) {
+      w = WalkResult{};
+      if (first_ends[k]) set_hit(w, ray.t_in);
+      if (first_ends[k] || ends_at_once(ray, w)) {
         w.lookups = 4;
         end_walk(w, ray);
         continue;
