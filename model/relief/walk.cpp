@@ -914,149 +914,6 @@ struct LaneFeed {
   }
 }
 
-// The binary searches (walk_binary) or the robust searches with a radius of 0 clamped to 1
-// (walk_robust, robust_clamp) of a run, eight at a time, each ending in bisect()'s bisections: lane
-// by lane the same operations in the same order as the one-by-one walks (walk_with's first height
-// and end per ray in scalar code). Each iteration tests one point a lane: its step's end (binary:
-// t_in + dt * k; robust: its texel's radius ahead of t) or its bracket's midpoint. The cells the
-// heights read, and the radius texels, are logged for the record as exact_lanes' cells are.
-template <bool Robust>
-[[gnu::target("avx2")]] void search_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
-                                          std::span<WalkResult> out, CellLog& log) {
-  const int n = field.size, linear = params.linear_steps, bisections = params.binary_steps, cap = walk_iteration_cap(n);
-  LaneFeed feed(field, rays, out, log);
-  std::uint32_t row = 0;
-  struct alignas(32) SearchLanes {
-    float o0[8], o1[8], o2[8], d0[8], d1[8], d2[8];
-    float start[8];  // binary: t_in; robust: t_out
-    float delta[8];  // binary: dt; robust: the inverse horizontal length (inverse_horizontal)
-    float lo[8];     // the last point tested above the surface (t_in at first)
-    float a[8], b[8];  // the bracket
-    std::int32_t k[8];       // steps taken (while stepping), or bisections done
-    std::int32_t bisect[8];  // -1: bisecting the bracket [a, b], else 0 (stepping)
-    std::int32_t ray[8];     // the ray's index in the run, -1: the lane is idle
-  } L;
-
-  // Gives lane `l` the run's next ray that needs a walk, or leaves it idle.
-  const auto load = [&](int l) {
-    const std::ptrdiff_t next = feed.take(l, row, [&](const FragmentRay&, WalkResult& w) {
-      w.capped = Robust && cap <= 0;  // walk_robust capped before its first step
-      return w.capped;
-    });
-    if (next >= 0) {
-      const auto k = static_cast<std::size_t>(next);
-      const FragmentRay& ray = *rays[k];
-      L.o0[l] = ray.o[0], L.o1[l] = ray.o[1], L.o2[l] = ray.o[2];
-      L.d0[l] = ray.d[0], L.d1[l] = ray.d[1], L.d2[l] = ray.d[2];
-      L.start[l] = Robust ? ray.t_out : ray.t_in;
-      L.delta[l] = Robust ? inverse_horizontal(ray) : (ray.t_out - ray.t_in) / static_cast<float>(linear);
-      L.lo[l] = ray.t_in, L.a[l] = L.b[l] = 0.0f;
-      L.k[l] = 0, L.bisect[l] = 0;
-      L.ray[l] = static_cast<std::int32_t>(k);
-      return;
-    }
-    L.ray[l] = -1;
-    L.o0[l] = L.o1[l] = L.o2[l] = L.d0[l] = L.d1[l] = L.d2[l] = L.start[l] = L.delta[l] = L.lo[l] = L.a[l] = L.b[l] = 0.0f;
-    L.k[l] = L.bisect[l] = 0;
-  };
-
-  for (int l = 0; l < 8; ++l) load(l);
-  const __m256i nv = _mm256_set1_epi32(n), one = _mm256_set1_epi32(1), minus1 = _mm256_set1_epi32(-1), zeroi = _mm256_setzero_si256();
-  const __m256i last_texel = _mm256_set1_epi32(n - 1), last_bisection = _mm256_set1_epi32(bisections);
-  const __m256i last_step = _mm256_set1_epi32(Robust ? cap : linear);
-  const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps(), onef = _mm256_set1_ps(1.0f);
-  const float* heights = field.heights.data();
-  for (;;) {
-    const __m256i live = _mm256_cmpgt_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(L.ray)), minus1);
-    if (_mm256_testz_si256(live, live)) break;
-    const __m256 o0 = _mm256_load_ps(L.o0), o1 = _mm256_load_ps(L.o1), o2 = _mm256_load_ps(L.o2);
-    const __m256 d0 = _mm256_load_ps(L.d0), d1 = _mm256_load_ps(L.d1), d2 = _mm256_load_ps(L.d2);
-    const __m256 start = _mm256_load_ps(L.start), delta = _mm256_load_ps(L.delta);
-    const __m256 lo = _mm256_load_ps(L.lo), a = _mm256_load_ps(L.a), b = _mm256_load_ps(L.b);
-    const __m256i k = _mm256_load_si256(reinterpret_cast<const __m256i*>(L.k));
-    const __m256i bisecting = _mm256_load_si256(reinterpret_cast<const __m256i*>(L.bisect));
-    const __m256 bisectingf = _mm256_castsi256_ps(bisecting);
-    const __m256i stepping = _mm256_andnot_si256(bisecting, live);
-    __m256 step_end;
-    __m256i rindex = minus1;
-    if constexpr (Robust) {
-      // The radius of the texel under lo (clamped into the field), 1 where it is 0, and the step's
-      // end: t_out for a vertical ray, else min(lo + radius * inv, t_out).
-      const __m256i ri = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(_mm256_floor_ps(_mm256_add_ps(o0, _mm256_mul_ps(lo, d0)))), zeroi),
-                                          last_texel);
-      const __m256i rj = _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(_mm256_floor_ps(_mm256_add_ps(o1, _mm256_mul_ps(lo, d1)))), zeroi),
-                                          last_texel);
-      rindex = _mm256_blendv_epi8(minus1, _mm256_add_epi32(_mm256_mullo_epi32(rj, nv), ri), stepping);
-      __m256 rad = _mm256_mask_i32gather_ps(zero, field.radius.data(), rindex, _mm256_castsi256_ps(stepping), 4);
-      rad = select(_mm256_cmp_ps(rad, zero, _CMP_EQ_OQ), onef, rad);
-      step_end = select(_mm256_cmp_ps(delta, zero, _CMP_EQ_OQ), start, std_min(_mm256_add_ps(lo, _mm256_mul_ps(rad, delta)), start));
-    } else {
-      step_end = _mm256_add_ps(start, _mm256_mul_ps(delta, _mm256_cvtepi32_ps(_mm256_add_epi32(k, one))));
-    }
-    // above(p) at the step's end or the bracket's midpoint: the cell under the point, its four
-    // corners (0 outside the field or in idle lanes).
-    const __m256 m = _mm256_mul_ps(_mm256_add_ps(a, b), half);
-    const __m256 p = select(bisectingf, m, step_end);
-    const __m256i i = _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_sub_ps(_mm256_add_ps(o0, _mm256_mul_ps(p, d0)), half)));
-    const __m256i j = _mm256_cvttps_epi32(_mm256_floor_ps(_mm256_sub_ps(_mm256_add_ps(o1, _mm256_mul_ps(p, d1)), half)));
-    log.rows.resize(log.rows.size() + 16);
-    std::int32_t* logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), i);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), j);
-    if constexpr (Robust) {
-      log.radii.resize(log.radii.size() + 8);
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(log.radii.data() + 8 * static_cast<std::size_t>(row)), rindex);
-    }
-    const __m256i i1 = _mm256_add_epi32(i, one), j1 = _mm256_add_epi32(j, one);
-    const __m256 h00 = corner(heights, i, j, nv, live), h10 = corner(heights, i1, j, nv, live);
-    const __m256 h01 = corner(heights, i, j1, nv, live), h11 = corner(heights, i1, j1, nv, live);
-    const __m256 f = cell_above(o0, o1, o2, d0, d1, d2, p, _mm256_cvtepi32_ps(i), _mm256_cvtepi32_ps(j), h00, h10, h01, h11);
-    const __m256 below = _mm256_cmp_ps(f, zero, _CMP_LE_OQ);
-    // Stepping lanes: below starts the bracket [lo, step_end] (bisections from 0), else lo moves to
-    // the step's end. Bisecting lanes: below takes [a, m], else [m, b].
-    const __m256 bracket = _mm256_andnot_ps(bisectingf, below);
-    _mm256_store_ps(L.a, select(bisectingf, select(below, a, m), select(bracket, lo, a)));
-    _mm256_store_ps(L.b, select(bisectingf, select(below, m, b), select(bracket, step_end, b)));
-    _mm256_store_ps(L.lo, select(bisectingf, lo, step_end));
-    const __m256i bracketi = _mm256_castps_si256(bracket);
-    const __m256i next_k = _mm256_blendv_epi8(_mm256_add_epi32(k, one), zeroi, bracketi);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(L.k), next_k);
-    const __m256i now_bisecting = _mm256_or_si256(bisecting, bracketi);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(L.bisect), now_bisecting);
-    ++row;
-    // Ends: a bracket with no bisection to run or after its last bisection; a step with neither
-    // (binary: the last linear step, a miss; robust: one that reached t_out, a miss, or else the
-    // cap-th, capped).
-    const __m256i bisected = _mm256_and_si256(now_bisecting, _mm256_cmpeq_epi32(next_k, last_bisection));
-    const __m256i still_stepping = _mm256_andnot_si256(now_bisecting, live);
-    const __m256i missed = Robust ? _mm256_castps_si256(_mm256_cmp_ps(step_end, start, _CMP_GE_OQ)) : _mm256_cmpeq_epi32(next_k, last_step);
-    const __m256i capped = Robust ? _mm256_andnot_si256(missed, _mm256_cmpeq_epi32(next_k, last_step)) : zeroi;
-    const __m256i ends = _mm256_or_si256(bisected, _mm256_and_si256(still_stepping, _mm256_or_si256(missed, capped)));
-    const int ended = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(live, ends)));
-    if (ended == 0) continue;
-    const int capped_bits = _mm256_movemask_ps(_mm256_castsi256_ps(capped));
-    for (int l = 0; l < 8; ++l) {
-      if (!(ended >> l & 1)) continue;
-      const auto r = static_cast<std::size_t>(L.ray[l]);
-      CellLog::Ray& ended_ray = log.rays[r];
-      ended_ray.row1 = row;
-      WalkResult& w = out[r];
-      const std::uint32_t tested = ended_ray.row1 - ended_ray.row0;
-      if (L.bisect[l]) {  // the bracket's bisections done: a hit at its below end
-        w.bisections = static_cast<std::uint32_t>(bisections);
-        w.steps = tested - w.bisections;
-        set_hit(w, L.b[l]);
-      } else {
-        w.steps = tested;
-        w.capped = capped_bits >> l & 1;
-      }
-      w.lookups = 4 * (1 + tested) + (Robust ? w.steps : 0);  // robust: a radius a step
-      end_walk(w, *rays[r]);
-      load(l);
-    }
-  }
-}
-
 // Eight lanes' ints from and to an aligned array.
 [[gnu::target("avx2")]] inline __m256i load_i(const std::int32_t* p) { return _mm256_load_si256(reinterpret_cast<const __m256i*>(p)); }
 [[gnu::target("avx2")]] inline void store_i(std::int32_t* p, __m256i v) { _mm256_store_si256(reinterpret_cast<__m256i*>(p), v); }
@@ -1064,6 +921,256 @@ template <bool Robust>
 [[gnu::target("avx2")]] inline __m256i clamp_lanes(__m256i v, __m256i lo, __m256i hi) { return _mm256_min_epi32(_mm256_max_epi32(v, lo), hi); }
 // floor_int in eight lanes.
 [[gnu::target("avx2")]] inline __m256i floor_lanes(__m256 v) { return _mm256_cvttps_epi32(_mm256_floor_ps(v)); }
+
+// cell_index() in eight lanes (the cell the ray enters at t along one axis).
+[[gnu::target("avx2")]] inline __m256i cell_indices(__m256 o, __m256 t, __m256 d, __m256i last_texel) {
+  const __m256 u = _mm256_sub_ps(_mm256_add_ps(o, _mm256_mul_ps(t, d)), _mm256_set1_ps(0.5f));
+  const __m256i c = select_i(_mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_LT_OQ), _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_ceil_ps(u)), _mm256_set1_epi32(1)),
+                             floor_lanes(u));
+  return clamp_lanes(c, _mm256_set1_epi32(-1), last_texel);
+}
+// CellWalk::inside() in eight lanes.
+[[gnu::target("avx2")]] inline __m256i cells_inside(__m256i ci, __m256i cj, __m256i nv) {
+  const __m256i minus2 = _mm256_set1_epi32(-2);
+  return _mm256_and_si256(_mm256_and_si256(_mm256_cmpgt_epi32(ci, minus2), _mm256_cmpgt_epi32(cj, minus2)),
+                          _mm256_and_si256(_mm256_cmpgt_epi32(nv, ci), _mm256_cmpgt_epi32(nv, cj)));
+}
+
+// CellWalk::step with the full cell test (cell_test(full): the entry, the exit, the middle and the
+// dip of the quadratic through them) from t in cell (ci, cj), in the lanes of `stepped` (the others'
+// values are meaningless): the cell's end tb, the hits (at the entry, or inside the cell, refined
+// later from t to end_b), and the next cell and whether the walk goes on there (no hit, the cell
+// inside the field, tb before t_out).
+struct CellStepLanes {
+  __m256 tb, entry, refined, end_b;
+  __m256i next_ci, next_cj, goes_on;
+};
+[[gnu::target("avx2")]] inline CellStepLanes full_cell_step(const float* heights, __m256i nv, __m256 o0, __m256 o1, __m256 o2, __m256 d0, __m256 d1,
+                                                            __m256 d2, __m256 t, __m256 t_out, __m256i ci, __m256i cj, __m256i sx, __m256i sy,
+                                                            __m256i stepped) {
+  const __m256i one = _mm256_set1_epi32(1);
+  const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps(), two = _mm256_set1_ps(2.0f), onef = _mm256_set1_ps(1.0f);
+  CellStepLanes c;
+  const __m256 tx = cell_exits(o0, d0, ci), ty = cell_exits(o1, d1, cj);
+  c.tb = std_max(t, std_min(std_min(tx, ty), t_out));
+  const __m256i ci1 = _mm256_add_epi32(ci, one), cj1 = _mm256_add_epi32(cj, one);
+  const __m256 h00 = corner(heights, ci, cj, nv, stepped), h10 = corner(heights, ci1, cj, nv, stepped);
+  const __m256 h01 = corner(heights, ci, cj1, nv, stepped), h11 = corner(heights, ci1, cj1, nv, stepped);
+  const __m256 fci = _mm256_cvtepi32_ps(ci), fcj = _mm256_cvtepi32_ps(cj);
+  const __m256 tm = _mm256_mul_ps(_mm256_add_ps(t, c.tb), half);
+  const __m256 fa = cell_above(o0, o1, o2, d0, d1, d2, t, fci, fcj, h00, h10, h01, h11);
+  const __m256 fb = cell_above(o0, o1, o2, d0, d1, d2, c.tb, fci, fcj, h00, h10, h01, h11);
+  const __m256 fm = cell_above(o0, o1, o2, d0, d1, d2, tm, fci, fcj, h00, h10, h01, h11);
+  const __m256 q2 = _mm256_mul_ps(two, _mm256_add_ps(_mm256_sub_ps(fa, _mm256_mul_ps(two, fm)), fb));
+  const __m256 q1 = _mm256_sub_ps(_mm256_sub_ps(fb, fa), q2);
+  const __m256 sv = _mm256_div_ps(_mm256_sub_ps(zero, q1), _mm256_mul_ps(two, q2));
+  const __m256 tv = _mm256_add_ps(t, _mm256_mul_ps(sv, _mm256_sub_ps(c.tb, t)));
+  const __m256 fv = cell_above(o0, o1, o2, d0, d1, d2, tv, fci, fcj, h00, h10, h01, h11);
+  const __m256 steppedf = _mm256_castsi256_ps(stepped);
+  c.entry = _mm256_and_ps(steppedf, _mm256_cmp_ps(fa, zero, _CMP_LE_OQ));
+  const __m256 hit_exit = _mm256_andnot_ps(c.entry, _mm256_and_ps(steppedf, _mm256_cmp_ps(fb, zero, _CMP_LE_OQ)));
+  const __m256 not_yet = _mm256_andnot_ps(_mm256_or_ps(c.entry, hit_exit), steppedf);
+  const __m256 hit_middle = _mm256_and_ps(not_yet, _mm256_cmp_ps(fm, zero, _CMP_LE_OQ));
+  const __m256 dip = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(q2, zero, _CMP_GT_OQ), _mm256_cmp_ps(sv, zero, _CMP_GT_OQ)),
+                                   _mm256_and_ps(_mm256_cmp_ps(sv, onef, _CMP_LT_OQ), _mm256_cmp_ps(fv, zero, _CMP_LE_OQ)));
+  const __m256 hit_dip = _mm256_andnot_ps(hit_middle, _mm256_and_ps(not_yet, dip));
+  c.refined = _mm256_or_ps(_mm256_or_ps(hit_exit, hit_middle), hit_dip);
+  c.end_b = select(c.entry, t, select(hit_exit, c.tb, select(hit_middle, tm, tv)));
+  const __m256i x_first = _mm256_castps_si256(_mm256_cmp_ps(tx, ty, _CMP_LT_OQ)), y_first = _mm256_castps_si256(_mm256_cmp_ps(ty, tx, _CMP_LT_OQ));
+  c.next_ci = _mm256_add_epi32(ci, _mm256_andnot_si256(y_first, sx));
+  c.next_cj = _mm256_add_epi32(cj, _mm256_andnot_si256(x_first, sy));
+  const __m256i hit = _mm256_castps_si256(_mm256_or_ps(c.entry, c.refined));
+  c.goes_on = _mm256_andnot_si256(hit, _mm256_and_si256(_mm256_and_si256(stepped, cells_inside(c.next_ci, c.next_cj, nv)),
+                                                        _mm256_castps_si256(_mm256_cmp_ps(c.tb, t_out, _CMP_LT_OQ))));
+  return c;
+}
+
+// The binary searches (walk_binary) or the robust searches (walk_robust) of a run, eight at a time,
+// each ending in bisect()'s bisections: lane by lane the same operations in the same order as the
+// one-by-one walks (walk_with's first height and end per ray in scalar code). Each iteration a lane
+// tests its step's end (binary: t_in + dt * k; robust: its texel's radius ahead of t) or its
+// bracket's midpoint, or, for the robust walk where the radius is 0 (robust_clamp takes 1), walks
+// one of its up to two cells with the full cell test (full_cell_step; a hit inside a cell refined
+// with the run's others). The cells the heights read, and the radius texels, are logged for the
+// record as exact_lanes' cells are.
+template <Method M>
+[[gnu::target("avx2")]] void search_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
+                                          std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
+  constexpr bool kRobust = M != Method::Binary, kCells = M == Method::Robust;
+  const int n = field.size, linear = params.linear_steps, bisections = params.binary_steps, cap = walk_iteration_cap(n);
+  LaneFeed feed(field, rays, out, log);
+  std::uint32_t row = 0;
+  struct alignas(32) SearchLanes {
+    float o0[8], o1[8], o2[8], d0[8], d1[8], d2[8];
+    float start[8];  // binary: t_in; robust: t_out
+    float delta[8];  // binary: dt; robust: the inverse horizontal length (inverse_horizontal)
+    float lo[8];     // the last point tested above the surface (t_in at first), or the cell walk's t
+    float a[8], b[8];  // the bracket, or (in b) a cell hit's t or its refinement's below end
+    std::int32_t k[8];       // steps (binary) or iterations (robust) begun, or bisections done
+    std::int32_t bisect[8];  // -1: bisecting the bracket [a, b]
+    std::int32_t cell2[8];   // -1: the cell walk's second cell next (robust)
+    std::int32_t ci[8], cj[8], sx[8], sy[8];  // the cell walk (robust)
+    std::int32_t steps[8], lookups[8];
+    std::int32_t ray[8];  // the ray's index in the run, -1: the lane is idle
+  } L;
+
+  // Gives lane `l` the run's next ray that needs a walk, or leaves it idle.
+  const auto load = [&](int l) {
+    const std::ptrdiff_t next = feed.take(l, row, [&](const FragmentRay&, WalkResult& w) {
+      w.capped = kRobust && cap <= 0;  // walk_robust capped before its first step
+      return w.capped;
+    });
+    L.o0[l] = L.o1[l] = L.o2[l] = L.d0[l] = L.d1[l] = L.d2[l] = L.start[l] = L.delta[l] = L.lo[l] = L.a[l] = L.b[l] = 0.0f;
+    L.k[l] = L.bisect[l] = L.cell2[l] = L.ci[l] = L.cj[l] = L.sx[l] = L.sy[l] = L.steps[l] = L.lookups[l] = 0;
+    L.ray[l] = static_cast<std::int32_t>(next);
+    if (next < 0) return;
+    const FragmentRay& ray = *rays[static_cast<std::size_t>(next)];
+    L.o0[l] = ray.o[0], L.o1[l] = ray.o[1], L.o2[l] = ray.o[2];
+    L.d0[l] = ray.d[0], L.d1[l] = ray.d[1], L.d2[l] = ray.d[2];
+    L.start[l] = kRobust ? ray.t_out : ray.t_in;
+    L.delta[l] = kRobust ? inverse_horizontal(ray) : (ray.t_out - ray.t_in) / static_cast<float>(linear);
+    L.lo[l] = ray.t_in;
+    L.sx[l] = ray.d[0] > 0.0f ? 1 : -1, L.sy[l] = ray.d[1] > 0.0f ? 1 : -1;
+    L.lookups[l] = 4;  // the first height
+  };
+
+  for (int l = 0; l < 8; ++l) load(l);
+  const __m256i nv = _mm256_set1_epi32(n), one = _mm256_set1_epi32(1), four = _mm256_set1_epi32(4), minus1 = _mm256_set1_epi32(-1);
+  const __m256i zeroi = _mm256_setzero_si256(), no_cell = _mm256_set1_epi32(CellLog::kNoCell);
+  const __m256i last_texel = _mm256_set1_epi32(n - 1), last_bisection = _mm256_set1_epi32(bisections);
+  const __m256i last_step = _mm256_set1_epi32(kRobust ? cap : linear);
+  const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps(), onef = _mm256_set1_ps(1.0f);
+  const float* heights = field.heights.data();
+  for (;;) {
+    const __m256i live = _mm256_cmpgt_epi32(load_i(L.ray), minus1);
+    if (_mm256_testz_si256(live, live)) break;
+    const __m256 o0 = _mm256_load_ps(L.o0), o1 = _mm256_load_ps(L.o1), o2 = _mm256_load_ps(L.o2);
+    const __m256 d0 = _mm256_load_ps(L.d0), d1 = _mm256_load_ps(L.d1), d2 = _mm256_load_ps(L.d2);
+    const __m256 start = _mm256_load_ps(L.start), delta = _mm256_load_ps(L.delta);
+    const __m256 lo = _mm256_load_ps(L.lo), a = _mm256_load_ps(L.a), b = _mm256_load_ps(L.b);
+    const __m256i k = load_i(L.k), bisecting = load_i(L.bisect), cell2 = load_i(L.cell2);
+    const __m256 bisectingf = _mm256_castsi256_ps(bisecting);
+    // Stepping lanes begin an iteration (robust: with their texel's radius).
+    const __m256i stepping = _mm256_andnot_si256(_mm256_or_si256(bisecting, cell2), live);
+    __m256 step_end;
+    __m256i rindex = minus1, zero_radius = zeroi;
+    if constexpr (kRobust) {
+      // The radius of the texel under lo (clamped into the field) and the step's end: t_out for a
+      // vertical ray, else min(lo + radius * inv, t_out).
+      const __m256i ri = clamp_lanes(floor_lanes(_mm256_add_ps(o0, _mm256_mul_ps(lo, d0))), zeroi, last_texel);
+      const __m256i rj = clamp_lanes(floor_lanes(_mm256_add_ps(o1, _mm256_mul_ps(lo, d1))), zeroi, last_texel);
+      rindex = _mm256_blendv_epi8(minus1, _mm256_add_epi32(_mm256_mullo_epi32(rj, nv), ri), stepping);
+      __m256 rad = _mm256_mask_i32gather_ps(zero, field.radius.data(), rindex, _mm256_castsi256_ps(stepping), 4);
+      const __m256 radius_zero = _mm256_cmp_ps(rad, zero, _CMP_EQ_OQ);
+      if constexpr (kCells) zero_radius = _mm256_and_si256(stepping, _mm256_castps_si256(radius_zero));
+      else rad = select(radius_zero, onef, rad);
+      step_end = select(_mm256_cmp_ps(delta, zero, _CMP_EQ_OQ), start, std_min(_mm256_add_ps(lo, _mm256_mul_ps(rad, delta)), start));
+    } else {
+      step_end = _mm256_add_ps(start, _mm256_mul_ps(delta, _mm256_cvtepi32_ps(_mm256_add_epi32(k, one))));
+    }
+    // The lanes that test a point (a step's end or the bracket's midpoint) and those that walk a cell.
+    const __m256i cells = _mm256_or_si256(zero_radius, cell2);
+    const __m256i pointing = _mm256_andnot_si256(cells, live);
+    const __m256 m = _mm256_mul_ps(_mm256_add_ps(a, b), half);
+    const __m256 p = select(bisectingf, m, step_end);
+    const __m256i i = floor_lanes(_mm256_sub_ps(_mm256_add_ps(o0, _mm256_mul_ps(p, d0)), half));
+    const __m256i j = floor_lanes(_mm256_sub_ps(_mm256_add_ps(o1, _mm256_mul_ps(p, d1)), half));
+    const __m256i i1 = _mm256_add_epi32(i, one), j1 = _mm256_add_epi32(j, one);
+    const __m256 h00 = corner(heights, i, j, nv, pointing), h10 = corner(heights, i1, j, nv, pointing);
+    const __m256 h01 = corner(heights, i, j1, nv, pointing), h11 = corner(heights, i1, j1, nv, pointing);
+    const __m256 f = cell_above(o0, o1, o2, d0, d1, d2, p, _mm256_cvtepi32_ps(i), _mm256_cvtepi32_ps(j), h00, h10, h01, h11);
+    const __m256 below = _mm256_and_ps(_mm256_castsi256_ps(pointing), _mm256_cmp_ps(f, zero, _CMP_LE_OQ));
+    // The cell walks (robust, rare): from lo, in a new walk's first cell or its stored second one.
+    __m256i walked = zeroi, cell_miss = zeroi, ci = zeroi, cj = zeroi;
+    CellStepLanes cs{};
+    if (kCells && !_mm256_testz_si256(cells, cells)) {
+      ci = _mm256_blendv_epi8(cell_indices(o0, lo, d0, last_texel), load_i(L.ci), cell2);
+      cj = _mm256_blendv_epi8(cell_indices(o1, lo, d1, last_texel), load_i(L.cj), cell2);
+      walked = _mm256_and_si256(_mm256_and_si256(cells, cells_inside(ci, cj, nv)), _mm256_castps_si256(_mm256_cmp_ps(lo, start, _CMP_LT_OQ)));
+      cell_miss = _mm256_andnot_si256(walked, cells);
+      cs = full_cell_step(heights, nv, o0, o1, o2, d0, d1, d2, lo, start, ci, cj, load_i(L.sx), load_i(L.sy), walked);
+    }
+    log.rows.resize(log.rows.size() + 16);
+    std::int32_t* logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), _mm256_blendv_epi8(_mm256_blendv_epi8(no_cell, ci, walked), i, pointing));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), _mm256_blendv_epi8(cj, j, pointing));
+    if constexpr (kRobust) {
+      log.radii.resize(log.radii.size() + 8);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(log.radii.data() + 8 * static_cast<std::size_t>(row)), rindex);
+    }
+    // Point lanes: a stepping one below starts the bracket [lo, step_end] (bisections from 0), else
+    // lo moves to the step's end; a bisecting one takes [a, m] below, else [m, b].
+    const __m256 stepped_pointf = _mm256_castsi256_ps(_mm256_and_si256(pointing, stepping));
+    const __m256 bracket = _mm256_and_ps(stepped_pointf, below);
+    const __m256 cell_hit = _mm256_or_ps(cs.entry, cs.refined);
+    const __m256i moved = _mm256_andnot_si256(_mm256_castps_si256(cell_hit), walked);
+    _mm256_store_ps(L.a, select(bisectingf, select(below, a, m), select(bracket, lo, a)));
+    _mm256_store_ps(L.b, select(bisectingf, select(below, m, b), select(bracket, step_end, select(cell_hit, cs.end_b, b))));
+    _mm256_store_ps(L.lo, select(stepped_pointf, step_end, select(_mm256_castsi256_ps(moved), cs.tb, lo)));
+    const __m256i bracketi = _mm256_castps_si256(bracket);
+    const __m256i next_k = _mm256_blendv_epi8(_mm256_add_epi32(k, _mm256_and_si256(one, _mm256_or_si256(stepping, bisecting))), zeroi, bracketi);
+    store_i(L.k, next_k);
+    const __m256i now_bisecting = _mm256_or_si256(bisecting, bracketi);
+    store_i(L.bisect, now_bisecting);
+    // A cell walk goes on from its first cell to its second; from its second, to the next iteration.
+    const __m256i to_cell2 = _mm256_andnot_si256(cell2, cs.goes_on);
+    store_i(L.cell2, to_cell2);
+    store_i(L.ci, _mm256_blendv_epi8(load_i(L.ci), _mm256_blendv_epi8(ci, cs.next_ci, moved), walked));
+    store_i(L.cj, _mm256_blendv_epi8(load_i(L.cj), _mm256_blendv_epi8(cj, cs.next_cj, moved), walked));
+    // Counts: a step a point stepped to and a cell walked; a radius an iteration begun, four heights a
+    // point or a cell.
+    const __m256i stepped_point = _mm256_castps_si256(stepped_pointf);
+    store_i(L.steps, _mm256_sub_epi32(_mm256_sub_epi32(load_i(L.steps), stepped_point), walked));
+    __m256i looked = _mm256_and_si256(four, _mm256_or_si256(pointing, walked));
+    if constexpr (kRobust) looked = _mm256_sub_epi32(looked, stepping);
+    store_i(L.lookups, _mm256_add_epi32(load_i(L.lookups), looked));
+    ++row;
+    // Ends: a bracket with no bisection to run or after its last bisection; a stepping point with
+    // neither (binary: the last linear step, a miss; robust: one that reached t_out, a miss, or else
+    // the cap-th iteration, capped); a cell hit; a cell walk that ran out of the field or to t_out; a
+    // cell walk's second cell after the cap-th iteration (capped).
+    const __m256i bisected = _mm256_and_si256(now_bisecting, _mm256_cmpeq_epi32(next_k, last_bisection));
+    const __m256i still_stepping = _mm256_andnot_si256(bracketi, stepped_point);
+    const __m256i missed = kRobust ? _mm256_castps_si256(_mm256_cmp_ps(step_end, start, _CMP_GE_OQ)) : _mm256_cmpeq_epi32(next_k, last_step);
+    const __m256i at_cap = _mm256_cmpeq_epi32(next_k, last_step);
+    const __m256i step_capped = kRobust ? _mm256_and_si256(still_stepping, _mm256_andnot_si256(missed, at_cap)) : zeroi;
+    const __m256i cells_out = _mm256_or_si256(cell_miss, _mm256_andnot_si256(cs.goes_on, moved));
+    const __m256i cell_capped = _mm256_and_si256(_mm256_and_si256(cell2, cs.goes_on), at_cap);
+    const __m256i capped = _mm256_or_si256(step_capped, cell_capped);
+    const __m256i ends = _mm256_or_si256(_mm256_or_si256(bisected, _mm256_and_si256(still_stepping, missed)),
+                                         _mm256_or_si256(_mm256_or_si256(_mm256_castps_si256(cell_hit), cells_out), capped));
+    const int ended = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(live, ends)));
+    if (ended == 0) continue;
+    const int capped_bits = _mm256_movemask_ps(_mm256_castsi256_ps(capped)), refined_bits = _mm256_movemask_ps(cs.refined);
+    const int entry_bits = _mm256_movemask_ps(cs.entry);
+    for (int l = 0; l < 8; ++l) {
+      if (!(ended >> l & 1)) continue;
+      const auto r = static_cast<std::size_t>(L.ray[l]);
+      log.rays[r].row1 = row;
+      WalkResult& w = out[r];
+      const FragmentRay& ray = *rays[r];
+      w.steps = static_cast<std::uint32_t>(L.steps[l]);
+      w.lookups = static_cast<std::uint32_t>(L.lookups[l]);
+      if (L.bisect[l]) {  // the bracket's bisections done: a hit at its below end
+        w.bisections = static_cast<std::uint32_t>(bisections);
+        set_hit(w, L.b[l]);
+      } else if (entry_bits >> l & 1) {
+        set_hit(w, L.b[l]);
+      } else if (refined_bits >> l & 1) {  // refined from lo with the run's other hits (refine_lanes)
+        Refinement job{&ray, Cell{}, L.lo[l], L.b[l], r};
+        job.cell.ci = L.ci[l], job.cell.cj = L.cj[l];
+        job.cell.read(feed.reader);
+        refinements.push_back(job);
+        w.bisections = static_cast<std::uint32_t>(params.root_steps);
+        set_hit(w, L.b[l]);
+      } else {
+        w.capped = capped_bits >> l & 1;
+      }
+      end_walk(w, ray);
+      load(l);
+    }
+  }
+}
 
 // The paper's covering with top alignment (cover(): paper(), grid(), anchors()) of the rectangles
 // [i0, i0 + w) x [j0, j0 + h) (w, h >= 1, i0, j0 >= 0) in eight lanes: the level, and square q's
@@ -1162,7 +1269,7 @@ struct CoverLanes {
   const __m256i nv = _mm256_set1_epi32(n), one = _mm256_set1_epi32(1), minus1 = _mm256_set1_epi32(-1), zeroi = _mm256_setzero_si256();
   const __m256i last_texel = _mm256_set1_epi32(n - 1), topv = _mm256_set1_epi32(top), capv = _mm256_set1_epi32(cap);
   const __m256i no_cell = _mm256_set1_epi32(CellLog::kNoCell);
-  const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps(), two = _mm256_set1_ps(2.0f), onef = _mm256_set1_ps(1.0f);
+  const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps();
   const float* heights = field.heights.data();
   const float* levels = field.nbuffer.data();
   for (;;) {
@@ -1209,59 +1316,26 @@ struct CoverLanes {
     // A failed query at s = 0: a cell step (the cell walk started at t when not walking).
     const __m256i walking = load_i(L.walking);
     const __m256i cell_try = _mm256_and_si256(live, _mm256_andnot_si256(pass, s0));
-    const __m256 u0 = _mm256_sub_ps(xa, half), u1 = _mm256_sub_ps(ya, half);
-    const __m256i start_ci = clamp_lanes(select_i(_mm256_cmp_ps(d0, zero, _CMP_LT_OQ), _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_ceil_ps(u0)), one),
-                                                  floor_lanes(u0)), minus1, last_texel);
-    const __m256i start_cj = clamp_lanes(select_i(_mm256_cmp_ps(d1, zero, _CMP_LT_OQ), _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_ceil_ps(u1)), one),
-                                                  floor_lanes(u1)), minus1, last_texel);
-    const __m256i ci = _mm256_blendv_epi8(start_ci, load_i(L.ci), walking), cj = _mm256_blendv_epi8(start_cj, load_i(L.cj), walking);
-    const __m256i inside = _mm256_and_si256(_mm256_and_si256(_mm256_cmpgt_epi32(ci, _mm256_set1_epi32(-2)), _mm256_cmpgt_epi32(cj, _mm256_set1_epi32(-2))),
-                                            _mm256_and_si256(_mm256_cmpgt_epi32(nv, ci), _mm256_cmpgt_epi32(nv, cj)));
+    const __m256i ci = _mm256_blendv_epi8(cell_indices(o0, t, d0, last_texel), load_i(L.ci), walking);
+    const __m256i cj = _mm256_blendv_epi8(cell_indices(o1, t, d1, last_texel), load_i(L.cj), walking);
     const __m256i before_end = _mm256_castps_si256(_mm256_cmp_ps(t, t_out, _CMP_LT_OQ));
-    const __m256i stepped = _mm256_and_si256(cell_try, _mm256_and_si256(inside, before_end));  // the lanes that read a cell
-    const __m256i cell_miss = _mm256_andnot_si256(stepped, cell_try);                           // ended before it
-    const __m256 tx = cell_exits(o0, d0, ci), ty = cell_exits(o1, d1, cj);
-    const __m256 tb = std_max(t, std_min(std_min(tx, ty), t_out));
-    const __m256i ci1 = _mm256_add_epi32(ci, one), cj1 = _mm256_add_epi32(cj, one);
-    const __m256 h00 = corner(heights, ci, cj, nv, stepped), h10 = corner(heights, ci1, cj, nv, stepped);
-    const __m256 h01 = corner(heights, ci, cj1, nv, stepped), h11 = corner(heights, ci1, cj1, nv, stepped);
-    std::int32_t* logged = nullptr;
+    const __m256i stepped = _mm256_and_si256(cell_try, _mm256_and_si256(cells_inside(ci, cj, nv), before_end));  // the lanes that read a cell
+    const __m256i cell_miss = _mm256_andnot_si256(stepped, cell_try);                                              // ended before it
+    const CellStepLanes cs = full_cell_step(heights, nv, o0, o1, o2, d0, d1, d2, t, t_out, ci, cj, load_i(L.sx), load_i(L.sy), stepped);
     log.rows.resize(log.rows.size() + 16);
-    logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
+    std::int32_t* logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), _mm256_blendv_epi8(no_cell, ci, stepped));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), cj);
-    // cell_test(full): the entry, the exit, the middle, and the dip of the quadratic through them.
-    const __m256 fci = _mm256_cvtepi32_ps(ci), fcj = _mm256_cvtepi32_ps(cj);
-    const __m256 tm = _mm256_mul_ps(_mm256_add_ps(t, tb), half);
-    const __m256 fa = cell_above(o0, o1, o2, d0, d1, d2, t, fci, fcj, h00, h10, h01, h11);
-    const __m256 fb = cell_above(o0, o1, o2, d0, d1, d2, tb, fci, fcj, h00, h10, h01, h11);
-    const __m256 fm = cell_above(o0, o1, o2, d0, d1, d2, tm, fci, fcj, h00, h10, h01, h11);
-    const __m256 q2 = _mm256_mul_ps(two, _mm256_add_ps(_mm256_sub_ps(fa, _mm256_mul_ps(two, fm)), fb));
-    const __m256 q1 = _mm256_sub_ps(_mm256_sub_ps(fb, fa), q2);
-    const __m256 sv = _mm256_div_ps(_mm256_sub_ps(zero, q1), _mm256_mul_ps(two, q2));
-    const __m256 tv = _mm256_add_ps(t, _mm256_mul_ps(sv, _mm256_sub_ps(tb, t)));
-    const __m256 fv = cell_above(o0, o1, o2, d0, d1, d2, tv, fci, fcj, h00, h10, h01, h11);
-    const __m256 steppedf = _mm256_castsi256_ps(stepped);
-    const __m256 hit_entry = _mm256_and_ps(steppedf, _mm256_cmp_ps(fa, zero, _CMP_LE_OQ));
-    const __m256 hit_exit = _mm256_andnot_ps(hit_entry, _mm256_and_ps(steppedf, _mm256_cmp_ps(fb, zero, _CMP_LE_OQ)));
-    const __m256 not_yet = _mm256_andnot_ps(_mm256_or_ps(hit_entry, hit_exit), steppedf);
-    const __m256 hit_middle = _mm256_and_ps(not_yet, _mm256_cmp_ps(fm, zero, _CMP_LE_OQ));
-    const __m256 dip = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(q2, zero, _CMP_GT_OQ), _mm256_cmp_ps(sv, zero, _CMP_GT_OQ)),
-                                     _mm256_and_ps(_mm256_cmp_ps(sv, onef, _CMP_LT_OQ), _mm256_cmp_ps(fv, zero, _CMP_LE_OQ)));
-    const __m256 hit_dip = _mm256_andnot_ps(hit_middle, _mm256_and_ps(not_yet, dip));
-    const __m256 refined = _mm256_or_ps(_mm256_or_ps(hit_exit, hit_middle), hit_dip);
     _mm256_store_ps(L.end_a, t);
-    _mm256_store_ps(L.end_b, select(hit_entry, t, select(hit_exit, tb, select(hit_middle, tm, tv))));
+    _mm256_store_ps(L.end_b, cs.end_b);
+    const __m256 hit_entry = cs.entry, refined = cs.refined;
+    const __m256 tb = cs.tb;
+    const __m256i next_ci = cs.next_ci, next_cj = cs.next_cj;
     // The walk goes on: a passed query moves t to the span's end (not walking, s up to the top);
     // a failed one at s > 0 halves the span; a cell step without a hit moves to the next cell.
     const __m256i hit = _mm256_castps_si256(_mm256_or_ps(hit_entry, refined));
-    const __m256i x_first = _mm256_castps_si256(_mm256_cmp_ps(tx, ty, _CMP_LT_OQ)), y_first = _mm256_castps_si256(_mm256_cmp_ps(ty, tx, _CMP_LT_OQ));
-    const __m256i next_ci = _mm256_add_epi32(ci, _mm256_andnot_si256(y_first, load_i(L.sx)));
-    const __m256i next_cj = _mm256_add_epi32(cj, _mm256_andnot_si256(x_first, load_i(L.sy)));
     const __m256i moved = _mm256_andnot_si256(hit, stepped);
-    const __m256i next_inside = _mm256_and_si256(_mm256_and_si256(_mm256_cmpgt_epi32(next_ci, _mm256_set1_epi32(-2)), _mm256_cmpgt_epi32(next_cj, _mm256_set1_epi32(-2))),
-                                                 _mm256_and_si256(_mm256_cmpgt_epi32(nv, next_ci), _mm256_cmpgt_epi32(nv, next_cj)));
-    const __m256i moved_out = _mm256_andnot_si256(_mm256_and_si256(next_inside, _mm256_castps_si256(_mm256_cmp_ps(tb, t_out, _CMP_LT_OQ))), moved);
+    const __m256i moved_out = _mm256_andnot_si256(cs.goes_on, moved);
     const __m256i passed = _mm256_and_si256(live, pass);
     const __m256i passed_out = _mm256_and_si256(passed, _mm256_castps_si256(_mm256_cmp_ps(te, t_out, _CMP_GE_OQ)));
     const __m256i halved = _mm256_andnot_si256(_mm256_or_si256(pass, s0), live);
@@ -1354,11 +1428,15 @@ void walk_each(Method method, const FieldView& field, const WalkParams& params, 
     refine_lanes(refinements, params.root_steps, out);
     return;
   }
-  if (vector && (method == Method::Binary || method == Method::RobustClamp) && vector_walks_available()) {
+  if (vector && (method == Method::Binary || method == Method::Robust || method == Method::RobustClamp) && vector_walks_available()) {
     thread_local CellLog log;
-    if (method == Method::Binary) search_lanes<false>(field, params, rays, out, log);
-    else search_lanes<true>(field, params, rays, out, log);
+    thread_local std::vector<Refinement> refinements;
+    refinements.clear();
+    if (method == Method::Binary) search_lanes<Method::Binary>(field, params, rays, out, log, refinements);
+    else if (method == Method::Robust) search_lanes<Method::Robust>(field, params, rays, out, log, refinements);
+    else search_lanes<Method::RobustClamp>(field, params, rays, out, log, refinements);
     if (lines) log.replay(field, *lines);
+    refine_lanes(refinements, params.root_steps, out);
     return;
   }
 #endif
