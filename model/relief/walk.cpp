@@ -578,13 +578,21 @@ struct CellLog {
     std::uint32_t row0 = 0, row1 = 0;
   };
   std::vector<Ray> rays;
-  std::vector<std::int32_t> rows;  // per step of the lanes: the eight lanes' ci, then their cj
-  // Empty, or per step of the lanes: the radius texel each lane read before its cell (-1: none).
-  std::vector<std::int32_t> radii;
-  // Empty, or per step of the lanes: the N-buffer level texels each lane's query read before its
-  // cell, four a lane (the k-th of lane l at 8 k + l; -1: none).
-  std::vector<std::int32_t> texels;
-  static constexpr std::int32_t kNoCell = CellWalk::kNoCell;  // in `rows`: the lane read no cell
+  // Per step of the lanes (row), from 0 to the run's last:
+  // - rows: the eight lanes' ci, then their cj (kNoCell: the lane read no cell);
+  // - radii, when with_radii: the radius texel each lane read before its cell (-1: none);
+  // - texels, when with_texels: the N-buffer level texels each lane's query read before its cell,
+  //   four a lane (the k-th of lane l at 8 k + l; -1: none).
+  std::vector<std::int32_t> rows, radii, texels;
+  bool with_radii = false, with_texels = false;
+  static constexpr std::int32_t kNoCell = CellWalk::kNoCell;
+  // The `stride` entries of row `row` in `v`. The vectors only grow (kept from run to run, and not
+  // cleared: a run writes every row it reads), so a row costs no zeroing.
+  static std::int32_t* slot(std::vector<std::int32_t>& v, std::uint32_t row, std::size_t stride) {
+    const std::size_t need = stride * (static_cast<std::size_t>(row) + 1);
+    if (v.size() < need) v.resize(std::max(need, 2 * v.size()));
+    return v.data() + stride * row;
+  }
   std::vector<std::uint8_t> first_ends;  // scratch of the lanes' runs (LaneFeed)
 
   void replay(const FieldView& field, LookupLines& lines) const {
@@ -594,11 +602,11 @@ struct CellLog {
       r.note(ray.first_i, ray.first_j);
       if (ray.lane < 0) continue;
       for (std::uint32_t row = ray.row0; row < ray.row1; ++row) {
-        if (!radii.empty()) {
+        if (with_radii) {
           const std::int32_t index = radii[8 * static_cast<std::size_t>(row) + static_cast<std::size_t>(ray.lane)];
           if (index >= 0) ++r.lookups, sink(Texture::Radius, index);
         }
-        if (!texels.empty())
+        if (with_texels)
           for (std::size_t q = 0; q < 4; ++q) {
             const std::int32_t index = texels[32 * static_cast<std::size_t>(row) + 8 * q + static_cast<std::size_t>(ray.lane)];
             if (index >= 0) ++r.lookups, sink(Texture::NBuffer, index);
@@ -754,9 +762,7 @@ struct LaneFeed {
   LaneFeed(const FieldView& field, std::span<const FragmentRay* const> r, std::span<WalkResult> o, CellLog& l)
       : rays(r), out(o), log(l), reader{field, none}, first_ends(l.first_ends) {
     log.rays.assign(rays.size(), CellLog::Ray{});
-    log.rows.clear();
-    log.radii.clear();
-    log.texels.clear();
+    log.with_radii = log.with_texels = false;
     first_heights(field, rays, log, first_ends);
   }
   LaneFeed(const LaneFeed&) = delete;
@@ -859,8 +865,7 @@ struct LaneFeed {
     const __m256 t = _mm256_load_ps(L.t), t_out = _mm256_load_ps(L.t_out);
     const __m256i ci = _mm256_load_si256(reinterpret_cast<const __m256i*>(L.ci)), cj = _mm256_load_si256(reinterpret_cast<const __m256i*>(L.cj));
     // The step's cells, for the record.
-    log.rows.resize(log.rows.size() + 16);
-    std::int32_t* logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
+    std::int32_t* logged = CellLog::slot(log.rows, row, 16);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), ci);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), cj);
     // CellWalk::step: the cell's exits, its end tb, its corners, the cell test.
@@ -1090,13 +1095,12 @@ template <Method M>
       cell_miss = _mm256_andnot_si256(walked, cells);
       cs = full_cell_step(heights, nv, o0, o1, o2, d0, d1, d2, lo, start, ci, cj, load_i(L.sx), load_i(L.sy), walked);
     }
-    log.rows.resize(log.rows.size() + 16);
-    std::int32_t* logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
+    std::int32_t* logged = CellLog::slot(log.rows, row, 16);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), _mm256_blendv_epi8(_mm256_blendv_epi8(no_cell, ci, walked), i, pointing));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), _mm256_blendv_epi8(cj, j, pointing));
     if constexpr (kRobust) {
-      log.radii.resize(log.radii.size() + 8);
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(log.radii.data() + 8 * static_cast<std::size_t>(row)), rindex);
+      log.with_radii = true;
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(CellLog::slot(log.radii, row, 8)), rindex);
     }
     // Point lanes: a stepping one below starts the bracket [lo, step_end] (bisections from 0), else
     // lo moves to the step's end; a bisecting one takes [a, m] below, else [m, b].
@@ -1300,8 +1304,8 @@ struct CoverLanes {
         }
     }
     const __m256i plane = _mm256_mullo_epi32(c.level, nv);
-    log.texels.resize(log.texels.size() + 32);
-    std::int32_t* logged_texels = log.texels.data() + 32 * static_cast<std::size_t>(row);
+    log.with_texels = true;
+    std::int32_t* logged_texels = CellLog::slot(log.texels, row, 32);
     __m256 top_height = zero;
     for (int k = 0; k < 4; ++k) {
       const __m256i read = _mm256_and_si256(live, _mm256_cmpgt_epi32(c.count, _mm256_set1_epi32(k)));
@@ -1322,8 +1326,7 @@ struct CoverLanes {
     const __m256i stepped = _mm256_and_si256(cell_try, _mm256_and_si256(cells_inside(ci, cj, nv), before_end));  // the lanes that read a cell
     const __m256i cell_miss = _mm256_andnot_si256(stepped, cell_try);                                              // ended before it
     const CellStepLanes cs = full_cell_step(heights, nv, o0, o1, o2, d0, d1, d2, t, t_out, ci, cj, load_i(L.sx), load_i(L.sy), stepped);
-    log.rows.resize(log.rows.size() + 16);
-    std::int32_t* logged = log.rows.data() + 16 * static_cast<std::size_t>(row);
+    std::int32_t* logged = CellLog::slot(log.rows, row, 16);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), _mm256_blendv_epi8(no_cell, ci, stepped));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), cj);
     _mm256_store_ps(L.end_a, t);
