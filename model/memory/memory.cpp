@@ -6,6 +6,10 @@
 
 #include "model/common/error.h"
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace nbsim::memory {
 
 Channel::Channel(ChannelConfig c) : c_(c) {
@@ -103,7 +107,46 @@ LineCache::LineCache(CacheConfig c) : c_(c) {
     set_mask_ = sets_ - 1;
     pow2_ = true;
   }
+#if defined(__x86_64__) && !defined(NBSIM_BASELINE_ONLY)
+  vector_sets_ = __builtin_cpu_supports("avx2");
+#endif
 }
+
+#if defined(__x86_64__) && !defined(NBSIM_BASELINE_ONLY)
+namespace {
+// For each hit mask (bit k: way k holds the line), the ways that keep their line: way k (k >= 1)
+// when the line is at a way before it; the others take the line of the way before them.
+struct KeepMasks {
+  alignas(32) std::int64_t lanes[16][4];
+  constexpr KeepMasks() : lanes{} {
+    for (int m = 0; m < 16; ++m)
+      for (int k = 1; k < 4; ++k) lanes[m][k] = (m & ((1 << k) - 1)) != 0 ? -1 : 0;
+  }
+};
+constexpr KeepMasks kKeep;
+}  // namespace
+
+[[gnu::target("avx2")]] std::uint64_t LineCache::read_all_4_lanes(std::span<const std::uint64_t> lines) noexcept {
+  std::uint64_t hits = 0;
+  std::uint64_t* const tags = tags_.data();
+  for (const std::uint64_t line : lines) {
+    auto* set = reinterpret_cast<__m256i*>(tags + (pow2_ ? line & set_mask_ : line % sets_) * 4);
+    const __m256i old = _mm256_loadu_si256(set);
+    const __m256i wanted = _mm256_set1_epi64x(static_cast<long long>(line));
+    const int at = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(old, wanted)));
+    // [line, old 0, old 1, old 2] with the ways after the hit keeping theirs.
+    const __m256i back = _mm256_permute4x64_epi64(old, 0x90);
+    const __m256i keep = _mm256_load_si256(reinterpret_cast<const __m256i*>(kKeep.lanes[at]));
+    _mm256_storeu_si256(set, _mm256_blend_epi32(_mm256_blendv_epi8(back, old, keep), wanted, 0x03));
+    hits += at != 0 ? 1 : 0;
+  }
+  hits_ += hits;
+  misses_ += lines.size() - hits;
+  return hits;
+}
+#else
+std::uint64_t LineCache::read_all_4_lanes(std::span<const std::uint64_t> lines) noexcept { return read_all_ways<4>(lines); }
+#endif
 
 void LineCache::invalidate() { std::fill(tags_.begin(), tags_.end(), kInvalid); }
 

@@ -49,8 +49,8 @@ TEST(MemoryTest, ZeroSizeCacheAlwaysMisses) {
 
 
 // LineCache must give every read the hit or miss Cache gives it, for any geometry: associativities
-// with an unrolled path (1, 2, 4, 8) and without (3, 16), set counts that are powers of two and not,
-// fewer bytes than one set, and none. The random streams mix a hot region (hits at every LRU depth)
+// with an unrolled path (1, 2, 4, 8; 4 ways in AVX2 registers in read_all where the CPU has AVX2)
+// and without (3, 16), set counts that are powers of two and not, fewer bytes than one set, and none. The random streams mix a hot region (hits at every LRU depth)
 // with a wide one (misses and evictions).
 TEST(LineCacheTest, SameHitsAndMissesAsCache) {
   const CacheConfig configs[] = {{16 * 1024, 64, 4}, {16 * 1024, 64, 1}, {8 * 1024, 32, 2},  {4096, 64, 8},  {12000, 64, 3},
@@ -76,6 +76,13 @@ TEST(LineCacheTest, SameHitsAndMissesAsCache) {
     for (const std::uint64_t line : sequence) each_hits += each.read(line) ? 1 : 0;
     EXPECT_EQ(all.read_all(sequence), each_hits);
     EXPECT_EQ(all.misses(), each.misses());
+    // ... and leaves the same ways in the same order: a second sequence hits and misses alike.
+    for (const std::uint64_t line : sequence) ASSERT_EQ(all.read((line * 7 + 3) % (sequence.size() / 2 + 1)), each.read((line * 7 + 3) % (sequence.size() / 2 + 1)));
+    EXPECT_EQ(all.read_all(sequence), [&] {
+      std::uint64_t h = 0;
+      for (const std::uint64_t line : sequence) h += each.read(line) ? 1 : 0;
+      return h;
+    }());
     EXPECT_EQ(lines.hits(), reference.hits());
     EXPECT_EQ(lines.misses(), reference.misses());
     if (config.size_bytes >= config.line_bytes * config.ways) {
