@@ -1325,7 +1325,9 @@ struct CoverLanes {
     const __m256i before_end = _mm256_castps_si256(_mm256_cmp_ps(t, t_out, _CMP_LT_OQ));
     const __m256i stepped = _mm256_and_si256(cell_try, _mm256_and_si256(cells_inside(ci, cj, nv), before_end));  // the lanes that read a cell
     const __m256i cell_miss = _mm256_andnot_si256(stepped, cell_try);                                              // ended before it
-    const CellStepLanes cs = full_cell_step(heights, nv, o0, o1, o2, d0, d1, d2, t, t_out, ci, cj, load_i(L.sx), load_i(L.sy), stepped);
+    CellStepLanes cs{};  // no hit and no walk on where no lane steps
+    if (!_mm256_testz_si256(stepped, stepped))
+      cs = full_cell_step(heights, nv, o0, o1, o2, d0, d1, d2, t, t_out, ci, cj, load_i(L.sx), load_i(L.sy), stepped);
     std::int32_t* logged = CellLog::slot(log.rows, row, 16);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged), _mm256_blendv_epi8(no_cell, ci, stepped));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(logged + 8), cj);
