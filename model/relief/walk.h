@@ -273,11 +273,12 @@ WalkResult walk(Method method, const FieldView& field, const WalkParams& params,
 
 // The walks of a run of fragments with one method, one after another: out[k] is walk(method, field,
 // params, *rays[k], ...) and `lines` (may be null) receives every walk's lookups in the order of k,
-// the same records bit for bit. When the CPU has AVX2 and `vector` is true, the exact method walks
-// eight rays at once in AVX2 lanes (each lane takes the run's next ray when its walk ends, and the
-// lookups are recorded after the run, ray by ray), and the exact and N-buffer walks' hits are refined
-// in their cells together, eight at a time (the refinement reads no texel); otherwise, and for the
-// other methods, the rays walk one by one.
+// the same records bit for bit. When the CPU has AVX2 and `vector` is true, the rays walk eight at
+// once in AVX2 lanes (each lane takes the run's next ray when its walk ends; the texels each walk
+// read are logged and recorded after the run, ray by ray): every method, the N-buffer walk with the
+// paper's covering (top alignment, no direct squares) only. The hits found inside a cell (exact,
+// robust and N-buffer walks) are refined together, eight at a time (the refinement reads no texel).
+// Otherwise the rays walk one by one.
 void walk_each(Method method, const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
                std::span<WalkResult> out, LookupLines* lines, bool vector = true);
 // Whether walk_each's lanes run here (the CPU has AVX2).
