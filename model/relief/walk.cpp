@@ -792,7 +792,7 @@ struct LaneFeed {
 };
 
 // The exact walks of a run, eight at a time: walk_exact's steps, lane by lane the same operations in
-// the same order (and walk_with's first height and end, done per ray in scalar code).
+// the same order (walk_with's first height in LaneFeed, its end per ray in scalar code).
 [[gnu::target("avx2")]] void exact_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
                                          std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
   const int n = field.size, cap = walk_iteration_cap(n);
@@ -992,12 +992,12 @@ struct CellStepLanes {
 
 // The binary searches (walk_binary) or the robust searches (walk_robust) of a run, eight at a time,
 // each ending in bisect()'s bisections: lane by lane the same operations in the same order as the
-// one-by-one walks (walk_with's first height and end per ray in scalar code). Each iteration a lane
-// tests its step's end (binary: t_in + dt * k; robust: its texel's radius ahead of t) or its
-// bracket's midpoint, or, for the robust walk where the radius is 0 (robust_clamp takes 1), walks
-// one of its up to two cells with the full cell test (full_cell_step; a hit inside a cell refined
-// with the run's others). The cells the heights read, and the radius texels, are logged for the
-// record as exact_lanes' cells are.
+// one-by-one walks (walk_with's first height in LaneFeed, its end per ray in scalar code). Each
+// iteration a lane tests its step's end (binary: t_in + dt * k; robust: its texel's radius ahead of
+// t) or its bracket's midpoint, or, for the robust walk where the radius is 0 (robust_clamp takes
+// 1), walks one of its up to two cells with the full cell test (full_cell_step; a hit inside a cell
+// refined with the run's others). The cells the heights read, and the radius texels, are logged for
+// the record as exact_lanes' cells are.
 template <Method M>
 [[gnu::target("avx2")]] void search_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
                                           std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
@@ -1225,10 +1225,10 @@ struct CoverLanes {
 
 // The N-buffer walks of a run with the paper's covering (top alignment, no direct squares), eight at
 // a time: walk_nbuffer's queries and cell steps, lane by lane the same operations in the same order
-// (walk_with's first height and end per ray in scalar code). Each iteration is one query a lane and,
-// where it fails at a span of one texel, one cell step with the full cell test; the hits found inside
-// a cell are refined with the run's others (refine_lanes). The level texels and cells read are
-// logged for the record.
+// (walk_with's first height in LaneFeed, its end per ray in scalar code). Each iteration is one
+// query a lane and, where it fails at a span of one texel, one cell step with the full cell test;
+// the hits found inside a cell are refined with the run's others (refine_lanes). The level texels
+// and cells read are logged for the record.
 [[gnu::target("avx2")]] void nbuffer_lanes(const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
                                            std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
   const int n = field.size, top = field.levels - 1, cap = walk_iteration_cap(n);
