@@ -789,6 +789,18 @@ struct LaneFeed {
     }
     return -1;
   }
+
+  // Ray k's hit inside cell (ci, cj), its bracket [a, b] refined later with the run's other hits
+  // (refine_lanes; b stands for the hit's t until then): the cell's corners read again (no record),
+  // the job listed, the bisections counted.
+  void refine_later(std::size_t k, int ci, int cj, float a, float b, int root_steps, std::vector<Refinement>& jobs) {
+    Refinement job{rays[k], Cell{}, a, b, k};
+    job.cell.ci = ci, job.cell.cj = cj;
+    job.cell.read(reader);
+    jobs.push_back(job);
+    out[k].bisections += static_cast<std::uint32_t>(root_steps);
+    set_hit(out[k], b);
+  }
 };
 
 // The exact walks of a run, eight at a time: walk_exact's steps, lane by lane the same operations in
@@ -797,7 +809,6 @@ struct LaneFeed {
                                          std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
   const int n = field.size, cap = walk_iteration_cap(n);
   LaneFeed feed(field, rays, out, log);
-  Reader<ObserverSink>& reader = feed.reader;
   std::uint32_t row = 0;
   Lanes L;
 
@@ -837,15 +848,7 @@ struct LaneFeed {
     w.lookups = 4 * (1 + w.steps);
     switch (how) {
       case LaneEnd::HitEntry: set_hit(w, L.t[l]); break;
-      case LaneEnd::HitInside: {  // refined with the run's other hits (refine_lanes)
-        Refinement job{&ray, Cell{}, L.t[l], L.tb[l], k};
-        job.cell.ci = L.ci[l], job.cell.cj = L.cj[l];
-        job.cell.read(reader);
-        refinements.push_back(job);
-        w.bisections += static_cast<std::uint32_t>(params.root_steps);
-        set_hit(w, L.tb[l]);
-        break;
-      }
+      case LaneEnd::HitInside: feed.refine_later(k, L.ci[l], L.cj[l], L.t[l], L.tb[l], params.root_steps, refinements); break;
       case LaneEnd::Miss: break;
       case LaneEnd::Capped: w.capped = true; break;
     }
@@ -1160,13 +1163,8 @@ template <Method M>
         set_hit(w, L.b[l]);
       } else if (entry_bits >> l & 1) {
         set_hit(w, L.b[l]);
-      } else if (refined_bits >> l & 1) {  // refined from lo with the run's other hits (refine_lanes)
-        Refinement job{&ray, Cell{}, L.lo[l], L.b[l], r};
-        job.cell.ci = L.ci[l], job.cell.cj = L.cj[l];
-        job.cell.read(feed.reader);
-        refinements.push_back(job);
-        w.bisections = static_cast<std::uint32_t>(params.root_steps);
-        set_hit(w, L.b[l]);
+      } else if (refined_bits >> l & 1) {  // refined from lo
+        feed.refine_later(r, L.ci[l], L.cj[l], L.lo[l], L.b[l], params.root_steps, refinements);
       } else {
         w.capped = capped_bits >> l & 1;
       }
@@ -1233,7 +1231,6 @@ struct CoverLanes {
                                            std::span<WalkResult> out, CellLog& log, std::vector<Refinement>& refinements) {
   const int n = field.size, top = field.levels - 1, cap = walk_iteration_cap(n);
   LaneFeed feed(field, rays, out, log);
-  Reader<ObserverSink>& reader = feed.reader;
   std::uint32_t row = 0;
   struct alignas(32) NBufferLanes {
     float o0[8], o1[8], o2[8], d0[8], d1[8], d2[8], t_out[8], inv[8], t[8];
@@ -1375,13 +1372,8 @@ struct CoverLanes {
       w.lookups = static_cast<std::uint32_t>(L.lookups[l]);
       if (entry_bits >> l & 1) {
         set_hit(w, L.end_b[l]);
-      } else if (refined_bits >> l & 1) {  // refined with the run's other hits (refine_lanes)
-        Refinement job{&ray, Cell{}, L.end_a[l], L.end_b[l], r};
-        job.cell.ci = L.ci[l], job.cell.cj = L.cj[l];
-        job.cell.read(reader);
-        refinements.push_back(job);
-        w.bisections += static_cast<std::uint32_t>(params.root_steps);
-        set_hit(w, L.end_b[l]);
+      } else if (refined_bits >> l & 1) {
+        feed.refine_later(r, L.ci[l], L.cj[l], L.end_a[l], L.end_b[l], params.root_steps, refinements);
       } else if (capped_bits >> l & 1) {
         w.capped = true;
       }
