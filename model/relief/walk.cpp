@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -594,8 +595,16 @@ struct CellLog {
     return v.data() + stride * row;
   }
   std::vector<std::uint8_t> first_ends;  // scratch of the lanes' runs (LaneFeed)
+  // Scratch of replay_repeats: per lane, its cells but the repeats (see there); per row and one past
+  // the last, the lanes' counts of those before the row, then of all their cells; per row, the lanes
+  // whose ray begins there.
+  std::vector<std::int32_t> kept, counts;
+  std::vector<std::uint8_t> begins;
 
-  void replay(const FieldView& field, LookupLines& lines) const {
+  void replay(const FieldView& field, LookupLines& lines) {
+#if defined(__x86_64__)
+    if (!with_radii && !with_texels && repeats_known(field, lines)) return replay_repeats(field, lines);
+#endif
     LinesSink sink{lines};
     Reader<LinesSink> r{field, sink};
     for (const Ray& ray : rays) {
@@ -617,6 +626,22 @@ struct CellLog {
     }
     sink.walked(r.lookups);
   }
+
+  // A cell whose four texels lie in the lines its ray's cell before had (right before it in the
+  // record) is a repeat when each of those lines is still its set's last: they fall in different sets
+  // of the cache (or are the same line). Then the cell's four lookups are all merged (counted, not
+  // recorded). The binary searches and the exact walks read nothing but cells, and nearly half their
+  // cells are repeats (a step along x within the 16 texels of a line): replay_repeats finds them
+  // eight lanes at a time and records only the others, the same record in less time. It needs a
+  // table of sets, lines of a texel or more and cells whose texel addresses fit 31 bits. (The robust
+  // walks' radius texels between their cells would need a check of their sets and a branch between
+  // two kinds of entry: measured, no faster.)
+  static bool repeats_known(const FieldView& field, const LookupLines& lines) noexcept {
+    return lines.merges() && lines.set_mask() != 0 && lines.line_shift() >= 2 && lines.line_shift() < 31 && field.size >= 2 && field.size <= 16384;
+  }
+#if defined(__x86_64__)
+  [[gnu::target("avx2")]] void replay_repeats(const FieldView& field, LookupLines& lines);
+#endif
 };
 
 void walk_one_by_one(Method method, const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
@@ -991,6 +1016,90 @@ struct CellStepLanes {
   c.goes_on = _mm256_andnot_si256(hit, _mm256_and_si256(_mm256_and_si256(stepped, cells_inside(c.next_ci, c.next_cj, nv)),
                                                         _mm256_castps_si256(_mm256_cmp_ps(c.tb, t_out, _CMP_LT_OQ))));
   return c;
+}
+
+// Lines a and b can be each their set's last at once (set: line & mask): the same line, or in
+// different sets.
+[[gnu::target("avx2")]] inline __m256i apart_lines(__m256i mask, __m256i a, __m256i b) {
+  const __m256i same_set = _mm256_cmpeq_epi32(_mm256_and_si256(a, mask), _mm256_and_si256(b, mask));
+  return _mm256_or_si256(_mm256_cmpeq_epi32(a, b), _mm256_xor_si256(same_set, _mm256_set1_epi32(-1)));
+}
+
+// The lanes' rows gone through in order: each lane's cells but the repeats listed in its column of
+// `kept`, in its rays' order, then each ray's recorded (its first height, its cells listed) and its
+// repeats counted.
+[[gnu::target("avx2")]] void CellLog::replay_repeats(const FieldView& field, LookupLines& lines) {
+  std::uint32_t row_count = 0;
+  for (const Ray& ray : rays)
+    if (ray.lane >= 0) row_count = std::max(row_count, ray.row1);
+  const std::size_t rows_n = row_count;
+  begins.assign(rows_n + 1, 0);
+  for (const Ray& ray : rays)
+    if (ray.lane >= 0) begins[ray.row0] = static_cast<std::uint8_t>(begins[ray.row0] | 1u << ray.lane);
+  if (kept.size() < 16 * rows_n) kept.resize(16 * rows_n);
+  if (counts.size() < 16 * (rows_n + 1)) counts.resize(16 * (rows_n + 1));
+  const int n = field.size;
+  const __m256i nv = _mm256_set1_epi32(n), one = _mm256_set1_epi32(1), zero = _mm256_setzero_si256(), minus1 = _mm256_set1_epi32(-1);
+  const __m256i four = _mm256_set1_epi32(4), row_bytes = _mm256_set1_epi32(4 * n);
+  const __m256i mask = _mm256_set1_epi32(static_cast<std::int32_t>(lines.set_mask()));
+  const __m128i shift = _mm_cvtsi32_si128(lines.line_shift());
+  const __m256i no_cell = _mm256_set1_epi32(kNoCell), lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  // Per lane: the lines of the cell before (valid: in the field, its lines each their set's last),
+  // and the counts so far (vectors: a row's are stored whole and read lane by lane, never the other way).
+  __m256i pa = zero, pa2 = zero, pb = zero, pb2 = zero, valid = zero, kept_count = zero, cell_count = zero;
+  alignas(32) std::int32_t pairs[16];
+  std::int32_t* const out = kept.data();
+  for (std::size_t row = 0; row < rows_n; ++row) {
+    std::int32_t* const count_row = counts.data() + 16 * row;
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(count_row), kept_count);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(count_row + 8), cell_count);
+    const std::int32_t* p = rows.data() + 16 * row;
+    const __m256i ci = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)), cj = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + 8));
+    const __m256i begun = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(begins[row]), lane_bit), lane_bit);
+    const __m256i cell = _mm256_xor_si256(_mm256_cmpeq_epi32(ci, no_cell), minus1);
+    const __m256i inside = _mm256_and_si256(_mm256_and_si256(_mm256_cmpgt_epi32(ci, minus1), _mm256_cmpgt_epi32(cj, minus1)),
+                                            _mm256_and_si256(_mm256_cmpgt_epi32(nv, _mm256_add_epi32(ci, one)), _mm256_cmpgt_epi32(nv, _mm256_add_epi32(cj, one))));
+    // The lines of the corners (Reader::note's texels: (j n + i) 4, the next texel, the next row).
+    const __m256i address = _mm256_slli_epi32(_mm256_add_epi32(_mm256_mullo_epi32(cj, nv), ci), 2);
+    const __m256i a = _mm256_srl_epi32(address, shift), a2 = _mm256_srl_epi32(_mm256_add_epi32(address, four), shift);
+    const __m256i below = _mm256_add_epi32(address, row_bytes);
+    const __m256i b = _mm256_srl_epi32(below, shift), b2 = _mm256_srl_epi32(_mm256_add_epi32(below, four), shift);
+    const __m256i same = _mm256_and_si256(_mm256_and_si256(_mm256_cmpeq_epi32(a, pa), _mm256_cmpeq_epi32(a2, pa2)),
+                                          _mm256_and_si256(_mm256_cmpeq_epi32(b, pb), _mm256_cmpeq_epi32(b2, pb2)));
+    const __m256i repeat = _mm256_andnot_si256(begun, _mm256_and_si256(_mm256_and_si256(cell, inside), _mm256_and_si256(same, valid)));
+    // (a and a2, b and b2, are the same line or lines side by side, in different sets.)
+    const __m256i apart = _mm256_and_si256(_mm256_and_si256(apart_lines(mask, a, b), apart_lines(mask, a, b2)),
+                                           _mm256_and_si256(apart_lines(mask, a2, b), apart_lines(mask, a2, b2)));
+    const __m256i lasts = _mm256_and_si256(inside, apart);
+    // A lane without a cell this row keeps its cell before (it recorded nothing), unless its ray begins.
+    valid = _mm256_andnot_si256(_mm256_andnot_si256(cell, begun), _mm256_blendv_epi8(valid, lasts, cell));
+    pa = _mm256_blendv_epi8(pa, a, cell), pa2 = _mm256_blendv_epi8(pa2, a2, cell);
+    pb = _mm256_blendv_epi8(pb, b, cell), pb2 = _mm256_blendv_epi8(pb2, b2, cell);
+    // Each lane's cell written at its column's end, which moves on when the cell is kept: no branch.
+    const __m256i lo = _mm256_unpacklo_epi32(ci, cj), hi = _mm256_unpackhi_epi32(ci, cj);  // lanes 0 1 4 5, 2 3 6 7
+    _mm256_store_si256(reinterpret_cast<__m256i*>(pairs), _mm256_permute2x128_si256(lo, hi, 0x20));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(pairs + 8), _mm256_permute2x128_si256(lo, hi, 0x31));
+    for (std::size_t l = 0; l < 8; ++l)
+      std::memcpy(out + 2 * (l * rows_n + static_cast<std::size_t>(count_row[l])), pairs + 2 * l, 2 * sizeof(std::int32_t));
+    kept_count = _mm256_sub_epi32(kept_count, _mm256_andnot_si256(repeat, cell));
+    cell_count = _mm256_sub_epi32(cell_count, cell);
+  }
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(counts.data() + 16 * rows_n), kept_count);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(counts.data() + 16 * rows_n + 8), cell_count);
+
+  LinesSink sink{lines};
+  Reader<LinesSink> r{field, sink};
+  for (const Ray& ray : rays) {
+    r.note(ray.first_i, ray.first_j);
+    if (ray.lane < 0) continue;
+    const auto l = static_cast<std::size_t>(ray.lane);
+    const std::int32_t* c0 = counts.data() + 16 * static_cast<std::size_t>(ray.row0);
+    const std::int32_t* c1 = counts.data() + 16 * static_cast<std::size_t>(ray.row1);
+    const std::int32_t* cells = out + 2 * l * rows_n;
+    for (std::int32_t k = c0[l]; k < c1[l]; ++k) r.note(cells[2 * k], cells[2 * k + 1]);
+    r.lookups += 4 * static_cast<std::uint32_t>((c1[8 + l] - c0[8 + l]) - (c1[l] - c0[l]));  // the repeats
+  }
+  sink.walked(r.lookups);
 }
 
 // The binary searches (walk_binary) or the robust searches (walk_robust) of a run, eight at a time,

@@ -220,6 +220,11 @@ class alignas(64) LookupLines {
   };
 
   std::span<const std::uint64_t> lines() const noexcept { return {storage_.data(), size_}; }
+  // How lookups are taken (reset()'s geometry): line = address >> line_shift(); with merges(), a
+  // line repeating the last of its set (line & set_mask(); 0: one entry for every line) is merged.
+  int line_shift() const noexcept { return line_shift_; }
+  bool merges() const noexcept { return merge_; }
+  std::uint32_t set_mask() const noexcept { return set_mask_; }
   // The merged lookups: every lookup of a texel in memory but those recorded.
   std::uint64_t repeats() const noexcept { return lookups_ - borders_ - size_; }
   // Marks the N-buffer level texels the walks read, one byte a texel of FieldView::nbuffer (null:

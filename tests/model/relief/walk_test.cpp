@@ -182,14 +182,16 @@ TEST(ReliefWalkTest, ExactMethodsAgreeWithTheReferenceOnRandomRays) {
 // exact and N-buffer walks) against the one-by-one walks: every result and the record of lookups the
 // same bit for bit, on fields of every kind and size 2 to 64 and on rays from above, through the
 // sides, grazing, vertical, axis-aligned and along cell diagonals, with step counts that vary with
-// the size (1 to 16 linear steps, 0 to 9 bisections).
+// the size (1 to 16 linear steps, 0 to 9 bisections), and records of caches whose sets a cell's
+// lines share or not (the repeats the lanes' replay leaves out: 64-byte lines in 64 or 4 sets,
+// 16-byte lines in 2, a line a texel in 8).
 TEST(ReliefWalkTest, LanesWalkAsOneByOne) {
   if (!vector_walks_available()) GTEST_SKIP() << "no AVX2 here: walk_each walks one by one";
   std::mt19937 rng(23);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   int hits = 0, refined = 0, walked = 0;
   for (const std::string_view kind : heightfield_kinds())
-    for (const int n : {2, 5, 16, 64}) {
+    for (const int n : {2, 5, 15, 16, 17, 64}) {
       const Fixture s(make_heightfield(kind, n, 0, 7));
       const float size = static_cast<float>(n);
       std::vector<FragmentRay> rays;
@@ -210,7 +212,8 @@ TEST(ReliefWalkTest, LanesWalkAsOneByOne) {
       std::vector<const FragmentRay*> pointers;
       for (const FragmentRay& r : rays) pointers.push_back(&r);
       for (const Method m : kAllMethods)
-      for (const LineGeometry g : {LineGeometry{6, 64, true}, LineGeometry{6, 0, false}, LineGeometry{7, 3, true}}) {
+      for (const LineGeometry g : {LineGeometry{6, 64, true}, LineGeometry{6, 0, false}, LineGeometry{7, 3, true}, LineGeometry{6, 4, true},
+                                   LineGeometry{4, 2, true}, LineGeometry{2, 8, true}}) {
         const int linear[] = {16, 1, 5}, bisections[] = {8, 0, 9};
         const auto variant = static_cast<std::size_t>(n % 3);
         const WalkParams p{linear[variant], bisections[variant], 16 - (n % 3) * 5, {}};
