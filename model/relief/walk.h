@@ -278,14 +278,19 @@ WalkResult walk(Method method, const FieldView& field, const WalkParams& params,
 
 // The walks of a run of fragments with one method, one after another: out[k] is walk(method, field,
 // params, *rays[k], ...) and `lines` (may be null) receives every walk's lookups in the order of k,
-// the same records bit for bit. When the CPU has AVX2 and `vector` is true, the rays walk eight at
-// once in AVX2 lanes (each lane takes the run's next ray when its walk ends; the texels each walk
-// read are logged and recorded after the run, ray by ray): every method, the N-buffer walk with the
+// the same records bit for bit. When the CPU has AVX2 and `lanes` is not None, the rays walk eight
+// at once in lanes (each lane takes the run's next ray when its walk ends; the texels each walk read
+// are logged and recorded after the run, ray by ray): every method, the N-buffer walk with the
 // paper's covering (top alignment, no direct squares) only. The hits found inside a cell (exact,
 // robust and N-buffer walks) are refined together, eight at a time (the refinement reads no texel).
-// Otherwise the rays walk one by one.
+// Otherwise the rays walk one by one. `lanes` is the instruction set of the lanes, or the best below
+// it that the CPU has: AVX2, or AVX-512 (the same 256-bit operations, which the compiler encodes with
+// twice the registers and masked gathers).
+enum class LaneSet : std::uint8_t { None, Avx2, Avx512 };
+bool lane_set_available(LaneSet set) noexcept;
+LaneSet best_lane_set() noexcept;  // the best the CPU has
 void walk_each(Method method, const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
-               std::span<WalkResult> out, LookupLines* lines, bool vector = true);
+               std::span<WalkResult> out, LookupLines* lines, LaneSet lanes = best_lane_set());
 // Whether walk_each's lanes run here (the CPU has AVX2).
 bool vector_walks_available() noexcept;
 

@@ -178,8 +178,8 @@ TEST(ReliefWalkTest, ExactMethodsAgreeWithTheReferenceOnRandomRays) {
   RecordProperty("exact_saddle_misses", exact_misses);
 }
 
-// walk_each's lanes (the exact, binary and robust_clamp methods in AVX2, the hits' refinements of the
-// exact and N-buffer walks) against the one-by-one walks: every result and the record of lookups the
+// walk_each's lanes (every method, in AVX2 and, where the CPU has it, AVX-512; the hits' refinements
+// of the exact and N-buffer walks) against the one-by-one walks: every result and the record of lookups the
 // same bit for bit, on fields of every kind and size 2 to 64 and on rays from above, through the
 // sides, grazing, vertical, axis-aligned and along cell diagonals, with step counts that vary with
 // the size (1 to 16 linear steps, 0 to 9 bisections), and records of caches whose sets a cell's
@@ -217,23 +217,30 @@ TEST(ReliefWalkTest, LanesWalkAsOneByOne) {
         const int linear[] = {16, 1, 5}, bisections[] = {8, 0, 9};
         const auto variant = static_cast<std::size_t>(n % 3);
         const WalkParams p{linear[variant], bisections[variant], 16 - (n % 3) * 5, {}};
-        LookupLines want, got;
-        want.reset(g), got.reset(g);
-        std::vector<WalkResult> a(rays.size()), b(rays.size()), c(rays.size());
-        walk_each(m, s.view(), p, pointers, a, &want, false);
-        walk_each(m, s.view(), p, pointers, b, &got, true);
-        walk_each(m, s.view(), p, pointers, c, nullptr, true);
-        for (std::size_t k = 0; k < rays.size(); ++k) {
-          ASSERT_TRUE(a[k].hit == b[k].hit && std::bit_cast<std::uint32_t>(a[k].t) == std::bit_cast<std::uint32_t>(b[k].t) &&
-                      a[k].lookups == b[k].lookups && a[k].steps == b[k].steps && a[k].bisections == b[k].bisections &&
-                      a[k].capped == b[k].capped)
-              << to_string(m) << " " << kind << " " << n << ": ray " << k << " hit " << a[k].hit << "/" << b[k].hit << " t " << a[k].t << "/" << b[k].t << " steps "
-              << a[k].steps << "/" << b[k].steps;
-          ASSERT_TRUE(b[k].hit == c[k].hit && b[k].t == c[k].t && b[k].lookups == c[k].lookups) << kind << " " << n << ": ray " << k;
-          hits += a[k].hit, refined += a[k].bisections > 0, walked += a[k].steps > 0;
+        LookupLines want;
+        want.reset(g);
+        std::vector<WalkResult> a(rays.size());
+        walk_each(m, s.view(), p, pointers, a, &want, LaneSet::None);
+        for (const LaneSet lanes : {LaneSet::Avx2, LaneSet::Avx512}) {
+          if (!lane_set_available(lanes)) continue;
+          const char* set = lanes == LaneSet::Avx2 ? "avx2" : "avx512";
+          LookupLines got;
+          got.reset(g);
+          std::vector<WalkResult> b(rays.size()), c(rays.size());
+          walk_each(m, s.view(), p, pointers, b, &got, lanes);
+          walk_each(m, s.view(), p, pointers, c, nullptr, lanes);
+          for (std::size_t k = 0; k < rays.size(); ++k) {
+            ASSERT_TRUE(a[k].hit == b[k].hit && std::bit_cast<std::uint32_t>(a[k].t) == std::bit_cast<std::uint32_t>(b[k].t) &&
+                        a[k].lookups == b[k].lookups && a[k].steps == b[k].steps && a[k].bisections == b[k].bisections &&
+                        a[k].capped == b[k].capped)
+                << set << " " << to_string(m) << " " << kind << " " << n << ": ray " << k << " hit " << a[k].hit << "/" << b[k].hit << " t " << a[k].t
+                << "/" << b[k].t << " steps " << a[k].steps << "/" << b[k].steps;
+            ASSERT_TRUE(b[k].hit == c[k].hit && b[k].t == c[k].t && b[k].lookups == c[k].lookups) << set << " " << kind << " " << n << ": ray " << k;
+            if (lanes == LaneSet::Avx2) hits += a[k].hit, refined += a[k].bisections > 0, walked += a[k].steps > 0;
+          }
+          ASSERT_TRUE(std::ranges::equal(want.lines(), got.lines())) << set << " " << kind << " " << n;
+          EXPECT_EQ(want.repeats(), got.repeats()) << set << " " << kind << " " << n;
         }
-        ASSERT_TRUE(std::ranges::equal(want.lines(), got.lines())) << kind << " " << n;
-        EXPECT_EQ(want.repeats(), got.repeats()) << kind << " " << n;
       }
     }
   // The rays take every way out of a walk.
