@@ -43,8 +43,8 @@ Timing replay_in_child(const pipeline::ReplayOptions& r) {
     ::close(fds[0]);
     // The heap's free pages, inherited from the capture, go back to the system: a replay that
     // reused them would copy each on its first write (copy on write, the fork's), a cost a replay in
-    // a process of its own (nbsim replay) never pays. Measured on the relief bench: without this,
-    // the repetitions in a child took 6 to 13% longer than the one in this process.
+    // a process of its own (nbsim replay) never pays. Measured: without this, the repetitions in a
+    // child took 6 to 13% longer than the one in this process.
     ::malloc_trim(0);
     Timing t;
     try {
