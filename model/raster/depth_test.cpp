@@ -6,10 +6,7 @@
 #include <cmath>
 
 #include "model/common/error.h"
-
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
+#include "model/raster/block_lanes.h"
 
 // The plain depth-test loop gets an FMA clone next to the baseline one on x86-64 (picked when the
 // program loads): the depth plane's fused evaluation (DepthPlane::raw_at, std::fma) is then one
@@ -47,52 +44,18 @@ template <DepthFunc F>
   k.written += written;
 }
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define NBSIM_BLOCK_LANES 1
-
-// A 4x4 block wholly inside a float buffer, four pixels a row in SSE lanes: each lane computes what
-// run_block computes for its pixel, with the same operations in the same order (the plane's value,
-// + 0, the clamp as std::max then std::min, the compare), so the same passes and writes.
-// The block's depths, row by row: fused (FMA instructions: fma's one rounding, as std::fma) or not
-// (SSE2: a product and a sum, each rounded, as DepthPlane::raw_at's unfused form).
-[[gnu::target("fma")]] inline void plane_rows_fused(const DepthPlane& p, int x, int y, __m128 (&z)[4]) {
-  const __m128 fx = _mm_cvtepi32_ps(_mm_setr_epi32(x, x + 1, x + 2, x + 3));
-  const __m128 row = _mm_fmadd_ps(_mm_set1_ps(p.dzdx), fx, _mm_set1_ps(p.a0));
-  for (int r = 0; r < 4; ++r) z[r] = _mm_fmadd_ps(_mm_set1_ps(p.dzdy), _mm_set1_ps(static_cast<float>(y + r)), row);
-}
-inline void plane_rows_unfused(const DepthPlane& p, int x, int y, __m128 (&z)[4]) {
-  const __m128 fx = _mm_cvtepi32_ps(_mm_setr_epi32(x, x + 1, x + 2, x + 3));
-  const __m128 a = _mm_add_ps(_mm_set1_ps(p.a0), _mm_mul_ps(_mm_set1_ps(p.dzdx), fx));
-  for (int r = 0; r < 4; ++r) z[r] = _mm_add_ps(a, _mm_mul_ps(_mm_set1_ps(p.dzdy), _mm_set1_ps(static_cast<float>(y + r))));
-}
-
+#ifdef NBSIM_BLOCK_LANES
+// A 4x4 block wholly inside the buffer, four pixels a row in SSE lanes (block_lanes.h): the same
+// passes and writes as run_block.
 template <DepthFunc F>
-[[gnu::always_inline]] inline __m128 lanes_pass(__m128 z, __m128 stored) {
-  if constexpr (F == DepthFunc::Less) return _mm_cmplt_ps(z, stored);
-  else if constexpr (F == DepthFunc::Equal) return _mm_cmpeq_ps(z, stored);
-  else if constexpr (F == DepthFunc::Lequal) return _mm_cmple_ps(z, stored);
-  else if constexpr (F == DepthFunc::Greater) return _mm_cmpgt_ps(z, stored);
-  else if constexpr (F == DepthFunc::NotEqual) return _mm_cmpneq_ps(z, stored);  // true for a NaN, as !(==)
-  else if constexpr (F == DepthFunc::Gequal) return _mm_cmpge_ps(z, stored);
-  else if constexpr (F == DepthFunc::Always) return _mm_castsi128_ps(_mm_set1_epi32(-1));
-  else return _mm_setzero_ps();
-}
-
-template <DepthFunc F>
-void lanes_block(DepthImage& img, const __m128 (&raw)[4], int x, int y, std::uint16_t mask, bool write, DepthCounters& k) {
-  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
-  const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
+void lanes_block(DepthImage& img, const __m128 (&raw)[4], int x, int y, std::uint16_t mask, bool write, DepthFormat format, DepthCounters& k) {
   std::uint64_t passed = 0;
   for (int r = 0; r < 4; ++r) {
-    const unsigned row_mask = (mask >> (4 * r)) & 0xFu;
-    if (row_mask == 0) continue;
-    // std::min(std::max(z + 0, 0), 1): max(0, v) keeps v when v is not below 0 (NaN too), min(1, v)
-    // keeps v when 1 is not below it.
-    const __m128 z = _mm_min_ps(one, _mm_max_ps(zero, _mm_add_ps(raw[r], zero)));
+    if (((mask >> (4 * r)) & 0xFu) == 0) continue;
+    const __m128 z = lanes::stored_lanes(raw[r], format);
     float* row = img.texels.data() + static_cast<std::size_t>(y + r) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x);
     const __m128 stored = _mm_loadu_ps(row);
-    const __m128 live = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<int>(row_mask)), bits), bits));
-    const __m128 pass = _mm_and_ps(lanes_pass<F>(z, stored), live);
+    const __m128 pass = _mm_and_ps(lanes::passes<F>(z, stored), lanes::row_lanes(mask, r));
     const int pass_bits = _mm_movemask_ps(pass);
     passed += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(pass_bits)));
     if (write && pass_bits != 0) _mm_storeu_ps(row, _mm_or_ps(_mm_and_ps(pass, z), _mm_andnot_ps(pass, stored)));
@@ -100,29 +63,23 @@ void lanes_block(DepthImage& img, const __m128 (&raw)[4], int x, int y, std::uin
   k.passed += passed;
   if (write) k.written += passed;
 }
-
-bool host_fma() noexcept {
-  static const bool fma = __builtin_cpu_supports("fma");
-  return fma;
-}
 #endif
 
 NBSIM_FMA_CLONES void test_plain_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint16_t mask, DepthFunc func,
                                        bool w, bool fused, DepthFormat format, DepthCounters& k) {
 #ifdef NBSIM_BLOCK_LANES
-  if (format == DepthFormat::Float32 && x >= 0 && y >= 0 && x + 4 <= img.width && y + 4 <= img.height && (!fused || host_fma())) {
+  if (lanes::block_fits(img, x, y, fused)) {
     __m128 raw[4];
-    if (fused) plane_rows_fused(plane, x, y, raw);
-    else plane_rows_unfused(plane, x, y, raw);
+    lanes::plane_rows(plane, x, y, fused, raw);
     switch (func) {
       case DepthFunc::Never: break;
-      case DepthFunc::Less: lanes_block<DepthFunc::Less>(img, raw, x, y, mask, w, k); break;
-      case DepthFunc::Equal: lanes_block<DepthFunc::Equal>(img, raw, x, y, mask, w, k); break;
-      case DepthFunc::Lequal: lanes_block<DepthFunc::Lequal>(img, raw, x, y, mask, w, k); break;
-      case DepthFunc::Greater: lanes_block<DepthFunc::Greater>(img, raw, x, y, mask, w, k); break;
-      case DepthFunc::NotEqual: lanes_block<DepthFunc::NotEqual>(img, raw, x, y, mask, w, k); break;
-      case DepthFunc::Gequal: lanes_block<DepthFunc::Gequal>(img, raw, x, y, mask, w, k); break;
-      case DepthFunc::Always: lanes_block<DepthFunc::Always>(img, raw, x, y, mask, w, k); break;
+      case DepthFunc::Less: lanes_block<DepthFunc::Less>(img, raw, x, y, mask, w, format, k); break;
+      case DepthFunc::Equal: lanes_block<DepthFunc::Equal>(img, raw, x, y, mask, w, format, k); break;
+      case DepthFunc::Lequal: lanes_block<DepthFunc::Lequal>(img, raw, x, y, mask, w, format, k); break;
+      case DepthFunc::Greater: lanes_block<DepthFunc::Greater>(img, raw, x, y, mask, w, format, k); break;
+      case DepthFunc::NotEqual: lanes_block<DepthFunc::NotEqual>(img, raw, x, y, mask, w, format, k); break;
+      case DepthFunc::Gequal: lanes_block<DepthFunc::Gequal>(img, raw, x, y, mask, w, format, k); break;
+      case DepthFunc::Always: lanes_block<DepthFunc::Always>(img, raw, x, y, mask, w, format, k); break;
     }
     return;
   }

@@ -149,10 +149,15 @@ class DepthStencilTest {
   bool fused_interpolation() const noexcept { return depth_test_.fused_interpolation(); }
   DepthFormat depth_format() const noexcept { return depth_test_.format(); }
   void set_depth_format(DepthFormat format) noexcept { depth_test_.set_format(format); }
+  // Whether blocks wholly inside the buffers are tested in SSE lanes where the host has them (the
+  // default; the same results as one fragment at a time, which false forces, for the tests that
+  // compare the two).
+  void set_lanes(bool lanes) noexcept { lanes_ = lanes; }
 
  private:
   EarlyDepthTest depth_test_;
   StencilImage* stencil_;
+  bool lanes_ = true;
 };
 
 }  // namespace nbsim::raster

@@ -1,12 +1,16 @@
 // StencilTestTest: the stencil test in front of the early depth test (model/raster/stencil_test.h):
 // every func, every op with its clamp or wrap, the masks, GL's order with the depth test, two-sided
-// selection through RasterPath (triangle winding, points), and a random comparison with a
-// per-pixel reference written from the GL specification's wording.
+// selection through RasterPath (triangle winding, points), a random comparison with a per-pixel
+// reference written from the GL specification's wording, and the blocks tested in lanes against
+// the same blocks one fragment at a time.
 #include "model/raster/stencil_test.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <bit>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -313,6 +317,77 @@ TEST(StencilTestTest, RandomBlocksMatchReference) {
   EXPECT_EQ(dk.passed, ref_passed) << "samples passed";
   EXPECT_GT(sk.changed, 0u);
   EXPECT_GT(sk.depth_failed, 0u);
+}
+
+// Blocks wholly inside the buffers are tested in lanes (block_lanes.h): the same buffers, bit for
+// bit, and the same counts as one fragment at a time, for random states (every func and op, masks),
+// sloped planes (fused and not, both depth formats, NaN, -0, ties), the depth test on and off,
+// writes on and off, and blocks on the ragged right and top edges (one fragment at a time there).
+TEST(StencilTestTest, LanesTestAsOneByOne) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> unit(-0.25f, 1.25f), slope(-0.05f, 0.05f);
+  const auto small = [&] { return static_cast<std::uint8_t>(rng() % 4 == 0 ? rng() : rng() % 4); };
+  const auto face = [&] {
+    StencilFace f;
+    f.func = static_cast<DepthFunc>(rng() % 8);
+    f.ref = small();
+    f.value_mask = rng() % 3 == 0 ? static_cast<std::uint8_t>(rng()) : 0xFF;
+    f.write_mask = rng() % 4 == 0 ? static_cast<std::uint8_t>(rng() % 2 == 0 ? 0 : rng()) : 0xFF;
+    f.fail = static_cast<StencilOp>(rng() % 8);
+    f.depth_fail = static_cast<StencilOp>(rng() % 8);
+    f.pass = static_cast<StencilOp>(rng() % 8);
+    return f;
+  };
+  const auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
+  constexpr int kW = 14, kH = 10;  // not multiples of 4: the last column and row of blocks are ragged
+  std::uint64_t changed = 0, depth_failed = 0, written = 0;
+  for (const DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm24})
+    for (const bool fused : {true, false}) {
+      DepthImage depth_a(kW, kH, 0.5f);
+      StencilImage stencil_a(kW, kH, 0);
+      for (std::size_t i = 0; i < depth_a.texels.size(); ++i) {
+        const int pick = static_cast<int>(rng() % 8);
+        depth_a.texels[i] = pick == 0 ? NAN : pick == 1 ? 0.5f : stored_depth(format, std::clamp(unit(rng), 0.0f, 1.0f));
+        stencil_a.texels[i] = small();
+      }
+      DepthImage depth_b = depth_a;
+      StencilImage stencil_b = stencil_a;
+      DepthStencilTest lanes(depth_a, stencil_a, fused, format), one_by_one(depth_b, stencil_b, fused, format);
+      one_by_one.set_lanes(false);
+      DepthCounters dka, dkb;
+      StencilCounters ska, skb;
+      for (int trial = 0; trial < 600; ++trial) {
+        StencilState ss;
+        ss.test = true;
+        ss.front = face();
+        ss.back = face();
+        const DepthState ds{static_cast<DepthFunc>(rng() % 8), rng() % 4 != 0, rng() % 3 != 0};
+        DepthPlane plane{unit(rng), slope(rng), slope(rng)};
+        if (trial % 17 == 0) plane = DepthPlane{NAN, 0.0f, 0.0f};
+        if (trial % 19 == 0) plane = DepthPlane{-0.0f, 0.0f, 0.0f};
+        if (trial % 23 == 0) plane = DepthPlane{0.5f, 0.0f, 0.0f};  // ties with the stored 0.5s
+        const bool front = rng() % 2 == 0;
+        const int x = 4 * static_cast<int>(rng() % 4), y = 4 * static_cast<int>(rng() % 3);
+        auto mask = static_cast<std::uint16_t>(rng());
+        for (int i = 0; i < 16; ++i)  // pixels outside the buffers are never covered
+          if (x + (i & 3) >= kW || y + (i >> 2) >= kH) mask = static_cast<std::uint16_t>(mask & ~(1u << i));
+        lanes.test_block(plane, front, x, y, mask, ds, ss, dka, ska);
+        one_by_one.test_block(plane, front, x, y, mask, ds, ss, dkb, skb);
+        ASSERT_EQ(stencil_a.texels, stencil_b.texels) << "trial " << trial << (fused ? " fused" : " unfused");
+        for (std::size_t t = 0; t < depth_a.texels.size(); ++t)
+          ASSERT_EQ(bits(depth_a.texels[t]), bits(depth_b.texels[t])) << "texel " << t << ", trial " << trial;
+      }
+      // fragments, blocks, depth tests, passed, depth written; stencil tests, passed, depth failed,
+      // back facing, written, changed
+      const auto counts = [](const DepthCounters& d, const StencilCounters& k) {
+        return std::array{d.fragments, d.blocks, d.depth_tests, d.passed, d.written, k.tests, k.passed, k.depth_failed, k.back_facing, k.written, k.changed};
+      };
+      EXPECT_EQ(counts(dka, ska), counts(dkb, skb)) << (fused ? "fused" : "unfused");
+      changed += ska.changed, depth_failed += ska.depth_failed, written += dka.written;
+    }
+  EXPECT_GT(changed, 1000u);
+  EXPECT_GT(depth_failed, 1000u);
+  EXPECT_GT(written, 1000u);
 }
 
 // Through RasterPath: a triangle counter-clockwise in window space (y up) is front-facing under
