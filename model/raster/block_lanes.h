@@ -39,11 +39,6 @@ inline bool block_fits(const DepthImage& img, int x, int y, bool fused) noexcept
   return x >= 0 && y >= 0 && x + 4 <= img.width && y + 4 <= img.height && (!fused || host_fma());
 }
 
-inline void plane_rows(const DepthPlane& p, int x, int y, bool fused, __m128 (&z)[4]) {
-  if (fused) plane_rows_fused(p, x, y, z);
-  else plane_rows_unfused(p, x, y, z);
-}
-
 // stored_depth(format, DepthPlane::at's clamp of `raw`): std::min(std::max(z + 0, 0), 1) (max(0, v)
 // keeps v when v is not below 0, NaN too; min(1, v) keeps v when 1 is not below it), then for a
 // 24-bit buffer to_unorm24 (the product rounded to float, 0 unless above 0, at most 2^24 - 1, else

@@ -70,7 +70,8 @@ NBSIM_FMA_CLONES void test_plain_block(DepthImage& img, const DepthPlane& plane,
 #ifdef NBSIM_BLOCK_LANES
   if (lanes::block_fits(img, x, y, fused)) {
     __m128 raw[4];
-    lanes::plane_rows(plane, x, y, fused, raw);
+    if (fused) lanes::plane_rows_fused(plane, x, y, raw);  // (called here: inlined into the FMA clone)
+    else lanes::plane_rows_unfused(plane, x, y, raw);
     switch (func) {
       case DepthFunc::Never: break;
       case DepthFunc::Less: lanes_block<DepthFunc::Less>(img, raw, x, y, mask, w, format, k); break;

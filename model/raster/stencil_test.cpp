@@ -214,7 +214,8 @@ void DepthStencilTest::test_block(const DepthPlane& plane, bool front_facing, in
 #ifdef NBSIM_BLOCK_LANES
   if (lanes_ && lanes::block_fits(depth, x, y, fused)) {
     __m128 raw[4];
-    lanes::plane_rows(plane, x, y, fused, raw);
+    if (fused) lanes::plane_rows_fused(plane, x, y, raw);  // (called here: inlined into the FMA clone)
+    else lanes::plane_rows_unfused(plane, x, y, raw);
     LanesCounts c;
     const DepthFormat format = depth_test_.format();
     switch (ds.test ? ds.func : DepthFunc::Always) {
