@@ -72,6 +72,10 @@ class Rasterizer {
 
 // ---- implementation ---------------------------------------------------------------------------
 
+// 1 when v < 0, else 0: the sign bit, without a branch (which side of an edge a pixel falls on
+// follows the triangle, not a pattern a branch predictor could learn).
+constexpr unsigned negative(std::int64_t v) noexcept { return static_cast<unsigned>(static_cast<std::uint64_t>(v) >> 63); }
+
 inline std::uint16_t Rasterizer::block_mask(const EdgePlane* planes, int n, int x, int y) noexcept {
   std::uint32_t mask = 0xffff;
   for (int j = 0; j < n; ++j) {
@@ -80,8 +84,7 @@ inline std::uint16_t Rasterizer::block_mask(const EdgePlane* planes, int n, int 
     std::uint32_t out = 0;
     for (int row = 0; row < 4; ++row) {
       const std::int64_t cr = c0 + static_cast<std::int64_t>(p.dcdy) * row;
-      for (int col = 0; col < 4; ++col)
-        if (cr - static_cast<std::int64_t>(p.dcdx) * col < 0) out |= 1u << (row * 4 + col);
+      for (int col = 0; col < 4; ++col) out |= negative(cr - static_cast<std::int64_t>(p.dcdx) * col) << (row * 4 + col);
     }
     mask &= ~out;
   }
@@ -102,8 +105,8 @@ inline void classify16(const EdgePlane* planes, int n, int x, int y, int sub, un
     const std::int64_t stepy = static_cast<std::int64_t>(p.dcdy) * sub;
     for (int i = 0; i < 16; ++i) {
       const std::int64_t ci = c + stepx * (i & 3) + stepy * (i >> 2);
-      if (ci + cox < 0) outmask |= 1u << i;
-      if (ci + cio < 0) partmask |= 1u << i;
+      outmask |= negative(ci + cox) << i;
+      partmask |= negative(ci + cio) << i;
     }
   }
   out = outmask;
