@@ -173,6 +173,20 @@ void EarlyDepthTest::test_block(const DepthPlane& plane, int x, int y, std::uint
   const auto n = static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(mask)));
   k.fragments += n;
   k.blocks += 1;
+  if (state.shader && !state.peel_layer && !state.passed_mask)
+    if (const std::optional<std::uint16_t> kept = state.shader->keep_block(x, y, mask)) {  // discards whole
+      const auto keep = static_cast<std::uint16_t>(*kept & mask);
+      const auto n_kept = static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(keep)));
+      k.shader_discarded += n - n_kept;
+      if (keep == 0) return;
+      if (!state.test) {
+        k.passed += n_kept;
+        return;
+      }
+      k.depth_tests += n_kept;
+      test_plain_block(*buffer_, plane, x, y, keep, state.func, state.write, fused_, format_, k);
+      return;
+    }
   if (state.peel_layer || state.passed_mask || state.shader) {
     NBSIM_CHECK(!state.peel_layer || state.peel_layer->texels.size() == buffer_->texels.size(), "peel layer of another size");
     NBSIM_CHECK(!state.passed_mask || state.passed_mask->size() == buffer_->texels.size(), "passed mask of another size");

@@ -83,11 +83,16 @@ inline float stored_depth(DepthFormat format, float z) noexcept {
 // A shader that writes gl_FragDepth (frag_depth returns it) has it clamped to [0, 1], then tested and
 // stored instead of the interpolated depth (llvmpipe clamps a written depth even in a float buffer
 // without depth clamp: ReliefGlWalkTest.FragDepthOutsideTheUnitRange).
+// A shader that decides without the depth and writes none may keep_block: the pixels of `mask` in
+// the 4x4 block at (x, y) it keeps (bit i + 4 j is pixel (x + i, y + j), as the tests' masks), the
+// same as discards() pixel by pixel; the block is then depth tested whole (in lanes where it can
+// be). nullopt (the default): pixel by pixel.
 class FragmentShader {
  public:
   virtual ~FragmentShader() = default;
   virtual bool discards(int x, int y, float frag_z) const = 0;
   virtual std::optional<float> frag_depth(int /*x*/, int /*y*/) const { return std::nullopt; }
+  virtual std::optional<std::uint16_t> keep_block(int /*x*/, int /*y*/, std::uint16_t /*mask*/) const { return std::nullopt; }
 };
 
 struct DepthState {

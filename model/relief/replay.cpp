@@ -38,6 +38,16 @@ class KeepHits final : public raster::FragmentShader {
     if (!depth_) return std::nullopt;
     return (*depth_)[at(x, y)];
   }
+  // Without depths of its own (the box's depth), a block's kept pixels at once: its hit bytes.
+  std::optional<std::uint16_t> keep_block(int x, int y, std::uint16_t mask) const override {
+    if (depth_) return std::nullopt;
+    unsigned keep = 0;
+    for (unsigned m = mask; m != 0; m &= m - 1) {
+      const int i = std::countr_zero(m);
+      keep |= (hit_[at(x + (i & 3), y + (i >> 2))] != 0 ? 1u : 0u) << i;
+    }
+    return static_cast<std::uint16_t>(keep);
+  }
 
  private:
   std::size_t at(int x, int y) const noexcept { return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x); }

@@ -1,14 +1,18 @@
 // DepthTestTest: the early depth test (model/raster/depth_test.h): the depth functions, the depth
-// plane's interpolation and clamp, a disabled test, the 24-bit depth format.
+// plane's interpolation and clamp, a disabled test, the 24-bit depth format, fragment shaders'
+// discards (pixel by pixel and block by block), whole blocks against one pixel at a time.
 #include "model/raster/depth_test.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <random>
+#include <vector>
 
 #include "model/common/depth.h"
 #include "model/raster/setup.h"
@@ -96,6 +100,60 @@ TEST(DepthTestTest, FragmentShaderDiscardsBeforeTheTest) {
   EXPECT_EQ(img.at(0, 0), 0.0f) << "the kept fragment's depth, clamped";
   EXPECT_EQ(img.at(1, 0), 1.0f) << "a discarded fragment writes nothing";
   EXPECT_EQ(shader.last_z, -0.25f) << "gl_FragCoord.z is not clamped";
+}
+
+// A shader that keeps whole blocks (keep_block) tests as the same shader asked pixel by pixel: the
+// same buffer and counts, with the depth test on and off, writes on and off, sloped planes, both
+// formats and blocks on the ragged edges.
+TEST(DepthTestTest, ShaderKeepingBlocksTestsAsPixelByPixel) {
+  struct Pattern : FragmentShader {
+    std::vector<std::uint8_t> keep;
+    int width = 0;
+    bool discards(int x, int y, float) const override { return keep[static_cast<std::size_t>(y * width + x)] == 0; }
+  };
+  struct Blocks final : Pattern {
+    std::optional<std::uint16_t> keep_block(int x, int y, std::uint16_t mask) const override {
+      unsigned kept = 0;
+      for (int i = 0; i < 16; ++i)
+        if ((mask >> i & 1) && !discards(x + (i & 3), y + (i >> 2), 0.0f)) kept |= 1u << i;
+      return static_cast<std::uint16_t>(kept);
+    }
+  };
+  std::mt19937 random(3);
+  std::uniform_real_distribution<float> unit(-0.25f, 1.25f), slope(-0.05f, 0.05f);
+  constexpr int kW = 14, kH = 10;
+  Pattern pixels;
+  Blocks blocks;
+  for (Pattern* p : {static_cast<Pattern*>(&pixels), static_cast<Pattern*>(&blocks)}) p->width = kW;
+  for (const DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm24}) {
+    DepthImage a(kW, kH, 0.5f);
+    for (float& t : a.texels) t = stored_depth(format, std::clamp(unit(random), 0.0f, 1.0f));
+    DepthImage b = a;
+    EarlyDepthTest by_pixel(a, true, format), by_block(b, true, format);
+    DepthCounters ka, kb;
+    for (int trial = 0; trial < 300; ++trial) {
+      pixels.keep.resize(static_cast<std::size_t>(kW * kH));
+      for (std::uint8_t& k : pixels.keep) k = random() % 3 != 0 ? 1 : 0;
+      blocks.keep = pixels.keep;
+      const DepthPlane plane{unit(random), slope(random), slope(random)};
+      DepthState state{static_cast<DepthFunc>(random() % 8), random() % 4 != 0, random() % 2 == 0};
+      const int x = 4 * static_cast<int>(random() % 4), y = 4 * static_cast<int>(random() % 3);
+      auto mask = static_cast<std::uint16_t>(random());
+      for (int i = 0; i < 16; ++i)
+        if (x + (i & 3) >= kW || y + (i >> 2) >= kH) mask = static_cast<std::uint16_t>(mask & ~(1u << i));
+      state.shader = &pixels;
+      by_pixel.test_block(plane, x, y, mask, state, ka);
+      state.shader = &blocks;
+      by_block.test_block(plane, x, y, mask, state, kb);
+      ASSERT_TRUE(a.texels == b.texels) << "trial " << trial;
+    }
+    const auto counts = [](const DepthCounters& k) {
+      return std::array{k.fragments, k.blocks, k.depth_tests, k.passed, k.written, k.shader_discarded};
+    };
+    EXPECT_EQ(counts(ka), counts(kb));
+    EXPECT_GT(ka.shader_discarded, 500u);
+    EXPECT_GT(ka.written, 100u);
+  }
 }
 
 // llvmpipe's 24-bit depth: the product rounded to float, then ties to even; ends and NaN fixed.
