@@ -24,16 +24,17 @@ namespace {
 
 template <DepthFunc F>
 [[gnu::always_inline]] inline void run_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint16_t mask, bool write, bool fused,
-               DepthFormat format, DepthCounters& k) {
+               DepthFormat format, std::uint8_t* passed_mask, DepthCounters& k) {
   std::uint64_t passed = 0, written = 0;
   for (unsigned m = mask; m != 0; m &= m - 1) {
     const int i = std::countr_zero(m);
     const int px = x + (i & 3), py = y + (i >> 2);
     const float z = stored_depth(format, plane.at(px, py, fused));
-    float& stored =
-        img.texels[static_cast<std::size_t>(py) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(px)];
+    const std::size_t at = static_cast<std::size_t>(py) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(px);
+    float& stored = img.texels[at];
     if (depth_passes(F, z, stored)) {
       ++passed;
+      if (passed_mask) passed_mask[at] = 1;
       if (write) {
         stored = z;
         ++written;
@@ -48,7 +49,8 @@ template <DepthFunc F>
 // A 4x4 block wholly inside the buffer, four pixels a row in SSE lanes (block_lanes.h): the same
 // passes and writes as run_block.
 template <DepthFunc F>
-void lanes_block(DepthImage& img, const __m128 (&raw)[4], int x, int y, std::uint16_t mask, bool write, DepthFormat format, DepthCounters& k) {
+void lanes_block(DepthImage& img, const __m128 (&raw)[4], int x, int y, std::uint16_t mask, bool write, DepthFormat format,
+                 std::uint8_t* passed_mask, DepthCounters& k) {
   std::uint64_t passed = 0;
   for (int r = 0; r < 4; ++r) {
     if (((mask >> (4 * r)) & 0xFu) == 0) continue;
@@ -59,6 +61,10 @@ void lanes_block(DepthImage& img, const __m128 (&raw)[4], int x, int y, std::uin
     const int pass_bits = _mm_movemask_ps(pass);
     passed += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(pass_bits)));
     if (write && pass_bits != 0) _mm_storeu_ps(row, _mm_or_ps(_mm_and_ps(pass, z), _mm_andnot_ps(pass, stored)));
+    if (passed_mask && pass_bits != 0) {  // a byte 1 for each passing pixel of the row
+      std::uint8_t* marks = passed_mask + static_cast<std::size_t>(y + r) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x);
+      for (unsigned b = static_cast<unsigned>(pass_bits); b != 0; b &= b - 1) marks[std::countr_zero(b)] = 1;
+    }
   }
   k.passed += passed;
   if (write) k.written += passed;
@@ -66,7 +72,7 @@ void lanes_block(DepthImage& img, const __m128 (&raw)[4], int x, int y, std::uin
 #endif
 
 NBSIM_FMA_CLONES void test_plain_block(DepthImage& img, const DepthPlane& plane, int x, int y, std::uint16_t mask, DepthFunc func,
-                                       bool w, bool fused, DepthFormat format, DepthCounters& k) {
+                                       bool w, bool fused, DepthFormat format, std::uint8_t* passed, DepthCounters& k) {
 #ifdef NBSIM_BLOCK_LANES
   if (lanes::block_fits(img, x, y, fused)) {
     __m128 raw[4];
@@ -74,26 +80,26 @@ NBSIM_FMA_CLONES void test_plain_block(DepthImage& img, const DepthPlane& plane,
     else lanes::plane_rows_unfused(plane, x, y, raw);
     switch (func) {
       case DepthFunc::Never: break;
-      case DepthFunc::Less: lanes_block<DepthFunc::Less>(img, raw, x, y, mask, w, format, k); break;
-      case DepthFunc::Equal: lanes_block<DepthFunc::Equal>(img, raw, x, y, mask, w, format, k); break;
-      case DepthFunc::Lequal: lanes_block<DepthFunc::Lequal>(img, raw, x, y, mask, w, format, k); break;
-      case DepthFunc::Greater: lanes_block<DepthFunc::Greater>(img, raw, x, y, mask, w, format, k); break;
-      case DepthFunc::NotEqual: lanes_block<DepthFunc::NotEqual>(img, raw, x, y, mask, w, format, k); break;
-      case DepthFunc::Gequal: lanes_block<DepthFunc::Gequal>(img, raw, x, y, mask, w, format, k); break;
-      case DepthFunc::Always: lanes_block<DepthFunc::Always>(img, raw, x, y, mask, w, format, k); break;
+      case DepthFunc::Less: lanes_block<DepthFunc::Less>(img, raw, x, y, mask, w, format, passed, k); break;
+      case DepthFunc::Equal: lanes_block<DepthFunc::Equal>(img, raw, x, y, mask, w, format, passed, k); break;
+      case DepthFunc::Lequal: lanes_block<DepthFunc::Lequal>(img, raw, x, y, mask, w, format, passed, k); break;
+      case DepthFunc::Greater: lanes_block<DepthFunc::Greater>(img, raw, x, y, mask, w, format, passed, k); break;
+      case DepthFunc::NotEqual: lanes_block<DepthFunc::NotEqual>(img, raw, x, y, mask, w, format, passed, k); break;
+      case DepthFunc::Gequal: lanes_block<DepthFunc::Gequal>(img, raw, x, y, mask, w, format, passed, k); break;
+      case DepthFunc::Always: lanes_block<DepthFunc::Always>(img, raw, x, y, mask, w, format, passed, k); break;
     }
     return;
   }
 #endif
   switch (func) {
-    case DepthFunc::Never: run_block<DepthFunc::Never>(img, plane, x, y, mask, w, fused, format, k); break;
-    case DepthFunc::Less: run_block<DepthFunc::Less>(img, plane, x, y, mask, w, fused, format, k); break;
-    case DepthFunc::Equal: run_block<DepthFunc::Equal>(img, plane, x, y, mask, w, fused, format, k); break;
-    case DepthFunc::Lequal: run_block<DepthFunc::Lequal>(img, plane, x, y, mask, w, fused, format, k); break;
-    case DepthFunc::Greater: run_block<DepthFunc::Greater>(img, plane, x, y, mask, w, fused, format, k); break;
-    case DepthFunc::NotEqual: run_block<DepthFunc::NotEqual>(img, plane, x, y, mask, w, fused, format, k); break;
-    case DepthFunc::Gequal: run_block<DepthFunc::Gequal>(img, plane, x, y, mask, w, fused, format, k); break;
-    case DepthFunc::Always: run_block<DepthFunc::Always>(img, plane, x, y, mask, w, fused, format, k); break;
+    case DepthFunc::Never: run_block<DepthFunc::Never>(img, plane, x, y, mask, w, fused, format, passed, k); break;
+    case DepthFunc::Less: run_block<DepthFunc::Less>(img, plane, x, y, mask, w, fused, format, passed, k); break;
+    case DepthFunc::Equal: run_block<DepthFunc::Equal>(img, plane, x, y, mask, w, fused, format, passed, k); break;
+    case DepthFunc::Lequal: run_block<DepthFunc::Lequal>(img, plane, x, y, mask, w, fused, format, passed, k); break;
+    case DepthFunc::Greater: run_block<DepthFunc::Greater>(img, plane, x, y, mask, w, fused, format, passed, k); break;
+    case DepthFunc::NotEqual: run_block<DepthFunc::NotEqual>(img, plane, x, y, mask, w, fused, format, passed, k); break;
+    case DepthFunc::Gequal: run_block<DepthFunc::Gequal>(img, plane, x, y, mask, w, fused, format, passed, k); break;
+    case DepthFunc::Always: run_block<DepthFunc::Always>(img, plane, x, y, mask, w, fused, format, passed, k); break;
   }
 }
 
@@ -184,9 +190,15 @@ void EarlyDepthTest::test_block(const DepthPlane& plane, int x, int y, std::uint
         return;
       }
       k.depth_tests += n_kept;
-      test_plain_block(*buffer_, plane, x, y, keep, state.func, state.write, fused_, format_, k);
+      test_plain_block(*buffer_, plane, x, y, keep, state.func, state.write, fused_, format_, nullptr, k);
       return;
     }
+  if (state.passed_mask && !state.peel_layer && !state.shader && state.test) {  // the plain test, its passes marked
+    NBSIM_CHECK(state.passed_mask->size() == buffer_->texels.size(), "passed mask of another size");
+    k.depth_tests += n;
+    test_plain_block(*buffer_, plane, x, y, mask, state.func, state.write, fused_, format_, state.passed_mask->data(), k);
+    return;
+  }
   if (state.peel_layer || state.passed_mask || state.shader) {
     NBSIM_CHECK(!state.peel_layer || state.peel_layer->texels.size() == buffer_->texels.size(), "peel layer of another size");
     NBSIM_CHECK(!state.passed_mask || state.passed_mask->size() == buffer_->texels.size(), "passed mask of another size");
@@ -198,7 +210,7 @@ void EarlyDepthTest::test_block(const DepthPlane& plane, int x, int y, std::uint
     return;
   }
   k.depth_tests += n;
-  test_plain_block(*buffer_, plane, x, y, mask, state.func, state.write, fused_, format_, k);
+  test_plain_block(*buffer_, plane, x, y, mask, state.func, state.write, fused_, format_, nullptr, k);
 }
 
 }  // namespace nbsim::raster

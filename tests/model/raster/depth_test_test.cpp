@@ -213,8 +213,9 @@ TEST(DepthTestTest, DepthFormatNames) {
 
 // Whole 4x4 blocks test each pixel as the per-pixel definition does (plane.at, the stored format,
 // depth_passes, the write), bit for bit: every function, fused and unfused planes, both formats,
-// writes on and off, random masks, blocks inside the buffer and on its ragged right and top edges,
-// and depths that tie, fall outside [0, 1], are -0 or NaN (planes and stored values).
+// writes on and off, random masks, the passing pixels marked or not, blocks inside the buffer and
+// on its ragged right and top edges, and depths that tie, fall outside [0, 1], are -0 or NaN (planes
+// and stored values).
 TEST(DepthTestTest, BlocksTestEveryPixelAsOneByOne) {
   std::mt19937 random(5);
   std::uniform_real_distribution<float> unit(-0.25f, 1.25f), slope(-0.05f, 0.05f);
@@ -238,12 +239,16 @@ TEST(DepthTestTest, BlocksTestEveryPixelAsOneByOne) {
             EarlyDepthTest unit_under_test(got, fused, format);
             DepthCounters k;
             std::uint64_t passed = 0, written = 0, tests = 0;
+            // Every other trial marks the passing pixels (DepthState::passed_mask).
+            std::vector<std::uint8_t> marks(got.texels.size(), 0), want_marks(got.texels.size(), 0);
+            DepthState state{row.f, true, write};
+            if (trial % 2 == 1) state.passed_mask = &marks;
             for (int y = 0; y < kH; y += 4)
               for (int x = 0; x < kW; x += 4) {
                 std::uint16_t mask = static_cast<std::uint16_t>(random());
                 for (int i = 0; i < 16; ++i)  // pixels outside the buffer are never covered
                   if (x + (i & 3) >= kW || y + (i >> 2) >= kH) mask = static_cast<std::uint16_t>(mask & ~(1u << i));
-                unit_under_test.test_block(plane, x, y, mask, DepthState{row.f, true, write}, k);
+                unit_under_test.test_block(plane, x, y, mask, state, k);
                 for (int i = 0; i < 16; ++i) {
                   if (!(mask & (1u << i))) continue;
                   const int px = x + (i & 3), py = y + (i >> 2);
@@ -252,12 +257,14 @@ TEST(DepthTestTest, BlocksTestEveryPixelAsOneByOne) {
                   float& stored = want.texels[static_cast<std::size_t>(py * kW + px)];
                   if (!depth_passes(row.f, z, stored)) continue;
                   ++passed;
+                  if (state.passed_mask) want_marks[static_cast<std::size_t>(py * kW + px)] = 1;
                   if (write) stored = z, ++written;
                 }
               }
             EXPECT_EQ(k.depth_tests, tests);
             EXPECT_EQ(k.passed, passed) << "func " << static_cast<int>(row.f) << " trial " << trial << (fused ? " fused" : " unfused");
             EXPECT_EQ(k.written, written);
+            ASSERT_EQ(marks, want_marks) << "passed pixels, func " << static_cast<int>(row.f) << " trial " << trial;
             for (std::size_t t = 0; t < got.texels.size(); ++t)
               ASSERT_EQ(bits(got.texels[t]), bits(want.texels[t])) << "texel " << t << ", func " << static_cast<int>(row.f) << ", trial " << trial;
           }
