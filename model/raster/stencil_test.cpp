@@ -124,8 +124,10 @@ void stencil_lanes_block(DepthImage& depth, StencilImage& stencil, const __m128 
   }
   if (ds.test && ds.write && depth_passed != 0) {
     c.depth_written += depth_passed;
+    const __m128i rows_pass[4] = {_mm_cvtepi8_epi32(pass), _mm_cvtepi8_epi32(_mm_srli_si128(pass, 4)), _mm_cvtepi8_epi32(_mm_srli_si128(pass, 8)),
+                                  _mm_cvtepi8_epi32(_mm_srli_si128(pass, 12))};
     for (int r = 0; r < 4; ++r) {
-      const __m128 row_pass = _mm_castsi128_ps(_mm_cvtepi8_epi32(_mm_srli_si128(pass, 4 * r)));
+      const __m128 row_pass = _mm_castsi128_ps(rows_pass[r]);
       float* row = d_at + static_cast<std::size_t>(r) * width;
       _mm_storeu_ps(row, _mm_or_ps(_mm_and_ps(row_pass, z[r]), _mm_andnot_ps(row_pass, _mm_loadu_ps(row))));
     }
