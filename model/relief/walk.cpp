@@ -564,7 +564,7 @@ WalkResult walk(Method method, const FieldView& field, const WalkParams& params,
   return walk_with(method, field, params, ray, sink);
 }
 
-// ---- Runs of walks: the exact method in AVX2 lanes ----
+// ---- Runs of walks: every method in lanes (walk_lanes.inl) ----
 
 namespace {
 
