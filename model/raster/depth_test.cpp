@@ -179,38 +179,35 @@ void EarlyDepthTest::test_block(const DepthPlane& plane, int x, int y, std::uint
   const auto n = static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(mask)));
   k.fragments += n;
   k.blocks += 1;
+  NBSIM_CHECK(!state.peel_layer || state.peel_layer->texels.size() == buffer_->texels.size(), "peel layer of another size");
+  NBSIM_CHECK(!state.passed_mask || state.passed_mask->size() == buffer_->texels.size(), "passed mask of another size");
+  // A whole block goes to the plain test (in lanes where it can): a shader that keeps whole blocks
+  // first drops its discards; marked passes are set from the test's. Else one pixel at a time.
+  std::uint64_t tested = n;
+  std::uint8_t* marks = nullptr;
+  bool whole = !state.peel_layer && !state.passed_mask && !state.shader;
   if (state.shader && !state.peel_layer && !state.passed_mask)
-    if (const std::optional<std::uint16_t> kept = state.shader->keep_block(x, y, mask)) {  // discards whole
-      const auto keep = static_cast<std::uint16_t>(*kept & mask);
-      const auto n_kept = static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(keep)));
-      k.shader_discarded += n - n_kept;
-      if (keep == 0) return;
-      if (!state.test) {
-        k.passed += n_kept;
-        return;
-      }
-      k.depth_tests += n_kept;
-      test_plain_block(*buffer_, plane, x, y, keep, state.func, state.write, fused_, format_, nullptr, k);
-      return;
+    if (const std::optional<std::uint16_t> kept = state.shader->keep_block(x, y, mask)) {
+      mask = static_cast<std::uint16_t>(*kept & mask);
+      tested = static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(mask)));
+      k.shader_discarded += n - tested;
+      if (mask == 0) return;
+      whole = true;
     }
-  if (state.passed_mask && !state.peel_layer && !state.shader && state.test) {  // the plain test, its passes marked
-    NBSIM_CHECK(state.passed_mask->size() == buffer_->texels.size(), "passed mask of another size");
-    k.depth_tests += n;
-    test_plain_block(*buffer_, plane, x, y, mask, state.func, state.write, fused_, format_, state.passed_mask->data(), k);
-    return;
+  if (state.passed_mask && !state.peel_layer && !state.shader && state.test) {
+    marks = state.passed_mask->data();
+    whole = true;
   }
-  if (state.peel_layer || state.passed_mask || state.shader) {
-    NBSIM_CHECK(!state.peel_layer || state.peel_layer->texels.size() == buffer_->texels.size(), "peel layer of another size");
-    NBSIM_CHECK(!state.passed_mask || state.passed_mask->size() == buffer_->texels.size(), "passed mask of another size");
+  if (!whole) {
     run_peel_block(*buffer_, plane, x, y, mask, state, fused_, format_, k);
     return;
   }
   if (!state.test) {
-    k.passed += n;
+    k.passed += tested;
     return;
   }
-  k.depth_tests += n;
-  test_plain_block(*buffer_, plane, x, y, mask, state.func, state.write, fused_, format_, nullptr, k);
+  k.depth_tests += tested;
+  test_plain_block(*buffer_, plane, x, y, mask, state.func, state.write, fused_, format_, marks, k);
 }
 
 }  // namespace nbsim::raster

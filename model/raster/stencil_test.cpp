@@ -20,6 +20,17 @@ StencilOp checked_op(scene::StencilOp op, const char* which) {
   return static_cast<StencilOp>(op);
 }
 
+// A block's counts, kept in locals and added to the draw's once: a stencil value is a byte, and a
+// store through a byte may alias anything, so counters in memory would be reloaded and stored again
+// at every fragment.
+struct BlockCounts {
+  std::uint64_t passed = 0, depth_failed = 0, written = 0, changed = 0, depth_tests = 0, depth_written = 0, depth_passed = 0;
+  void add_to(DepthCounters& dk, StencilCounters& sk) const {
+    sk.passed += passed, sk.depth_failed += depth_failed, sk.written += written, sk.changed += changed;
+    dk.depth_tests += depth_tests, dk.written += depth_written, dk.passed += depth_passed;
+  }
+};
+
 #ifdef NBSIM_BLOCK_LANES
 // A 4x4 block wholly inside the buffers in SSE lanes: the stencil values as 16 bytes (byte i is pixel
 // i of the block's mask, rows of four), the depths as four rows of four floats (block_lanes.h).
@@ -63,13 +74,9 @@ inline __m128i stencil_lanes_op(StencilOp op, __m128i stored, std::uint8_t ref) 
 
 inline std::uint64_t count_bytes(__m128i mask) { return static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(_mm_movemask_epi8(mask)))); }
 
-struct LanesCounts {
-  std::uint64_t passed = 0, depth_failed = 0, written = 0, changed = 0, depth_tests = 0, depth_written = 0, depth_passed = 0;
-};
-
 template <DepthFunc F>
 void stencil_lanes_block(DepthImage& depth, StencilImage& stencil, const __m128 (&raw)[4], int x, int y, std::uint16_t mask,
-                         const DepthState& ds, const StencilFace& f, DepthFormat format, LanesCounts& c) {
+                         const DepthState& ds, const StencilFace& f, DepthFormat format, BlockCounts& c) {
   const auto width = static_cast<std::size_t>(depth.width);
   std::uint8_t* const s_at = stencil.texels.data() + static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x);
   float* const d_at = depth.texels.data() + static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x);
@@ -203,22 +210,12 @@ void DepthStencilTest::test_block(const DepthPlane& plane, bool front_facing, in
   DepthImage& depth = depth_test_.buffer();
   const bool fused = depth_test_.fused_interpolation();
   const bool depth_write = ds.test && ds.write;
-  // The counts kept in locals and added once: a stencil value is a byte, and a store through a byte
-  // may alias anything, so counters in memory would be reloaded and stored again at every fragment.
-  std::uint64_t passed = 0, depth_failed = 0, written = 0, changed = 0, depth_tests = 0, depth_written = 0, depth_passed = 0;
-  const auto store = [&](std::uint8_t& s, StencilOp op) {
-    if (op == StencilOp::Keep || f.write_mask == 0) return;
-    const std::uint8_t v = stencil_update(op, s, f.ref, f.write_mask);
-    ++written;
-    if (v != s) ++changed;
-    s = v;
-  };
+  BlockCounts c;
 #ifdef NBSIM_BLOCK_LANES
   if (lanes_ && lanes::block_fits(depth, x, y, fused)) {
     __m128 raw[4];
     if (fused) lanes::plane_rows_fused(plane, x, y, raw);  // (called here: inlined into the FMA clone)
     else lanes::plane_rows_unfused(plane, x, y, raw);
-    LanesCounts c;
     const DepthFormat format = depth_test_.format();
     switch (ds.test ? ds.func : DepthFunc::Always) {
       case DepthFunc::Never: stencil_lanes_block<DepthFunc::Never>(depth, *stencil_, raw, x, y, mask, ds, f, format, c); break;
@@ -230,11 +227,17 @@ void DepthStencilTest::test_block(const DepthPlane& plane, bool front_facing, in
       case DepthFunc::Gequal: stencil_lanes_block<DepthFunc::Gequal>(depth, *stencil_, raw, x, y, mask, ds, f, format, c); break;
       case DepthFunc::Always: stencil_lanes_block<DepthFunc::Always>(depth, *stencil_, raw, x, y, mask, ds, f, format, c); break;
     }
-    sk.passed += c.passed, sk.depth_failed += c.depth_failed, sk.written += c.written, sk.changed += c.changed;
-    dk.depth_tests += c.depth_tests, dk.written += c.depth_written, dk.passed += c.depth_passed;
+    c.add_to(dk, sk);
     return;
   }
 #endif
+  const auto store = [&](std::uint8_t& s, StencilOp op) {
+    if (op == StencilOp::Keep || f.write_mask == 0) return;
+    const std::uint8_t v = stencil_update(op, s, f.ref, f.write_mask);
+    ++c.written;
+    if (v != s) ++c.changed;
+    s = v;
+  };
   std::uint8_t* const stencil = stencil_->texels.data();
   float* const depths = depth.texels.data();
   const auto width = static_cast<std::size_t>(depth.width);
@@ -247,25 +250,24 @@ void DepthStencilTest::test_block(const DepthPlane& plane, bool front_facing, in
       store(s, f.fail);
       continue;
     }
-    ++passed;
+    ++c.passed;
     if (ds.test) {
-      ++depth_tests;
+      ++c.depth_tests;
       const float z = stored_depth(depth_test_.format(), plane.at(px, py, fused));
       if (!depth_passes(ds.func, z, depths[at])) {
-        ++depth_failed;
+        ++c.depth_failed;
         store(s, f.depth_fail);
         continue;
       }
       if (depth_write) {
         depths[at] = z;
-        ++depth_written;
+        ++c.depth_written;
       }
     }
-    ++depth_passed;
+    ++c.depth_passed;
     store(s, f.pass);
   }
-  sk.passed += passed, sk.depth_failed += depth_failed, sk.written += written, sk.changed += changed;
-  dk.depth_tests += depth_tests, dk.written += depth_written, dk.passed += depth_passed;
+  c.add_to(dk, sk);
 }
 
 }  // namespace nbsim::raster

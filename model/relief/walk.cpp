@@ -680,7 +680,6 @@ LaneSet best_lane_set() noexcept {
   return best;
 }
 
-bool vector_walks_available() noexcept { return lane_set_available(LaneSet::Avx2); }
 
 void walk_each(Method method, const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
                std::span<WalkResult> out, LookupLines* lines, LaneSet lanes) {

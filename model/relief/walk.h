@@ -291,8 +291,6 @@ bool lane_set_available(LaneSet set) noexcept;
 LaneSet best_lane_set() noexcept;  // the best the CPU has
 void walk_each(Method method, const FieldView& field, const WalkParams& params, std::span<const FragmentRay* const> rays,
                std::span<WalkResult> out, LookupLines* lines, LaneSet lanes = best_lane_set());
-// Whether walk_each's lanes run here (the CPU has AVX2).
-bool vector_walks_available() noexcept;
 
 // The iteration cap of every walk's main loop (a walk that reaches it is a capped miss).
 int walk_iteration_cap(int size) noexcept;

@@ -186,7 +186,7 @@ TEST(ReliefWalkTest, ExactMethodsAgreeWithTheReferenceOnRandomRays) {
 // lines share or not (the repeats the lanes' replay leaves out: 64-byte lines in 64 or 4 sets,
 // 16-byte lines in 2, a line a texel in 8).
 TEST(ReliefWalkTest, LanesWalkAsOneByOne) {
-  if (!vector_walks_available()) GTEST_SKIP() << "no AVX2 here: walk_each walks one by one";
+  if (!lane_set_available(LaneSet::Avx2)) GTEST_SKIP() << "no AVX2 here: walk_each walks one by one";
   std::mt19937 rng(23);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   int hits = 0, refined = 0, walked = 0;
